@@ -1,0 +1,63 @@
+//! BSDFs in the local shading frame (z = shading normal, unit directions pointing away from
+//! the surface): the finished-wood BSDF of Marschner et al. 2005 and the simple BSDFs scenes need.
+
+mod lambertian;
+
+pub use lambertian::Lambertian;
+
+use glam::{Vec2, Vec3};
+
+/// One importance sample of a BSDF. For a delta lobe `pdf` is the discrete lobe-selection
+/// probability and `f / pdf · |cos θi|` is the path weight.
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfSample {
+    pub wi: Vec3,
+    pub f: Vec3,
+    pub pdf: f32,
+    pub is_delta: bool,
+}
+
+/// A BSDF: `eval` is f(wo, wi) without the cosine and without delta lobes; `pdf` is the density
+/// per unit solid angle that `sample` draws its non-delta directions from (0 for delta lobes).
+pub trait Bsdf {
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3;
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32;
+    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample>;
+}
+
+/// Parameters of the finished-wood BSDF (Marschner et al. 2005, §4; Liu et al. 2016, §6.3).
+/// Directions are in the local shading frame; angles in radians.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WoodBsdfParams {
+    /// Lambertian albedo of the wood substrate (under the finish).
+    pub diffuse: Vec3,
+    /// Fibre-lobe colour k_f, each channel in [0, 1].
+    pub fiber_color: Vec3,
+    /// Longitudinal fibre axis u (unit; may dip into the surface).
+    pub fiber_dir: Vec3,
+    /// Ray-fibre axis (unit), used where `ray_mask` > 0.
+    pub ray_dir: Vec3,
+    /// Blend weight of the ray-fibre BSDF, in [0, 1].
+    pub ray_mask: f32,
+    /// Gaussian width β of the fibre highlight, radians.
+    pub highlight_width: f32,
+    /// Refractive index of the finish; 1 means no finish.
+    pub eta: f32,
+    /// GGX roughness of the finish; 0 means smooth.
+    pub roughness: f32,
+}
+
+impl Default for WoodBsdfParams {
+    fn default() -> Self {
+        WoodBsdfParams {
+            diffuse: Vec3::new(0.45, 0.22, 0.10),
+            fiber_color: Vec3::new(0.6, 0.4, 0.25),
+            fiber_dir: Vec3::X,
+            ray_dir: Vec3::Z,
+            ray_mask: 0.0,
+            highlight_width: 8.0_f32.to_radians(),
+            eta: 1.5,
+            roughness: 0.0,
+        }
+    }
+}

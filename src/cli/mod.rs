@@ -1,0 +1,67 @@
+//! The `xylem` command line: clap subcommands, each in its own file, each a thin layer that
+//! parses, calls the library and reports errors with context. No logic of its own.
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+mod bake;
+mod bench;
+mod preset;
+mod render;
+mod sweep;
+mod texture;
+mod tradeoff;
+mod validate;
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "xylem",
+    version,
+    about = "Wood-appearance simulator: fibre BSDF, procedural solid wood, light sweeps"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Render a scene to EXR (with AOV layers) and a PNG preview.
+    Render(render::Args),
+    /// Render a light sweep: frames, contact sheet, animated PNG, CSV and an HTML viewer.
+    Sweep(sweep::Args),
+    /// Run the validation suite (BSDF and sweep checks) and write validation/REPORT.md.
+    Validate(validate::Args),
+    /// Render a planar slice of a solid texture, a noise or a wood preset to PNG.
+    Texture(texture::Args),
+    /// Species presets.
+    Preset(preset::Args),
+    /// Benchmarks (tracing, BSDF, noise, wood).
+    Bench(bench::Args),
+    /// Measure the speed/accuracy trade of every quality knob for a scene.
+    Tradeoff(tradeoff::Args),
+    /// Bake texture maps of a preset for other tools.
+    Bake(bake::Args),
+}
+
+/// Entry point of the binary: runs the subcommand and turns an error into a message and exit code 1.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Render(a) => render::run(a),
+        Command::Sweep(a) => sweep::run(a),
+        Command::Validate(a) => validate::run(a),
+        Command::Texture(a) => texture::run(a),
+        Command::Preset(a) => preset::run(a),
+        Command::Bench(a) => bench::run(a),
+        Command::Tradeoff(a) => tradeoff::run(a),
+        Command::Bake(a) => bake::run(a),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

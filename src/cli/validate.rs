@@ -1,0 +1,10 @@
+//! `xylem validate`.
+
+use std::process::ExitCode;
+
+#[derive(clap::Args, Debug)]
+pub struct Args {}
+
+pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
+    anyhow::bail!("`xylem validate` is not built yet")
+}

@@ -1,0 +1,19 @@
+//! xylem: a wood-appearance simulator.
+//!
+//! The finished-wood fibre BSDF of Marschner et al. 2005, driven by the procedural
+//! solid-wood frame fields of Liu, Dong, Hašan and Marschner 2016, rendered by a BVH
+//! path tracer. Module layout and dependency direction: `../shared/DESIGN.md`
+//! (arrows point down the list below; only `cli` may use everything).
+
+pub mod bsdf;
+pub mod cli;
+pub mod field;
+pub mod material;
+pub mod math;
+pub mod noise;
+pub mod render;
+pub mod scene;
+pub mod sweep;
+pub mod texture;
+pub mod validate;
+pub mod wood;

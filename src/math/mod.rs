@@ -1,0 +1,73 @@
+//! Small pure math shared by every module: orthonormal frames, safe inverse
+//! trigonometry, sampling warps and a seedable random number generator.
+
+mod frame;
+mod rng;
+mod sampling;
+
+pub use frame::Frame;
+pub use glam::{Mat3, Vec2, Vec3};
+pub use rng::Pcg32;
+pub use sampling::*;
+
+pub const PI: f32 = std::f32::consts::PI;
+pub const INV_PI: f32 = std::f32::consts::FRAC_1_PI;
+
+/// `sqrt(max(x, 0))`: rounding can push a mathematically non-negative argument below 0.
+#[inline]
+pub fn safe_sqrt(x: f32) -> f32 {
+    x.max(0.0).sqrt()
+}
+
+/// `asin` with its argument clamped to [-1, 1], so rounding never yields NaN.
+#[inline]
+pub fn safe_asin(x: f32) -> f32 {
+    x.clamp(-1.0, 1.0).asin()
+}
+
+/// `acos` with its argument clamped to [-1, 1], so rounding never yields NaN.
+#[inline]
+pub fn safe_acos(x: f32) -> f32 {
+    x.clamp(-1.0, 1.0).acos()
+}
+
+/// Degrees to radians (files hold degrees, code works in radians).
+#[inline]
+pub fn radians(deg: f32) -> f32 {
+    deg.to_radians()
+}
+
+/// Relative luminance of a linear-sRGB colour (ITU-R BT.709 weights).
+#[inline]
+pub fn luminance(c: Vec3) -> f32 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
+/// Reflect `v` about the normal `n` (both unit vectors; result points away from the surface when `v` does).
+#[inline]
+pub fn reflect(v: Vec3, n: Vec3) -> Vec3 {
+    2.0 * v.dot(n) * n - v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn safe_functions_never_nan() {
+        for x in [-1.000_001_f32, -1.0, 0.0, 1.0, 1.000_001, -0.0] {
+            assert!(safe_asin(x).is_finite());
+            assert!(safe_acos(x).is_finite());
+            assert!(safe_sqrt(x - 1.0).is_finite());
+        }
+        assert_eq!(safe_sqrt(-1e-9), 0.0);
+    }
+
+    #[test]
+    fn reflect_preserves_angle() {
+        let n = Vec3::Z;
+        let v = Vec3::new(0.3, -0.4, 0.866).normalize();
+        let r = reflect(v, n);
+        assert!((r.z - v.z).abs() < 1e-6 && (r.x + v.x).abs() < 1e-6);
+    }
+}

@@ -1,0 +1,1 @@
+//! The TOML scene format, built-in procedural shapes, mesh loading and preset lookup.

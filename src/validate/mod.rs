@@ -1,0 +1,1 @@
+//! The validation suite (BSDF and sweep checks) and its report.

@@ -1,0 +1,75 @@
+//! The procedural solid-wood model of Liu, Dong, Hašan and Marschner 2016 ("Simulating the
+//! structure and texture of solid wood"): `WoodVolume::eval(p, needs) -> WoodTexel`.
+
+use glam::Vec3;
+
+/// What a caller needs from a wood lookup; the model skips the work for anything not asked for
+/// ("model only what a scene requires").
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Needs {
+    /// Diffuse and fibre colour (and growth time).
+    pub color: bool,
+    /// Fibre and ray-fibre directions, ray mask and highlight width (what the fibre lobe needs).
+    pub fibers: bool,
+    /// Bump height and gradient from the pore mask.
+    pub bump: bool,
+}
+
+impl Needs {
+    pub const COLOR: Needs = Needs {
+        color: true,
+        fibers: false,
+        bump: false,
+    };
+    pub const COLOR_FIBERS: Needs = Needs {
+        color: true,
+        fibers: true,
+        bump: false,
+    };
+    pub const ALL: Needs = Needs {
+        color: true,
+        fibers: true,
+        bump: true,
+    };
+}
+
+/// Everything the BSDF and the renderer need at one point of the tree. Directions and the bump
+/// gradient are in tree space (millimetres, pith along z).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WoodTexel {
+    pub diffuse: Vec3,
+    pub fiber_color: Vec3,
+    /// Longitudinal fibre direction (unit).
+    pub fiber_dir: Vec3,
+    /// Ray-fibre direction (unit, radial).
+    pub ray_dir: Vec3,
+    /// Ray-fibre BSDF blend weight in [0, 1].
+    pub ray_mask: f32,
+    /// Pore mask in [0, 1].
+    pub pore_mask: f32,
+    /// Bump height (mm; ≤ 0 inside pores).
+    pub bump: f32,
+    /// Gradient of `bump` with respect to tree-space position.
+    pub bump_grad: Vec3,
+    /// Fibre highlight width β, radians.
+    pub highlight_width: f32,
+    /// Growth time (years from the pith) for the AOV.
+    pub growth_time: f32,
+}
+
+impl Default for WoodTexel {
+    fn default() -> Self {
+        WoodTexel {
+            diffuse: Vec3::splat(0.5),
+            fiber_color: Vec3::splat(0.5),
+            fiber_dir: Vec3::Z,
+            ray_dir: Vec3::X,
+            ray_mask: 0.0,
+            pore_mask: 0.0,
+            bump: 0.0,
+            bump_grad: Vec3::ZERO,
+            highlight_width: 8.0_f32.to_radians(),
+            growth_time: 0.0,
+        }
+    }
+}
