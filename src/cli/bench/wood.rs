@@ -1,4 +1,4 @@
-//! `xylem validate`.
+//! `xylem bench wood`.
 
 use std::process::ExitCode;
 
@@ -6,5 +6,5 @@ use std::process::ExitCode;
 pub struct Args {}
 
 pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`xylem validate` is not built yet")
+    anyhow::bail!("`xylem bench wood` is not built yet")
 }

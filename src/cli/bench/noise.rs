@@ -1,4 +1,4 @@
-//! `xylem bench`.
+//! `xylem bench noise`.
 
 use std::process::ExitCode;
 
@@ -6,5 +6,5 @@ use std::process::ExitCode;
 pub struct Args {}
 
 pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`xylem bench` is not built yet")
+    anyhow::bail!("`xylem bench noise` is not built yet")
 }

@@ -1,0 +1,36 @@
+//! `xylem validate [bsdf|sweep]`: runs the validation suite; exits non-zero when a check fails.
+
+use std::process::ExitCode;
+
+mod bsdf;
+mod sweep;
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    #[command(subcommand)]
+    what: Option<What>,
+}
+
+#[derive(clap::Subcommand, Debug)]
+enum What {
+    /// The BSDF checks: white furnace, reciprocity, chi-square, pdf normalisation, extremes.
+    Bsdf(bsdf::Args),
+    /// The light-sweep checks: highlight tracking, renderer against the BSDF, figure signatures.
+    Sweep(sweep::Args),
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    match args.what {
+        Some(What::Bsdf(a)) => bsdf::run(a),
+        Some(What::Sweep(a)) => sweep::run(a),
+        None => {
+            let b = bsdf::run(bsdf::Args::default())?;
+            let s = sweep::run(sweep::Args::default())?;
+            Ok(if b == ExitCode::SUCCESS && s == ExitCode::SUCCESS {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::FAILURE
+            })
+        }
+    }
+}
