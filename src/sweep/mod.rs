@@ -1,1 +1,16 @@
-//! Light-sweep sequences: the light path, the per-sweep cache of what does not change, contact sheet and viewer.
+//! Light-sweep sequences: the light path, the per-sweep cache of what does not change, contact
+//! sheet and viewer.
+//!
+//! - [`path`]: the arc of light directions, frame angles and `--frames-range` slices;
+//! - [`sequence`]: per-frame records and the assembly of a folder of frames into the contact
+//!   sheet ([`contact`]), animated PNG, CSV and the HTML [`viewer`];
+//! - [`highlight`]: where the fibre highlight of a flat finished board peaks along the arc.
+
+pub mod contact;
+pub mod highlight;
+pub mod path;
+pub mod sequence;
+pub mod viewer;
+
+pub use path::{parse_arc, parse_frames_range, ArcPlane, LightArc, PathError};
+pub use sequence::{assemble, AssembleOptions, FrameRecord, Region, SequenceError};

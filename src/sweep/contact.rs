@@ -1,0 +1,221 @@
+//! The contact sheet: every frame of a sweep as a thumbnail on one grid, each labelled with its
+//! light angle, so the highlight's travel can be read at a glance.
+
+/// An 8-bit sRGB image (RGB, row-major, top row first), as read back from a frame's PNG.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Rgb8 {
+    pub width: u32,
+    pub height: u32,
+    pub data: Vec<u8>,
+}
+
+impl Rgb8 {
+    /// A `width × height` image filled with one colour.
+    pub fn filled(width: u32, height: u32, rgb: [u8; 3]) -> Self {
+        let data = rgb
+            .iter()
+            .copied()
+            .cycle()
+            .take(width as usize * height as usize * 3)
+            .collect();
+        Rgb8 {
+            width,
+            height,
+            data,
+        }
+    }
+
+    fn put(&mut self, x: u32, y: u32, rgb: [u8; 3]) {
+        if x < self.width && y < self.height {
+            let i = (y as usize * self.width as usize + x as usize) * 3;
+            self.data[i..i + 3].copy_from_slice(&rgb);
+        }
+    }
+
+    /// Copies `src` with its top-left corner at `(x, y)`, clipping what falls outside.
+    pub fn blit(&mut self, src: &Rgb8, x: u32, y: u32) {
+        for sy in 0..src.height {
+            for sx in 0..src.width {
+                let i = (sy as usize * src.width as usize + sx as usize) * 3;
+                let p = [src.data[i], src.data[i + 1], src.data[i + 2]];
+                self.put(x + sx, y + sy, p);
+            }
+        }
+    }
+
+    /// The image shrunk by the smallest whole factor that makes it at most `max_width` wide,
+    /// averaging each factor × factor block in linear light (averaging sRGB codes would darken edges).
+    pub fn shrink_to_width(&self, max_width: u32) -> Rgb8 {
+        let f = self.width.div_ceil(max_width.max(1)).max(1);
+        if f == 1 {
+            return self.clone();
+        }
+        let (w, h) = ((self.width / f).max(1), (self.height / f).max(1));
+        let mut out = Rgb8::filled(w, h, [0, 0, 0]);
+        for ty in 0..h {
+            for tx in 0..w {
+                let mut acc = [0.0f32; 3];
+                let mut n = 0.0f32;
+                for y in ty * f..((ty + 1) * f).min(self.height) {
+                    for x in tx * f..((tx + 1) * f).min(self.width) {
+                        let i = (y as usize * self.width as usize + x as usize) * 3;
+                        for c in 0..3 {
+                            acc[c] += srgb8_to_linear(self.data[i + c]);
+                        }
+                        n += 1.0;
+                    }
+                }
+                let px = acc.map(|a| {
+                    (crate::render::image_io::linear_to_srgb(a / n) * 255.0 + 0.5) as u8
+                });
+                out.put(tx, ty, px);
+            }
+        }
+        out
+    }
+}
+
+/// The inverse sRGB transfer function (IEC 61966-2-1) of an 8-bit code.
+pub fn srgb8_to_linear(v: u8) -> f32 {
+    let x = v as f32 / 255.0;
+    if x <= 0.040_45 {
+        x / 12.92
+    } else {
+        ((x + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Columns of a contact sheet for `n` frames: about a 4:3 grid of frames.
+pub fn sheet_columns(n: usize) -> usize {
+    ((n as f64 * 4.0 / 3.0).sqrt().ceil() as usize).clamp(1, n.max(1))
+}
+
+/// Lays out `thumbs` (all the same size) in a grid with `gap` pixels between them and draws each
+/// `labels[i]` in the thumbnail's lower-left corner.
+pub fn contact_sheet(thumbs: &[Rgb8], labels: &[String], gap: u32) -> Rgb8 {
+    let Some(first) = thumbs.first() else {
+        return Rgb8::filled(1, 1, [24, 24, 24]);
+    };
+    let (tw, th) = (first.width, first.height);
+    let cols = sheet_columns(thumbs.len()) as u32;
+    let rows = (thumbs.len() as u32).div_ceil(cols);
+    let mut sheet = Rgb8::filled(
+        cols * tw + (cols + 1) * gap,
+        rows * th + (rows + 1) * gap,
+        [24, 24, 24],
+    );
+    for (i, t) in thumbs.iter().enumerate() {
+        let (c, r) = (i as u32 % cols, i as u32 / cols);
+        let (x, y) = (gap + c * (tw + gap), gap + r * (th + gap));
+        sheet.blit(t, x, y);
+        if let Some(label) = labels.get(i) {
+            let scale = if th >= 96 { 2 } else { 1 };
+            draw_label(&mut sheet, label, x + 2, y + th - 2 - 7 * scale, scale);
+        }
+    }
+    sheet
+}
+
+/// A 3×5 pixel font for light-angle labels: digits, sign, point and degree sign (rows top to
+/// bottom, bit 2 = left column). Characters without a glyph are drawn as blanks.
+fn glyph(c: char) -> [u8; 5] {
+    match c {
+        '0' => [7, 5, 5, 5, 7],
+        '1' => [2, 6, 2, 2, 7],
+        '2' => [7, 1, 7, 4, 7],
+        '3' => [7, 1, 7, 1, 7],
+        '4' => [5, 5, 7, 1, 1],
+        '5' => [7, 4, 7, 1, 7],
+        '6' => [7, 4, 7, 5, 7],
+        '7' => [7, 1, 1, 1, 1],
+        '8' => [7, 5, 7, 5, 7],
+        '9' => [7, 5, 7, 1, 7],
+        '-' => [0, 0, 7, 0, 0],
+        '+' => [0, 2, 7, 2, 0],
+        '.' => [0, 0, 0, 0, 2],
+        '°' => [2, 5, 2, 0, 0],
+        _ => [0; 5],
+    }
+}
+
+/// Draws `text` in white on a dark box with its top-left corner at `(x, y)`, each font pixel
+/// `scale × scale` image pixels.
+pub fn draw_label(img: &mut Rgb8, text: &str, x: u32, y: u32, scale: u32) {
+    let n = text.chars().count() as u32;
+    let (w, h) = ((4 * n + 1) * scale, 7 * scale);
+    for yy in y..y + h {
+        for xx in x..x + w {
+            img.put(xx, yy, [0, 0, 0]);
+        }
+    }
+    for (k, c) in text.chars().enumerate() {
+        let ox = x + (1 + 4 * k as u32) * scale;
+        for (row, bits) in glyph(c).iter().enumerate() {
+            for col in 0..3u32 {
+                if bits & (4 >> col) != 0 {
+                    for dy in 0..scale {
+                        for dx in 0..scale {
+                            let px = ox + col * scale + dx;
+                            let py = y + (1 + row as u32) * scale + dy;
+                            img.put(px, py, [255, 255, 255]);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shrinking_averages_in_linear_light() {
+        // A 2×1 image of black and white shrinks to one pixel of linear 0.5, i.e. sRGB code 188.
+        let img = Rgb8 {
+            width: 2,
+            height: 1,
+            data: vec![0, 0, 0, 255, 255, 255],
+        };
+        let s = img.shrink_to_width(1);
+        assert_eq!((s.width, s.height), (1, 1));
+        assert_eq!(s.data, vec![188, 188, 188]);
+        assert_eq!(img.shrink_to_width(5), img);
+    }
+
+    #[test]
+    fn srgb_decoding_inverts_encoding() {
+        for v in 0..=255u8 {
+            let back = crate::render::image_io::linear_to_srgb(srgb8_to_linear(v)) * 255.0;
+            assert!((back - v as f32).abs() < 0.01, "{v}");
+        }
+    }
+
+    #[test]
+    fn sheet_grid_holds_every_frame() {
+        for n in [1usize, 2, 5, 12, 48, 49, 100] {
+            let c = sheet_columns(n);
+            assert!(c * n.div_ceil(c) >= n && c <= n);
+        }
+        assert_eq!(sheet_columns(48), 8);
+        let thumbs: Vec<Rgb8> = (0..5).map(|i| Rgb8::filled(10, 6, [i * 50, 0, 0])).collect();
+        let sheet = contact_sheet(&thumbs, &[], 2);
+        // 3 columns, 2 rows: 3·10 + 4·2 by 2·6 + 3·2.
+        assert_eq!((sheet.width, sheet.height), (38, 18));
+        // The 5th thumbnail (red 200) sits in row 1, column 1.
+        let (x, y) = (2 + 12 + 3, 2 + 8 + 3);
+        let i = (y * 38 + x) as usize * 3;
+        assert_eq!(&sheet.data[i..i + 3], &[200, 0, 0]);
+    }
+
+    #[test]
+    fn labels_draw_inside_their_box() {
+        let mut img = Rgb8::filled(40, 12, [100, 100, 100]);
+        draw_label(&mut img, "-7.5°", 1, 1, 1);
+        let white = img.data.chunks(3).filter(|p| p == &[255, 255, 255]).count();
+        // '-' 3 + '7' 7 + '.' 1 + '5' 11 + '°' 4 lit font pixels.
+        assert_eq!(white, 26);
+        assert_eq!(&img.data[..3], &[100, 100, 100], "outside the box is untouched");
+    }
+}

@@ -1,0 +1,245 @@
+//! The light path of a sweep: an arc of light directions over the object, the light angle of each
+//! frame, and the slice of frames (`--frames-range`) one machine renders.
+//!
+//! The setup is that of Marschner et al. 2005 (§5, the gantry measurements) and Liu et al. 2016
+//! (Fig. 13): the camera and the object stay fixed while the light travels along an arc in a plane
+//! through the object's zenith.
+
+use crate::math::Vec3;
+use std::ops::Range;
+
+/// Errors in a light path or frame selection; each message names the value and the allowed range.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum PathError {
+    #[error("arc `{0}`: expected FROM..TO in degrees, e.g. `-60..60`")]
+    ArcSyntax(String),
+    #[error("arc {from}..{to} deg: both ends must lie in [-90, 90] (above the horizon)")]
+    ArcRange { from: f32, to: f32 },
+    #[error("frames-range `{0}`: expected A..B (frames A to B-1) or A..=B, with whole numbers")]
+    RangeSyntax(String),
+    #[error("frames-range `{text}`: selects no frame (needs A < B, or A <= B with ..=)")]
+    RangeEmpty { text: String },
+    #[error("frames-range `{text}`: frame {end} is past the last frame of a {frames}-frame sweep (allowed 0..{frames})")]
+    RangePastEnd {
+        text: String,
+        end: usize,
+        frames: usize,
+    },
+    #[error("frames = {0}: a sweep needs at least 1 frame (allowed 1..=100000)")]
+    Frames(usize),
+}
+
+/// The light angles of a sweep: `frames` angles spread evenly from `from_deg` to `to_deg`
+/// (inclusive), measured from the zenith towards the arc direction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightArc {
+    pub from_deg: f32,
+    pub to_deg: f32,
+    pub frames: usize,
+}
+
+impl LightArc {
+    /// Checks the frame count and that both ends lie above the horizon.
+    pub fn new(from_deg: f32, to_deg: f32, frames: usize) -> Result<Self, PathError> {
+        if frames == 0 || frames > 100_000 {
+            return Err(PathError::Frames(frames));
+        }
+        let ok = |a: f32| a.is_finite() && (-90.0..=90.0).contains(&a);
+        if !ok(from_deg) || !ok(to_deg) {
+            return Err(PathError::ArcRange {
+                from: from_deg,
+                to: to_deg,
+            });
+        }
+        Ok(LightArc {
+            from_deg,
+            to_deg,
+            frames,
+        })
+    }
+
+    /// The light angle of frame `i` in degrees; a single frame sits at the middle of the arc.
+    pub fn angle_deg(&self, i: usize) -> f32 {
+        if self.frames == 1 {
+            return 0.5 * (self.from_deg + self.to_deg);
+        }
+        let t = i as f64 / (self.frames - 1) as f64;
+        (self.from_deg as f64 + t * (self.to_deg as f64 - self.from_deg as f64)) as f32
+    }
+
+    /// The signed change of light angle from one frame to the next, in degrees.
+    pub fn step_deg(&self) -> f32 {
+        if self.frames < 2 {
+            0.0
+        } else {
+            (self.to_deg - self.from_deg) / (self.frames - 1) as f32
+        }
+    }
+
+    /// All light angles in degrees, frame by frame.
+    pub fn angles_deg(&self) -> Vec<f32> {
+        (0..self.frames).map(|i| self.angle_deg(i)).collect()
+    }
+}
+
+/// The plane an arc moves in: `zenith` is the direction at angle 0 (the object's up), `toward` the
+/// direction at +90°. Both are unit vectors and orthogonal (the constructor makes them so).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ArcPlane {
+    pub zenith: Vec3,
+    pub toward: Vec3,
+}
+
+impl ArcPlane {
+    /// The plane through `zenith` perpendicular to the rotation `axis`; `None` when the two are
+    /// parallel (or either is zero), so no plane is defined.
+    pub fn from_axis(zenith: Vec3, axis: Vec3) -> Option<Self> {
+        let z = zenith.try_normalize()?;
+        let toward = axis.cross(z).try_normalize()?;
+        Some(ArcPlane { zenith: z, toward })
+    }
+
+    /// The unit direction towards the light at `angle_deg` from the zenith:
+    /// `cos θ · zenith + sin θ · toward` (a rotation of the zenith about the arc's axis).
+    pub fn direction(&self, angle_deg: f32) -> Vec3 {
+        let (s, c) = angle_deg.to_radians().sin_cos();
+        (c * self.zenith + s * self.toward).normalize()
+    }
+
+    /// The position of a light at distance `radius` from `pivot`, at `angle_deg` along the arc.
+    pub fn position(&self, pivot: Vec3, radius: f32, angle_deg: f32) -> Vec3 {
+        pivot + radius * self.direction(angle_deg)
+    }
+}
+
+/// Parses `FROM..TO` (degrees; either may be negative, e.g. `-60..60`, and TO may be below FROM
+/// to sweep the other way).
+pub fn parse_arc(text: &str) -> Result<(f32, f32), PathError> {
+    let err = || PathError::ArcSyntax(text.to_string());
+    let (a, b) = text.trim().split_once("..").ok_or_else(err)?;
+    let from: f32 = a.trim().parse().map_err(|_| err())?;
+    let to: f32 = b.trim().parse().map_err(|_| err())?;
+    if !from.is_finite() || !to.is_finite() {
+        return Err(err());
+    }
+    Ok((from, to))
+}
+
+/// Parses `A..B` (frames A to B-1, as Rust ranges) or `A..=B` (frames A to B) against a sweep of
+/// `frames` frames. `A..` runs to the last frame.
+pub fn parse_frames_range(text: &str, frames: usize) -> Result<Range<usize>, PathError> {
+    let syntax = || PathError::RangeSyntax(text.to_string());
+    let (a, rest) = text.trim().split_once("..").ok_or_else(syntax)?;
+    let (inclusive, b) = match rest.strip_prefix('=') {
+        Some(b) => (true, b),
+        None => (false, rest),
+    };
+    let start: usize = a.trim().parse().map_err(|_| syntax())?;
+    let end = if b.trim().is_empty() && !inclusive {
+        frames
+    } else {
+        let b: usize = b.trim().parse().map_err(|_| syntax())?;
+        if inclusive {
+            b + 1
+        } else {
+            b
+        }
+    };
+    if start >= end {
+        return Err(PathError::RangeEmpty {
+            text: text.to_string(),
+        });
+    }
+    if end > frames {
+        return Err(PathError::RangePastEnd {
+            text: text.to_string(),
+            end: end - 1,
+            frames,
+        });
+    }
+    Ok(start..end)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn angles_cover_the_arc_evenly() {
+        let arc = LightArc::new(-60.0, 60.0, 49).unwrap();
+        assert_eq!(arc.angle_deg(0), -60.0);
+        assert_eq!(arc.angle_deg(48), 60.0);
+        assert!((arc.angle_deg(24)).abs() < 1e-5);
+        assert!((arc.step_deg() - 2.5).abs() < 1e-6);
+        let a = arc.angles_deg();
+        for w in a.windows(2) {
+            assert!((w[1] - w[0] - 2.5).abs() < 1e-4);
+        }
+        assert_eq!(LightArc::new(10.0, 30.0, 1).unwrap().angle_deg(0), 20.0);
+        assert_eq!(LightArc::new(30.0, -30.0, 3).unwrap().angle_deg(2), -30.0);
+    }
+
+    #[test]
+    fn bad_arcs_are_refused() {
+        assert!(matches!(
+            LightArc::new(-95.0, 0.0, 4),
+            Err(PathError::ArcRange { .. })
+        ));
+        assert_eq!(LightArc::new(0.0, 1.0, 0), Err(PathError::Frames(0)));
+        assert!(LightArc::new(f32::NAN, 0.0, 4).is_err());
+    }
+
+    #[test]
+    fn arc_directions_rotate_the_zenith_about_the_axis() {
+        let plane = ArcPlane::from_axis(Vec3::Z, Vec3::Y).unwrap();
+        // Rotating +z about +y by +90° gives +x (right-handed).
+        assert!((plane.direction(90.0) - Vec3::X).length() < 1e-6);
+        assert!((plane.direction(0.0) - Vec3::Z).length() < 1e-6);
+        let d = plane.direction(30.0);
+        assert!((d.z - 30f32.to_radians().cos()).abs() < 1e-6 && d.y.abs() < 1e-7);
+        let p = plane.position(Vec3::new(1.0, 2.0, 3.0), 10.0, -90.0);
+        assert!((p - Vec3::new(-9.0, 2.0, 3.0)).length() < 1e-5);
+        assert!(ArcPlane::from_axis(Vec3::Z, Vec3::Z).is_none());
+        assert!(ArcPlane::from_axis(Vec3::ZERO, Vec3::Y).is_none());
+    }
+
+    #[test]
+    fn arcs_parse_with_negative_ends() {
+        assert_eq!(parse_arc("-60..60"), Ok((-60.0, 60.0)));
+        assert_eq!(parse_arc(" 45 .. -45.5 "), Ok((45.0, -45.5)));
+        for bad in ["", "60", "a..b", "1..", "..3", "nan..2", "1..inf"] {
+            assert!(
+                matches!(parse_arc(bad), Err(PathError::ArcSyntax(_))),
+                "{bad}"
+            );
+        }
+    }
+
+    #[test]
+    fn frame_ranges_parse_and_name_their_errors() {
+        assert_eq!(parse_frames_range("0..12", 48), Ok(0..12));
+        assert_eq!(parse_frames_range("12..=23", 48), Ok(12..24));
+        assert_eq!(parse_frames_range("40..", 48), Ok(40..48));
+        assert_eq!(parse_frames_range("47..=47", 48), Ok(47..48));
+        assert!(matches!(
+            parse_frames_range("5..5", 48),
+            Err(PathError::RangeEmpty { .. })
+        ));
+        assert!(matches!(
+            parse_frames_range("9..3", 48),
+            Err(PathError::RangeEmpty { .. })
+        ));
+        let e = parse_frames_range("40..=48", 48).unwrap_err();
+        assert!(matches!(e, PathError::RangePastEnd { end: 48, .. }));
+        assert!(e.to_string().contains("allowed 0..48"), "{e}");
+        for bad in ["", "3", "-1..4", "a..4", "1..b", "1..=", "1.5..3"] {
+            assert!(
+                matches!(
+                    parse_frames_range(bad, 48),
+                    Err(PathError::RangeSyntax(_))
+                ),
+                "{bad}"
+            );
+        }
+    }
+}

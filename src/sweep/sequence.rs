@@ -1,0 +1,522 @@
+//! The files of a sweep sequence. Each frame leaves `frame_NNNN.png` (and `.exr`) plus a small
+//! `frame_NNNN.json` record of its light angle and mean radiances; [`assemble`] turns a folder of
+//! such frames — rendered here or farmed out with `--frames-range` — into the contact sheet, the
+//! animated PNG, the CSV and the `index.html` viewer. One code path serves both cases.
+
+use super::contact::{contact_sheet, Rgb8};
+use super::viewer::viewer_html;
+use crate::math::{luminance, Vec3};
+use crate::render::image_io::{write_png_linear, write_png_rgb8, ImageError};
+use serde::{Deserialize, Serialize};
+use std::io::BufWriter;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+/// The contact sheet's file name in a sweep folder.
+pub const CONTACT_SHEET: &str = "contact_sheet.png";
+/// The animated PNG's file name.
+pub const ANIMATION: &str = "sweep_animation.png";
+/// The per-frame table of light angle and mean radiance.
+pub const CSV: &str = "sweep.csv";
+/// The viewer page.
+pub const VIEWER: &str = "index.html";
+
+/// Errors while writing or assembling a sequence; each names the file concerned.
+#[derive(Debug, thiserror::Error)]
+pub enum SequenceError {
+    #[error("{path}: {cause}")]
+    Io {
+        path: String,
+        cause: std::io::Error,
+    },
+    #[error("frame record {path}: {cause}")]
+    Json {
+        path: String,
+        cause: serde_json::Error,
+    },
+    #[error("cannot read PNG {path}: {cause}")]
+    Decode {
+        path: String,
+        cause: png::DecodingError,
+    },
+    #[error("cannot encode animated PNG {path}: {cause}")]
+    Encode {
+        path: String,
+        cause: png::EncodingError,
+    },
+    #[error(transparent)]
+    Image(#[from] ImageError),
+    #[error("{dir}: no frame records (frame_NNNN.json) to assemble; render frames first")]
+    Empty { dir: String },
+    #[error("{dir}: a {frames}-frame sweep lacks frames {missing}; render them (e.g. --frames-range {hint}) and assemble again")]
+    Missing {
+        dir: String,
+        frames: usize,
+        missing: String,
+        hint: String,
+    },
+    #[error("{path}: {what}")]
+    Mismatch { path: String, what: String },
+}
+
+/// A named rectangle of the image whose mean radiance the CSV follows, in fractions of the
+/// image size (`0..1`, origin at the top-left corner), so it does not depend on the resolution.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Region {
+    pub name: String,
+    pub x0: f32,
+    pub y0: f32,
+    pub x1: f32,
+    pub y1: f32,
+}
+
+impl Region {
+    /// The pixel columns and rows the region covers in a `width × height` image (at least one each).
+    pub fn pixels(&self, width: u32, height: u32) -> (Range<u32>, Range<u32>) {
+        let span = |a: f32, b: f32, n: u32| {
+            let lo = ((a.min(b).clamp(0.0, 1.0) * n as f32).floor() as u32).min(n - 1);
+            let hi = ((a.max(b).clamp(0.0, 1.0) * n as f32).ceil() as u32).clamp(lo + 1, n);
+            lo..hi
+        };
+        (
+            span(self.x0, self.x1, width.max(1)),
+            span(self.y0, self.y1, height.max(1)),
+        )
+    }
+
+    /// Mean luminance of the region in a linear RGB image.
+    pub fn mean_luminance(&self, width: u32, height: u32, pixels: &[Vec3]) -> f32 {
+        let (xs, ys) = self.pixels(width, height);
+        let n = xs.len() * ys.len();
+        let sum: f64 = ys
+            .flat_map(|y| xs.clone().map(move |x| (x, y)))
+            .map(|(x, y)| luminance(pixels[(y * width + x) as usize]) as f64)
+            .sum();
+        (sum / n as f64) as f32
+    }
+}
+
+/// Mean luminance of one named region in one frame.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RegionMean {
+    pub name: String,
+    pub luminance: f32,
+}
+
+/// What a frame leaves beside its images: enough to assemble the sequence without the scene.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FrameRecord {
+    pub index: usize,
+    pub frames: usize,
+    pub light_deg: f32,
+    pub width: u32,
+    pub height: u32,
+    pub mean_rgb: [f32; 3],
+    pub mean_luminance: f32,
+    pub regions: Vec<RegionMean>,
+}
+
+impl FrameRecord {
+    /// Measures a rendered frame (linear RGB, row-major, top row first).
+    pub fn measure(
+        index: usize,
+        frames: usize,
+        light_deg: f32,
+        (width, height): (u32, u32),
+        pixels: &[Vec3],
+        regions: &[Region],
+    ) -> Self {
+        let n = pixels.len().max(1) as f64;
+        let sum = pixels
+            .iter()
+            .fold([0f64; 3], |a, p| [a[0] + p.x as f64, a[1] + p.y as f64, a[2] + p.z as f64]);
+        let mean_rgb = sum.map(|s| (s / n) as f32);
+        FrameRecord {
+            index,
+            frames,
+            light_deg,
+            width,
+            height,
+            mean_luminance: luminance(Vec3::from_array(mean_rgb)),
+            mean_rgb,
+            regions: regions
+                .iter()
+                .map(|r| RegionMean {
+                    name: r.name.clone(),
+                    luminance: r.mean_luminance(width, height, pixels),
+                })
+                .collect(),
+        }
+    }
+}
+
+/// The file stem of frame `index`: `frame_0007`.
+pub fn frame_stem(index: usize) -> String {
+    format!("frame_{index:04}")
+}
+
+/// Writes `text` to `path` through a temporary file, so a failure leaves no half-written file.
+pub fn write_text_atomic(path: &Path, text: &str) -> Result<(), SequenceError> {
+    let io = |cause| SequenceError::Io {
+        path: path.display().to_string(),
+        cause,
+    };
+    let tmp = path.with_extension("partial");
+    std::fs::write(&tmp, text).map_err(io)?;
+    std::fs::rename(&tmp, path).map_err(io)
+}
+
+/// Writes a frame's PNG preview (exposure in stops) and then its record, which marks it complete.
+pub fn write_frame(
+    dir: &Path,
+    record: &FrameRecord,
+    pixels: &[Vec3],
+    exposure: f32,
+) -> Result<(), SequenceError> {
+    let stem = frame_stem(record.index);
+    let png = dir.join(format!("{stem}.png"));
+    write_png_linear(&png, record.width, record.height, pixels, exposure)?;
+    let json = dir.join(format!("{stem}.json"));
+    let text = serde_json::to_string_pretty(record).map_err(|cause| SequenceError::Json {
+        path: json.display().to_string(),
+        cause,
+    })?;
+    write_text_atomic(&json, &text)
+}
+
+/// How [`assemble`] lays out its outputs.
+#[derive(Clone, Debug)]
+pub struct AssembleOptions {
+    /// Largest thumbnail width on the contact sheet, in pixels.
+    pub thumb_width: u32,
+    /// Largest frame width in the animated PNG.
+    pub animation_width: u32,
+    /// Frames per second of the animated PNG and the viewer's playback.
+    pub fps: u16,
+    /// Title of the viewer page.
+    pub title: String,
+}
+
+impl Default for AssembleOptions {
+    fn default() -> Self {
+        AssembleOptions {
+            thumb_width: 240,
+            animation_width: 480,
+            fps: 12,
+            title: "xylem light sweep".into(),
+        }
+    }
+}
+
+/// Reads every `frame_NNNN.json` in `dir`, sorted by frame index, and checks that they describe
+/// one complete sweep (same frame count and size, every frame present exactly once).
+pub fn read_records(dir: &Path) -> Result<Vec<FrameRecord>, SequenceError> {
+    let io = |cause| SequenceError::Io {
+        path: dir.display().to_string(),
+        cause,
+    };
+    let mut records = Vec::new();
+    for entry in std::fs::read_dir(dir).map_err(io)? {
+        let path = entry.map_err(io)?.path();
+        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        if !(name.starts_with("frame_") && name.ends_with(".json")) {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).map_err(|cause| SequenceError::Io {
+            path: path.display().to_string(),
+            cause,
+        })?;
+        let rec: FrameRecord =
+            serde_json::from_str(&text).map_err(|cause| SequenceError::Json {
+                path: path.display().to_string(),
+                cause,
+            })?;
+        records.push((path, rec));
+    }
+    records.sort_by_key(|(_, r)| r.index);
+    let Some((_, first)) = records.first() else {
+        return Err(SequenceError::Empty {
+            dir: dir.display().to_string(),
+        });
+    };
+    let (frames, size) = (first.frames, (first.width, first.height));
+    for (path, r) in &records {
+        let what = if r.frames != frames {
+            Some(format!(
+                "belongs to a {}-frame sweep, the others to a {frames}-frame one",
+                r.frames
+            ))
+        } else if (r.width, r.height) != size {
+            Some(format!(
+                "is {}x{}, the others {}x{}",
+                r.width, r.height, size.0, size.1
+            ))
+        } else if r.index >= frames {
+            Some(format!("frame {} is past the sweep's end ({frames} frames)", r.index))
+        } else {
+            None
+        };
+        if let Some(what) = what {
+            return Err(SequenceError::Mismatch {
+                path: path.display().to_string(),
+                what,
+            });
+        }
+    }
+    let present: Vec<usize> = records.iter().map(|(_, r)| r.index).collect();
+    let missing: Vec<usize> = (0..frames)
+        .filter(|i| present.binary_search(i).is_err())
+        .collect();
+    if !missing.is_empty() {
+        let runs = runs(&missing);
+        let hint = format!("{}..{}", runs[0].start, runs[0].end);
+        let missing = runs
+            .iter()
+            .map(|r| {
+                if r.len() == 1 {
+                    r.start.to_string()
+                } else {
+                    format!("{}..={}", r.start, r.end - 1)
+                }
+            })
+            .collect::<Vec<_>>()
+            .join(", ");
+        return Err(SequenceError::Missing {
+            dir: dir.display().to_string(),
+            frames,
+            missing,
+            hint,
+        });
+    }
+    Ok(records.into_iter().map(|(_, r)| r).collect())
+}
+
+/// Groups sorted indices into runs of consecutive values.
+fn runs(sorted: &[usize]) -> Vec<Range<usize>> {
+    let mut out: Vec<Range<usize>> = Vec::new();
+    for &i in sorted {
+        match out.last_mut() {
+            Some(r) if r.end == i => r.end = i + 1,
+            _ => out.push(i..i + 1),
+        }
+    }
+    out
+}
+
+/// Reads an 8-bit RGB (or RGBA, alpha dropped) PNG.
+pub fn read_png_rgb8(path: &Path) -> Result<Rgb8, SequenceError> {
+    let name = path.display().to_string();
+    let decode = |cause| SequenceError::Decode {
+        path: name.clone(),
+        cause,
+    };
+    let file = std::fs::File::open(path).map_err(|cause| SequenceError::Io {
+        path: name.clone(),
+        cause,
+    })?;
+    let mut dec = png::Decoder::new(std::io::BufReader::new(file));
+    dec.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
+    let mut reader = dec.read_info().map_err(decode)?;
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).map_err(decode)?;
+    buf.truncate(info.buffer_size());
+    let data = match info.color_type {
+        png::ColorType::Rgb => buf,
+        png::ColorType::Rgba => buf
+            .chunks_exact(4)
+            .flat_map(|p| [p[0], p[1], p[2]])
+            .collect(),
+        png::ColorType::Grayscale => buf.iter().flat_map(|&g| [g, g, g]).collect(),
+        png::ColorType::GrayscaleAlpha => {
+            buf.chunks_exact(2).flat_map(|p| [p[0], p[0], p[0]]).collect()
+        }
+        png::ColorType::Indexed => {
+            return Err(SequenceError::Mismatch {
+                path: name,
+                what: "indexed colour was not expanded".into(),
+            })
+        }
+    };
+    Ok(Rgb8 {
+        width: info.width,
+        height: info.height,
+        data,
+    })
+}
+
+/// Writes `frames` (all the same size) as a looping animated PNG, `fps` frames per second.
+pub fn write_apng(path: &Path, frames: &[Rgb8], fps: u16) -> Result<(), SequenceError> {
+    let name = path.display().to_string();
+    let first = frames.first().ok_or_else(|| SequenceError::Mismatch {
+        path: name.clone(),
+        what: "an animation needs at least one frame".into(),
+    })?;
+    let io = |cause| SequenceError::Io {
+        path: name.clone(),
+        cause,
+    };
+    let enc_err = |cause| SequenceError::Encode {
+        path: name.clone(),
+        cause,
+    };
+    let tmp = path.with_extension("png.partial");
+    let file = std::fs::File::create(&tmp).map_err(io)?;
+    let mut enc = png::Encoder::new(BufWriter::new(file), first.width, first.height);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+    enc.set_animated(frames.len() as u32, 0).map_err(enc_err)?;
+    enc.set_frame_delay(1, fps.max(1)).map_err(enc_err)?;
+    let mut w = enc.write_header().map_err(enc_err)?;
+    for f in frames {
+        w.write_image_data(&f.data).map_err(enc_err)?;
+    }
+    w.finish().map_err(enc_err)?;
+    std::fs::rename(&tmp, path).map_err(io)
+}
+
+/// The CSV of light angle and mean radiance per frame, one column per named region.
+pub fn csv_table(records: &[FrameRecord]) -> String {
+    let mut s = String::from("frame,light_deg,mean_luminance,mean_r,mean_g,mean_b");
+    if let Some(r) = records.first() {
+        for reg in &r.regions {
+            s.push_str(&format!(",region_{}", csv_name(&reg.name)));
+        }
+    }
+    s.push('\n');
+    for r in records {
+        let [cr, cg, cb] = r.mean_rgb;
+        s.push_str(&format!(
+            "{},{},{},{cr},{cg},{cb}",
+            r.index, r.light_deg, r.mean_luminance
+        ));
+        for reg in &r.regions {
+            s.push_str(&format!(",{}", reg.luminance));
+        }
+        s.push('\n');
+    }
+    s
+}
+
+/// A region name safe inside a CSV header (no separators or quotes).
+fn csv_name(name: &str) -> String {
+    name.chars()
+        .map(|c| if c.is_alphanumeric() || c == '_' || c == '-' { c } else { '_' })
+        .collect()
+}
+
+/// The files [`assemble`] wrote.
+#[derive(Clone, Debug)]
+pub struct Assembled {
+    pub frames: usize,
+    pub files: Vec<PathBuf>,
+}
+
+/// Builds the contact sheet, the animated PNG, the CSV and the viewer from the frames in `dir`.
+pub fn assemble(dir: &Path, opts: &AssembleOptions) -> Result<Assembled, SequenceError> {
+    let records = read_records(dir)?;
+    let mut images = Vec::with_capacity(records.len());
+    for r in &records {
+        let path = dir.join(format!("{}.png", frame_stem(r.index)));
+        let img = read_png_rgb8(&path)?;
+        if (img.width, img.height) != (r.width, r.height) {
+            return Err(SequenceError::Mismatch {
+                path: path.display().to_string(),
+                what: format!(
+                    "is {}x{} but its record says {}x{}",
+                    img.width, img.height, r.width, r.height
+                ),
+            });
+        }
+        images.push(img);
+    }
+    let labels: Vec<String> = records
+        .iter()
+        .map(|r| format!("{:.1}°", r.light_deg))
+        .collect();
+    let thumbs: Vec<Rgb8> = images
+        .iter()
+        .map(|i| i.shrink_to_width(opts.thumb_width))
+        .collect();
+    let sheet = contact_sheet(&thumbs, &labels, 4);
+    let sheet_path = dir.join(CONTACT_SHEET);
+    write_png_rgb8(&sheet_path, sheet.width, sheet.height, &sheet.data)?;
+
+    let anim: Vec<Rgb8> = images
+        .iter()
+        .map(|i| i.shrink_to_width(opts.animation_width))
+        .collect();
+    let anim_path = dir.join(ANIMATION);
+    write_apng(&anim_path, &anim, opts.fps)?;
+
+    let csv_path = dir.join(CSV);
+    write_text_atomic(&csv_path, &csv_table(&records))?;
+    let html_path = dir.join(VIEWER);
+    write_text_atomic(&html_path, &viewer_html(&records, &opts.title, opts.fps))?;
+    Ok(Assembled {
+        frames: records.len(),
+        files: vec![sheet_path, anim_path, csv_path, html_path],
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn regions_cover_their_pixels_and_average_them() {
+        let r = Region {
+            name: "left".into(),
+            x0: 0.0,
+            y0: 0.0,
+            x1: 0.5,
+            y1: 1.0,
+        };
+        assert_eq!(r.pixels(4, 2), (0..2, 0..2));
+        let px: Vec<Vec3> = (0..8)
+            .map(|i| Vec3::splat(if i % 4 < 2 { 1.0 } else { 3.0 }))
+            .collect();
+        assert!((r.mean_luminance(4, 2, &px) - 1.0).abs() < 1e-6);
+        // A degenerate region still covers one pixel, never none.
+        let thin = Region {
+            name: "t".into(),
+            x0: 0.9,
+            y0: 0.9,
+            x1: 0.9,
+            y1: 0.9,
+        };
+        let (xs, ys) = thin.pixels(4, 2);
+        assert_eq!((xs.len(), ys.len()), (1, 1));
+    }
+
+    #[test]
+    fn missing_frames_are_named_as_runs() {
+        assert_eq!(runs(&[1, 2, 3, 7, 9, 10]), vec![1..4, 7..8, 9..11]);
+        assert!(runs(&[]).is_empty());
+    }
+
+    #[test]
+    fn csv_has_one_row_per_frame_and_a_column_per_region() {
+        let rec = |i| FrameRecord {
+            index: i,
+            frames: 2,
+            light_deg: i as f32 * 10.0,
+            width: 1,
+            height: 1,
+            mean_rgb: [0.5, 0.25, 1.0],
+            mean_luminance: 0.4,
+            regions: vec![RegionMean {
+                name: "a stripe,1".into(),
+                luminance: 2.0,
+            }],
+        };
+        let t = csv_table(&[rec(0), rec(1)]);
+        let lines: Vec<&str> = t.lines().collect();
+        assert_eq!(
+            lines[0],
+            "frame,light_deg,mean_luminance,mean_r,mean_g,mean_b,region_a_stripe_1"
+        );
+        assert_eq!(lines[2], "1,10,0.4,0.5,0.25,1,2");
+        assert_eq!(lines.len(), 3);
+    }
+}
