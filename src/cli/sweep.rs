@@ -1,9 +1,9 @@
 //! `xylem sweep`: renders a light sweep (or a slice of one) and assembles its outputs.
 
+use crate::sweep::sequence::{assemble, AssembleOptions};
 use anyhow::Context;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use crate::sweep::sequence::{assemble, AssembleOptions};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -31,7 +31,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if let Some(dir) = &args.assemble {
         return assemble_dir(dir);
     }
-    anyhow::bail!("`xylem sweep SCENE` needs the renderer, which has not landed yet; `--assemble DIR` works")
+    anyhow::bail!(
+        "`xylem sweep SCENE` needs the renderer, which has not landed yet; `--assemble DIR` works"
+    )
 }
 
 /// Assembles a folder of frames and reports what it wrote.

@@ -65,9 +65,8 @@ impl Rgb8 {
                         n += 1.0;
                     }
                 }
-                let px = acc.map(|a| {
-                    (crate::render::image_io::linear_to_srgb(a / n) * 255.0 + 0.5) as u8
-                });
+                let px = acc
+                    .map(|a| (crate::render::image_io::linear_to_srgb(a / n) * 255.0 + 0.5) as u8);
                 out.put(tx, ty, px);
             }
         }
@@ -199,7 +198,9 @@ mod tests {
             assert!(c * n.div_ceil(c) >= n && c <= n);
         }
         assert_eq!(sheet_columns(48), 8);
-        let thumbs: Vec<Rgb8> = (0..5).map(|i| Rgb8::filled(10, 6, [i * 50, 0, 0])).collect();
+        let thumbs: Vec<Rgb8> = (0..5)
+            .map(|i| Rgb8::filled(10, 6, [i * 50, 0, 0]))
+            .collect();
         let sheet = contact_sheet(&thumbs, &[], 2);
         // 3 columns, 2 rows: 3·10 + 4·2 by 2·6 + 3·2.
         assert_eq!((sheet.width, sheet.height), (38, 18));
@@ -216,6 +217,10 @@ mod tests {
         let white = img.data.chunks(3).filter(|p| p == &[255, 255, 255]).count();
         // '-' 3 + '7' 7 + '.' 1 + '5' 11 + '°' 4 lit font pixels.
         assert_eq!(white, 26);
-        assert_eq!(&img.data[..3], &[100, 100, 100], "outside the box is untouched");
+        assert_eq!(
+            &img.data[..3],
+            &[100, 100, 100],
+            "outside the box is untouched"
+        );
     }
 }

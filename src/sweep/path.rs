@@ -234,10 +234,7 @@ mod tests {
         assert!(e.to_string().contains("allowed 0..48"), "{e}");
         for bad in ["", "3", "-1..4", "a..4", "1..b", "1..=", "1.5..3"] {
             assert!(
-                matches!(
-                    parse_frames_range(bad, 48),
-                    Err(PathError::RangeSyntax(_))
-                ),
+                matches!(parse_frames_range(bad, 48), Err(PathError::RangeSyntax(_))),
                 "{bad}"
             );
         }

@@ -25,10 +25,7 @@ pub const VIEWER: &str = "index.html";
 #[derive(Debug, thiserror::Error)]
 pub enum SequenceError {
     #[error("{path}: {cause}")]
-    Io {
-        path: String,
-        cause: std::io::Error,
-    },
+    Io { path: String, cause: std::io::Error },
     #[error("frame record {path}: {cause}")]
     Json {
         path: String,
@@ -127,9 +124,9 @@ impl FrameRecord {
         regions: &[Region],
     ) -> Self {
         let n = pixels.len().max(1) as f64;
-        let sum = pixels
-            .iter()
-            .fold([0f64; 3], |a, p| [a[0] + p.x as f64, a[1] + p.y as f64, a[2] + p.z as f64]);
+        let sum = pixels.iter().fold([0f64; 3], |a, p| {
+            [a[0] + p.x as f64, a[1] + p.y as f64, a[2] + p.z as f64]
+        });
         let mean_rgb = sum.map(|s| (s / n) as f32);
         FrameRecord {
             index,
@@ -252,7 +249,10 @@ pub fn read_records(dir: &Path) -> Result<Vec<FrameRecord>, SequenceError> {
                 r.width, r.height, size.0, size.1
             ))
         } else if r.index >= frames {
-            Some(format!("frame {} is past the sweep's end ({frames} frames)", r.index))
+            Some(format!(
+                "frame {} is past the sweep's end ({frames} frames)",
+                r.index
+            ))
         } else {
             None
         };
@@ -327,9 +327,10 @@ pub fn read_png_rgb8(path: &Path) -> Result<Rgb8, SequenceError> {
             .flat_map(|p| [p[0], p[1], p[2]])
             .collect(),
         png::ColorType::Grayscale => buf.iter().flat_map(|&g| [g, g, g]).collect(),
-        png::ColorType::GrayscaleAlpha => {
-            buf.chunks_exact(2).flat_map(|p| [p[0], p[0], p[0]]).collect()
-        }
+        png::ColorType::GrayscaleAlpha => buf
+            .chunks_exact(2)
+            .flat_map(|p| [p[0], p[0], p[0]])
+            .collect(),
         png::ColorType::Indexed => {
             return Err(SequenceError::Mismatch {
                 path: name,
@@ -401,7 +402,13 @@ pub fn csv_table(records: &[FrameRecord]) -> String {
 /// A region name safe inside a CSV header (no separators or quotes).
 fn csv_name(name: &str) -> String {
     name.chars()
-        .map(|c| if c.is_alphanumeric() || c == '_' || c == '-' { c } else { '_' })
+        .map(|c| {
+            if c.is_alphanumeric() || c == '_' || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
         .collect()
 }
 

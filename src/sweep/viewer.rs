@@ -164,7 +164,10 @@ mod tests {
         assert!(html.contains("max=\"2\""));
         assert!(html.contains("<title>board &lt;1&gt;</title>"));
         for external in ["src=\"http", "href=\"http", "https://", "<link"] {
-            assert!(!html.contains(external), "no external resources: {external}");
+            assert!(
+                !html.contains(external),
+                "no external resources: {external}"
+            );
         }
         // The region name cannot close the script early.
         assert_eq!(html.matches("</script>").count(), 1);
