@@ -1,9 +1,19 @@
 //! BSDFs in the local shading frame (z = shading normal, unit directions pointing away from
 //! the surface): the finished-wood BSDF of Marschner et al. 2005 and the simple BSDFs scenes need.
 
+mod fiber;
+mod fresnel;
+mod ggx;
 mod lambertian;
+mod specular;
+mod wood;
 
+pub use fiber::{erf_inv, gaussian, FiberAxis, FiberNormalization};
+pub use fresnel::{fresnel_dielectric, fresnel_diffuse_reflectance, refract, refract_in, refract_out};
+pub use ggx::Ggx;
 pub use lambertian::Lambertian;
+pub use specular::{Glass, Mirror};
+pub use wood::WoodBsdf;
 
 use glam::{Vec2, Vec3};
 
@@ -23,6 +33,17 @@ pub trait Bsdf {
     fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3;
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32;
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample>;
+}
+
+/// A BSDF parameter outside its allowed range (or not finite).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum BsdfError {
+    #[error("WoodBsdfParams.{field} = {value}: must be {range}")]
+    OutOfRange {
+        field: &'static str,
+        value: String,
+        range: &'static str,
+    },
 }
 
 /// Parameters of the finished-wood BSDF (Marschner et al. 2005, §4; Liu et al. 2016, §6.3).

@@ -1,0 +1,233 @@
+//! The fibre lobe of Marschner et al. 2005 ("Measuring and modeling the appearance of finished
+//! wood", SIGGRAPH 2005, §4.2, eq. 3; restated as eq. 1 of Liu et al. 2016): light reflected by
+//! subsurface fibres of axis u leaves on the cone ψr ≈ −ψi, spread by a Gaussian of width β.
+//! All directions here are *inside* the finish. The normalisation and the sampling density are
+//! derived in notes/bsdf.md.
+
+use crate::math::{safe_asin, safe_sqrt, Frame, PI};
+use glam::{Vec2, Vec3};
+
+/// How the fibre lobe is normalised.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FiberNormalization {
+    /// `g(β, ψh) / (2π max(cos ψi, cos ψr))`: directional albedo ≤ 1 at every angle (notes/bsdf.md §2).
+    #[default]
+    EnergyBounded,
+    /// The published `g(β, ψh) / cos²(ψd/2)` (Marschner et al. 2005, eq. 3): reflects ≈ 2·k_f at
+    /// normal incidence and without bound towards grazing along the fibre.
+    Published,
+}
+
+/// Below this cos ψ a direction is treated as lying on the fibre axis: the cone degenerates to a
+/// point there, so `sample` never returns it and `pdf` is 0 (a cap of solid angle ~3e-10 sr).
+const MIN_COS_PSI: f32 = 1e-5;
+
+/// A fibre axis `u` with a frame `(v, w)` around it for the azimuth of the reflection cone.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FiberAxis {
+    frame: Frame,
+}
+
+/// Normalised Gaussian g(β, x) = exp(−x²/2β²) / (β√(2π)) (Marschner et al. 2005, §4.2).
+#[inline]
+pub fn gaussian(beta: f32, x: f32) -> f32 {
+    const INV_SQRT_2PI: f32 = 0.398_942_3;
+    INV_SQRT_2PI / beta * (-0.5 * (x / beta) * (x / beta)).exp()
+}
+
+/// Inverse error function, single-precision polynomial of Giles 2010 ("Approximating the erfinv
+/// function", GPU Computing Gems Jade, ch. 10), relative error ≲ 4e-7 on (−1, 1).
+pub fn erf_inv(x: f32) -> f32 {
+    let w = -((1.0 - x) * (1.0 + x)).ln();
+    let p = if w < 5.0 {
+        let w = w - 2.5;
+        let mut p = 2.810_226_4e-8_f32;
+        for c in [
+            3.432_739_4e-7,
+            -3.523_387_7e-6,
+            -4.391_506_5e-6,
+            2.185_808_7e-4,
+            -1.253_725e-3,
+            -4.177_681_6e-3,
+            2.466_407_3e-1,
+            1.501_409_4,
+        ] {
+            p = c + p * w;
+        }
+        p
+    } else {
+        let w = w.sqrt() - 3.0;
+        let mut p = -2.002_142_6e-4_f32;
+        for c in [
+            1.009_505_6e-4,
+            1.349_343_2e-3,
+            -3.673_428_4e-3,
+            5.739_507_7e-3,
+            -7.622_461_3e-3,
+            9.438_870_5e-3,
+            1.001_674_1,
+            2.832_976_8,
+        ] {
+            p = c + p * w;
+        }
+        p
+    };
+    p * x
+}
+
+impl FiberAxis {
+    /// `u` must be a unit vector.
+    pub fn new(u: Vec3) -> Self {
+        FiberAxis {
+            frame: Frame::from_normal(u),
+        }
+    }
+
+    #[inline]
+    pub fn axis(&self) -> Vec3 {
+        self.frame.n
+    }
+
+    /// Longitudinal angle ψ = asin(ω·u) (Marschner et al. 2005, eq. 2).
+    #[inline]
+    fn psi(&self, w: Vec3) -> f32 {
+        safe_asin(w.dot(self.frame.n))
+    }
+
+    /// The lobe without its colour k_f, for interior directions `wo`, `wi`.
+    pub fn eval(&self, wo: Vec3, wi: Vec3, beta: f32, norm: FiberNormalization) -> f32 {
+        let (psi_r, psi_i) = (self.psi(wo), self.psi(wi));
+        let g = gaussian(beta, psi_i + psi_r);
+        match norm {
+            FiberNormalization::EnergyBounded => {
+                let c = psi_i.cos().max(psi_r.cos()).max(MIN_COS_PSI);
+                g / (2.0 * PI * c)
+            }
+            FiberNormalization::Published => {
+                let c = (0.5 * (psi_r - psi_i)).cos();
+                g / (c * c).max(MIN_COS_PSI * MIN_COS_PSI)
+            }
+        }
+    }
+
+    /// Half-width Δ of the azimuth arc of the cone at longitudinal angle ψ whose directions have
+    /// z > `z_min` (those that can leave the finish): z(φ) = sinψ u_z + cosψ h cos(φ − φ0),
+    /// with h = |(v_z, w_z)|. Returns (Δ, φ0); Δ = 0 when no part of the cone qualifies.
+    #[inline]
+    fn arc(&self, sin_psi: f32, cos_psi: f32, z_min: f32) -> (f32, f32) {
+        let (u, v, w) = (self.frame.n, self.frame.s, self.frame.t);
+        let h = (v.z * v.z + w.z * w.z).sqrt();
+        let phi0 = w.z.atan2(v.z);
+        let a = sin_psi * u.z;
+        let b = cos_psi * h;
+        if b < 1e-7 {
+            return (if a > z_min { PI } else { 0.0 }, phi0);
+        }
+        let t = (z_min - a) / b;
+        let delta = if t <= -1.0 {
+            PI
+        } else if t >= 1.0 {
+            0.0
+        } else {
+            t.acos()
+        };
+        (delta, phi0)
+    }
+
+    /// Samples an interior direction: ψi from the Gaussian about −ψr (inverse CDF), φ uniform on
+    /// the arc of the cone above `z_min`. `None` when ψi falls outside (−π/2, π/2) or the arc is
+    /// empty; [`FiberAxis::pdf`] is the density of the returned directions exactly.
+    pub fn sample(&self, wo: Vec3, u: Vec2, beta: f32, z_min: f32) -> Option<Vec3> {
+        let psi_r = self.psi(wo);
+        let x = (2.0 * u.x - 1.0).clamp(-0.999_999_9, 0.999_999_9);
+        let psi_i = -psi_r + beta * std::f32::consts::SQRT_2 * erf_inv(x);
+        if !(psi_i.abs() < 0.5 * PI) {
+            return None;
+        }
+        let (sin_psi, cos_psi) = psi_i.sin_cos();
+        if cos_psi < MIN_COS_PSI {
+            return None;
+        }
+        let (delta, phi0) = self.arc(sin_psi, cos_psi, z_min);
+        if delta <= 0.0 {
+            return None;
+        }
+        let phi = phi0 + delta * (2.0 * u.y - 1.0);
+        let (sp, cp) = phi.sin_cos();
+        let w = sin_psi * self.frame.n + cos_psi * (cp * self.frame.s + sp * self.frame.t);
+        if !(w.z > z_min) {
+            return None;
+        }
+        Some(w)
+    }
+
+    /// Density per unit solid angle of [`FiberAxis::sample`]: g(β, ψi + ψr) / (2Δ(ψi) cos ψi),
+    /// the Jacobian dω = cos ψ dψ dφ of the fibre's (ψ, φ) coordinates (notes/bsdf.md §3).
+    pub fn pdf(&self, wo: Vec3, wi: Vec3, beta: f32, z_min: f32) -> f32 {
+        if !(wi.z > z_min) {
+            return 0.0;
+        }
+        let psi_r = self.psi(wo);
+        let sin_psi = wi.dot(self.frame.n).clamp(-1.0, 1.0);
+        let cos_psi = safe_sqrt(1.0 - sin_psi * sin_psi);
+        if cos_psi < MIN_COS_PSI {
+            return 0.0;
+        }
+        let (delta, _) = self.arc(sin_psi, cos_psi, z_min);
+        if delta <= 0.0 {
+            return 0.0;
+        }
+        gaussian(beta, sin_psi.asin() + psi_r) / (2.0 * delta * cos_psi)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::{uniform_sphere, Pcg32};
+
+    #[test]
+    fn erf_inv_inverts_statrs_erf() {
+        for i in 1..200 {
+            let y = -1.0 + i as f64 / 100.0;
+            let x = erf_inv(y as f32) as f64;
+            let back = statrs::function::erf::erf(x);
+            assert!((back - y).abs() < 2e-6 * (1.0 + y.abs()), "{y}: {back}");
+        }
+    }
+
+    #[test]
+    fn lobe_is_reciprocal_and_peaks_on_the_cone() {
+        let ax = FiberAxis::new(Vec3::new(1.0, 0.0, -0.3).normalize());
+        let mut r = Pcg32::new(11, 0);
+        for _ in 0..1000 {
+            let a = uniform_sphere(r.next_vec2());
+            let b = uniform_sphere(r.next_vec2());
+            for n in [FiberNormalization::EnergyBounded, FiberNormalization::Published] {
+                let (f1, f2) = (ax.eval(a, b, 0.2, n), ax.eval(b, a, 0.2, n));
+                assert!((f1 - f2).abs() <= 1e-5 * f1.max(f2), "{f1} {f2}");
+            }
+        }
+        // On the specular cone (ψi = −ψr) the Gaussian is at its maximum 1/(β√2π).
+        let wo = Vec3::new(0.3, 0.2, 0.93).normalize();
+        let u = ax.axis();
+        let wi = (wo - 2.0 * wo.dot(u) * u).normalize();
+        let psi = wo.dot(u).asin();
+        let want = gaussian(0.2, 0.0) / (2.0 * PI * psi.cos());
+        let got = ax.eval(wo, wi, 0.2, FiberNormalization::EnergyBounded);
+        assert!((got - want).abs() < 1e-4 * want);
+    }
+
+    #[test]
+    fn arc_contains_exactly_the_directions_above_z_min() {
+        let ax = FiberAxis::new(Vec3::new(0.5, 0.5, 0.7).normalize());
+        let mut r = Pcg32::new(3, 1);
+        for _ in 0..2000 {
+            let wo = uniform_sphere(r.next_vec2());
+            if let Some(w) = ax.sample(wo, r.next_vec2(), 0.3, 0.4) {
+                assert!(w.z > 0.4 && (w.length() - 1.0).abs() < 1e-5);
+                assert!(ax.pdf(wo, w, 0.3, 0.4) > 0.0);
+            }
+        }
+    }
+}

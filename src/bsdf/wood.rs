@@ -1,0 +1,553 @@
+//! The finished-wood BSDF: a Lambertian substrate plus the fibre lobes of Marschner et al. 2005
+//! (longitudinal and ray fibres blended by the ray mask, Liu et al. 2016 §6.3.1), seen through a
+//! dielectric finish (Marschner et al. 2005 §4.3), smooth or rough (GGX). The exterior BSDF, its
+//! reciprocity, the closed-form internal reflections of the diffuse part and the sampling
+//! densities are derived in notes/bsdf.md.
+
+use super::fiber::{FiberAxis, FiberNormalization};
+use super::fresnel::{fresnel_diffuse_reflectance, fresnel_dielectric, refract_in, refract_out};
+use super::ggx::Ggx;
+use super::{Bsdf, BsdfError, BsdfSample, WoodBsdfParams};
+use crate::math::{cosine_hemisphere, luminance, safe_sqrt, INV_PI, PI};
+use glam::{Vec2, Vec3};
+
+/// Below this roughness the finish is treated as smooth (a delta reflection): a GGX lobe of
+/// α < 1e-3 is narrower than f32 directions resolve reliably.
+const MIN_ROUGHNESS: f32 = 1e-3;
+
+/// The finished-wood BSDF for one shading point. Cheap to build (no allocation, one 12-point
+/// quadrature when η > 1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WoodBsdf {
+    params: WoodBsdfParams,
+    norm: FiberNormalization,
+    fiber: FiberAxis,
+    ray: FiberAxis,
+    /// ρ'/(1 − ρ' F̄_int): the diffuse albedo including the closed-form series of internal
+    /// reflections under the finish (notes/bsdf.md §1.3), with ρ' = min(ρ, 1 − k_f).
+    diffuse_eff: Vec3,
+    /// 1 − F̄_int = (1 − F̄_ext)/η²: fraction of Lambertian light from the substrate that leaves.
+    escape: f32,
+    inv_eta2: f32,
+    /// cos of the critical angle inside the finish: interior directions with z ≤ this cannot leave.
+    z_crit: f32,
+    ggx: Option<Ggx>,
+}
+
+fn check_unit_interval(field: &'static str, v: f32) -> Result<(), BsdfError> {
+    if v.is_finite() && (0.0..=1.0).contains(&v) {
+        Ok(())
+    } else {
+        Err(BsdfError::OutOfRange {
+            field,
+            value: format!("{v}"),
+            range: "a finite value in [0, 1]",
+        })
+    }
+}
+
+fn check_colour(field: &'static str, c: Vec3) -> Result<(), BsdfError> {
+    if c.is_finite() && c.min_element() >= 0.0 && c.max_element() <= 1.0 {
+        Ok(())
+    } else {
+        Err(BsdfError::OutOfRange {
+            field,
+            value: format!("{c}"),
+            range: "finite channels in [0, 1]",
+        })
+    }
+}
+
+fn check_unit_vector(field: &'static str, v: Vec3) -> Result<Vec3, BsdfError> {
+    let len = v.length();
+    if v.is_finite() && (len - 1.0).abs() <= 1e-3 {
+        Ok(v / len)
+    } else {
+        Err(BsdfError::OutOfRange {
+            field,
+            value: format!("{v}"),
+            range: "a finite unit vector (length within 1e-3 of 1)",
+        })
+    }
+}
+
+fn check_range(field: &'static str, v: f32, lo: f32, hi: f32, range: &'static str) -> Result<(), BsdfError> {
+    if v.is_finite() && v >= lo && v <= hi {
+        Ok(())
+    } else {
+        Err(BsdfError::OutOfRange {
+            field,
+            value: format!("{v}"),
+            range,
+        })
+    }
+}
+
+/// Which lobe `sample` picked.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Lobe {
+    Specular,
+    Diffuse,
+    Fiber,
+    Ray,
+}
+
+/// Lobe-selection probabilities for one `wo`, proportional to the estimated albedo of each lobe.
+#[derive(Clone, Copy, Debug)]
+struct LobeProbs {
+    specular: f32,
+    diffuse: f32,
+    fiber: f32,
+    ray: f32,
+}
+
+impl WoodBsdf {
+    /// Validates `params` (every field finite and in range) and precomputes what every call needs.
+    pub fn new(params: WoodBsdfParams) -> Result<WoodBsdf, BsdfError> {
+        check_colour("diffuse", params.diffuse)?;
+        check_colour("fiber_color", params.fiber_color)?;
+        let fiber_dir = check_unit_vector("fiber_dir", params.fiber_dir)?;
+        let ray_dir = check_unit_vector("ray_dir", params.ray_dir)?;
+        check_unit_interval("ray_mask", params.ray_mask)?;
+        check_range(
+            "highlight_width",
+            params.highlight_width,
+            1e-3,
+            0.5 * PI,
+            "radians in [0.001, π/2]",
+        )?;
+        check_range("eta", params.eta, 1.0, 4.0, "a finite index in [1, 4]")?;
+        check_unit_interval("roughness", params.roughness)?;
+        let mut params = params;
+        params.fiber_dir = fiber_dir;
+        params.ray_dir = ray_dir;
+
+        let eta = params.eta;
+        let f_ext = fresnel_diffuse_reflectance(eta);
+        let escape = (1.0 - f_ext) / (eta * eta);
+        let f_int = 1.0 - escape;
+        let rho = params.diffuse.min(Vec3::ONE - params.fiber_color);
+        let diffuse_eff = rho / (Vec3::ONE - rho * f_int);
+        Ok(WoodBsdf {
+            params,
+            norm: FiberNormalization::EnergyBounded,
+            fiber: FiberAxis::new(fiber_dir),
+            ray: FiberAxis::new(ray_dir),
+            diffuse_eff,
+            escape,
+            inv_eta2: 1.0 / (eta * eta),
+            z_crit: safe_sqrt(1.0 - 1.0 / (eta * eta)),
+            ggx: (params.roughness >= MIN_ROUGHNESS).then_some(Ggx {
+                alpha: params.roughness,
+            }),
+        })
+    }
+
+    /// The same BSDF with another fibre-lobe normalisation (the published one for comparison).
+    pub fn with_normalization(mut self, norm: FiberNormalization) -> Self {
+        self.norm = norm;
+        self
+    }
+
+    pub fn params(&self) -> &WoodBsdfParams {
+        &self.params
+    }
+
+    pub fn normalization(&self) -> FiberNormalization {
+        self.norm
+    }
+
+    /// True when the finish reflects through a delta lobe (η > 1 and roughness below 1e-3).
+    pub fn has_delta(&self) -> bool {
+        self.params.eta > 1.0 && self.ggx.is_none()
+    }
+
+    /// Fresnel transmittance of the finish for an exterior direction with cosine `cos`.
+    #[inline]
+    fn transmittance(&self, cos: f32) -> f32 {
+        1.0 - fresnel_dielectric(cos, self.params.eta)
+    }
+
+    /// The substrate BSDF for interior directions (no cosine): diffuse with its internal
+    /// reflections, plus k_f times the ray-mask blend of the two fibre lobes.
+    #[inline]
+    fn substrate(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        let p = &self.params;
+        let beta = p.highlight_width;
+        let mut fib = 0.0;
+        if p.ray_mask < 1.0 {
+            fib += (1.0 - p.ray_mask) * self.fiber.eval(wo, wi, beta, self.norm);
+        }
+        if p.ray_mask > 0.0 {
+            fib += p.ray_mask * self.ray.eval(wo, wi, beta, self.norm);
+        }
+        self.diffuse_eff * INV_PI + p.fiber_color * fib
+    }
+
+    /// Rough-finish reflection: GGX with the Fresnel factor taken at the macro-surface angles,
+    /// min(F(θo), F(θi)) D G2 / (4 cos θo cos θi): reciprocal, and its albedo is at most F(θo),
+    /// so together with the transmitted part it never exceeds 1 (notes/bsdf.md §4).
+    #[inline]
+    fn rough_reflection(&self, ggx: &Ggx, wo: Vec3, wi: Vec3) -> f32 {
+        let h = (wo + wi).normalize_or_zero();
+        if h.z <= 0.0 {
+            return 0.0;
+        }
+        let eta = self.params.eta;
+        let f = fresnel_dielectric(wo.z, eta).min(fresnel_dielectric(wi.z, eta));
+        f * ggx.d(h) * ggx.g2(wo, wi) / (4.0 * wo.z * wi.z)
+    }
+
+    fn lobe_probs(&self, wo: Vec3) -> LobeProbs {
+        let p = &self.params;
+        let spec = if p.eta > 1.0 {
+            fresnel_dielectric(wo.z, p.eta)
+        } else {
+            0.0
+        };
+        let t = 1.0 - spec;
+        let diff = t * luminance(self.diffuse_eff) * self.escape;
+        let fib_scale = match self.norm {
+            FiberNormalization::EnergyBounded => INV_PI,
+            FiberNormalization::Published => 2.0,
+        };
+        let kf = t * luminance(p.fiber_color) * fib_scale;
+        let (fib, ray) = (kf * (1.0 - p.ray_mask), kf * p.ray_mask);
+        let sum = spec + diff + fib + ray;
+        if !(sum > 0.0) {
+            return LobeProbs {
+                specular: 0.0,
+                diffuse: 0.0,
+                fiber: 0.0,
+                ray: 0.0,
+            };
+        }
+        LobeProbs {
+            specular: spec / sum,
+            diffuse: diff / sum,
+            fiber: fib / sum,
+            ray: ray / sum,
+        }
+    }
+
+    /// The lobe whose cumulative probability interval holds `uc`; rounding never selects a
+    /// lobe of probability 0 (the last positive one is the fallback).
+    fn pick(probs: &LobeProbs, uc: f32) -> Lobe {
+        let lobes = [
+            (Lobe::Specular, probs.specular),
+            (Lobe::Diffuse, probs.diffuse),
+            (Lobe::Fiber, probs.fiber),
+            (Lobe::Ray, probs.ray),
+        ];
+        let mut acc = 0.0;
+        let mut last = Lobe::Diffuse;
+        for (lobe, p) in lobes {
+            if p > 0.0 {
+                acc += p;
+                last = lobe;
+                if uc < acc {
+                    return lobe;
+                }
+            }
+        }
+        last
+    }
+
+    fn pdf_with(&self, probs: &LobeProbs, wo: Vec3, wi: Vec3) -> f32 {
+        if !(wo.z > 0.0 && wi.z > 0.0) {
+            return 0.0;
+        }
+        let eta = self.params.eta;
+        let beta = self.params.highlight_width;
+        let mut pdf = probs.diffuse * wi.z * INV_PI;
+        if probs.fiber > 0.0 || probs.ray > 0.0 {
+            let (wo_in, wi_in) = (refract_in(wo, eta), refract_in(wi, eta));
+            // dω_int/dω_ext = cos θi / (η² cos θi') (notes/bsdf.md §1.1).
+            let jac = wi.z * self.inv_eta2 / wi_in.z.max(1e-7);
+            let mut p_int = 0.0;
+            if probs.fiber > 0.0 {
+                p_int += probs.fiber * self.fiber.pdf(wo_in, wi_in, beta, self.z_crit);
+            }
+            if probs.ray > 0.0 {
+                p_int += probs.ray * self.ray.pdf(wo_in, wi_in, beta, self.z_crit);
+            }
+            pdf += p_int * jac;
+        }
+        if let Some(ggx) = &self.ggx {
+            if probs.specular > 0.0 {
+                let h = (wo + wi).normalize_or_zero();
+                pdf += probs.specular * ggx.reflection_pdf(wo, h);
+            }
+        }
+        if pdf.is_finite() {
+            pdf
+        } else {
+            0.0
+        }
+    }
+}
+
+impl Bsdf for WoodBsdf {
+    /// f(ωo, ωi) = T(θo) T(θi) f_s(ωo', ωi') / η² (+ the rough reflection), ω' refracted into
+    /// the finish (notes/bsdf.md eq. 1.4).
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        if !(wo.z > 0.0 && wi.z > 0.0) {
+            return Vec3::ZERO;
+        }
+        let eta = self.params.eta;
+        let (wo_in, wi_in) = (refract_in(wo, eta), refract_in(wi, eta));
+        let t = self.transmittance(wo.z) * self.transmittance(wi.z) * self.inv_eta2;
+        let mut f = self.substrate(wo_in, wi_in) * t;
+        if let Some(ggx) = &self.ggx {
+            f += Vec3::splat(self.rough_reflection(ggx, wo, wi));
+        }
+        if f.is_finite() {
+            f.max(Vec3::ZERO)
+        } else {
+            Vec3::ZERO
+        }
+    }
+
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if !(wo.z > 0.0 && wi.z > 0.0) {
+            return 0.0;
+        }
+        self.pdf_with(&self.lobe_probs(wo), wo, wi)
+    }
+
+    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
+        if !(wo.z > 0.0) {
+            return None;
+        }
+        let probs = self.lobe_probs(wo);
+        let lobe = Self::pick(&probs, uc);
+        let eta = self.params.eta;
+        let beta = self.params.highlight_width;
+        let wi = match lobe {
+            Lobe::Specular => match &self.ggx {
+                None => {
+                    if probs.specular <= 0.0 {
+                        return None;
+                    }
+                    let f = fresnel_dielectric(wo.z, eta);
+                    return Some(BsdfSample {
+                        wi: Vec3::new(-wo.x, -wo.y, wo.z),
+                        f: Vec3::splat(f / wo.z),
+                        pdf: probs.specular,
+                        is_delta: true,
+                    });
+                }
+                Some(ggx) => {
+                    let h = ggx.sample_visible_normal(wo, u);
+                    2.0 * wo.dot(h) * h - wo
+                }
+            },
+            Lobe::Diffuse => cosine_hemisphere(u),
+            Lobe::Fiber | Lobe::Ray => {
+                let axis = if lobe == Lobe::Fiber { &self.fiber } else { &self.ray };
+                let wi_in = axis.sample(refract_in(wo, eta), u, beta, self.z_crit)?;
+                refract_out(wi_in, eta)?
+            }
+        };
+        if !(wi.z > 0.0) {
+            return None;
+        }
+        let pdf = self.pdf_with(&probs, wo, wi);
+        if !(pdf > 0.0) {
+            return None;
+        }
+        Some(BsdfSample {
+            wi,
+            f: self.eval(wo, wi),
+            pdf,
+            is_delta: false,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::{Pcg32, PI};
+
+    fn dir(theta_deg: f32, phi_deg: f32) -> Vec3 {
+        let (t, p) = (theta_deg.to_radians(), phi_deg.to_radians());
+        Vec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
+    }
+
+    fn configs() -> Vec<WoodBsdfParams> {
+        let base = WoodBsdfParams::default();
+        vec![
+            base,
+            WoodBsdfParams {
+                eta: 1.0,
+                ..base
+            },
+            WoodBsdfParams {
+                fiber_dir: Vec3::new(1.0, 0.0, -0.5).normalize(),
+                ray_dir: Vec3::new(0.0, 0.6, 0.8),
+                ray_mask: 0.5,
+                highlight_width: 0.3,
+                eta: 1.8,
+                ..base
+            },
+            WoodBsdfParams {
+                roughness: 0.3,
+                ..base
+            },
+        ]
+    }
+
+    /// ∫ f cos dω over the upper hemisphere by the midpoint rule in (cos θ, φ).
+    fn quadrature_albedo(b: &WoodBsdf, wo: Vec3, n: usize) -> Vec3 {
+        let mut s = Vec3::ZERO;
+        for i in 0..n {
+            let mu = (i as f32 + 0.5) / n as f32;
+            let st = (1.0 - mu * mu).sqrt();
+            for j in 0..2 * n {
+                let phi = (j as f32 + 0.5) / (2 * n) as f32 * 2.0 * PI;
+                let wi = Vec3::new(st * phi.cos(), st * phi.sin(), mu);
+                s += b.eval(wo, wi) * mu;
+            }
+        }
+        s * (2.0 * PI / (2 * n * n) as f32)
+    }
+
+    #[test]
+    fn rejects_bad_parameters_naming_the_field() {
+        let base = WoodBsdfParams::default();
+        let cases: [(WoodBsdfParams, &str); 6] = [
+            (WoodBsdfParams { eta: 0.5, ..base }, "eta"),
+            (WoodBsdfParams { roughness: f32::NAN, ..base }, "roughness"),
+            (WoodBsdfParams { highlight_width: 0.0, ..base }, "highlight_width"),
+            (WoodBsdfParams { fiber_dir: Vec3::ZERO, ..base }, "fiber_dir"),
+            (WoodBsdfParams { diffuse: Vec3::splat(1.5), ..base }, "diffuse"),
+            (WoodBsdfParams { ray_mask: -0.1, ..base }, "ray_mask"),
+        ];
+        for (p, field) in cases {
+            let e = WoodBsdf::new(p).unwrap_err().to_string();
+            assert!(e.contains(field), "{e}");
+        }
+        assert!(WoodBsdf::new(base).is_ok());
+    }
+
+    #[test]
+    fn eval_is_reciprocal() {
+        let mut r = Pcg32::new(5, 0);
+        for p in configs() {
+            for norm in [FiberNormalization::EnergyBounded, FiberNormalization::Published] {
+                let b = WoodBsdf::new(p).unwrap().with_normalization(norm);
+                for _ in 0..2000 {
+                    let a = cosine_hemisphere(r.next_vec2());
+                    let c = cosine_hemisphere(r.next_vec2());
+                    let (f1, f2) = (b.eval(a, c), b.eval(c, a));
+                    let d = (f1 - f2).abs().max_element();
+                    assert!(d <= 1e-4 * f1.max(f2).max_element().max(1e-6), "{p:?} {f1} {f2}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn white_substrate_under_smooth_finish_reflects_everything() {
+        // Independent check: delta reflection F(θo) plus a quadrature of eval·cos.
+        for eta in [1.0f32, 1.33, 1.5, 2.0, 2.5] {
+            let b = WoodBsdf::new(WoodBsdfParams {
+                diffuse: Vec3::ONE,
+                fiber_color: Vec3::ZERO,
+                eta,
+                ..WoodBsdfParams::default()
+            })
+            .unwrap();
+            for theta in [0.0f32, 30.0, 60.0, 80.0, 85.0] {
+                let wo = dir(theta, 20.0);
+                let a = quadrature_albedo(&b, wo, 200).x + fresnel_dielectric(wo.z, eta);
+                assert!((0.99..=1.001).contains(&a), "eta {eta} θ {theta}: {a}");
+            }
+        }
+    }
+
+    #[test]
+    fn samples_match_eval_and_pdf_and_weights_stay_bounded() {
+        let mut r = Pcg32::new(8, 3);
+        for p in configs() {
+            let b = WoodBsdf::new(p).unwrap();
+            for theta in [5.0f32, 45.0, 80.0] {
+                let wo = dir(theta, 60.0);
+                for _ in 0..3000 {
+                    let Some(s) = b.sample(wo, r.next_f32(), r.next_vec2()) else {
+                        continue;
+                    };
+                    assert!(s.f.is_finite() && s.pdf.is_finite() && s.pdf > 0.0);
+                    if s.is_delta {
+                        let w = s.f * s.wi.z / s.pdf;
+                        assert!(w.max_element() <= 1.0 + 1e-4, "{w}");
+                        continue;
+                    }
+                    let (f, pdf) = (b.eval(wo, s.wi), b.pdf(wo, s.wi));
+                    assert!((f - s.f).abs().max_element() <= 1e-5 * f.max_element().max(1e-6));
+                    assert!((pdf - s.pdf).abs() <= 1e-5 * pdf);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn sampled_fraction_equals_integral_of_pdf() {
+        // P(sample returns a non-delta direction) = ∫ pdf dω: pdf is the density of `sample`.
+        for p in configs() {
+            let b = WoodBsdf::new(p).unwrap();
+            let wo = dir(40.0, 10.0);
+            let n_q = 400;
+            let mut integral = 0.0f64;
+            for i in 0..n_q {
+                let mu = (i as f32 + 0.5) / n_q as f32;
+                let st = (1.0 - mu * mu).sqrt();
+                for j in 0..2 * n_q {
+                    let phi = (j as f32 + 0.5) / (2 * n_q) as f32 * 2.0 * PI;
+                    let wi = Vec3::new(st * phi.cos(), st * phi.sin(), mu);
+                    integral += b.pdf(wo, wi) as f64;
+                }
+            }
+            integral *= 2.0 * PI as f64 / (2 * n_q * n_q) as f64;
+            let mut r = Pcg32::new(21, 0);
+            let n = 200_000;
+            let hits = (0..n)
+                .filter(|_| {
+                    matches!(b.sample(wo, r.next_f32(), r.next_vec2()), Some(s) if !s.is_delta)
+                })
+                .count() as f64
+                / n as f64;
+            // Binomial standard error ≤ 0.5/√n ≈ 1.1e-3; allow 5σ plus 0.5 % quadrature error.
+            assert!((hits - integral).abs() < 5.5e-3 + 0.005 * integral, "{p:?}: {hits} vs {integral}");
+        }
+    }
+
+    #[test]
+    fn energy_bounded_lobe_never_exceeds_one() {
+        // Worst case for the bound: white diffuse, k_f = 1, grazing and along-fibre views.
+        let mut r = Pcg32::new(77, 0);
+        for fiber_dir in [Vec3::X, Vec3::new(1.0, 0.0, -1.0).normalize(), Vec3::Z] {
+            let b = WoodBsdf::new(WoodBsdfParams {
+                diffuse: Vec3::ONE,
+                fiber_color: Vec3::ONE,
+                fiber_dir,
+                highlight_width: 0.5,
+                eta: 1.0,
+                ..WoodBsdfParams::default()
+            })
+            .unwrap();
+            for wo in [dir(0.0, 0.0), dir(60.0, 0.0), dir(88.0, 0.0), dir(88.0, 180.0)] {
+                let n = 100_000;
+                let mut s = 0.0f64;
+                for _ in 0..n {
+                    if let Some(x) = b.sample(wo, r.next_f32(), r.next_vec2()) {
+                        s += (x.f.x * x.wi.z / x.pdf) as f64;
+                    }
+                }
+                let a = s / n as f64;
+                assert!(a <= 1.0 + 0.01, "{fiber_dir} {wo}: {a}");
+            }
+        }
+    }
+}
