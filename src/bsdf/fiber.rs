@@ -203,7 +203,10 @@ mod tests {
         for _ in 0..1000 {
             let a = uniform_sphere(r.next_vec2());
             let b = uniform_sphere(r.next_vec2());
-            for n in [FiberNormalization::EnergyBounded, FiberNormalization::Published] {
+            for n in [
+                FiberNormalization::EnergyBounded,
+                FiberNormalization::Published,
+            ] {
                 let (f1, f2) = (ax.eval(a, b, 0.2, n), ax.eval(b, a, 0.2, n));
                 assert!((f1 - f2).abs() <= 1e-5 * f1.max(f2), "{f1} {f2}");
             }

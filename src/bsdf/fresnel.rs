@@ -150,6 +150,9 @@ mod tests {
         assert!((refract_out(i, 1.5).unwrap() - w).length() < 1e-5);
         assert!(refract_out(Vec3::new(0.8, 0.0, 0.6), 1.5).is_none());
         let t = refract(w, Vec3::Z, 1.5).unwrap();
-        assert!((t + i).length() < 1e-5, "refract goes through to −refract_in");
+        assert!(
+            (t + i).length() < 1e-5,
+            "refract goes through to −refract_in"
+        );
     }
 }

@@ -9,7 +9,9 @@ mod specular;
 mod wood;
 
 pub use fiber::{erf_inv, gaussian, FiberAxis, FiberNormalization};
-pub use fresnel::{fresnel_dielectric, fresnel_diffuse_reflectance, refract, refract_in, refract_out};
+pub use fresnel::{
+    fresnel_dielectric, fresnel_diffuse_reflectance, refract, refract_in, refract_out,
+};
 pub use ggx::Ggx;
 pub use lambertian::Lambertian;
 pub use specular::{Glass, Mirror};

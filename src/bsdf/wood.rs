@@ -5,7 +5,7 @@
 //! densities are derived in notes/bsdf.md.
 
 use super::fiber::{FiberAxis, FiberNormalization};
-use super::fresnel::{fresnel_diffuse_reflectance, fresnel_dielectric, refract_in, refract_out};
+use super::fresnel::{fresnel_dielectric, fresnel_diffuse_reflectance, refract_in, refract_out};
 use super::ggx::Ggx;
 use super::{Bsdf, BsdfError, BsdfSample, WoodBsdfParams};
 use crate::math::{cosine_hemisphere, luminance, safe_sqrt, INV_PI, PI};
@@ -71,7 +71,13 @@ fn check_unit_vector(field: &'static str, v: Vec3) -> Result<Vec3, BsdfError> {
     }
 }
 
-fn check_range(field: &'static str, v: f32, lo: f32, hi: f32, range: &'static str) -> Result<(), BsdfError> {
+fn check_range(
+    field: &'static str,
+    v: f32,
+    lo: f32,
+    hi: f32,
+    range: &'static str,
+) -> Result<(), BsdfError> {
     if v.is_finite() && v >= lo && v <= hi {
         Ok(())
     } else {
@@ -344,7 +350,11 @@ impl Bsdf for WoodBsdf {
             },
             Lobe::Diffuse => cosine_hemisphere(u),
             Lobe::Fiber | Lobe::Ray => {
-                let axis = if lobe == Lobe::Fiber { &self.fiber } else { &self.ray };
+                let axis = if lobe == Lobe::Fiber {
+                    &self.fiber
+                } else {
+                    &self.ray
+                };
                 let wi_in = axis.sample(refract_in(wo, eta), u, beta, self.z_crit)?;
                 refract_out(wi_in, eta)?
             }
@@ -379,10 +389,7 @@ mod tests {
         let base = WoodBsdfParams::default();
         vec![
             base,
-            WoodBsdfParams {
-                eta: 1.0,
-                ..base
-            },
+            WoodBsdfParams { eta: 1.0, ..base },
             WoodBsdfParams {
                 fiber_dir: Vec3::new(1.0, 0.0, -0.5).normalize(),
                 ray_dir: Vec3::new(0.0, 0.6, 0.8),
@@ -418,11 +425,41 @@ mod tests {
         let base = WoodBsdfParams::default();
         let cases: [(WoodBsdfParams, &str); 6] = [
             (WoodBsdfParams { eta: 0.5, ..base }, "eta"),
-            (WoodBsdfParams { roughness: f32::NAN, ..base }, "roughness"),
-            (WoodBsdfParams { highlight_width: 0.0, ..base }, "highlight_width"),
-            (WoodBsdfParams { fiber_dir: Vec3::ZERO, ..base }, "fiber_dir"),
-            (WoodBsdfParams { diffuse: Vec3::splat(1.5), ..base }, "diffuse"),
-            (WoodBsdfParams { ray_mask: -0.1, ..base }, "ray_mask"),
+            (
+                WoodBsdfParams {
+                    roughness: f32::NAN,
+                    ..base
+                },
+                "roughness",
+            ),
+            (
+                WoodBsdfParams {
+                    highlight_width: 0.0,
+                    ..base
+                },
+                "highlight_width",
+            ),
+            (
+                WoodBsdfParams {
+                    fiber_dir: Vec3::ZERO,
+                    ..base
+                },
+                "fiber_dir",
+            ),
+            (
+                WoodBsdfParams {
+                    diffuse: Vec3::splat(1.5),
+                    ..base
+                },
+                "diffuse",
+            ),
+            (
+                WoodBsdfParams {
+                    ray_mask: -0.1,
+                    ..base
+                },
+                "ray_mask",
+            ),
         ];
         for (p, field) in cases {
             let e = WoodBsdf::new(p).unwrap_err().to_string();
@@ -435,14 +472,20 @@ mod tests {
     fn eval_is_reciprocal() {
         let mut r = Pcg32::new(5, 0);
         for p in configs() {
-            for norm in [FiberNormalization::EnergyBounded, FiberNormalization::Published] {
+            for norm in [
+                FiberNormalization::EnergyBounded,
+                FiberNormalization::Published,
+            ] {
                 let b = WoodBsdf::new(p).unwrap().with_normalization(norm);
                 for _ in 0..2000 {
                     let a = cosine_hemisphere(r.next_vec2());
                     let c = cosine_hemisphere(r.next_vec2());
                     let (f1, f2) = (b.eval(a, c), b.eval(c, a));
                     let d = (f1 - f2).abs().max_element();
-                    assert!(d <= 1e-4 * f1.max(f2).max_element().max(1e-6), "{p:?} {f1} {f2}");
+                    assert!(
+                        d <= 1e-4 * f1.max(f2).max_element().max(1e-6),
+                        "{p:?} {f1} {f2}"
+                    );
                 }
             }
         }
@@ -513,13 +556,16 @@ mod tests {
             let mut r = Pcg32::new(21, 0);
             let n = 200_000;
             let hits = (0..n)
-                .filter(|_| {
-                    matches!(b.sample(wo, r.next_f32(), r.next_vec2()), Some(s) if !s.is_delta)
-                })
+                .filter(
+                    |_| matches!(b.sample(wo, r.next_f32(), r.next_vec2()), Some(s) if !s.is_delta),
+                )
                 .count() as f64
                 / n as f64;
             // Binomial standard error ≤ 0.5/√n ≈ 1.1e-3; allow 5σ plus 0.5 % quadrature error.
-            assert!((hits - integral).abs() < 5.5e-3 + 0.005 * integral, "{p:?}: {hits} vs {integral}");
+            assert!(
+                (hits - integral).abs() < 5.5e-3 + 0.005 * integral,
+                "{p:?}: {hits} vs {integral}"
+            );
         }
     }
 
@@ -537,7 +583,12 @@ mod tests {
                 ..WoodBsdfParams::default()
             })
             .unwrap();
-            for wo in [dir(0.0, 0.0), dir(60.0, 0.0), dir(88.0, 0.0), dir(88.0, 180.0)] {
+            for wo in [
+                dir(0.0, 0.0),
+                dir(60.0, 0.0),
+                dir(88.0, 0.0),
+                dir(88.0, 180.0),
+            ] {
                 let n = 100_000;
                 let mut s = 0.0f64;
                 for _ in 0..n {
