@@ -28,11 +28,11 @@ fn regions() -> Vec<Region> {
     let r = |name: &str, x0, x1| Region {
         name: name.into(),
         x0,
-        y0: 0.0,
+        y0: 0,
         x1,
-        y1: 1.0,
+        y1: 8,
     };
-    vec![r("left", 0.0, 0.5), r("right", 0.5, 1.0)]
+    vec![r("left", 0, 8), r("right", 8, 16)]
 }
 
 fn render_slice(dir: &std::path::Path, arc: &LightArc, range: std::ops::Range<usize>) {

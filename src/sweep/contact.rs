@@ -115,7 +115,7 @@ pub fn contact_sheet(thumbs: &[Rgb8], labels: &[String], gap: u32) -> Rgb8 {
     sheet
 }
 
-/// A 3×5 pixel font for light-angle labels: digits, sign, point and degree sign (rows top to
+/// A 3×5 pixel font for light-angle labels: digits, sign, point, degree sign, `e`, `x` and `%` (rows top to
 /// bottom, bit 2 = left column). Characters without a glyph are drawn as blanks.
 fn glyph(c: char) -> [u8; 5] {
     match c {
@@ -133,6 +133,9 @@ fn glyph(c: char) -> [u8; 5] {
         '+' => [0, 2, 7, 2, 0],
         '.' => [0, 0, 0, 0, 2],
         '°' => [2, 5, 2, 0, 0],
+        'e' => [0, 7, 7, 4, 7],
+        'x' => [0, 5, 2, 5, 0],
+        '%' => [5, 1, 2, 4, 5],
         _ => [0; 5],
     }
 }

@@ -4,11 +4,13 @@
 //! - [`path`]: the arc of light directions, frame angles and `--frames-range` slices;
 //! - [`sequence`]: per-frame records and the assembly of a folder of frames into the contact
 //!   sheet ([`contact`]), animated PNG, CSV and the HTML [`viewer`];
+//! - [`plot`]: small line plots for the validation report and the trade-off curve;
 //! - [`highlight`]: where the fibre highlight of a flat finished board peaks along the arc.
 
 pub mod contact;
 pub mod highlight;
 pub mod path;
+pub mod plot;
 pub mod sequence;
 pub mod viewer;
 

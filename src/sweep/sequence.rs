@@ -56,28 +56,29 @@ pub enum SequenceError {
     Mismatch { path: String, what: String },
 }
 
-/// A named rectangle of the image whose mean radiance the CSV follows, in fractions of the
-/// image size (`0..1`, origin at the top-left corner), so it does not depend on the resolution.
+/// A named rectangle of the image whose mean radiance the CSV follows: pixel columns `x0..x1`
+/// and rows `y0..y1` (half-open, top-left origin), as the scene's `[[sweep.regions]]` give them.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Region {
     pub name: String,
-    pub x0: f32,
-    pub y0: f32,
-    pub x1: f32,
-    pub y1: f32,
+    pub x0: u32,
+    pub y0: u32,
+    pub x1: u32,
+    pub y1: u32,
 }
 
 impl Region {
-    /// The pixel columns and rows the region covers in a `width × height` image (at least one each).
+    /// The pixel columns and rows the region covers in a `width × height` image, clipped to it
+    /// (at least one pixel each, so a region never averages nothing).
     pub fn pixels(&self, width: u32, height: u32) -> (Range<u32>, Range<u32>) {
-        let span = |a: f32, b: f32, n: u32| {
-            let lo = ((a.min(b).clamp(0.0, 1.0) * n as f32).floor() as u32).min(n - 1);
-            let hi = ((a.max(b).clamp(0.0, 1.0) * n as f32).ceil() as u32).clamp(lo + 1, n);
-            lo..hi
+        let span = |a: u32, b: u32, n: u32| {
+            let n = n.max(1);
+            let lo = a.min(b).min(n - 1);
+            lo..a.max(b).clamp(lo + 1, n)
         };
         (
-            span(self.x0, self.x1, width.max(1)),
-            span(self.y0, self.y1, height.max(1)),
+            span(self.x0, self.x1, width),
+            span(self.y0, self.y1, height),
         )
     }
 
@@ -474,10 +475,10 @@ mod tests {
     fn regions_cover_their_pixels_and_average_them() {
         let r = Region {
             name: "left".into(),
-            x0: 0.0,
-            y0: 0.0,
-            x1: 0.5,
-            y1: 1.0,
+            x0: 0,
+            y0: 0,
+            x1: 2,
+            y1: 2,
         };
         assert_eq!(r.pixels(4, 2), (0..2, 0..2));
         let px: Vec<Vec3> = (0..8)
@@ -487,10 +488,10 @@ mod tests {
         // A degenerate region still covers one pixel, never none.
         let thin = Region {
             name: "t".into(),
-            x0: 0.9,
-            y0: 0.9,
-            x1: 0.9,
-            y1: 0.9,
+            x0: 9,
+            y0: 9,
+            x1: 9,
+            y1: 9,
         };
         let (xs, ys) = thin.pixels(4, 2);
         assert_eq!((xs.len(), ys.len()), (1, 1));

@@ -1,0 +1,228 @@
+//! Small line plots as images (validation figures, the error-against-time curve): axes, one
+//! polyline per series with optional point markers, the axis ranges printed at the corners.
+//! The captions live in the Markdown that embeds the plot.
+
+use super::contact::{draw_label, Rgb8};
+
+/// One curve of a plot.
+#[derive(Clone, Debug)]
+pub struct Series {
+    pub points: Vec<(f64, f64)>,
+    pub color: [u8; 3],
+    /// Draw a small square on every point (for measurements, not sampled curves).
+    pub markers: bool,
+}
+
+/// Plot size and axis scaling.
+#[derive(Clone, Copy, Debug)]
+pub struct PlotOptions {
+    pub width: u32,
+    pub height: u32,
+    pub log_x: bool,
+    pub log_y: bool,
+}
+
+impl Default for PlotOptions {
+    fn default() -> Self {
+        PlotOptions {
+            width: 480,
+            height: 240,
+            log_x: false,
+            log_y: false,
+        }
+    }
+}
+
+/// Distinct colours for up to six series (cycled beyond).
+pub const PALETTE: [[u8; 3]; 6] = [
+    [31, 119, 180],
+    [214, 39, 40],
+    [44, 160, 44],
+    [255, 127, 14],
+    [148, 103, 189],
+    [23, 190, 207],
+];
+
+/// A compact number label (the 3×5 font has digits, sign, point and `e`).
+fn number_label(v: f64) -> String {
+    let a = v.abs();
+    if a != 0.0 && !(1e-2..1e4).contains(&a) {
+        format!("{v:.0e}")
+    } else if a >= 100.0 || v.fract() == 0.0 {
+        format!("{v:.0}")
+    } else {
+        format!("{v:.2}")
+    }
+}
+
+/// Draws the series; non-finite points (and non-positive ones on a log axis) are skipped.
+pub fn line_plot(series: &[Series], opts: &PlotOptions) -> Rgb8 {
+    let (w, h) = (opts.width.max(64), opts.height.max(48));
+    let mut img = Rgb8::filled(w, h, [255, 255, 255]);
+    let tx = |v: f64| if opts.log_x { v.log10() } else { v };
+    let ty = |v: f64| if opts.log_y { v.log10() } else { v };
+    let pts: Vec<Vec<(f64, f64)>> = series
+        .iter()
+        .map(|s| {
+            s.points
+                .iter()
+                .filter(|(x, y)| x.is_finite() && y.is_finite())
+                .filter(|(x, _)| !opts.log_x || *x > 0.0)
+                .filter(|(_, y)| !opts.log_y || *y > 0.0)
+                .map(|&(x, y)| (tx(x), ty(y)))
+                .collect()
+        })
+        .collect();
+    let all = pts.iter().flatten();
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for &(x, y) in all {
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    if x0 > x1 {
+        (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
+    }
+    if x1 - x0 < 1e-12 {
+        (x0, x1) = (x0 - 0.5, x1 + 0.5);
+    }
+    if y1 - y0 < 1e-12 {
+        (y0, y1) = (y0 - 0.5, y1 + 0.5);
+    }
+    let pad = 0.05 * (y1 - y0);
+    let (y0, y1) = (y0 - pad, y1 + pad);
+    let (left, right, top, bottom) = (8i64, w as i64 - 8, 14i64, h as i64 - 14);
+    let px = |x: f64| left as f64 + (x - x0) / (x1 - x0) * (right - left) as f64;
+    let py = |y: f64| bottom as f64 - (y - y0) / (y1 - y0) * (bottom - top) as f64;
+    let grey = [150, 150, 150];
+    line(&mut img, left, bottom, right, bottom, grey);
+    line(&mut img, left, top, left, bottom, grey);
+    if y0 < 0.0 && y1 > 0.0 && !opts.log_y {
+        let z = py(0.0).round() as i64;
+        line(&mut img, left, z, right, z, [220, 220, 220]);
+    }
+    for (s, p) in series.iter().zip(&pts) {
+        for pair in p.windows(2) {
+            let (a, b) = (pair[0], pair[1]);
+            line(
+                &mut img,
+                px(a.0).round() as i64,
+                py(a.1).round() as i64,
+                px(b.0).round() as i64,
+                py(b.1).round() as i64,
+                s.color,
+            );
+        }
+        if s.markers {
+            for &(x, y) in p {
+                let (cx, cy) = (px(x).round() as i64, py(y).round() as i64);
+                for dy in -2..=2 {
+                    for dx in -2..=2 {
+                        set(&mut img, cx + dx, cy + dy, s.color);
+                    }
+                }
+            }
+        }
+    }
+    let un = |v: f64, log: bool| if log { 10f64.powf(v) } else { v };
+    let xl = number_label(un(x0, opts.log_x));
+    let xr = number_label(un(x1, opts.log_x));
+    draw_label(&mut img, &xl, left as u32, h - 8, 1);
+    draw_label(
+        &mut img,
+        &xr,
+        (right as u32).saturating_sub(4 * xr.len() as u32 + 1),
+        h - 8,
+        1,
+    );
+    draw_label(
+        &mut img,
+        &number_label(un(y1, opts.log_y)),
+        left as u32 + 2,
+        2,
+        1,
+    );
+    draw_label(
+        &mut img,
+        &number_label(un(y0, opts.log_y)),
+        left as u32 + 2,
+        bottom as u32 - 8,
+        1,
+    );
+    img
+}
+
+fn set(img: &mut Rgb8, x: i64, y: i64, c: [u8; 3]) {
+    if x >= 0 && y >= 0 && (x as u32) < img.width && (y as u32) < img.height {
+        let i = (y as usize * img.width as usize + x as usize) * 3;
+        img.data[i..i + 3].copy_from_slice(&c);
+    }
+}
+
+/// Bresenham's line between two pixel positions (inclusive).
+fn line(img: &mut Rgb8, mut x0: i64, mut y0: i64, x1: i64, y1: i64, c: [u8; 3]) {
+    let (dx, dy) = ((x1 - x0).abs(), -(y1 - y0).abs());
+    let (sx, sy) = (if x0 < x1 { 1 } else { -1 }, if y0 < y1 { 1 } else { -1 });
+    let mut err = dx + dy;
+    loop {
+        set(img, x0, y0, c);
+        if x0 == x1 && y0 == y1 {
+            break;
+        }
+        let e2 = 2 * err;
+        if e2 >= dy {
+            err += dy;
+            x0 += sx;
+        }
+        if e2 <= dx {
+            err += dx;
+            y0 += sy;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_rising_line_runs_from_lower_left_to_upper_right() {
+        let s = Series {
+            points: vec![(0.0, 0.0), (1.0, 1.0)],
+            color: [255, 0, 0],
+            markers: false,
+        };
+        let img = line_plot(&[s], &PlotOptions::default());
+        let red = |x: u32, y: u32| {
+            let i = (y * img.width + x) as usize * 3;
+            img.data[i..i + 3] == [255, 0, 0]
+        };
+        let (w, h) = (img.width, img.height);
+        // Some red pixel near each end, none in the opposite corners.
+        let near = |cx: u32, cy: u32| {
+            (cx.saturating_sub(12)..(cx + 12).min(w))
+                .any(|x| (cy.saturating_sub(12)..(cy + 12).min(h)).any(|y| red(x, y)))
+        };
+        assert!(near(8, h - 14) && near(w - 8, 14));
+        assert!(!near(w - 20, h - 20) && !near(20, 20));
+    }
+
+    #[test]
+    fn log_axes_and_bad_points_do_not_panic() {
+        let s = Series {
+            points: vec![(0.0, 1.0), (1.0, f64::NAN), (10.0, 1e-3), (100.0, -1.0)],
+            color: [0, 0, 255],
+            markers: true,
+        };
+        let opts = PlotOptions {
+            log_x: true,
+            log_y: true,
+            ..Default::default()
+        };
+        let img = line_plot(&[s], &opts);
+        assert_eq!(img.data.len(), (img.width * img.height * 3) as usize);
+        assert_eq!(number_label(1e-3), "1e-3");
+        assert_eq!(number_label(-60.0), "-60");
+    }
+}
