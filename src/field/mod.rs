@@ -1,1 +1,11 @@
-//! Frame fields and point fields of the wood model (Liu et al. 2016 §5): cylindrical coordinates, interlocked grain, distortion with its Jacobian.
+//! Frame fields and point fields of the wood model (Liu et al. 2016 §5–6): cylindrical coordinates
+//! and their frame (r̂, θ̂, ẑ), the interlocked-grain rotation about r̂, and the distortion
+//! `f(p) = p + m(p) a(p)` with its Jacobian for transporting fibre directions and gradients.
+
+mod cylindrical;
+mod distortion;
+mod interlock;
+
+pub use cylindrical::{cylinder_frame, Cylindrical, PITH_EPSILON};
+pub use distortion::{exact_jacobian, Displacement, Distortion, Magnitude};
+pub use interlock::rotate_about_radial;

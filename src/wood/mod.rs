@@ -1,7 +1,71 @@
 //! The procedural solid-wood model of Liu, Dong, Hašan and Marschner 2016 ("Simulating the
 //! structure and texture of solid wood"): `WoodVolume::eval(p, needs) -> WoodTexel`.
 
+mod board;
+mod color;
+mod error;
+mod growth;
+mod knots;
+mod params;
+mod volume;
+
+pub use board::*;
+pub use color::BeerColor;
+pub use error::WoodError;
+pub use growth::{SmoothRectangleWave, SmoothTriangleWave};
+pub use knots::{smooth_min, KnotSample, Knots};
+pub use params::*;
+pub use volume::WoodVolume;
+
 use glam::Vec3;
+
+/// Names of the built-in species presets (`scenes/presets/<name>.toml`).
+pub const PRESET_NAMES: [&str; 11] = [
+    "african_mahogany",
+    "curly_maple",
+    "padauk",
+    "yellowheart",
+    "red_oak",
+    "quartersawn_white_oak",
+    "walnut",
+    "cherry",
+    "birdseye_maple",
+    "quilted_maple",
+    "knotty_pine",
+];
+
+/// The preset files, embedded so lookup works from any directory.
+const PRESET_FILES: [&str; 11] = [
+    include_str!("../../scenes/presets/african_mahogany.toml"),
+    include_str!("../../scenes/presets/curly_maple.toml"),
+    include_str!("../../scenes/presets/padauk.toml"),
+    include_str!("../../scenes/presets/yellowheart.toml"),
+    include_str!("../../scenes/presets/red_oak.toml"),
+    include_str!("../../scenes/presets/quartersawn_white_oak.toml"),
+    include_str!("../../scenes/presets/walnut.toml"),
+    include_str!("../../scenes/presets/cherry.toml"),
+    include_str!("../../scenes/presets/birdseye_maple.toml"),
+    include_str!("../../scenes/presets/quilted_maple.toml"),
+    include_str!("../../scenes/presets/knotty_pine.toml"),
+];
+
+/// The TOML text of a built-in preset.
+pub fn preset_text(name: &str) -> Result<&'static str, WoodError> {
+    PRESET_NAMES
+        .iter()
+        .position(|n| *n == name)
+        .map(|i| PRESET_FILES[i])
+        .ok_or_else(|| WoodError::UnknownPreset {
+            name: name.to_string(),
+            valid: PRESET_NAMES.join(", "),
+        })
+}
+
+/// The parameters of a built-in preset by name; an unknown name lists the valid ones.
+pub fn preset(name: &str) -> Result<WoodParams, WoodError> {
+    let text = preset_text(name)?;
+    WoodParams::from_toml_str(text, &format!("scenes/presets/{name}.toml"))
+}
 
 /// What a caller needs from a wood lookup; the model skips the work for anything not asked for
 /// ("model only what a scene requires").

@@ -1,0 +1,80 @@
+//! Beer's-law colour (Liu et al. 2016 §6.1.8, eq. 25): c = exp(−σ (ℓ₀ + ℓ_g g + ℓ_p p)).
+
+use super::params::ColorParams;
+use glam::Vec3;
+
+/// Absorbances fitted to the earlywood (g = 0) and latewood (g = 1) colours, as the paper fits
+/// them to photograph percentiles: σℓ₀ = −ln c_early, σℓ_g = ln c_early − ln c_late; pore, ray and
+/// knot path lengths are in units of the latewood absorbance σ(ℓ₀ + ℓ_g) = −ln c_late.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BeerColor {
+    base: Vec3,
+    ring: Vec3,
+    late: Vec3,
+    pore_path: f32,
+    ray_path: f32,
+    fiber_saturation: f32,
+}
+
+impl BeerColor {
+    pub fn new(p: &ColorParams) -> Self {
+        let early = -Vec3::from(p.earlywood).ln();
+        let late = -Vec3::from(p.latewood).ln();
+        BeerColor {
+            base: early,
+            ring: late - early,
+            late,
+            pore_path: p.pore_path,
+            ray_path: p.ray_path,
+            fiber_saturation: p.fiber_saturation,
+        }
+    }
+
+    /// Absorbance σℓ for ring value g, pore mask p, ray mask `ray` and extra path `extra`
+    /// (latewood units, e.g. knot wood).
+    #[inline]
+    pub fn absorbance(&self, g: f32, pore: f32, ray: f32, extra: f32) -> Vec3 {
+        self.base
+            + self.ring * g
+            + self.late * (self.pore_path * pore + self.ray_path * ray + extra)
+    }
+
+    /// (diffuse, fibre) colours of an absorbance; the fibre colour uses a scaled absorbance so it is
+    /// less saturated than the diffuse (App. A.3). Clamped to [0, 1] (a negative path may lighten).
+    #[inline]
+    pub fn colors(&self, absorbance: Vec3) -> (Vec3, Vec3) {
+        let a = absorbance.max(Vec3::ZERO);
+        (exp3(-a), exp3(-a * self.fiber_saturation))
+    }
+}
+
+#[inline]
+fn exp3(v: Vec3) -> Vec3 {
+    Vec3::new(v.x.exp(), v.y.exp(), v.z.exp())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reproduces_earlywood_and_latewood_colours() {
+        let p = ColorParams {
+            earlywood: [0.6, 0.4, 0.2],
+            latewood: [0.3, 0.15, 0.05],
+            pore_path: 0.5,
+            ray_path: 0.0,
+            fiber_saturation: 0.5,
+        };
+        let b = BeerColor::new(&p);
+        let (e, _) = b.colors(b.absorbance(0.0, 0.0, 0.0, 0.0));
+        let (l, f) = b.colors(b.absorbance(1.0, 0.0, 0.0, 0.0));
+        assert!((e - Vec3::new(0.6, 0.4, 0.2)).abs().max_element() < 1e-5);
+        assert!((l - Vec3::new(0.3, 0.15, 0.05)).abs().max_element() < 1e-5);
+        // Fibre colour = sqrt of the diffuse for saturation 0.5.
+        assert!((f - Vec3::new(0.3f32.sqrt(), 0.15f32.sqrt(), 0.05f32.sqrt())).abs().max_element() < 1e-5);
+        // Pores darken by (c_late)^(ℓ_p).
+        let (pc, _) = b.colors(b.absorbance(0.0, 1.0, 0.0, 0.0));
+        assert!((pc.x - 0.6 * 0.3f32.powf(0.5)).abs() < 1e-5);
+    }
+}

@@ -1,0 +1,165 @@
+//! Seasonal growth (Liu et al. 2016 §6.1.3–6.1.4): the C¹ smoothed triangle wave that makes some
+//! years grow faster than others (eq. 23), and the C² smoothed rectangle wave that turns growth
+//! time into earlywood / latewood (the growth-ring volume g = w(t)).
+
+/// A periodic C¹ "triangle" wave: a rising line of slope `s_up`, a quadratic top, a falling line of
+/// slope −`s_down`, a quadratic bottom (Liu et al. 2016 §6.1.3). Its derivative is continuous and
+/// piecewise linear; the two slopes are tied so the wave has no drift over a period.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SmoothTriangleWave {
+    /// Segment lengths: rise, top, fall, bottom (same unit as the argument).
+    lengths: [f32; 4],
+    period: f32,
+    s_up: f32,
+    s_down: f32,
+    /// w at the start of the top, fall and bottom segments (w = 0 at the start of the rise).
+    knots: [f32; 3],
+}
+
+impl SmoothTriangleWave {
+    /// The wave with segment lengths `[rise, top, fall, bottom]` and peak-to-peak `amplitude`.
+    /// Zero drift: ∫w' = s_up (L_rise + Q/2) − s_down (L_fall + Q/2) = 0 with Q = top + bottom, so
+    /// s_down = k s_up, k = (L_rise + Q/2)/(L_fall + Q/2); the positive part of w' integrates to the
+    /// amplitude: A = s_up (L_rise + Q / (2 (1 + k))) (derivation in notes/wood.md). Requires
+    /// non-negative lengths with L_rise + Q/2 > 0 and L_fall + Q/2 > 0 (checked by the parameters).
+    pub fn new(lengths: [f32; 4], amplitude: f32) -> Self {
+        let [rise, top, fall, bottom] = lengths;
+        let q = top + bottom;
+        let k = (rise + 0.5 * q) / (fall + 0.5 * q);
+        let s_up = amplitude / (rise + q / (2.0 * (1.0 + k)));
+        let s_down = k * s_up;
+        let w1 = s_up * rise;
+        let w2 = w1 + 0.5 * top * (s_up - s_down);
+        let w3 = w2 - s_down * fall;
+        SmoothTriangleWave {
+            lengths,
+            period: rise + top + fall + bottom,
+            s_up,
+            s_down,
+            knots: [w1, w2, w3],
+        }
+    }
+
+    /// Steepest descent −min w' = s_down: the time volume r + w(r) is monotone iff s_down < 1.
+    pub fn max_descent(&self) -> f32 {
+        self.s_down
+    }
+
+    /// (w(x), w'(x)).
+    #[inline]
+    pub fn eval(&self, x: f32) -> (f32, f32) {
+        let [rise, top, fall, _bottom] = self.lengths;
+        let [w1, w2, w3] = self.knots;
+        let (a, b) = (self.s_up, -self.s_down);
+        let mut u = x.rem_euclid(self.period);
+        if u < rise {
+            return (a * u, a);
+        }
+        u -= rise;
+        if u < top {
+            // w' goes linearly from a to b over the top.
+            let slope = (b - a) / top;
+            return (w1 + a * u + 0.5 * slope * u * u, a + slope * u);
+        }
+        u -= top;
+        if u < fall {
+            return (w2 + b * u, b);
+        }
+        u -= fall;
+        let bottom = self.lengths[3];
+        let slope = (a - b) / bottom;
+        (w3 + b * u + 0.5 * slope * u * u, b + slope * u)
+    }
+}
+
+/// A periodic C² "rectangle" wave of period 1: `min` for the `low` fraction of a period, a quintic
+/// rise, `max` for the `high` fraction, a quintic fall (Liu et al. 2016 §6.1.4; they write cubic
+/// segments, but C² continuity needs the quintic smootherstep 6x⁵ − 15x⁴ + 10x³, whose first and
+/// second derivatives vanish at both ends).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SmoothRectangleWave {
+    /// End of low, rise, high (the fall ends at 1), as fractions of the period.
+    ends: [f32; 3],
+    rise: f32,
+    fall: f32,
+    pub min: f32,
+    pub max: f32,
+}
+
+/// Quintic smootherstep on [0, 1] (C²).
+#[inline]
+fn smootherstep(x: f32) -> f32 {
+    x * x * x * (x * (x * 6.0 - 15.0) + 10.0)
+}
+
+impl SmoothRectangleWave {
+    /// Fractions `[low, rise, high, fall]` of a period (normalised to sum 1; the sum must be > 0).
+    pub fn new(fractions: [f32; 4], min: f32, max: f32) -> Self {
+        let sum: f32 = fractions.iter().sum();
+        let [low, rise, high, fall] = fractions.map(|f| f / sum);
+        SmoothRectangleWave {
+            ends: [low, low + rise, low + rise + high],
+            rise,
+            fall,
+            min,
+            max,
+        }
+    }
+
+    /// The wave at time `t` (period 1).
+    #[inline]
+    pub fn eval(&self, t: f32) -> f32 {
+        let u = t - t.floor();
+        let [e0, e1, e2] = self.ends;
+        let s = if u < e0 {
+            0.0
+        } else if u < e1 {
+            smootherstep((u - e0) / self.rise)
+        } else if u < e2 {
+            1.0
+        } else {
+            1.0 - smootherstep(((u - e2) / self.fall).min(1.0))
+        };
+        self.min + (self.max - self.min) * s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn triangle_wave_is_periodic_c1_with_the_requested_amplitude() {
+        let w = SmoothTriangleWave::new([3.0, 1.0, 1.5, 0.5], 0.8);
+        let period = 6.0;
+        let (mut lo, mut hi) = (f32::MAX, f32::MIN);
+        let n = 60_000;
+        let mut prev = w.eval(0.0);
+        for i in 1..=n {
+            let x = i as f32 * period / n as f32;
+            let (v, d) = w.eval(x);
+            lo = lo.min(v);
+            hi = hi.max(v);
+            // C¹: value and slope change by O(h) between neighbouring samples.
+            assert!((v - prev.0).abs() < 1e-3 && (d - prev.1).abs() < 1e-2, "jump at {x}");
+            prev = (v, d);
+        }
+        assert!((hi - lo - 0.8).abs() < 1e-3, "peak-to-peak {}", hi - lo);
+        assert!((w.eval(period).0 - w.eval(0.0).0).abs() < 1e-5, "no drift");
+        assert!(w.eval(0.1).1 > 0.0 && w.eval(4.5).1 < 0.0);
+    }
+
+    #[test]
+    fn rectangle_wave_is_c2_and_reaches_its_levels() {
+        let g = SmoothRectangleWave::new([0.5, 0.2, 0.2, 0.1], 0.2, 0.9);
+        assert!((g.eval(0.25) - 0.2).abs() < 1e-6 && (g.eval(0.8) - 0.9).abs() < 1e-6);
+        // Second differences stay O(h²) everywhere (no kink), also across the year boundary.
+        let h = 1e-3_f32;
+        for i in 0..2000 {
+            let t = i as f32 / 1000.0 + 0.0005;
+            let d2 = g.eval(t + h) - 2.0 * g.eval(t) + g.eval(t - h);
+            // |g''| ≤ (max − min) · 5.77 / fall² for the quintic; times h².
+            assert!(d2.abs() < 0.7 * 5.8 / 0.01 * h * h + 1e-5, "kink at {t}: {d2}");
+        }
+    }
+}

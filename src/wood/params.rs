@@ -1,0 +1,373 @@
+//! Parameters of the wood model as data (`scenes/presets/*.toml`): serde structs that reject
+//! unknown fields, plus range validation whose errors name the file, field and allowed range.
+//! Lengths are millimetres, angles degrees, colours linear RGB, times years.
+
+use super::error::WoodError;
+use super::growth::SmoothTriangleWave;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// The whole model. Optional sections switch a feature off when absent (and its work is skipped).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WoodParams {
+    pub rings: RingParams,
+    #[serde(default)]
+    pub growth: Option<GrowthParams>,
+    #[serde(default)]
+    pub interlock: Option<InterlockParams>,
+    #[serde(default)]
+    pub distortion: DistortionParams,
+    #[serde(default)]
+    pub pores: Option<PoreParams>,
+    #[serde(default)]
+    pub rays: Option<RayParams>,
+    pub color: ColorParams,
+    #[serde(default)]
+    pub highlight: HighlightParams,
+    #[serde(default)]
+    pub knots: Option<KnotParams>,
+}
+
+/// Growth rings (§6.1.4): mean yearly ring width and the year's earlywood/latewood proportions of
+/// the C² rectangle wave g(t) (0 = earlywood, 1 = latewood).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RingParams {
+    /// Mean ring width, mm.
+    pub width: f32,
+    /// Fractions of a year `[earlywood, transition, latewood, fall]` (normalised to sum 1).
+    pub proportions: [f32; 4],
+}
+
+/// Slow / fast growth periods (§6.1.3, eq. 23–24): a C¹ triangle wave in radius plus 1D noise.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GrowthParams {
+    /// Triangle-wave segment lengths `[rise, top, fall, bottom]`, years at mean growth.
+    pub wave: [f32; 4],
+    /// Peak-to-peak amplitude of the wave, years.
+    pub amplitude: f32,
+    /// Amplitude of the 1D growth noise n(t_pre), years.
+    #[serde(default)]
+    pub noise_amplitude: f32,
+    /// Feature length of the growth noise, years.
+    #[serde(default = "one")]
+    pub noise_scale: f32,
+}
+
+/// Interlocked grain (§6.1.5): the fibre helix angle is 1D noise of r.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InterlockParams {
+    /// Largest helix angle, degrees.
+    pub angle: f32,
+    /// Feature length of the angle noise along r, mm (about half the reversal period).
+    pub period: f32,
+}
+
+/// Multiband sparse convolution noise (Wyvill kernel) used as a distortion magnitude (§4.4, §6.2).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NoiseParams {
+    /// Magnitude of the base band, mm.
+    pub magnitude: f32,
+    /// Kernel envelope `[r, θ, z]` of the base band, mm (Fig. 10: its shape sets the figure).
+    pub size: [f32; 3],
+    /// Mean number of kernels overlapping a point.
+    #[serde(default = "two")]
+    pub density: f32,
+    /// Number of bands.
+    #[serde(default = "one_u32")]
+    pub bands: u32,
+    /// Kernel size factor β from one band to the next.
+    #[serde(default = "half")]
+    pub size_factor: f32,
+    /// Power-law magnitude drop-off exponent γ.
+    #[serde(default = "one")]
+    pub dropoff: f32,
+}
+
+/// Distortion along r̂ (blister, quilted, birdseye), θ̂ (curly, fiddleback) and ẑ (§6.2).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DistortionParams {
+    #[serde(default)]
+    pub radial: Option<NoiseParams>,
+    #[serde(default)]
+    pub tangential: Option<NoiseParams>,
+    #[serde(default)]
+    pub longitudinal: Option<NoiseParams>,
+}
+
+/// Pores / vessels (§6.1.6): bump-kernel noise aligned with the fibres.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PoreParams {
+    /// Pore radius across the fibre, mm.
+    pub radius: f32,
+    /// Pore length along the fibre, mm.
+    pub length: f32,
+    /// Mean number of pores overlapping a point (at full size).
+    pub density: f32,
+    /// Bump-kernel sharpness s (0 box, 1 bump, large spike).
+    #[serde(default = "one")]
+    pub sharpness: f32,
+    /// 0 diffuse-porous (uniform pores) … 1 ring-porous (pores vanish in latewood).
+    pub ring_porosity: f32,
+    /// Bump depth at full pore mask, as a fraction of the pore radius (§6.1.7).
+    #[serde(default = "half")]
+    pub depth: f32,
+}
+
+/// Rays (§3.2, §6.1.6): bump-kernel noise in cylindrical cells, thin in θ, tall in z, long in r.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RayParams {
+    /// Ray thickness along θ, mm.
+    pub width: f32,
+    /// Ray height along z, mm.
+    pub height: f32,
+    /// Ray extent along r, mm.
+    pub length: f32,
+    /// Mean number of rays overlapping a point.
+    pub density: f32,
+    #[serde(default = "one")]
+    pub sharpness: f32,
+    /// Largest ray mask (blend weight of the ray-fibre BSDF), in [0, 1].
+    #[serde(default = "one")]
+    pub strength: f32,
+}
+
+/// Beer's-law colour (§6.1.8, eq. 25): the earlywood (g = 0) and latewood (g = 1) colours fix σℓ₀
+/// and σℓ_g; pores and rays add path length in units of the latewood absorbance.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ColorParams {
+    /// Linear RGB of earlywood, each channel in (0, 1].
+    pub earlywood: [f32; 3],
+    /// Linear RGB of latewood, each channel in (0, 1].
+    pub latewood: [f32; 3],
+    /// Extra path length ℓ_p inside pores (multiples of the latewood path).
+    #[serde(default)]
+    pub pore_path: f32,
+    /// Extra path length inside rays (negative: rays lighter).
+    #[serde(default)]
+    pub ray_path: f32,
+    /// Fibre colour absorbance as a fraction of the diffuse absorbance (less saturated, App. A.3).
+    #[serde(default = "half")]
+    pub fiber_saturation: f32,
+}
+
+/// Fibre highlight width (App. A.3): a rectangle wave of time between earlywood and latewood.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HighlightParams {
+    /// Earlywood highlight width β, degrees.
+    pub earlywood: f32,
+    /// Latewood highlight width β, degrees.
+    pub latewood: f32,
+}
+
+impl Default for HighlightParams {
+    fn default() -> Self {
+        HighlightParams {
+            earlywood: 8.0,
+            latewood: 8.0,
+        }
+    }
+}
+
+/// Knots after Larsson et al. 2022: branches leave the pith in whorls as cones with their own rings
+/// (the knot ring width follows from the cone angle, see `knots.rs`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KnotParams {
+    /// Distance between whorls along z, mm.
+    pub whorl_spacing: f32,
+    /// Branches per whorl.
+    pub per_whorl: u32,
+    /// Upward angle of a branch from the horizontal, degrees.
+    pub rise: f32,
+    /// Half-angle of the knot cone, degrees.
+    pub cone: f32,
+    /// Year the branches die (the knot stops growing and becomes a dead, bark-rimmed cylinder);
+    /// absent: live knots.
+    #[serde(default)]
+    pub death_year: Option<f32>,
+    /// Extra absorbance of knot wood (multiples of the latewood path).
+    #[serde(default = "half")]
+    pub darkening: f32,
+}
+
+fn one() -> f32 {
+    1.0
+}
+fn two() -> f32 {
+    2.0
+}
+fn half() -> f32 {
+    0.5
+}
+fn one_u32() -> u32 {
+    1
+}
+
+/// Bound on |dn/du| for the unit 1D gradient noise `noise::gradient1` (slopes in [−1, 1], quintic
+/// fade): sup over t of |1 − u − t u'| + |u − (1 − t) u'| = 1.3472 (notes/wood.md); used to keep the
+/// time volume monotone.
+pub const GROWTH_NOISE_SLOPE_BOUND: f32 = 1.35;
+
+struct Checker<'a> {
+    file: &'a str,
+}
+
+impl Checker<'_> {
+    fn range(&self, field: &str, v: f32, lo: f32, hi: f32) -> Result<(), WoodError> {
+        if v.is_finite() && v >= lo && v <= hi {
+            Ok(())
+        } else {
+            Err(self.err(field, v, format!("[{lo}, {hi}]")))
+        }
+    }
+    fn positive(&self, field: &str, v: f32, hi: f32) -> Result<(), WoodError> {
+        if v.is_finite() && v > 0.0 && v <= hi {
+            Ok(())
+        } else {
+            Err(self.err(field, v, format!("(0, {hi}]")))
+        }
+    }
+    fn err(&self, field: &str, v: impl std::fmt::Display, allowed: String) -> WoodError {
+        WoodError::OutOfRange {
+            file: self.file.to_string(),
+            field: field.to_string(),
+            value: v.to_string(),
+            allowed,
+        }
+    }
+    fn noise(&self, name: &str, n: &NoiseParams) -> Result<(), WoodError> {
+        self.range(&format!("{name}.magnitude"), n.magnitude, 0.0, 100.0)?;
+        for (i, s) in n.size.iter().enumerate() {
+            self.range(&format!("{name}.size[{i}]"), *s, 0.01, 10_000.0)?;
+        }
+        self.positive(&format!("{name}.density"), n.density, 64.0)?;
+        if !(1..=8).contains(&n.bands) {
+            return Err(self.err(&format!("{name}.bands"), n.bands, "1..=8".into()));
+        }
+        self.range(&format!("{name}.size_factor"), n.size_factor, 0.1, 0.9)?;
+        self.range(&format!("{name}.dropoff"), n.dropoff, 0.0, 4.0)
+    }
+}
+
+impl WoodParams {
+    /// Parse TOML text; `file` names the source in error messages.
+    pub fn from_toml_str(text: &str, file: &str) -> Result<WoodParams, WoodError> {
+        let params: WoodParams = toml::from_str(text).map_err(|e| WoodError::Parse {
+            file: file.to_string(),
+            message: e.to_string(),
+        })?;
+        params.validate(file)?;
+        Ok(params)
+    }
+
+    /// Read and validate a parameter file.
+    pub fn from_toml_file(path: impl AsRef<Path>) -> Result<WoodParams, WoodError> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|source| WoodError::Io {
+            file: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_toml_str(&text, &path.display().to_string())
+    }
+
+    /// Check every value against its allowed range; the error names `file`, the field and the range.
+    pub fn validate(&self, file: &str) -> Result<(), WoodError> {
+        let c = Checker { file };
+        c.range("rings.width", self.rings.width, 0.05, 50.0)?;
+        for (i, f) in self.rings.proportions.iter().enumerate() {
+            c.range(&format!("rings.proportions[{i}]"), *f, 0.0, 1.0)?;
+        }
+        let [_, rise, _, fall] = self.rings.proportions;
+        c.range("rings.proportions[1] (transition)", rise, 0.01, 1.0)?;
+        c.range("rings.proportions[3] (fall)", fall, 0.01, 1.0)?;
+        if let Some(g) = &self.growth {
+            for (i, l) in g.wave.iter().enumerate() {
+                c.range(&format!("growth.wave[{i}]"), *l, 0.0, 1000.0)?;
+            }
+            let [rise, top, fall, bottom] = g.wave;
+            c.range("growth.wave[1] (top)", top, 0.01, 1000.0)?;
+            c.range("growth.wave[3] (bottom)", bottom, 0.01, 1000.0)?;
+            let _ = (rise, fall);
+            c.range("growth.amplitude", g.amplitude, 0.0, 1000.0)?;
+            // Monotone time (notes/wood.md): the wave's steepest descent must stay below 1.
+            let descent = SmoothTriangleWave::new(g.wave, g.amplitude).max_descent();
+            if descent >= 0.95 {
+                return Err(c.err(
+                    "growth.amplitude",
+                    g.amplitude,
+                    format!(
+                        "small enough that the wave's steepest descent is < 0.95 (it is {descent:.3}; time would run backwards)"
+                    ),
+                ));
+            }
+            c.positive("growth.noise_scale", g.noise_scale, 1000.0)?;
+            let max_noise = 0.95 * g.noise_scale / GROWTH_NOISE_SLOPE_BOUND;
+            c.range("growth.noise_amplitude", g.noise_amplitude, 0.0, max_noise)?;
+        }
+        if let Some(i) = &self.interlock {
+            c.range("interlock.angle", i.angle, 0.0, 45.0)?;
+            c.positive("interlock.period", i.period, 10_000.0)?;
+        }
+        for (name, n) in [
+            ("distortion.radial", &self.distortion.radial),
+            ("distortion.tangential", &self.distortion.tangential),
+            ("distortion.longitudinal", &self.distortion.longitudinal),
+        ] {
+            if let Some(n) = n {
+                c.noise(name, n)?;
+            }
+        }
+        if let Some(p) = &self.pores {
+            c.range("pores.radius", p.radius, 0.005, 5.0)?;
+            c.range("pores.length", p.length, 0.005, 100.0)?;
+            c.positive("pores.density", p.density, 16.0)?;
+            c.range("pores.sharpness", p.sharpness, 0.0, 100.0)?;
+            c.range("pores.ring_porosity", p.ring_porosity, 0.0, 1.0)?;
+            c.range("pores.depth", p.depth, 0.0, 4.0)?;
+        }
+        if let Some(r) = &self.rays {
+            c.range("rays.width", r.width, 0.005, 10.0)?;
+            c.range("rays.height", r.height, 0.005, 100.0)?;
+            c.range("rays.length", r.length, 0.005, 1000.0)?;
+            c.positive("rays.density", r.density, 16.0)?;
+            c.range("rays.sharpness", r.sharpness, 0.0, 100.0)?;
+            c.range("rays.strength", r.strength, 0.0, 1.0)?;
+        }
+        for (name, col) in [
+            ("color.earlywood", self.color.earlywood),
+            ("color.latewood", self.color.latewood),
+        ] {
+            for (i, v) in col.iter().enumerate() {
+                c.range(&format!("{name}[{i}]"), *v, 1e-4, 1.0)?;
+            }
+        }
+        c.range("color.pore_path", self.color.pore_path, -1.0, 10.0)?;
+        c.range("color.ray_path", self.color.ray_path, -1.0, 10.0)?;
+        c.range("color.fiber_saturation", self.color.fiber_saturation, 0.0, 1.0)?;
+        c.range("highlight.earlywood", self.highlight.earlywood, 0.5, 45.0)?;
+        c.range("highlight.latewood", self.highlight.latewood, 0.5, 45.0)?;
+        if let Some(k) = &self.knots {
+            c.range("knots.whorl_spacing", k.whorl_spacing, 10.0, 100_000.0)?;
+            if !(1..=12).contains(&k.per_whorl) {
+                return Err(c.err("knots.per_whorl", k.per_whorl, "1..=12".into()));
+            }
+            c.range("knots.rise", k.rise, 0.0, 80.0)?;
+            c.range("knots.cone", k.cone, 0.5, 30.0)?;
+            if let Some(d) = k.death_year {
+                c.range("knots.death_year", d, 0.0, 1000.0)?;
+            }
+            c.range("knots.darkening", k.darkening, 0.0, 10.0)?;
+        }
+        Ok(())
+    }
+}
