@@ -3,9 +3,7 @@
 //! implementation, and the transport identities of Liu et al. 2016 eq. 17–18.
 
 use glam::{DVec3, Mat3, Vec3};
-use xylem::field::{
-    cylinder_frame, exact_jacobian, rotate_about_radial, Displacement, Distortion,
-};
+use xylem::field::{cylinder_frame, exact_jacobian, rotate_about_radial, Displacement, Distortion};
 use xylem::math::{Frame, Pcg32};
 
 fn assert_orthonormal(f: &Frame, tol: f32, at: Vec3) {
@@ -15,13 +13,20 @@ fn assert_orthonormal(f: &Frame, tol: f32, at: Vec3) {
     for v in [f.s, f.t, f.n] {
         assert!((v.length() - 1.0).abs() < tol, "not unit at {at}");
     }
-    assert!((f.s.cross(f.t) - f.n).length() < tol, "not right-handed at {at}");
+    assert!(
+        (f.s.cross(f.t) - f.n).length() < tol,
+        "not right-handed at {at}"
+    );
 }
 
 #[test]
 fn cylinder_frame_is_orthonormal_everywhere_including_the_pith() {
     let mut rng = Pcg32::new(11, 0);
-    let mut points = vec![Vec3::ZERO, Vec3::new(0.0, 0.0, -5.0), Vec3::new(1e-9, -1e-9, 3.0)];
+    let mut points = vec![
+        Vec3::ZERO,
+        Vec3::new(0.0, 0.0, -5.0),
+        Vec3::new(1e-9, -1e-9, 3.0),
+    ];
     for _ in 0..20_000 {
         let scale = [1e-7, 1e-3, 1.0, 100.0, 1e4][(rng.next_u32() % 5) as usize];
         points.push((Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) - 0.5) * scale);
@@ -122,7 +127,10 @@ fn safe_jacobian_is_invertible_and_transport_keeps_tangency() {
         let tg = d.gradient(g);
         assert!(tv.is_finite() && tg.is_finite());
         if d.jacobian.determinant().abs() > 1e-2 {
-            assert!(tg.dot(tv).abs() < 1e-3 * tg.length() * tv.length().max(1.0), "at {p}");
+            assert!(
+                tg.dot(tv).abs() < 1e-3 * tg.length() * tv.length().max(1.0),
+                "at {p}"
+            );
         }
     }
 }
@@ -133,7 +141,8 @@ fn one_term_safe_jacobian_never_folds() {
     let mut rng = Pcg32::new(3, 3);
     for _ in 0..10_000 {
         let a = xylem::math::uniform_sphere(rng.next_vec2());
-        let g = xylem::math::uniform_sphere(rng.next_vec2()) * 10f32.powf(rng.next_f32() * 8.0 - 2.0);
+        let g =
+            xylem::math::uniform_sphere(rng.next_vec2()) * 10f32.powf(rng.next_f32() * 8.0 - 2.0);
         let mut d = Distortion::identity(Vec3::ZERO);
         d.add(Displacement {
             dir: a,

@@ -24,14 +24,22 @@ fn every_preset_is_finite_over_a_dense_cube() {
                         && t.fiber_dir.is_finite()
                         && t.ray_dir.is_finite()
                         && t.bump_grad.is_finite()
-                        && [t.ray_mask, t.pore_mask, t.bump, t.highlight_width, t.growth_time]
-                            .iter()
-                            .all(|x| x.is_finite());
+                        && [
+                            t.ray_mask,
+                            t.pore_mask,
+                            t.bump,
+                            t.highlight_width,
+                            t.growth_time,
+                        ]
+                        .iter()
+                        .all(|x| x.is_finite());
                     assert!(ok, "{name} at {p}: {t:?}");
                     assert!((t.fiber_dir.length() - 1.0).abs() < 1e-4, "{name} at {p}");
                     assert!((t.ray_dir.length() - 1.0).abs() < 1e-4, "{name} at {p}");
                     assert!(t.diffuse.min_element() >= 0.0 && t.diffuse.max_element() <= 1.0);
-                    assert!((0.0..=1.0).contains(&t.pore_mask) && (0.0..=1.0).contains(&t.ray_mask));
+                    assert!(
+                        (0.0..=1.0).contains(&t.pore_mask) && (0.0..=1.0).contains(&t.ray_mask)
+                    );
                 }
             }
         }

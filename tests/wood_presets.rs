@@ -13,7 +13,12 @@ fn every_preset_parses_and_validates() {
         let path = format!("{}/scenes/presets/{name}.toml", env!("CARGO_MANIFEST_DIR"));
         assert_eq!(WoodParams::from_toml_file(&path).unwrap(), p);
     }
-    assert_eq!(std::fs::read_dir(format!("{}/scenes/presets", env!("CARGO_MANIFEST_DIR"))).unwrap().count(), PRESET_NAMES.len());
+    assert_eq!(
+        std::fs::read_dir(format!("{}/scenes/presets", env!("CARGO_MANIFEST_DIR")))
+            .unwrap()
+            .count(),
+        PRESET_NAMES.len()
+    );
 }
 
 fn base() -> String {
@@ -21,7 +26,9 @@ fn base() -> String {
 }
 
 fn err_of(text: &str) -> String {
-    WoodParams::from_toml_str(text, "bad.toml").unwrap_err().to_string()
+    WoodParams::from_toml_str(text, "bad.toml")
+        .unwrap_err()
+        .to_string()
 }
 
 #[test]
@@ -46,7 +53,10 @@ fn out_of_range_value_is_rejected_with_the_range() {
     // A growth wave so steep that time would run backwards.
     let text = base().replace("amplitude = 1.0", "amplitude = 9.0");
     let msg = err_of(&text);
-    assert!(msg.contains("growth.amplitude") && msg.contains("backwards"), "{msg}");
+    assert!(
+        msg.contains("growth.amplitude") && msg.contains("backwards"),
+        "{msg}"
+    );
     // Growth noise beyond the monotonicity bound.
     let text = base().replace("noise_amplitude = 0.4", "noise_amplitude = 1.5");
     assert!(err_of(&text).contains("growth.noise_amplitude"));

@@ -40,12 +40,20 @@ fn features(p: &wood::WoodParams) -> Vec<&'static str> {
         (d.radial.is_some(), "r-distortion"),
         (d.tangential.is_some(), "θ-distortion"),
         (d.longitudinal.is_some(), "z-distortion"),
-        (p.pores.as_ref().is_some_and(|x| x.ring_porosity >= 0.75), "ring-porous"),
         (
-            p.pores.as_ref().is_some_and(|x| x.ring_porosity > 0.25 && x.ring_porosity < 0.75),
+            p.pores.as_ref().is_some_and(|x| x.ring_porosity >= 0.75),
+            "ring-porous",
+        ),
+        (
+            p.pores
+                .as_ref()
+                .is_some_and(|x| x.ring_porosity > 0.25 && x.ring_porosity < 0.75),
             "semi-ring-porous",
         ),
-        (p.pores.as_ref().is_some_and(|x| x.ring_porosity <= 0.25), "diffuse-porous"),
+        (
+            p.pores.as_ref().is_some_and(|x| x.ring_porosity <= 0.25),
+            "diffuse-porous",
+        ),
         (p.rays.is_some(), "rays"),
         (p.knots.is_some(), "knots"),
     ]

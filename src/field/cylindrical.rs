@@ -20,7 +20,11 @@ impl Cylindrical {
     #[inline]
     pub fn from_point(p: Vec3) -> Self {
         let r = (p.x * p.x + p.y * p.y).sqrt();
-        let theta = if r > PITH_EPSILON { p.y.atan2(p.x) } else { 0.0 };
+        let theta = if r > PITH_EPSILON {
+            p.y.atan2(p.x)
+        } else {
+            0.0
+        };
         Cylindrical { r, theta, z: p.z }
     }
 }

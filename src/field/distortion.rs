@@ -105,14 +105,12 @@ fn outer(a: Vec3, b: Vec3) -> Mat3 {
 /// (m, ∇m) along r̂, θ̂, ẑ. For tests and analysis; the model uses the safe form of
 /// [`Distortion::add`].
 pub fn exact_jacobian(p: Vec3, frame: &Frame, terms: [(f32, Vec3); 3]) -> Mat3 {
-    let r = (p.x * p.x + p.y * p.y).sqrt().max(crate::field::PITH_EPSILON);
+    let r = (p.x * p.x + p.y * p.y)
+        .sqrt()
+        .max(crate::field::PITH_EPSILON);
     let (rh, th, zh) = (frame.s, frame.t, frame.n);
     let [(mr, gr), (mt, gt), (_mz, gz)] = terms;
-    Mat3::IDENTITY
-        + outer(rh, gr)
-        + outer(th, gt)
-        + outer(zh, gz)
-        + outer(th, th) * (mr / r)
+    Mat3::IDENTITY + outer(rh, gr) + outer(th, gt) + outer(zh, gz) + outer(th, th) * (mr / r)
         - outer(rh, th) * (mt / r)
 }
 

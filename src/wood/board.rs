@@ -112,7 +112,14 @@ pub fn board_at(layout: &BoardLayout, uv: Vec2) -> BoardPoint {
 
 /// Where board `index` sits in the tree: the index is hashed into `region` (§7.2). Returns the
 /// tree-space point of board coordinates (along the grain, across it, depth below the face).
-pub fn board_to_tree(index: [i32; 3], along: f32, across: f32, depth: f32, region: &TreeRegion, seed: u64) -> Vec3 {
+pub fn board_to_tree(
+    index: [i32; 3],
+    along: f32,
+    across: f32,
+    depth: f32,
+    region: &TreeRegion,
+    seed: u64,
+) -> Vec3 {
     let stream = (index[0] as u32 as u64)
         .wrapping_mul(0x9e37_79b9_7f4a_7c15)
         .wrapping_add((index[1] as u32 as u64).wrapping_mul(0xc2b2_ae3d_27d4_eb4f))
@@ -184,9 +191,19 @@ mod tests {
             tile: 400.0,
             strip: 50.0,
         };
-        for (x, y) in [(10.0, 200.0), (200.0, 10.0), (390.0, 200.0), (200.0, 390.0), (130.0, 220.0)] {
+        for (x, y) in [
+            (10.0, 200.0),
+            (200.0, 10.0),
+            (390.0, 200.0),
+            (200.0, 390.0),
+            (130.0, 220.0),
+        ] {
             let b = board_at(&l, Vec2::new(x, y));
-            assert!((0.0..=50.0).contains(&b.across), "across {} at ({x}, {y})", b.across);
+            assert!(
+                (0.0..=50.0).contains(&b.across),
+                "across {} at ({x}, {y})",
+                b.across
+            );
             assert!((0.0..=400.0).contains(&b.along));
         }
         // Top and left strips of the outer frame are different boards.

@@ -72,7 +72,12 @@ mod tests {
         assert!((e - Vec3::new(0.6, 0.4, 0.2)).abs().max_element() < 1e-5);
         assert!((l - Vec3::new(0.3, 0.15, 0.05)).abs().max_element() < 1e-5);
         // Fibre colour = sqrt of the diffuse for saturation 0.5.
-        assert!((f - Vec3::new(0.3f32.sqrt(), 0.15f32.sqrt(), 0.05f32.sqrt())).abs().max_element() < 1e-5);
+        assert!(
+            (f - Vec3::new(0.3f32.sqrt(), 0.15f32.sqrt(), 0.05f32.sqrt()))
+                .abs()
+                .max_element()
+                < 1e-5
+        );
         // Pores darken by (c_late)^(ℓ_p).
         let (pc, _) = b.colors(b.absorbance(0.0, 1.0, 0.0, 0.0));
         assert!((pc.x - 0.6 * 0.3f32.powf(0.5)).abs() < 1e-5);

@@ -141,7 +141,10 @@ mod tests {
             lo = lo.min(v);
             hi = hi.max(v);
             // C¹: value and slope change by O(h) between neighbouring samples.
-            assert!((v - prev.0).abs() < 1e-3 && (d - prev.1).abs() < 1e-2, "jump at {x}");
+            assert!(
+                (v - prev.0).abs() < 1e-3 && (d - prev.1).abs() < 1e-2,
+                "jump at {x}"
+            );
             prev = (v, d);
         }
         assert!((hi - lo - 0.8).abs() < 1e-3, "peak-to-peak {}", hi - lo);
@@ -159,7 +162,10 @@ mod tests {
             let t = i as f32 / 1000.0 + 0.0005;
             let d2 = g.eval(t + h) - 2.0 * g.eval(t) + g.eval(t - h);
             // |g''| ≤ (max − min) · 5.77 / fall² for the quintic; times h².
-            assert!(d2.abs() < 0.7 * 5.8 / 0.01 * h * h + 1e-5, "kink at {t}: {d2}");
+            assert!(
+                d2.abs() < 0.7 * 5.8 / 0.01 * h * h + 1e-5,
+                "kink at {t}: {d2}"
+            );
         }
     }
 }

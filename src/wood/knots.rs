@@ -214,7 +214,11 @@ mod tests {
             assert_eq!(k.inside, 1.0, "on the axis at s = {s}");
             // The radius grows linearly: R ≈ s tan β (cos α of the trunk time cancels).
             let expect = s * 6f32.to_radians().tan();
-            assert!((k.radius - expect).abs() < 0.05 * expect, "{} vs {expect}", k.radius);
+            assert!(
+                (k.radius - expect).abs() < 0.05 * expect,
+                "{} vs {expect}",
+                k.radius
+            );
         }
     }
 

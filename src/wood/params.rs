@@ -353,7 +353,12 @@ impl WoodParams {
         }
         c.range("color.pore_path", self.color.pore_path, -1.0, 10.0)?;
         c.range("color.ray_path", self.color.ray_path, -1.0, 10.0)?;
-        c.range("color.fiber_saturation", self.color.fiber_saturation, 0.0, 1.0)?;
+        c.range(
+            "color.fiber_saturation",
+            self.color.fiber_saturation,
+            0.0,
+            1.0,
+        )?;
         c.range("highlight.earlywood", self.highlight.earlywood, 0.5, 45.0)?;
         c.range("highlight.latewood", self.highlight.latewood, 0.5, 45.0)?;
         if let Some(k) = &self.knots {
