@@ -1,10 +1,116 @@
-//! `xylem render`.
+//! `xylem render`: render a scene file to `DIR/<scene>.exr` (beauty + AOV layers) and
+//! `DIR/<scene>.png` (sRGB preview).
 
+use anyhow::{bail, Context};
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(clap::Args, Debug)]
-pub struct Args {}
+pub struct Args {
+    /// Scene file (TOML, see scenes/README.md).
+    scene: PathBuf,
+    /// Samples per pixel (overrides the scene's render.spp).
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Image size WxH (overrides render.width / render.height), e.g. 512x512.
+    #[arg(long, value_parser = parse_res)]
+    res: Option<(u32, u32)>,
+    /// Output folder.
+    #[arg(long, default_value = "out")]
+    out: PathBuf,
+    /// Worker threads (0 = all cores).
+    #[arg(long, default_value_t = 0)]
+    threads: usize,
+    /// Random seed (overrides render.seed).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Do not show the progress bar.
+    #[arg(long)]
+    quiet: bool,
+}
 
-pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`xylem render` is not built yet")
+/// Parses `WxH` with both in 1..=16384.
+fn parse_res(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("`{s}`: expected WxH, e.g. 512x512"))?;
+    let p = |v: &str| -> Result<u32, String> {
+        let n: u32 = v
+            .trim()
+            .parse()
+            .map_err(|_| format!("`{s}`: `{v}` is not a whole number"))?;
+        if (1..=16384).contains(&n) {
+            Ok(n)
+        } else {
+            Err(format!("`{s}`: {n} is out of range (allowed 1 to 16384)"))
+        }
+    };
+    Ok((p(w)?, p(h)?))
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let mut loaded = crate::scene::load(&args.scene)?;
+    for w in &loaded.warnings {
+        eprintln!("warning: {w}");
+    }
+    if let Some(spp) = args.spp {
+        if spp == 0 {
+            bail!("--spp 0: need at least 1 sample per pixel");
+        }
+        loaded.settings.spp = spp;
+    }
+    if let Some(seed) = args.seed {
+        loaded.settings.seed = seed;
+    }
+    if let Some((w, h)) = args.res {
+        loaded.scene.camera = loaded.scene.camera.with_resolution(w, h);
+    }
+    let run = crate::render::RunOptions {
+        threads: args.threads,
+        progress: !args.quiet,
+    };
+    let cam = &loaded.scene.camera;
+    eprintln!(
+        "{}: {}x{}, {} spp, {:?}, {} triangles (BVH built in {:.1} ms)",
+        loaded.name,
+        cam.width,
+        cam.height,
+        loaded.settings.spp,
+        loaded.settings.integrator,
+        loaded.scene.accel.triangle_count(),
+        loaded.scene.accel.build_time.as_secs_f64() * 1e3
+    );
+    let out = crate::render::render(&loaded.scene, &loaded.settings, &run)?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create output folder {}", args.out.display()))?;
+    let exr = args.out.join(format!("{}.exr", loaded.name));
+    let png = args.out.join(format!("{}.png", loaded.name));
+    write_outputs(&out.image, &exr, &png, loaded.exposure)?;
+    let secs = out.elapsed.as_secs_f64();
+    println!(
+        "rendered {} in {:.2} s: {:.2} Mrays/s ({} rays)",
+        loaded.name,
+        secs,
+        out.rays as f64 / secs.max(1e-9) / 1e6,
+        out.rays
+    );
+    if out.image.nonfinite > 0 {
+        eprintln!(
+            "warning: {} non-finite samples were dropped (counted as zero)",
+            out.image.nonfinite
+        );
+    }
+    println!("wrote {} and {}", exr.display(), png.display());
+    Ok(ExitCode::SUCCESS)
+}
+
+fn write_outputs(
+    image: &crate::render::Image,
+    exr: &Path,
+    png: &Path,
+    exposure: f32,
+) -> anyhow::Result<()> {
+    crate::render::image_io::write_image_exr(exr, image)?;
+    crate::render::image_io::write_png_linear(png, image.width, image.height, &image.beauty, exposure)?;
+    Ok(())
 }

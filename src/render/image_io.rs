@@ -1,4 +1,5 @@
-//! Writing images people look at: sRGB PNG previews of linear RGB buffers.
+//! Writing images people look at: sRGB PNG previews of linear RGB buffers, and multi-layer
+//! OpenEXR files (beauty plus AOV layers) through the `exr` crate.
 
 use glam::Vec3;
 use std::io::BufWriter;
@@ -17,6 +18,10 @@ pub enum ImageError {
         path: String,
         source: png::EncodingError,
     },
+    #[error("cannot write EXR {path}: {message}")]
+    ExrWrite { path: String, message: String },
+    #[error("cannot read EXR {path}: {message}")]
+    ExrRead { path: String, message: String },
     #[error("image {path}: buffer holds {got} pixels, {width}x{height} needs {want}")]
     Size {
         path: String,
@@ -97,6 +102,162 @@ pub fn write_png_linear(
     write_png_rgb8(path, width, height, &to_srgb8(pixels, exposure))
 }
 
+/// One named layer of a multi-layer EXR: `channels` are the channel suffixes (e.g. `["R","G","B"]`
+/// or `["X","Y","Z"]`), `data` is row-major with `channels.len()` values per pixel.
+pub struct ExrLayer<'a> {
+    /// Layer name; empty for the beauty layer (plain `R`, `G`, `B` channels).
+    pub name: &'a str,
+    pub channels: &'a [&'a str],
+    pub data: Vec<f32>,
+}
+
+/// Writes a single-part EXR whose layers are channel-name prefixes (`albedo.R`, `depth.Z`, ...),
+/// the OpenEXR multi-layer convention that compositors read. 32-bit float, ZIP compression.
+/// Written to a temporary name and renamed, so a failure never leaves a half-written file.
+pub fn write_exr_layers(
+    path: &Path,
+    width: u32,
+    height: u32,
+    layers: &[ExrLayer],
+) -> Result<(), ImageError> {
+    use exr::prelude::*;
+    let name = path.display().to_string();
+    let n = width as usize * height as usize;
+    let mut channels: Vec<AnyChannel<FlatSamples>> = Vec::new();
+    for layer in layers {
+        let k = layer.channels.len();
+        if layer.data.len() != n * k {
+            return Err(ImageError::Size {
+                path: name,
+                width,
+                height,
+                got: layer.data.len() / k.max(1),
+                want: n,
+            });
+        }
+        for (c, suffix) in layer.channels.iter().enumerate() {
+            let full = if layer.name.is_empty() {
+                suffix.to_string()
+            } else {
+                format!("{}.{}", layer.name, suffix)
+            };
+            let samples: Vec<f32> = layer.data.iter().skip(c).step_by(k).copied().collect();
+            channels.push(AnyChannel::new(full.as_str(), FlatSamples::F32(samples)));
+        }
+    }
+    let layer = Layer::new(
+        (width as usize, height as usize),
+        LayerAttributes::default(),
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(SmallVec::from_vec(channels)),
+    );
+    let tmp = path.with_extension("exr.partial");
+    let err = |message: String| ImageError::ExrWrite {
+        path: name.clone(),
+        message,
+    };
+    Image::from_layer(layer)
+        .write()
+        .to_file(&tmp)
+        .map_err(|e| err(e.to_string()))?;
+    std::fs::rename(&tmp, path).map_err(|source| ImageError::Io {
+        path: name.clone(),
+        source,
+    })
+}
+
+/// Writes a rendered image as EXR: beauty `R G B` plus the AOV layers `albedo` (RGB), `normal`
+/// (XYZ), `depth` (Z), `fiber` (XYZ), `ray_mask` (Y), `growth_time` (Y) and `std_error` (Y).
+pub fn write_image_exr(path: &Path, image: &super::Image) -> Result<(), ImageError> {
+    let v3 = |f: &dyn Fn(&super::Aov) -> Vec3| -> Vec<f32> {
+        image.aov.iter().flat_map(|a| f(a).to_array()).collect()
+    };
+    let s = |f: &dyn Fn(&super::Aov) -> f32| -> Vec<f32> { image.aov.iter().map(f).collect() };
+    let layers = [
+        ExrLayer {
+            name: "",
+            channels: &["R", "G", "B"],
+            data: image.beauty.iter().flat_map(|c| c.to_array()).collect(),
+        },
+        ExrLayer {
+            name: "albedo",
+            channels: &["R", "G", "B"],
+            data: v3(&|a| a.albedo),
+        },
+        ExrLayer {
+            name: "normal",
+            channels: &["X", "Y", "Z"],
+            data: v3(&|a| a.normal),
+        },
+        ExrLayer {
+            name: "depth",
+            channels: &["Z"],
+            data: s(&|a| a.depth),
+        },
+        ExrLayer {
+            name: "fiber",
+            channels: &["X", "Y", "Z"],
+            data: v3(&|a| a.fiber),
+        },
+        ExrLayer {
+            name: "ray_mask",
+            channels: &["Y"],
+            data: s(&|a| a.ray_mask),
+        },
+        ExrLayer {
+            name: "growth_time",
+            channels: &["Y"],
+            data: s(&|a| a.growth_time),
+        },
+        ExrLayer {
+            name: "std_error",
+            channels: &["Y"],
+            data: image.std_error.clone(),
+        },
+    ];
+    write_exr_layers(path, image.width, image.height, &layers)
+}
+
+/// Reads the RGB channels of the first layer of an EXR (alpha ignored): (width, height, pixels).
+pub fn read_exr_rgb(path: &Path) -> Result<(usize, usize, Vec<Vec3>), ImageError> {
+    let img = exr::prelude::read_first_rgba_layer_from_file(
+        path,
+        |res, _| (res.width(), res.height(), vec![Vec3::ZERO; res.width() * res.height()]),
+        |buf: &mut (usize, usize, Vec<Vec3>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            let w = buf.0;
+            buf.2[pos.y() * w + pos.x()] = Vec3::new(r, g, b);
+        },
+    )
+    .map_err(|e| ImageError::ExrRead {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })?;
+    Ok(img.layer_data.channel_data.pixels)
+}
+
+/// Reads every channel of the first layer of an EXR as (name, values).
+pub fn read_exr_channels(path: &Path) -> Result<Vec<(String, Vec<f32>)>, ImageError> {
+    use exr::prelude::*;
+    let img = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .map_err(|e| ImageError::ExrRead {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })?;
+    Ok(img
+        .layer_data
+        .channel_data
+        .list
+        .iter()
+        .map(|c| (c.name.to_string(), c.sample_data.values_as_f32().collect()))
+        .collect())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -124,6 +285,26 @@ mod tests {
         assert_eq!((info.width, info.height), (3, 2));
         assert_eq!(&buf[..3], &[255, 188, 0]);
         assert!(write_png_linear(&p, 4, 2, &px, 0.0).is_err());
+        let e = dir.join("t.exr");
+        let layers = [
+            ExrLayer {
+                name: "",
+                channels: &["R", "G", "B"],
+                data: px.iter().flat_map(|c| c.to_array()).collect(),
+            },
+            ExrLayer {
+                name: "depth",
+                channels: &["Z"],
+                data: vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0],
+            },
+        ];
+        write_exr_layers(&e, 3, 2, &layers).unwrap();
+        let (w, h, rgb) = read_exr_rgb(&e).unwrap();
+        assert_eq!((w, h), (3, 2));
+        assert_eq!(rgb, px);
+        let ch = read_exr_channels(&e).unwrap();
+        let z = ch.iter().find(|(n, _)| n == "depth.Z").unwrap();
+        assert_eq!(z.1, vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

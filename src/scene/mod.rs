@@ -1,1 +1,595 @@
 //! The TOML scene format, built-in procedural shapes, mesh loading and preset lookup.
+//!
+//! [`load`] reads a scene file (format in scenes/README.md) and builds a [`render::Scene`] with
+//! its render settings. Every error names the file, the field and what is allowed.
+
+pub mod format;
+pub mod mesh_io;
+pub mod shapes;
+
+pub use format::{SceneFile, SweepRegion, SweepTable};
+
+use crate::material::{Material, Placement};
+use crate::render::{
+    self, Accel, Camera, EnvMap, Environment, Filter, Instance, Integrator, Light, Projection,
+    RenderSettings, Transform, TriMesh,
+};
+use format::*;
+use glam::{Affine3A, EulerRot, Quat, Vec2, Vec3};
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Why a scene could not be loaded.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    #[error("cannot read scene {path}: {source}")]
+    Io {
+        path: String,
+        source: std::io::Error,
+    },
+    #[error("scene {path}: {message}")]
+    Parse { path: String, message: String },
+    #[error("scene {path}: field `{field}`: {message}")]
+    Invalid {
+        path: String,
+        field: String,
+        message: String,
+    },
+    #[error("scene {path}: field `{field}`: {source}")]
+    Mesh {
+        path: String,
+        field: String,
+        source: mesh_io::MeshError,
+    },
+}
+
+/// A loaded scene: what to render and how.
+pub struct LoadedScene {
+    /// The file stem (`sweep_board` for scenes/sweep_board.toml).
+    pub name: String,
+    pub scene: render::Scene,
+    pub settings: RenderSettings,
+    /// PNG exposure in stops.
+    pub exposure: f32,
+    /// Name of each light in `scene.lights` (None where the file gave none).
+    pub light_names: Vec<Option<String>>,
+    pub sweep: Option<SweepTable>,
+    /// Non-fatal problems (e.g. degenerate triangles dropped), for the CLI to print.
+    pub warnings: Vec<String>,
+}
+
+/// Reads and builds a scene file.
+pub fn load(path: &Path) -> Result<LoadedScene, SceneError> {
+    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+        path: path.display().to_string(),
+        source,
+    })?;
+    let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let name = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "scene".into());
+    from_str(&text, &path.display().to_string(), &base, &name)
+}
+
+/// Parses the scene text only (no meshes built), for checks and the sweep setup.
+pub fn parse(text: &str, path: &str) -> Result<SceneFile, SceneError> {
+    toml::from_str(text).map_err(|e| SceneError::Parse {
+        path: path.to_string(),
+        message: e.to_string().trim_end().replace('\n', "\n  "),
+    })
+}
+
+/// Builds a scene from TOML text; `path` names it in errors and `base` resolves relative files.
+pub fn from_str(text: &str, path: &str, base: &Path, name: &str) -> Result<LoadedScene, SceneError> {
+    let file = parse(text, path)?;
+    Builder {
+        path,
+        base,
+        warnings: Vec::new(),
+    }
+    .build(file, name)
+}
+
+struct Builder<'a> {
+    path: &'a str,
+    base: &'a Path,
+    warnings: Vec<String>,
+}
+
+fn v3(a: [f32; 3]) -> Vec3 {
+    Vec3::from_array(a)
+}
+
+impl Builder<'_> {
+    fn invalid(&self, field: impl Into<String>, message: impl Into<String>) -> SceneError {
+        SceneError::Invalid {
+            path: self.path.to_string(),
+            field: field.into(),
+            message: message.into(),
+        }
+    }
+
+    /// Checks `lo <= x <= hi` (and finite), naming the field and the range.
+    fn range(&self, field: &str, x: f32, lo: f32, hi: f32) -> Result<f32, SceneError> {
+        if x.is_finite() && x >= lo && x <= hi {
+            Ok(x)
+        } else {
+            Err(self.invalid(field, format!("{x} is out of range (allowed {lo} to {hi})")))
+        }
+    }
+
+    fn finite3(&self, field: &str, a: [f32; 3]) -> Result<Vec3, SceneError> {
+        if a.iter().all(|x| x.is_finite()) {
+            Ok(v3(a))
+        } else {
+            Err(self.invalid(field, "every component must be finite"))
+        }
+    }
+
+    fn unit3(&self, field: &str, a: [f32; 3]) -> Result<Vec3, SceneError> {
+        let v = self.finite3(field, a)?;
+        if v.length_squared() > 1e-12 {
+            Ok(v.normalize())
+        } else {
+            Err(self.invalid(field, "must be a non-zero direction"))
+        }
+    }
+
+    fn color(&self, field: &str, a: [f32; 3], hi: f32) -> Result<Vec3, SceneError> {
+        for x in a {
+            self.range(field, x, 0.0, hi)?;
+        }
+        Ok(v3(a))
+    }
+
+    fn build(mut self, file: SceneFile, name: &str) -> Result<LoadedScene, SceneError> {
+        let r = &file.render;
+        let width = self.range("render.width", r.width as f32, 1.0, 16384.0)? as u32;
+        let height = self.range("render.height", r.height as f32, 1.0, 16384.0)? as u32;
+        self.range("render.spp", r.spp as f32, 1.0, 1_000_000.0)?;
+        self.range("render.max_depth", r.max_depth as f32, 1.0, 1000.0)?;
+        self.range("render.exposure", r.exposure, -30.0, 30.0)?;
+        let integrator = match r.integrator {
+            IntegratorName::Direct => Integrator::Direct,
+            IntegratorName::Path => Integrator::Path {
+                max_depth: r.max_depth,
+            },
+        };
+        let filter = match r.filter {
+            FilterName::Box => Filter::Box {
+                radius: self.range("render.filter_radius", r.filter_radius.unwrap_or(0.5), 0.0, 8.0)?,
+            },
+            FilterName::Tent => Filter::Tent {
+                radius: self.range("render.filter_radius", r.filter_radius.unwrap_or(1.0), 0.0, 8.0)?,
+            },
+            FilterName::Gaussian => {
+                let radius = self.range("render.filter_radius", r.filter_radius.unwrap_or(1.5), 0.01, 8.0)?;
+                Filter::Gaussian {
+                    sigma: radius / 3.0,
+                    radius,
+                }
+            }
+        };
+        let camera = self.camera(&file.camera, width, height)?;
+        let (lights, light_names) = self.lights(&file.lights)?;
+        let (materials, material_index) = self.materials(&file.materials)?;
+        let instances = self.objects(&file.objects, &material_index, &materials)?;
+        if let Some(s) = &file.sweep {
+            self.check_sweep(s, &light_names, width, height)?;
+        }
+        let scene = render::Scene {
+            accel: Accel::new(instances),
+            materials,
+            lights,
+            camera,
+            filter,
+        };
+        Ok(LoadedScene {
+            name: name.to_string(),
+            scene,
+            settings: RenderSettings {
+                spp: r.spp,
+                integrator,
+                seed: r.seed,
+            },
+            exposure: r.exposure,
+            light_names,
+            sweep: file.sweep,
+            warnings: self.warnings,
+        })
+    }
+
+    fn camera(&self, c: &CameraTable, width: u32, height: u32) -> Result<Camera, SceneError> {
+        let eye = self.finite3("camera.eye", c.eye)?;
+        let target = self.finite3("camera.target", c.target)?;
+        let up = self.unit3("camera.up", c.up)?;
+        let dir = target - eye;
+        if dir.length_squared() < 1e-12 {
+            return Err(self.invalid("camera.target", "must differ from camera.eye"));
+        }
+        if dir.normalize().cross(up).length_squared() < 1e-8 {
+            return Err(self.invalid("camera.up", "must not be parallel to the view direction"));
+        }
+        let projection = match c.projection {
+            ProjectionName::Perspective => {
+                if c.width.is_some() {
+                    return Err(self.invalid("camera.width", "only for projection = \"orthographic\""));
+                }
+                Projection::Perspective {
+                    fov_y: self.range("camera.fov_deg", c.fov_deg, 0.01, 179.0)?.to_radians(),
+                    lens_radius: self.range("camera.lens_radius", c.lens_radius, 0.0, 1e6)?,
+                    focus_distance: self.range(
+                        "camera.focus_distance",
+                        c.focus_distance.unwrap_or(dir.length()),
+                        1e-3,
+                        1e9,
+                    )?,
+                }
+            }
+            ProjectionName::Orthographic => {
+                let w = c.width.ok_or_else(|| {
+                    self.invalid("camera.width", "required for projection = \"orthographic\" (film width in mm)")
+                })?;
+                Projection::Orthographic {
+                    width: self.range("camera.width", w, 1e-3, 1e9)?,
+                }
+            }
+        };
+        Ok(Camera::look_at(eye, target, up, projection, width, height))
+    }
+
+    fn lights(&self, tables: &[LightTable]) -> Result<(Vec<Light>, Vec<Option<String>>), SceneError> {
+        let mut lights = Vec::new();
+        let mut names = Vec::new();
+        for (i, t) in tables.iter().enumerate() {
+            let f = |s: &str| format!("lights[{i}].{s}");
+            let light = match t {
+                LightTable::Point {
+                    position,
+                    intensity,
+                    color,
+                    ..
+                } => Light::Point {
+                    position: self.finite3(&f("position"), *position)?,
+                    intensity: self.color(&f("color"), *color, 1e3)?
+                        * self.range(&f("intensity"), *intensity, 0.0, 1e12)?,
+                },
+                LightTable::Spot {
+                    position,
+                    target,
+                    intensity,
+                    color,
+                    cone_deg,
+                    falloff_deg,
+                    ..
+                } => {
+                    let p = self.finite3(&f("position"), *position)?;
+                    let d = self.finite3(&f("target"), *target)? - p;
+                    if d.length_squared() < 1e-12 {
+                        return Err(self.invalid(f("target"), "must differ from position"));
+                    }
+                    let outer = self.range(&f("cone_deg"), *cone_deg, 0.01, 180.0)?;
+                    let falloff = self.range(&f("falloff_deg"), *falloff_deg, 0.0, outer)?;
+                    Light::Spot {
+                        position: p,
+                        direction: d.normalize(),
+                        intensity: self.color(&f("color"), *color, 1e3)?
+                            * self.range(&f("intensity"), *intensity, 0.0, 1e12)?,
+                        cos_inner: (outer - falloff).to_radians().cos(),
+                        cos_outer: outer.to_radians().cos(),
+                    }
+                }
+                LightTable::Distant {
+                    direction,
+                    irradiance,
+                    color,
+                    ..
+                } => Light::Distant {
+                    direction: self.unit3(&f("direction"), *direction)?,
+                    irradiance: self.color(&f("color"), *color, 1e3)?
+                        * self.range(&f("irradiance"), *irradiance, 0.0, 1e12)?,
+                },
+                LightTable::Rect {
+                    corner,
+                    edge_u,
+                    edge_v,
+                    radiance,
+                    color,
+                    ..
+                } => {
+                    let (u, v) = (self.finite3(&f("edge_u"), *edge_u)?, self.finite3(&f("edge_v"), *edge_v)?);
+                    if u.cross(v).length_squared() < 1e-12 {
+                        return Err(self.invalid(f("edge_v"), "edges must span a non-zero area"));
+                    }
+                    Light::Rect {
+                        corner: self.finite3(&f("corner"), *corner)?,
+                        edge_u: u,
+                        edge_v: v,
+                        radiance: self.color(&f("color"), *color, 1e3)?
+                            * self.range(&f("radiance"), *radiance, 0.0, 1e12)?,
+                    }
+                }
+                LightTable::Sphere {
+                    center,
+                    radius,
+                    radiance,
+                    color,
+                    ..
+                } => Light::Sphere {
+                    center: self.finite3(&f("center"), *center)?,
+                    radius: self.range(&f("radius"), *radius, 1e-4, 1e9)?,
+                    radiance: self.color(&f("color"), *color, 1e3)?
+                        * self.range(&f("radiance"), *radiance, 0.0, 1e12)?,
+                },
+                LightTable::Environment {
+                    radiance,
+                    color,
+                    map,
+                    rotate_deg,
+                    ..
+                } => {
+                    let scale = self.color(&f("color"), *color, 1e3)?
+                        * self.range(&f("radiance"), *radiance, 0.0, 1e12)?;
+                    let rot = self.range(&f("rotate_deg"), *rotate_deg, -360.0, 360.0)?;
+                    let map = match map {
+                        None => None,
+                        Some(m) => Some(Arc::new(self.env_map(&f("map"), m, rot)?)),
+                    };
+                    Light::Environment(Environment { scale, map })
+                }
+            };
+            if let Some(n) = t.name() {
+                if names.iter().any(|o: &Option<String>| o.as_deref() == Some(n)) {
+                    return Err(self.invalid(f("name"), format!("light name `{n}` is used twice")));
+                }
+            }
+            lights.push(light);
+            names.push(t.name().map(str::to_string));
+        }
+        Ok((lights, names))
+    }
+
+    fn env_map(&self, field: &str, file: &str, rotate_deg: f32) -> Result<EnvMap, SceneError> {
+        let p = self.base.join(file);
+        let (w, h, mut texels) = render::image_io::read_exr_rgb(&p)
+            .map_err(|e| self.invalid(field, e.to_string()))?;
+        if w < 2 || h < 1 {
+            return Err(self.invalid(field, format!("{} is too small ({w}x{h})", p.display())));
+        }
+        if texels.iter().any(|t| !t.is_finite() || t.min_element() < 0.0) {
+            return Err(self.invalid(field, format!("{} holds negative or non-finite texels", p.display())));
+        }
+        // Rotation about z: shift columns.
+        let shift = ((rotate_deg / 360.0) * w as f32).round() as i64;
+        if shift != 0 {
+            let old = texels.clone();
+            for y in 0..h {
+                for x in 0..w {
+                    let sx = (x as i64 - shift).rem_euclid(w as i64) as usize;
+                    texels[y * w + x] = old[y * w + sx];
+                }
+            }
+        }
+        Ok(EnvMap::new(w, h, texels))
+    }
+
+    fn materials(
+        &self,
+        tables: &BTreeMap<String, MaterialTable>,
+    ) -> Result<(Vec<Material>, HashMap<String, u32>), SceneError> {
+        let mut out = Vec::new();
+        let mut index = HashMap::new();
+        for (name, t) in tables {
+            let f = |s: &str| format!("materials.{name}.{s}");
+            let m = match t {
+                MaterialTable::Lambertian { albedo } => Material::Lambertian {
+                    albedo: self.color(&f("albedo"), *albedo, 1.0)?,
+                },
+            };
+            index.insert(name.clone(), out.len() as u32);
+            out.push(m);
+        }
+        Ok((out, index))
+    }
+
+    fn objects(
+        &mut self,
+        tables: &[ObjectTable],
+        materials: &HashMap<String, u32>,
+        _mats: &[Material],
+    ) -> Result<Vec<Instance>, SceneError> {
+        let mut cache: HashMap<PathBuf, Arc<TriMesh>> = HashMap::new();
+        let mut out = Vec::new();
+        for (i, o) in tables.iter().enumerate() {
+            let f = |s: &str| format!("objects[{i}].{s}");
+            let material = *materials.get(&o.material).ok_or_else(|| {
+                let mut names: Vec<&String> = materials.keys().collect();
+                names.sort();
+                self.invalid(
+                    f("material"),
+                    format!("no material named `{}` (defined: {names:?})", o.material),
+                )
+            })?;
+            let mesh = self.shape(o, i, &mut cache)?;
+            let scale = match o.scale {
+                Scale::Uniform(s) => Vec3::splat(s),
+                Scale::Axes(a) => v3(a),
+            };
+            for s in scale.to_array() {
+                if !(s.is_finite() && s.abs() > 1e-9) {
+                    return Err(self.invalid(f("scale"), "must be finite and non-zero"));
+                }
+            }
+            let r = self.finite3(&f("rotate_deg"), o.rotate_deg)?;
+            let rot = Quat::from_euler(EulerRot::ZYX, r.z.to_radians(), r.y.to_radians(), r.x.to_radians());
+            let transform = Transform::new(Affine3A::from_scale_rotation_translation(
+                scale,
+                rot,
+                self.finite3(&f("translate"), o.translate)?,
+            ));
+            if !transform.is_valid() {
+                return Err(self.invalid(f("scale"), "the transform is not invertible"));
+            }
+            let placement = match &o.tree {
+                None => Placement::default(),
+                Some(t) => Placement {
+                    origin: self.finite3(&f("tree.origin"), t.origin)?,
+                    axis: self.unit3(&f("tree.axis"), t.axis)?,
+                    rotation: self.range(&f("tree.rotation_deg"), t.rotation_deg, -360.0, 360.0)?.to_radians(),
+                    scale: self.range(&f("tree.scale"), t.scale, 1e-6, 1e6)?,
+                },
+            };
+            out.push(Instance {
+                mesh,
+                transform,
+                material,
+                placement,
+            });
+        }
+        Ok(out)
+    }
+
+    /// Builds (or loads) the mesh of one object, rejecting fields its shape does not use.
+    fn shape(
+        &mut self,
+        o: &ObjectTable,
+        i: usize,
+        cache: &mut HashMap<PathBuf, Arc<TriMesh>>,
+    ) -> Result<Arc<TriMesh>, SceneError> {
+        let f = |s: &str| format!("objects[{i}].{s}");
+        let (kind, used): (&str, &[&str]) = match o.shape {
+            ShapeKind::Box => ("box", &["size"]),
+            ShapeKind::Quad => ("quad", &["size"]),
+            ShapeKind::Sphere => ("sphere", &["radius", "segments"]),
+            ShapeKind::Cylinder => ("cylinder", &["radius", "height", "segments"]),
+            ShapeKind::Lathe => ("lathe", &["profile", "segments"]),
+            ShapeKind::Teapot => ("teapot", &["size", "resolution"]),
+            ShapeKind::Mesh => ("mesh", &["file"]),
+        };
+        let present = [
+            ("size", o.size.is_some()),
+            ("radius", o.radius.is_some()),
+            ("height", o.height.is_some()),
+            ("segments", o.segments.is_some()),
+            ("profile", o.profile.is_some()),
+            ("resolution", o.resolution.is_some()),
+            ("file", o.file.is_some()),
+        ];
+        for (name, is) in present {
+            if is && !used.contains(&name) {
+                return Err(self.invalid(
+                    f(name),
+                    format!("not used by shape `{kind}` (it takes: {})", used.join(", ")),
+                ));
+            }
+        }
+        let need = |name: &str| self.invalid(f(name), format!("required by shape `{kind}`"));
+        let segments = match o.segments {
+            None => 64,
+            Some(s) => self.range(&f("segments"), s as f32, 3.0, 4096.0)? as u32,
+        };
+        let positive = |name: &str, x: f32| self.range(&f(name), x, 1e-6, 1e9);
+        let mut mesh = match o.shape {
+            ShapeKind::Box | ShapeKind::Quad => {
+                let s = o.size.as_ref().ok_or_else(|| need("size"))?;
+                let want = if o.shape == ShapeKind::Box { 3 } else { 2 };
+                if s.len() != want {
+                    return Err(self.invalid(f("size"), format!("shape `{kind}` takes {want} numbers (mm)")));
+                }
+                for x in s {
+                    positive("size", *x)?;
+                }
+                if want == 3 {
+                    shapes::make_box(Vec3::new(s[0], s[1], s[2]))
+                } else {
+                    shapes::make_quad(Vec2::new(s[0], s[1]))
+                }
+            }
+            ShapeKind::Sphere => shapes::make_sphere(positive("radius", o.radius.ok_or_else(|| need("radius"))?)?, segments),
+            ShapeKind::Cylinder => shapes::make_cylinder(
+                positive("radius", o.radius.ok_or_else(|| need("radius"))?)?,
+                positive("height", o.height.ok_or_else(|| need("height"))?)?,
+                segments,
+            ),
+            ShapeKind::Lathe => {
+                let p = o.profile.as_ref().ok_or_else(|| need("profile"))?;
+                if p.len() < 2 {
+                    return Err(self.invalid(f("profile"), "needs at least 2 (radius, z) points"));
+                }
+                for q in p {
+                    self.range(&f("profile"), q[0], 0.0, 1e9)?;
+                    self.range(&f("profile"), q[1], -1e9, 1e9)?;
+                }
+                let pts: Vec<Vec2> = p.iter().map(|q| Vec2::new(q[0], q[1])).collect();
+                shapes::make_lathe(&pts, segments)
+            }
+            ShapeKind::Teapot => {
+                return Err(self.invalid(f("shape"), "the teapot is not built yet"));
+            }
+            ShapeKind::Mesh => {
+                let file = o.file.as_ref().ok_or_else(|| need("file"))?;
+                let p = self.base.join(file);
+                if let Some(m) = cache.get(&p) {
+                    return Ok(m.clone());
+                }
+                let mut m = mesh_io::load_mesh(&p).map_err(|source| SceneError::Mesh {
+                    path: self.path.to_string(),
+                    field: f("file"),
+                    source,
+                })?;
+                let dropped = m.drop_degenerate();
+                if dropped > 0 {
+                    self.warnings.push(format!(
+                        "{}: {}: dropped {dropped} degenerate triangles",
+                        self.path,
+                        f("file")
+                    ));
+                }
+                if m.indices.is_empty() {
+                    return Err(self.invalid(f("file"), format!("{} has no valid triangles", p.display())));
+                }
+                if !o.smooth {
+                    m.normals = None;
+                }
+                let m = Arc::new(m);
+                cache.insert(p, m.clone());
+                return Ok(m);
+            }
+        };
+        if !o.smooth {
+            mesh.normals = None;
+        }
+        Ok(Arc::new(mesh))
+    }
+
+    fn check_sweep(
+        &self,
+        s: &SweepTable,
+        names: &[Option<String>],
+        width: u32,
+        height: u32,
+    ) -> Result<(), SceneError> {
+        self.range("sweep.frames", s.frames as f32, 1.0, 100_000.0)?;
+        for a in s.arc_deg {
+            self.range("sweep.arc_deg", a, -90.0, 90.0)?;
+        }
+        self.range("sweep.radius", s.radius, 1e-3, 1e9)?;
+        self.finite3("sweep.pivot", s.pivot)?;
+        self.unit3("sweep.axis", s.axis)?;
+        if !names.iter().any(|n| n.as_deref() == Some(s.light.as_str())) {
+            let known: Vec<&str> = names.iter().flatten().map(String::as_str).collect();
+            return Err(self.invalid("sweep.light", format!("no light named `{}` (named lights: {known:?})", s.light)));
+        }
+        for (k, r) in s.regions.iter().enumerate() {
+            if !(r.x0 < r.x1 && r.y0 < r.y1 && r.x1 <= width && r.y1 <= height) {
+                return Err(self.invalid(
+                    format!("sweep.regions[{k}]"),
+                    format!("region `{}` must satisfy x0 < x1 <= {width}, y0 < y1 <= {height}", r.name),
+                ));
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,380 @@
+//! Triangle meshes, instances with affine transforms, and the acceleration structure: every
+//! instance is flattened into world space and put into one obvhs compressed wide BVH (CWBVH,
+//! Ylitie et al. 2017), the builder and CPU traversal obvhs recommends for speed.
+
+use crate::material::Placement;
+use glam::{Affine3A, Mat3, Vec2, Vec3, Vec3A};
+use obvhs::cwbvh::{builder::build_cwbvh_from_tris, CwBvh};
+use obvhs::ray::{Ray as BvhRay, RayHit};
+use obvhs::rt_triangle::RtTriangle;
+use obvhs::triangle::Triangle;
+use obvhs::BvhBuildParams;
+use std::sync::Arc;
+use std::time::Duration;
+
+/// An indexed triangle mesh in object space (millimetres).
+#[derive(Clone, Debug, Default)]
+pub struct TriMesh {
+    pub positions: Vec<Vec3>,
+    /// Per-vertex shading normals (same length as `positions`), if the mesh has them.
+    pub normals: Option<Vec<Vec3>>,
+    pub indices: Vec<[u32; 3]>,
+}
+
+impl TriMesh {
+    /// Drops triangles with out-of-range indices, non-finite vertices or zero area and returns
+    /// how many were dropped (scene loading reports the count as a warning).
+    pub fn drop_degenerate(&mut self) -> usize {
+        let n = self.positions.len() as u32;
+        let before = self.indices.len();
+        let pos = &self.positions;
+        self.indices.retain(|t| {
+            if t.iter().any(|&i| i >= n) {
+                return false;
+            }
+            let [a, b, c] = t.map(|i| pos[i as usize]);
+            let area2 = (b - a).cross(c - a).length_squared();
+            a.is_finite() && b.is_finite() && c.is_finite() && area2 > 0.0 && area2.is_finite()
+        });
+        if let Some(ns) = &mut self.normals {
+            for v in ns.iter_mut() {
+                *v = v.normalize_or_zero();
+            }
+        }
+        before - self.indices.len()
+    }
+
+    /// Appends `other` (re-indexing its triangles); normals are kept only if both have them.
+    pub fn append(&mut self, other: &TriMesh) {
+        let base = self.positions.len() as u32;
+        let keep_normals = (self.normals.is_some() || self.positions.is_empty()) && other.normals.is_some();
+        self.normals = if keep_normals {
+            let mut n = self.normals.take().unwrap_or_default();
+            n.extend_from_slice(other.normals.as_ref().unwrap());
+            Some(n)
+        } else {
+            None
+        };
+        self.positions.extend_from_slice(&other.positions);
+        self.indices
+            .extend(other.indices.iter().map(|t| t.map(|i| i + base)));
+    }
+}
+
+/// Object → world placement of one mesh: an affine map, with the inverse and the normal matrix
+/// (inverse transpose of the linear part) precomputed.
+#[derive(Clone, Copy, Debug)]
+pub struct Transform {
+    pub to_world: Affine3A,
+    pub to_object: Affine3A,
+    /// Transforms normals and gradients (covectors) from object to world.
+    pub normal_to_world: Mat3,
+}
+
+impl Transform {
+    pub fn new(to_world: Affine3A) -> Self {
+        let to_object = to_world.inverse();
+        Transform {
+            to_world,
+            to_object,
+            normal_to_world: Mat3::from(to_object.matrix3).transpose(),
+        }
+    }
+
+    pub fn identity() -> Self {
+        Transform::new(Affine3A::IDENTITY)
+    }
+
+    /// True when the map is invertible and finite.
+    pub fn is_valid(&self) -> bool {
+        let d = self.to_world.matrix3.determinant();
+        d.is_finite() && d.abs() > 1e-12 && self.to_object.is_finite()
+    }
+
+    #[inline]
+    pub fn point_to_world(&self, p: Vec3) -> Vec3 {
+        self.to_world.transform_point3(p)
+    }
+
+    #[inline]
+    pub fn point_to_object(&self, p: Vec3) -> Vec3 {
+        self.to_object.transform_point3(p)
+    }
+
+    #[inline]
+    pub fn vector_to_world(&self, v: Vec3) -> Vec3 {
+        self.to_world.transform_vector3(v)
+    }
+
+    #[inline]
+    pub fn normal_to_world(&self, n: Vec3) -> Vec3 {
+        self.normal_to_world * n
+    }
+}
+
+/// One placed mesh: which mesh, where, and which material (index into the scene's materials).
+#[derive(Clone, Debug)]
+pub struct Instance {
+    pub mesh: Arc<TriMesh>,
+    pub transform: Transform,
+    pub material: u32,
+    /// Where the object sits in the tree (solid-texture space).
+    pub placement: Placement,
+}
+
+/// A ray in world space; `d` need not be unit length for intersection, but the renderer keeps it unit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ray {
+    pub o: Vec3,
+    pub d: Vec3,
+}
+
+impl Ray {
+    #[inline]
+    pub fn at(&self, t: f32) -> Vec3 {
+        self.o + self.d * t
+    }
+}
+
+/// The closest intersection: distance, instance, triangle within the instance's mesh, and
+/// barycentrics (p = (1 − u − v)·v0 + u·v1 + v·v2).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    pub t: f32,
+    pub instance: u32,
+    pub triangle: u32,
+    pub uv: Vec2,
+}
+
+/// Surface data at a hit: world position, geometric and shading normals (world, unit, not yet
+/// flipped towards the viewer), object-space position.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceHit {
+    pub p: Vec3,
+    pub p_object: Vec3,
+    pub ng: Vec3,
+    pub ns: Vec3,
+    /// A tangent along the triangle's first edge (world), for a stable shading frame.
+    pub tangent: Vec3,
+    pub instance: u32,
+}
+
+/// All instances flattened into world-space triangles in one CWBVH.
+pub struct Accel {
+    bvh: CwBvh,
+    /// Triangles in BVH primitive order (so traversal needs no index indirection).
+    tris: Vec<RtTriangle>,
+    /// Global triangle id of each BVH primitive.
+    prim_tri: Vec<u32>,
+    /// First global triangle id of each instance (prefix sums), plus the total at the end.
+    offsets: Vec<u32>,
+    pub instances: Vec<Instance>,
+    /// Time spent in the obvhs core build.
+    pub build_time: Duration,
+    bounds_radius: f32,
+}
+
+/// The BVH build parameters used by the renderer (`medium_build`: PLOC with reinsertion; measured
+/// against the others in notes/render.md).
+pub const BUILD_PARAMS: BvhBuildParams = BvhBuildParams::medium_build();
+
+impl Accel {
+    pub fn new(instances: Vec<Instance>) -> Self {
+        Self::with_params(instances, BUILD_PARAMS)
+    }
+
+    pub fn with_params(instances: Vec<Instance>, params: BvhBuildParams) -> Self {
+        let mut world: Vec<Triangle> = Vec::new();
+        let mut offsets = Vec::with_capacity(instances.len() + 1);
+        for inst in &instances {
+            offsets.push(world.len() as u32);
+            let p: Vec<Vec3A> = inst
+                .mesh
+                .positions
+                .iter()
+                .map(|&v| inst.transform.point_to_world(v).into())
+                .collect();
+            world.extend(inst.mesh.indices.iter().map(|t| Triangle {
+                v0: p[t[0] as usize],
+                v1: p[t[1] as usize],
+                v2: p[t[2] as usize],
+            }));
+        }
+        offsets.push(world.len() as u32);
+        let mut build_time = Duration::ZERO;
+        let mut bounds_radius = 1.0f32;
+        for t in &world {
+            for v in [t.v0, t.v1, t.v2] {
+                bounds_radius = bounds_radius.max(v.abs().max_element());
+            }
+        }
+        if world.is_empty() {
+            return Accel {
+                bvh: CwBvh::default(),
+                tris: Vec::new(),
+                prim_tri: Vec::new(),
+                offsets,
+                instances,
+                build_time,
+                bounds_radius,
+            };
+        }
+        let bvh = build_cwbvh_from_tris(&world, params, &mut build_time);
+        let prim_tri = bvh.primitive_indices.clone();
+        let tris = prim_tri
+            .iter()
+            .map(|&i| RtTriangle::from(&world[i as usize]))
+            .collect();
+        Accel {
+            bvh,
+            tris,
+            prim_tri,
+            offsets,
+            instances,
+            build_time,
+            bounds_radius,
+        }
+    }
+
+    /// Number of triangles over all instances.
+    pub fn triangle_count(&self) -> usize {
+        *self.offsets.last().unwrap_or(&0) as usize
+    }
+
+    /// A length that scales ray offsets: the largest coordinate magnitude in the scene (≥ 1 mm).
+    pub fn scale(&self) -> f32 {
+        self.bounds_radius
+    }
+
+    /// Closest hit with `t` in (0, t_max).
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
+        if self.tris.is_empty() {
+            return None;
+        }
+        let r = BvhRay::new(ray.o.into(), ray.d.into(), 0.0, t_max);
+        let mut hit = RayHit::none();
+        let tris = &self.tris;
+        if !self
+            .bvh
+            .ray_traverse(r, &mut hit, |r, id| tris[id].intersect(r))
+        {
+            return None;
+        }
+        let prim = hit.primitive_id as usize;
+        let uv = self.tris[prim].compute_barycentric(&r);
+        let global = self.prim_tri[prim];
+        let instance = self.offsets.partition_point(|&o| o <= global) as u32 - 1;
+        Some(Hit {
+            t: hit.t,
+            instance,
+            triangle: global - self.offsets[instance as usize],
+            uv,
+        })
+    }
+
+    /// True when nothing blocks the segment `o + t·d`, t in (0, t_max) (early-out shadow query).
+    pub fn unoccluded(&self, ray: &Ray, t_max: f32) -> bool {
+        if self.tris.is_empty() {
+            return true;
+        }
+        let r = BvhRay::new(ray.o.into(), ray.d.into(), 0.0, t_max);
+        let tris = &self.tris;
+        self.bvh.ray_traverse_miss(r, |r, id| tris[id].intersect(r))
+    }
+
+    /// Position, normals and object-space point of a hit.
+    pub fn surface(&self, ray: &Ray, hit: &Hit) -> SurfaceHit {
+        let inst = &self.instances[hit.instance as usize];
+        let mesh = &inst.mesh;
+        let [i0, i1, i2] = mesh.indices[hit.triangle as usize].map(|i| i as usize);
+        let (a, b, c) = (mesh.positions[i0], mesh.positions[i1], mesh.positions[i2]);
+        let (u, v) = (hit.uv.x, hit.uv.y);
+        let w = 1.0 - u - v;
+        let p_object = a * w + b * u + c * v;
+        let tf = &inst.transform;
+        let ng = tf.normal_to_world((b - a).cross(c - a)).normalize_or_zero();
+        let ns = match &mesh.normals {
+            Some(n) => {
+                let n_obj = n[i0] * w + n[i1] * u + n[i2] * v;
+                let ns = tf.normal_to_world(n_obj).normalize_or_zero();
+                if ns == Vec3::ZERO {
+                    ng
+                } else {
+                    ns
+                }
+            }
+            None => ng,
+        };
+        let _ = ray;
+        SurfaceHit {
+            // The ray equation is the accurate hit point; the barycentric point is in object space.
+            p: ray.at(hit.t),
+            p_object,
+            ng,
+            ns,
+            tangent: tf.vector_to_world(b - a).normalize_or_zero(),
+            instance: hit.instance,
+        }
+    }
+}
+
+/// Brute-force closest hit over every world-space triangle (the reference the BVH is tested against).
+pub fn brute_force_closest(accel: &Accel, ray: &Ray, t_max: f32) -> Option<f32> {
+    let r = BvhRay::new(ray.o.into(), ray.d.into(), 0.0, t_max);
+    accel
+        .tris
+        .iter()
+        .map(|t| t.intersect(&r))
+        .filter(|t| *t < t_max)
+        .min_by(|a, b| a.total_cmp(b))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn unit_quad() -> TriMesh {
+        TriMesh {
+            positions: vec![
+                Vec3::new(0.0, 0.0, 0.0),
+                Vec3::new(1.0, 0.0, 0.0),
+                Vec3::new(1.0, 1.0, 0.0),
+                Vec3::new(0.0, 1.0, 0.0),
+            ],
+            normals: None,
+            indices: vec![[0, 1, 2], [0, 2, 3]],
+        }
+    }
+
+    #[test]
+    fn hit_point_matches_ray_equation_and_barycentrics() {
+        let inst = Instance {
+            mesh: Arc::new(unit_quad()),
+            transform: Transform::new(Affine3A::from_translation(Vec3::new(0.0, 0.0, 2.0))),
+            material: 0,
+            placement: Placement::default(),
+        };
+        let accel = Accel::new(vec![inst]);
+        let ray = Ray {
+            o: Vec3::new(0.3, 0.6, 5.0),
+            d: -Vec3::Z,
+        };
+        let hit = accel.intersect(&ray, f32::INFINITY).unwrap();
+        assert!((hit.t - 3.0).abs() < 1e-5);
+        let s = accel.surface(&ray, &hit);
+        // Object-space point from barycentrics must equal the ray point moved back to object space.
+        assert!((s.p_object - Vec3::new(0.3, 0.6, 0.0)).length() < 1e-5, "{s:?}");
+        assert!((s.ng - Vec3::Z).length() < 1e-6);
+        assert!(!accel.unoccluded(&ray, 10.0));
+        assert!(accel.unoccluded(&ray, 2.9));
+    }
+
+    #[test]
+    fn degenerate_triangles_are_dropped() {
+        let mut m = unit_quad();
+        m.indices.push([0, 0, 1]);
+        m.indices.push([0, 1, 9]);
+        assert_eq!(m.drop_degenerate(), 2);
+        assert_eq!(m.indices.len(), 2);
+    }
+}

@@ -1,0 +1,369 @@
+//! The integrators: direct lighting and unidirectional path tracing with next-event estimation,
+//! multiple importance sampling (power heuristic, Veach 1997 §9.2) and Russian roulette.
+//!
+//! Per pixel sample the work is split in two so a light sweep can cache the first part:
+//! - [`primary_sample`]: everything that does not depend on the lights — the camera ray, the first
+//!   hit, its shading frame, `wo` and the evaluated material (a small `Copy` [`ShadingPoint`]);
+//! - [`shade_direct`] / [`direct_radiance`]: the light-dependent part.
+//!
+//! Each part draws from its own random stream, derived only from (seed, pixel, sample) by
+//! [`sample_rngs`], so a render that caches primary samples and one that does not are bit-identical.
+
+use super::film::Aov;
+use super::geometry::{Hit, Ray};
+use super::light::Light;
+use super::Scene;
+use crate::bsdf::Bsdf;
+use crate::material::{MaterialHit, SurfaceBsdf};
+use crate::math::{power_heuristic, Frame, Pcg32};
+use glam::{Mat3, UVec2, Vec2, Vec3};
+
+/// Which light transport to simulate.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Integrator {
+    /// Emission plus single-bounce direct lighting (NEE + one MIS'd BSDF sample).
+    Direct,
+    /// Path tracing up to `max_depth` bounces, Russian roulette from bounce 3.
+    Path { max_depth: u32 },
+}
+
+/// A first hit ready to be lit: position, geometric normal, shading frame, outgoing direction in
+/// the local frame and the material's BSDF. `Copy`, so sweeps can cache one per pixel sample.
+#[derive(Clone, Copy, Debug)]
+pub struct ShadingPoint {
+    pub p: Vec3,
+    /// Geometric normal (world), on the side of `wo` unless the BSDF transmits.
+    pub ng: Vec3,
+    /// World shading frame (z = shading normal).
+    pub frame: Frame,
+    /// Direction towards the viewer, in the local frame.
+    pub wo: Vec3,
+    pub bsdf: SurfaceBsdf,
+    /// Ray-origin offset length for rays leaving this point (mm).
+    pub eps: f32,
+}
+
+/// The light-independent part of one pixel sample.
+#[derive(Clone, Copy, Debug)]
+pub struct PrimarySample {
+    pub ray: Ray,
+    /// Distance to the first surface (infinite on a miss).
+    pub t_hit: f32,
+    pub point: Option<ShadingPoint>,
+    pub aov: Aov,
+}
+
+/// Counts of rays traced, for the rays/s report.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RayCount(pub u64);
+
+/// The two independent random streams of sample `sample` of pixel `pixel_index`: the first for
+/// the camera (filter and lens), the second for lighting. PCG32 streams keyed by a SplitMix64
+/// hash (Steele et al. 2014) of (seed, sample, part) with the pixel index as stream selector.
+pub fn sample_rngs(seed: u64, pixel_index: u64, sample: u32) -> (Pcg32, Pcg32) {
+    let key = |part: u64| splitmix64(seed ^ splitmix64(((sample as u64) << 2) | part));
+    (
+        Pcg32::new(key(0), pixel_index),
+        Pcg32::new(key(1), pixel_index),
+    )
+}
+
+/// SplitMix64 finaliser (Steele, Lea, Flood 2014): a bijective 64-bit mix.
+fn splitmix64(x: u64) -> u64 {
+    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// Builds the shading point of a hit seen along `ray`.
+pub fn shading_point(scene: &Scene, ray: &Ray, hit: &Hit, aov: Option<&mut Aov>) -> ShadingPoint {
+    let s = scene.accel.surface(ray, hit);
+    let inst = &scene.accel.instances[s.instance as usize];
+    let material = &scene.materials[inst.material as usize];
+    let mh = MaterialHit {
+        p_object: s.p_object,
+        ng: s.ng,
+        ns: s.ns,
+        tangent: s.tangent,
+        object_to_world: Mat3::from(inst.transform.to_world.matrix3),
+        normal_to_world: inst.transform.normal_to_world,
+        placement: inst.placement,
+    };
+    let shading = material.shade(&mh);
+    let mut frame = shading.frame;
+    let mut ng = s.ng;
+    let wo_world = -ray.d;
+    if !shading.bsdf.is_transmissive() && ng.dot(wo_world) < 0.0 {
+        // Opaque surfaces are two-sided: face the viewer.
+        ng = -ng;
+        frame = Frame {
+            s: frame.s,
+            t: -frame.t,
+            n: -frame.n,
+        };
+    }
+    if let Some(a) = aov {
+        *a = Aov {
+            albedo: shading.aov.albedo,
+            normal: frame.n,
+            depth: hit.t,
+            fiber: shading.aov.fiber,
+            ray_mask: shading.aov.ray_mask,
+            growth_time: shading.aov.growth_time,
+        };
+    }
+    ShadingPoint {
+        p: s.p,
+        ng,
+        frame,
+        wo: frame.to_local(wo_world),
+        bsdf: shading.bsdf,
+        eps: 2e-5 * scene.accel.scale(),
+    }
+}
+
+/// The light-independent part of sample `sample` of pixel `pixel`.
+pub fn primary_sample(scene: &Scene, pixel: UVec2, sample: u32, seed: u64) -> PrimarySample {
+    let cam = &scene.camera;
+    let index = pixel.y as u64 * cam.width as u64 + pixel.x as u64;
+    let (mut rng, _) = sample_rngs(seed, index, sample);
+    let film = pixel.as_vec2() + Vec2::splat(0.5) + scene.filter.sample(&mut rng);
+    let ray = cam.ray(film, rng.next_vec2());
+    let mut aov = Aov::default();
+    match scene.accel.intersect(&ray, f32::INFINITY) {
+        Some(hit) => PrimarySample {
+            ray,
+            t_hit: hit.t,
+            point: Some(shading_point(scene, &ray, &hit, Some(&mut aov))),
+            aov,
+        },
+        None => PrimarySample {
+            ray,
+            t_hit: f32::INFINITY,
+            point: None,
+            aov,
+        },
+    }
+}
+
+/// The lighting random stream of a sample (the second of [`sample_rngs`]).
+pub fn light_rng(scene: &Scene, pixel: UVec2, sample: u32, seed: u64) -> Pcg32 {
+    let index = pixel.y as u64 * scene.camera.width as u64 + pixel.x as u64;
+    sample_rngs(seed, index, sample).1
+}
+
+/// The nearest light a ray meets before `t_max`: (light index, distance, radiance, light pdf).
+fn nearest_light(lights: &[Light], ray: &Ray, t_max: f32) -> Option<(usize, f32, Vec3, f32)> {
+    let mut best: Option<(usize, f32, Vec3, f32)> = None;
+    for (i, l) in lights.iter().enumerate() {
+        if let Some((t, le, pdf)) = l.hit(ray) {
+            let limit = best.map_or(t_max, |b| b.1);
+            // Environment lights (t = ∞) count only when nothing else was hit.
+            if t < limit || (t.is_infinite() && t_max.is_infinite() && best.is_none()) {
+                best = Some((i, t, le, pdf));
+            }
+        }
+    }
+    best
+}
+
+fn offset_origin(sp: &ShadingPoint, dir: Vec3) -> Vec3 {
+    let side = if sp.ng.dot(dir) >= 0.0 { 1.0 } else { -1.0 };
+    sp.p + sp.ng * (side * sp.eps)
+}
+
+/// Next-event estimation: one sample of every light, weighted against BSDF sampling by the power
+/// heuristic (delta lights take weight 1). Returns reflected radiance towards `wo`.
+pub fn sample_lights(
+    scene: &Scene,
+    sp: &ShadingPoint,
+    lights: &[Light],
+    rng: &mut Pcg32,
+    rays: &mut RayCount,
+) -> Vec3 {
+    let mut l = Vec3::ZERO;
+    if sp.bsdf.is_delta() {
+        return l;
+    }
+    for light in lights {
+        let u = rng.next_vec2();
+        let Some(ls) = light.sample(sp.p, u) else {
+            continue;
+        };
+        if !(ls.pdf > 0.0) || ls.li == Vec3::ZERO {
+            continue;
+        }
+        let wi = sp.frame.to_local(ls.wi);
+        let f = sp.bsdf.eval(sp.wo, wi);
+        if f == Vec3::ZERO {
+            continue;
+        }
+        let o = offset_origin(sp, ls.wi);
+        let shadow = Ray { o, d: ls.wi };
+        rays.0 += 1;
+        let t_max = if ls.dist.is_finite() {
+            ls.dist * (1.0 - 1e-4)
+        } else {
+            f32::INFINITY
+        };
+        if !scene.accel.unoccluded(&shadow, t_max) {
+            continue;
+        }
+        let w = if ls.is_delta {
+            1.0
+        } else {
+            power_heuristic(ls.pdf, sp.bsdf.pdf(sp.wo, wi))
+        };
+        l += f * ls.li * (wi.z.abs() * w / ls.pdf);
+    }
+    l
+}
+
+/// The light-dependent part of direct lighting at a shading point: next-event estimation over all
+/// `lights` plus one BSDF-sampled ray that collects the emission of the light it meets (MIS).
+pub fn shade_direct(scene: &Scene, sp: &ShadingPoint, lights: &[Light], rng: &mut Pcg32) -> Vec3 {
+    shade_direct_counted(scene, sp, lights, rng, &mut RayCount::default())
+}
+
+fn shade_direct_counted(
+    scene: &Scene,
+    sp: &ShadingPoint,
+    lights: &[Light],
+    rng: &mut Pcg32,
+    rays: &mut RayCount,
+) -> Vec3 {
+    let mut l = sample_lights(scene, sp, lights, rng, rays);
+    let uc = rng.next_f32();
+    let u = rng.next_vec2();
+    if lights.iter().all(Light::is_delta) {
+        return l;
+    }
+    let Some(bs) = sp.bsdf.sample(sp.wo, uc, u) else {
+        return l;
+    };
+    if !(bs.pdf > 0.0) {
+        return l;
+    }
+    let d = sp.frame.to_world(bs.wi);
+    let ray = Ray {
+        o: offset_origin(sp, d),
+        d,
+    };
+    rays.0 += 1;
+    let t_scene = scene
+        .accel
+        .intersect(&ray, f32::INFINITY)
+        .map_or(f32::INFINITY, |h| h.t);
+    if let Some((_, _, le, light_pdf)) = nearest_light(lights, &ray, t_scene) {
+        let w = if bs.is_delta {
+            1.0
+        } else {
+            power_heuristic(bs.pdf, light_pdf)
+        };
+        l += bs.f * le * (bs.wi.z.abs() * w / bs.pdf);
+    }
+    l
+}
+
+/// Emission seen directly along the camera ray plus direct lighting at the first hit.
+pub fn direct_radiance(scene: &Scene, ps: &PrimarySample, lights: &[Light], rng: &mut Pcg32) -> Vec3 {
+    direct_radiance_counted(scene, ps, lights, rng, &mut RayCount::default())
+}
+
+pub(crate) fn direct_radiance_counted(
+    scene: &Scene,
+    ps: &PrimarySample,
+    lights: &[Light],
+    rng: &mut Pcg32,
+    rays: &mut RayCount,
+) -> Vec3 {
+    if let Some((_, t, le, _)) = nearest_light(lights, &ps.ray, ps.t_hit) {
+        if t < ps.t_hit || ps.point.is_none() {
+            return le;
+        }
+    }
+    match &ps.point {
+        Some(sp) => shade_direct_counted(scene, sp, lights, rng, rays),
+        None => Vec3::ZERO,
+    }
+}
+
+/// Unidirectional path tracing from a primary sample (pbrt-v4 §13.4 structure): NEE at every
+/// non-delta vertex, BSDF-sampled continuation MIS-weighted when it meets a light, Russian
+/// roulette with survival probability min(1, max throughput) from bounce 3.
+pub(crate) fn path_radiance(
+    scene: &Scene,
+    ps: &PrimarySample,
+    lights: &[Light],
+    rng: &mut Pcg32,
+    max_depth: u32,
+    rays: &mut RayCount,
+) -> Vec3 {
+    let mut radiance = Vec3::ZERO;
+    let mut beta = Vec3::ONE;
+    let mut ray = ps.ray;
+    let mut t_hit = ps.t_hit;
+    let mut sp_opt = ps.point;
+    let mut prev_pdf = 0.0f32;
+    let mut specular = true;
+    let mut depth = 0u32;
+    loop {
+        // Emission along the current ray (a light in front of the surface, or the environment).
+        if let Some((_, t, le, light_pdf)) = nearest_light(lights, &ray, t_hit) {
+            if t < t_hit || sp_opt.is_none() {
+                let w = if specular {
+                    1.0
+                } else {
+                    power_heuristic(prev_pdf, light_pdf)
+                };
+                radiance += beta * le * w;
+                break;
+            }
+        }
+        let Some(sp) = sp_opt else { break };
+        if depth >= max_depth {
+            break;
+        }
+        radiance += beta * sample_lights(scene, &sp, lights, rng, rays);
+        let uc = rng.next_f32();
+        let u = rng.next_vec2();
+        let Some(bs) = sp.bsdf.sample(sp.wo, uc, u) else {
+            break;
+        };
+        if !(bs.pdf > 0.0) {
+            break;
+        }
+        beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
+        specular = bs.is_delta;
+        prev_pdf = bs.pdf;
+        depth += 1;
+        if depth >= 3 {
+            let q = beta.max_element().min(1.0);
+            if rng.next_f32() >= q {
+                break;
+            }
+            beta /= q;
+        }
+        if !beta.is_finite() || beta == Vec3::ZERO {
+            break;
+        }
+        let d = sp.frame.to_world(bs.wi);
+        ray = Ray {
+            o: offset_origin(&sp, d),
+            d,
+        };
+        rays.0 += 1;
+        match scene.accel.intersect(&ray, f32::INFINITY) {
+            Some(h) => {
+                t_hit = h.t;
+                sp_opt = Some(shading_point(scene, &ray, &h, None));
+            }
+            None => {
+                t_hit = f32::INFINITY;
+                sp_opt = None;
+            }
+        }
+    }
+    radiance
+}

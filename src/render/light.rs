@@ -1,0 +1,488 @@
+//! Lights: point, spot, distant, rectangular area, sphere, and a constant or lat-long (EXR)
+//! environment. Lights are not in the BVH: rays are tested against them analytically, so a
+//! light can move (a light sweep) without rebuilding anything, and lights never cast shadows.
+//!
+//! Units: lengths in mm; `intensity` in W/sr, `radiance` in W/(sr·mm²) and `irradiance` in W/mm²
+//! (any consistent unit works; the film records radiance).
+
+use super::geometry::Ray;
+use crate::math::{uniform_cone, uniform_sphere, Frame, PI, UNIFORM_SPHERE_PDF};
+use glam::{Vec2, Vec3};
+use std::sync::Arc;
+
+/// One light of the scene.
+#[derive(Clone, Debug)]
+pub enum Light {
+    /// Isotropic point light of radiant intensity `intensity`.
+    Point { position: Vec3, intensity: Vec3 },
+    /// Point light limited to a cone about `direction` with a smoothstep falloff between
+    /// `cos_outer` and `cos_inner` (pbrt-v4 §12.2.2).
+    Spot {
+        position: Vec3,
+        direction: Vec3,
+        intensity: Vec3,
+        cos_inner: f32,
+        cos_outer: f32,
+    },
+    /// Light from one direction (`direction` points towards the light), irradiance `irradiance`
+    /// on a surface facing it.
+    Distant { direction: Vec3, irradiance: Vec3 },
+    /// One-sided parallelogram `corner + a·edge_u + b·edge_v`, emitting `radiance` towards
+    /// `edge_u × edge_v`.
+    Rect {
+        corner: Vec3,
+        edge_u: Vec3,
+        edge_v: Vec3,
+        radiance: Vec3,
+    },
+    /// Sphere emitting `radiance` outwards.
+    Sphere {
+        center: Vec3,
+        radius: f32,
+        radiance: Vec3,
+    },
+    /// Light from infinitely far away in every direction.
+    Environment(Environment),
+}
+
+/// A constant environment or a lat-long map (z up; u = φ/2π with φ = atan2(y, x), v = θ/π).
+#[derive(Clone, Debug)]
+pub struct Environment {
+    pub scale: Vec3,
+    pub map: Option<Arc<EnvMap>>,
+}
+
+/// A lat-long radiance map with its sampling distribution.
+#[derive(Debug)]
+pub struct EnvMap {
+    pub width: usize,
+    pub height: usize,
+    pub texels: Vec<Vec3>,
+    dist: Distribution2D,
+}
+
+/// A sample of incident light at a point.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    /// Unit direction towards the light (world).
+    pub wi: Vec3,
+    /// Distance to the light sample (infinite for distant and environment lights).
+    pub dist: f32,
+    /// Incident radiance (or, for delta lights, irradiance at normal incidence: I/d², E).
+    pub li: Vec3,
+    /// Solid-angle density; 1 for delta lights.
+    pub pdf: f32,
+    pub is_delta: bool,
+}
+
+impl Light {
+    /// True for lights that a BSDF-sampled ray can never hit (point, spot, distant).
+    pub fn is_delta(&self) -> bool {
+        matches!(
+            self,
+            Light::Point { .. } | Light::Spot { .. } | Light::Distant { .. }
+        )
+    }
+
+    /// Samples incident light at `p` with uniform numbers `u`.
+    pub fn sample(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
+        match self {
+            Light::Point {
+                position,
+                intensity,
+            } => delta_point(p, *position, *intensity),
+            Light::Spot {
+                position,
+                direction,
+                intensity,
+                cos_inner,
+                cos_outer,
+            } => {
+                let mut s = delta_point(p, *position, *intensity)?;
+                let cos = (-s.wi).dot(*direction);
+                s.li *= smoothstep(*cos_outer, *cos_inner, cos);
+                Some(s)
+            }
+            Light::Distant {
+                direction,
+                irradiance,
+            } => Some(LightSample {
+                wi: *direction,
+                dist: f32::INFINITY,
+                li: *irradiance,
+                pdf: 1.0,
+                is_delta: true,
+            }),
+            Light::Rect {
+                corner,
+                edge_u,
+                edge_v,
+                radiance,
+            } => {
+                let q = *corner + *edge_u * u.x + *edge_v * u.y;
+                let n = edge_u.cross(*edge_v);
+                let area = n.length();
+                let to = q - p;
+                let d2 = to.length_squared();
+                let dist = d2.sqrt();
+                let wi = to / dist;
+                let cos_l = -wi.dot(n / area);
+                if cos_l <= 0.0 || !(dist > 0.0) {
+                    return None;
+                }
+                Some(LightSample {
+                    wi,
+                    dist,
+                    li: *radiance,
+                    pdf: d2 / (cos_l * area),
+                    is_delta: false,
+                })
+            }
+            Light::Sphere {
+                center,
+                radius,
+                radiance,
+            } => {
+                let to = *center - p;
+                let d2 = to.length_squared();
+                let r2 = radius * radius;
+                if d2 <= r2 {
+                    return None;
+                }
+                // Uniform in the cone of directions the sphere subtends (pbrt-v4 §6.2.3).
+                let cos_max = (1.0 - r2 / d2).max(0.0).sqrt();
+                let frame = Frame::from_normal(to / d2.sqrt());
+                let wi = frame.to_world(uniform_cone(u, cos_max));
+                let t = intersect_sphere(&Ray { o: p, d: wi }, *center, *radius)
+                    .unwrap_or(d2.sqrt() - radius);
+                Some(LightSample {
+                    wi,
+                    dist: t,
+                    li: *radiance,
+                    pdf: 1.0 / (2.0 * PI * (1.0 - cos_max)),
+                    is_delta: false,
+                })
+            }
+            Light::Environment(env) => {
+                let (wi, pdf) = match &env.map {
+                    None => (uniform_sphere(u), UNIFORM_SPHERE_PDF),
+                    Some(map) => map.sample(u)?,
+                };
+                Some(LightSample {
+                    wi,
+                    dist: f32::INFINITY,
+                    li: env.radiance(wi),
+                    pdf,
+                    is_delta: false,
+                })
+            }
+        }
+    }
+
+    /// Where a ray first meets this light (distance and emitted radiance towards the ray origin),
+    /// and the solid-angle density `sample` would have chosen that direction with from `ray.o`.
+    pub fn hit(&self, ray: &Ray) -> Option<(f32, Vec3, f32)> {
+        match self {
+            Light::Rect {
+                corner,
+                edge_u,
+                edge_v,
+                radiance,
+            } => {
+                let n = edge_u.cross(*edge_v);
+                let area = n.length();
+                let denom = ray.d.dot(n);
+                if denom >= 0.0 {
+                    return None; // one-sided: seen only from the front
+                }
+                let t = (*corner - ray.o).dot(n) / denom;
+                if !(t > 0.0) || !t.is_finite() {
+                    return None;
+                }
+                let rel = ray.at(t) - *corner;
+                // Coordinates in the (possibly non-orthogonal) edge basis.
+                let (uu, uv, vv) = (edge_u.dot(*edge_u), edge_u.dot(*edge_v), edge_v.dot(*edge_v));
+                let (ru, rv) = (rel.dot(*edge_u), rel.dot(*edge_v));
+                let det = uu * vv - uv * uv;
+                let a = (ru * vv - rv * uv) / det;
+                let b = (rv * uu - ru * uv) / det;
+                if !(0.0..=1.0).contains(&a) || !(0.0..=1.0).contains(&b) {
+                    return None;
+                }
+                let cos_l = -denom / area;
+                Some((t, *radiance, t * t / (cos_l * area)))
+            }
+            Light::Sphere {
+                center,
+                radius,
+                radiance,
+            } => {
+                let t = intersect_sphere(ray, *center, *radius)?;
+                let d2 = (*center - ray.o).length_squared();
+                let r2 = radius * radius;
+                if d2 <= r2 {
+                    return None;
+                }
+                let cos_max = (1.0 - r2 / d2).max(0.0).sqrt();
+                Some((t, *radiance, 1.0 / (2.0 * PI * (1.0 - cos_max))))
+            }
+            Light::Environment(env) => {
+                let pdf = match &env.map {
+                    None => UNIFORM_SPHERE_PDF,
+                    Some(map) => map.pdf(ray.d),
+                };
+                Some((f32::INFINITY, env.radiance(ray.d), pdf))
+            }
+            _ => None,
+        }
+    }
+}
+
+fn delta_point(p: Vec3, position: Vec3, intensity: Vec3) -> Option<LightSample> {
+    let to = position - p;
+    let d2 = to.length_squared();
+    if !(d2 > 0.0) {
+        return None;
+    }
+    let dist = d2.sqrt();
+    // Inverse-square law: irradiance at normal incidence E = I / d².
+    Some(LightSample {
+        wi: to / dist,
+        dist,
+        li: intensity / d2,
+        pdf: 1.0,
+        is_delta: true,
+    })
+}
+
+/// Hermite smoothstep, 0 below `a`, 1 above `b`.
+fn smoothstep(a: f32, b: f32, x: f32) -> f32 {
+    if a >= b {
+        return if x >= b { 1.0 } else { 0.0 };
+    }
+    let t = ((x - a) / (b - a)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+/// Nearest positive distance at which `ray` (unit direction) meets a sphere.
+pub fn intersect_sphere(ray: &Ray, center: Vec3, radius: f32) -> Option<f32> {
+    let oc = ray.o - center;
+    let b = oc.dot(ray.d);
+    let c = oc.length_squared() - radius * radius;
+    // Numerically stable form (Haines et al., Ray Tracing Gems ch. 7): discriminant from the
+    // distance of the centre to the ray line.
+    let perp = oc - ray.d * b;
+    let disc = radius * radius - perp.length_squared();
+    if disc < 0.0 {
+        return None;
+    }
+    let q = -b - b.signum() * disc.sqrt();
+    let (t0, t1) = if q != 0.0 { (c / q, q) } else { (-b, -b) };
+    let (t0, t1) = (t0.min(t1), t0.max(t1));
+    if t0 > 0.0 {
+        Some(t0)
+    } else if t1 > 0.0 {
+        Some(t1)
+    } else {
+        None
+    }
+}
+
+impl Environment {
+    /// Radiance arriving from direction `-d`, i.e. seen looking along `d`.
+    pub fn radiance(&self, d: Vec3) -> Vec3 {
+        match &self.map {
+            None => self.scale,
+            Some(m) => self.scale * m.lookup(d),
+        }
+    }
+}
+
+impl EnvMap {
+    /// A map from row-major texels (top row = +z); sampling is proportional to luminance·sin θ.
+    pub fn new(width: usize, height: usize, texels: Vec<Vec3>) -> Self {
+        let weights: Vec<f32> = (0..height)
+            .flat_map(|y| {
+                let sin = ((y as f32 + 0.5) / height as f32 * PI).sin();
+                let texels = &texels;
+                (0..width).map(move |x| {
+                    let c = texels[y * width + x];
+                    (crate::math::luminance(c).max(0.0) * sin).max(1e-8)
+                })
+            })
+            .collect();
+        EnvMap {
+            width,
+            height,
+            dist: Distribution2D::new(&weights, width, height),
+            texels,
+        }
+    }
+
+    fn uv(d: Vec3) -> Vec2 {
+        let phi = d.y.atan2(d.x);
+        let phi = if phi < 0.0 { phi + 2.0 * PI } else { phi };
+        Vec2::new(phi / (2.0 * PI), crate::math::safe_acos(d.z) / PI)
+    }
+
+    fn dir(uv: Vec2) -> Vec3 {
+        let (phi, theta) = (uv.x * 2.0 * PI, uv.y * PI);
+        Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos())
+    }
+
+    pub fn lookup(&self, d: Vec3) -> Vec3 {
+        let uv = Self::uv(d);
+        let x = ((uv.x * self.width as f32) as usize).min(self.width - 1);
+        let y = ((uv.y * self.height as f32) as usize).min(self.height - 1);
+        self.texels[y * self.width + x]
+    }
+
+    /// Direction and solid-angle pdf: p(ω) = p(u, v) / (2π² sin θ) (pbrt-v4 §12.5.2).
+    fn sample(&self, u: Vec2) -> Option<(Vec3, f32)> {
+        let (uv, pdf_uv) = self.dist.sample(u);
+        let sin = (uv.y * PI).sin();
+        if sin <= 0.0 || pdf_uv <= 0.0 {
+            return None;
+        }
+        Some((Self::dir(uv), pdf_uv / (2.0 * PI * PI * sin)))
+    }
+
+    fn pdf(&self, d: Vec3) -> f32 {
+        let uv = Self::uv(d);
+        let sin = (uv.y * PI).sin();
+        if sin <= 0.0 {
+            return 0.0;
+        }
+        self.dist.pdf(uv) / (2.0 * PI * PI * sin)
+    }
+}
+
+/// Piecewise-constant 1D density on [0, 1) (pbrt-v4 §A.4.1).
+#[derive(Debug, Clone)]
+struct Distribution1D {
+    func: Vec<f32>,
+    cdf: Vec<f32>,
+    integral: f32,
+}
+
+impl Distribution1D {
+    fn new(func: &[f32]) -> Self {
+        let n = func.len();
+        let mut cdf = vec![0.0f32; n + 1];
+        for i in 0..n {
+            cdf[i + 1] = cdf[i] + func[i] / n as f32;
+        }
+        let integral = cdf[n];
+        for c in &mut cdf[1..] {
+            *c /= integral;
+        }
+        Distribution1D {
+            func: func.to_vec(),
+            cdf,
+            integral,
+        }
+    }
+
+    /// Continuous sample in [0, 1), its density and its cell.
+    fn sample(&self, u: f32) -> (f32, f32, usize) {
+        let n = self.func.len();
+        let i = (self.cdf.partition_point(|&c| c <= u).max(1) - 1).min(n - 1);
+        let width = self.cdf[i + 1] - self.cdf[i];
+        let du = if width > 0.0 { (u - self.cdf[i]) / width } else { 0.5 };
+        let x = ((i as f32 + du.clamp(0.0, 1.0)) / n as f32).min(1.0 - f32::EPSILON);
+        (x, self.func[i] / self.integral, i)
+    }
+
+    fn pdf_cell(&self, i: usize) -> f32 {
+        self.func[i] / self.integral
+    }
+}
+
+/// Piecewise-constant 2D density: a marginal over rows and a conditional per row.
+#[derive(Debug, Clone)]
+struct Distribution2D {
+    rows: Vec<Distribution1D>,
+    marginal: Distribution1D,
+    width: usize,
+    height: usize,
+}
+
+impl Distribution2D {
+    fn new(f: &[f32], width: usize, height: usize) -> Self {
+        let rows: Vec<Distribution1D> = (0..height)
+            .map(|y| Distribution1D::new(&f[y * width..(y + 1) * width]))
+            .collect();
+        let marg: Vec<f32> = rows.iter().map(|r| r.integral).collect();
+        Distribution2D {
+            marginal: Distribution1D::new(&marg),
+            rows,
+            width,
+            height,
+        }
+    }
+
+    fn sample(&self, u: Vec2) -> (Vec2, f32) {
+        let (v, pv, row) = self.marginal.sample(u.y);
+        let (x, px, _) = self.rows[row].sample(u.x);
+        (Vec2::new(x, v), pv * px)
+    }
+
+    fn pdf(&self, uv: Vec2) -> f32 {
+        let x = ((uv.x * self.width as f32) as usize).min(self.width - 1);
+        let y = ((uv.y * self.height as f32) as usize).min(self.height - 1);
+        self.marginal.pdf_cell(y) * self.rows[y].pdf_cell(x)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Pcg32;
+
+    #[test]
+    fn sampled_pdf_matches_hit_pdf() {
+        let lights = [
+            Light::Rect {
+                corner: Vec3::new(-1.0, -1.0, 5.0),
+                edge_u: Vec3::new(0.0, 2.0, 0.0),
+                edge_v: Vec3::new(3.0, 0.0, 0.0),
+                radiance: Vec3::ONE,
+            },
+            Light::Sphere {
+                center: Vec3::new(0.5, 0.0, 4.0),
+                radius: 1.0,
+                radiance: Vec3::ONE,
+            },
+        ];
+        let mut rng = Pcg32::new(1, 1);
+        for l in &lights {
+            for _ in 0..100 {
+                let s = l.sample(Vec3::ZERO, rng.next_vec2()).unwrap();
+                let (t, _, pdf) = l.hit(&Ray { o: Vec3::ZERO, d: s.wi }).unwrap();
+                assert!((t - s.dist).abs() < 1e-3 * t, "{t} {}", s.dist);
+                assert!((pdf - s.pdf).abs() < 1e-3 * pdf, "{pdf} {}", s.pdf);
+            }
+        }
+    }
+
+    #[test]
+    fn env_map_pdf_integrates_to_one_and_matches_sampling() {
+        let (w, h) = (16, 8);
+        let texels = (0..w * h)
+            .map(|i| Vec3::splat(1.0 + (i % 7) as f32))
+            .collect();
+        let map = EnvMap::new(w, h, texels);
+        let mut rng = Pcg32::new(3, 0);
+        // ∫ p dω estimated with uniform sphere samples: mean of p / (1/4π) must be 1.
+        let n = 200_000;
+        let mean: f64 = (0..n)
+            .map(|_| map.pdf(uniform_sphere(rng.next_vec2())) as f64 * 4.0 * std::f64::consts::PI)
+            .sum::<f64>()
+            / n as f64;
+        assert!((mean - 1.0).abs() < 0.02, "{mean}");
+        for _ in 0..1000 {
+            let (d, pdf) = map.sample(rng.next_vec2()).unwrap();
+            assert!((map.pdf(d) - pdf).abs() <= 1e-2 * pdf, "{} {pdf}", map.pdf(d));
+        }
+    }
+}

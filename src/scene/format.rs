@@ -1,0 +1,317 @@
+//! The TOML scene format as plain serde data. Every table denies unknown fields, so a typo is an
+//! error naming the field and the allowed names. Documented field by field in scenes/README.md.
+
+use serde::Deserialize;
+use std::collections::BTreeMap;
+
+/// A whole scene file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    #[serde(default)]
+    pub render: RenderTable,
+    pub camera: CameraTable,
+    #[serde(default)]
+    pub lights: Vec<LightTable>,
+    #[serde(default)]
+    pub materials: BTreeMap<String, MaterialTable>,
+    #[serde(default)]
+    pub objects: Vec<ObjectTable>,
+    /// Light-sweep setup (used by `xylem sweep`).
+    pub sweep: Option<SweepTable>,
+}
+
+/// `[render]`: image size and sampling.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RenderTable {
+    pub width: u32,
+    pub height: u32,
+    pub spp: u32,
+    pub integrator: IntegratorName,
+    pub max_depth: u32,
+    pub seed: u64,
+    /// PNG exposure in stops.
+    pub exposure: f32,
+    pub filter: FilterName,
+    /// Filter radius in pixels (box: half-width).
+    pub filter_radius: Option<f32>,
+}
+
+impl Default for RenderTable {
+    fn default() -> Self {
+        RenderTable {
+            width: 512,
+            height: 512,
+            spp: 16,
+            integrator: IntegratorName::Direct,
+            max_depth: 8,
+            seed: 0,
+            exposure: 0.0,
+            filter: FilterName::Gaussian,
+            filter_radius: None,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum IntegratorName {
+    Direct,
+    Path,
+}
+
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum FilterName {
+    Box,
+    Tent,
+    Gaussian,
+}
+
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum ProjectionName {
+    #[default]
+    Perspective,
+    Orthographic,
+}
+
+/// `[camera]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraTable {
+    #[serde(default)]
+    pub projection: ProjectionName,
+    pub eye: [f32; 3],
+    pub target: [f32; 3],
+    #[serde(default = "default_up")]
+    pub up: [f32; 3],
+    #[serde(default = "default_fov")]
+    pub fov_deg: f32,
+    #[serde(default)]
+    pub lens_radius: f32,
+    pub focus_distance: Option<f32>,
+    /// Orthographic film width (mm).
+    pub width: Option<f32>,
+}
+
+fn default_up() -> [f32; 3] {
+    [0.0, 0.0, 1.0]
+}
+fn default_fov() -> f32 {
+    40.0
+}
+fn one() -> f32 {
+    1.0
+}
+fn white() -> [f32; 3] {
+    [1.0, 1.0, 1.0]
+}
+
+/// `[[lights]]`, one table per light, chosen by `type`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum LightTable {
+    Point {
+        name: Option<String>,
+        position: [f32; 3],
+        intensity: f32,
+        #[serde(default = "white")]
+        color: [f32; 3],
+    },
+    Spot {
+        name: Option<String>,
+        position: [f32; 3],
+        target: [f32; 3],
+        intensity: f32,
+        #[serde(default = "white")]
+        color: [f32; 3],
+        cone_deg: f32,
+        #[serde(default)]
+        falloff_deg: f32,
+    },
+    Distant {
+        name: Option<String>,
+        direction: [f32; 3],
+        irradiance: f32,
+        #[serde(default = "white")]
+        color: [f32; 3],
+    },
+    Rect {
+        name: Option<String>,
+        corner: [f32; 3],
+        edge_u: [f32; 3],
+        edge_v: [f32; 3],
+        radiance: f32,
+        #[serde(default = "white")]
+        color: [f32; 3],
+    },
+    Sphere {
+        name: Option<String>,
+        center: [f32; 3],
+        radius: f32,
+        radiance: f32,
+        #[serde(default = "white")]
+        color: [f32; 3],
+    },
+    Environment {
+        name: Option<String>,
+        #[serde(default = "one")]
+        radiance: f32,
+        #[serde(default = "white")]
+        color: [f32; 3],
+        map: Option<String>,
+        #[serde(default)]
+        rotate_deg: f32,
+    },
+}
+
+impl LightTable {
+    pub fn name(&self) -> Option<&str> {
+        match self {
+            LightTable::Point { name, .. }
+            | LightTable::Spot { name, .. }
+            | LightTable::Distant { name, .. }
+            | LightTable::Rect { name, .. }
+            | LightTable::Sphere { name, .. }
+            | LightTable::Environment { name, .. } => name.as_deref(),
+        }
+    }
+}
+
+/// `[materials.NAME]`, chosen by `type`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum MaterialTable {
+    Lambertian { albedo: [f32; 3] },
+}
+
+/// A uniform or per-axis scale.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(untagged)]
+pub enum Scale {
+    Uniform(f32),
+    Axes([f32; 3]),
+}
+
+impl Default for Scale {
+    fn default() -> Self {
+        Scale::Uniform(1.0)
+    }
+}
+
+/// `[[objects]]`: a shape, its material, its placement in the world and in the tree. Which of
+/// the shape fields (`size` ... `file`) are required depends on `shape`; the loader rejects the
+/// ones a shape does not use.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectTable {
+    pub name: Option<String>,
+    pub shape: ShapeKind,
+    pub material: String,
+    /// box: [x, y, z]; quad: [x, y] (mm).
+    pub size: Option<Vec<f32>>,
+    pub radius: Option<f32>,
+    pub height: Option<f32>,
+    pub segments: Option<u32>,
+    /// lathe: (radius, z) points (mm).
+    pub profile: Option<Vec<[f32; 2]>>,
+    /// teapot: tessellation steps per patch side.
+    pub resolution: Option<u32>,
+    /// mesh: OBJ or PLY path, relative to the scene file.
+    pub file: Option<String>,
+    #[serde(default)]
+    pub translate: [f32; 3],
+    #[serde(default)]
+    pub rotate_deg: [f32; 3],
+    #[serde(default)]
+    pub scale: Scale,
+    /// Use smooth (interpolated) normals where the shape or mesh has them.
+    #[serde(default = "yes")]
+    pub smooth: bool,
+    pub tree: Option<TreeTable>,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// The built-in shapes and meshes from files.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum ShapeKind {
+    /// Axis-aligned box centred at the origin (`size`).
+    Box,
+    /// Rectangle in the xy plane centred at the origin, facing +z (`size` = [x, y]).
+    Quad,
+    /// Sphere about the origin (`radius`, `segments`).
+    Sphere,
+    /// Cylinder along z from 0 to `height`, with caps (`radius`, `height`, `segments`).
+    Cylinder,
+    /// A `profile` of (radius, z) points revolved about z (`segments`).
+    Lathe,
+    /// The Utah teapot from Newell's Bézier patches, `size` = [mm per patch unit], `resolution`.
+    Teapot,
+    /// A triangle mesh from an OBJ or PLY `file`.
+    Mesh,
+}
+
+/// `[objects.tree]`: where the object sits in the tree (see `material::Placement`).
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TreeTable {
+    #[serde(default)]
+    pub origin: [f32; 3],
+    #[serde(default = "default_axis")]
+    pub axis: [f32; 3],
+    #[serde(default)]
+    pub rotation_deg: f32,
+    #[serde(default = "one")]
+    pub scale: f32,
+}
+
+fn default_axis() -> [f32; 3] {
+    [0.0, 0.0, 1.0]
+}
+
+/// `[sweep]`: the light-sweep setup. A light named `light` moves on an arc of radius `radius`
+/// about `pivot`, turning about `axis`; angle 0 is straight above the pivot (+z), positive angles
+/// turn by the right-hand rule about `axis`.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SweepTable {
+    #[serde(default = "default_frames")]
+    pub frames: u32,
+    /// Arc from / to, degrees from the zenith, each in [-90, 90].
+    pub arc_deg: [f32; 2],
+    /// Name of the light that moves (a point, spot or sphere light).
+    pub light: String,
+    #[serde(default)]
+    pub pivot: [f32; 3],
+    /// Distance from the pivot to the light (mm).
+    pub radius: f32,
+    #[serde(default = "default_sweep_axis")]
+    pub axis: [f32; 3],
+    /// Named image regions the sweep reports on (pixels, x0 < x1, y0 < y1, top-left origin).
+    #[serde(default)]
+    pub regions: Vec<SweepRegion>,
+}
+
+fn default_frames() -> u32 {
+    48
+}
+fn default_sweep_axis() -> [f32; 3] {
+    [0.0, 1.0, 0.0]
+}
+
+/// One `[[sweep.regions]]` entry.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SweepRegion {
+    pub name: String,
+    pub x0: u32,
+    pub y0: u32,
+    pub x1: u32,
+    pub y1: u32,
+}

@@ -1,0 +1,335 @@
+//! Mesh files: Wavefront OBJ (through `tobj`) and PLY (ASCII and binary, read here: vertex
+//! `x y z` with optional `nx ny nz`, faces as `vertex_indices` / `vertex_index` lists, polygons
+//! fanned into triangles).
+
+use crate::render::TriMesh;
+use glam::Vec3;
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+
+/// A mesh file that could not be read, naming the file and what is wrong.
+#[derive(Debug, thiserror::Error)]
+pub enum MeshError {
+    #[error("mesh {path}: {message}")]
+    Bad { path: String, message: String },
+    #[error("mesh {path}: unsupported extension (allowed: .obj, .ply)")]
+    Extension { path: String },
+}
+
+fn bad(path: &Path, message: impl Into<String>) -> MeshError {
+    MeshError::Bad {
+        path: path.display().to_string(),
+        message: message.into(),
+    }
+}
+
+/// Loads an OBJ or PLY file by extension.
+pub fn load_mesh(path: &Path) -> Result<TriMesh, MeshError> {
+    match path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase())
+        .as_deref()
+    {
+        Some("obj") => load_obj(path),
+        Some("ply") => load_ply(path),
+        _ => Err(MeshError::Extension {
+            path: path.display().to_string(),
+        }),
+    }
+}
+
+/// All models of an OBJ file merged into one mesh (normals kept when every model has them).
+pub fn load_obj(path: &Path) -> Result<TriMesh, MeshError> {
+    let opts = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ..Default::default()
+    };
+    let (models, _) = tobj::load_obj(path, &opts).map_err(|e| bad(path, e.to_string()))?;
+    let mut out = TriMesh::default();
+    for m in models {
+        let mesh = &m.mesh;
+        if mesh.positions.len() % 3 != 0 || mesh.indices.len() % 3 != 0 {
+            return Err(bad(path, format!("model `{}` is malformed", m.name)));
+        }
+        let v3 = |f: &[f32]| f.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect::<Vec<_>>();
+        let positions = v3(&mesh.positions);
+        let normals = (mesh.normals.len() == mesh.positions.len()).then(|| v3(&mesh.normals));
+        let part = TriMesh {
+            positions,
+            normals,
+            indices: mesh
+                .indices
+                .chunks_exact(3)
+                .map(|c| [c[0], c[1], c[2]])
+                .collect(),
+        };
+        out.append(&part);
+    }
+    if out.indices.is_empty() {
+        return Err(bad(path, "no triangles"));
+    }
+    Ok(out)
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Format {
+    Ascii,
+    BinaryLe,
+    BinaryBe,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Scalar {
+    I8,
+    U8,
+    I16,
+    U16,
+    I32,
+    U32,
+    F32,
+    F64,
+}
+
+impl Scalar {
+    fn parse(s: &str) -> Option<Scalar> {
+        Some(match s {
+            "char" | "int8" => Scalar::I8,
+            "uchar" | "uint8" => Scalar::U8,
+            "short" | "int16" => Scalar::I16,
+            "ushort" | "uint16" => Scalar::U16,
+            "int" | "int32" => Scalar::I32,
+            "uint" | "uint32" => Scalar::U32,
+            "float" | "float32" => Scalar::F32,
+            "double" | "float64" => Scalar::F64,
+            _ => return None,
+        })
+    }
+
+    fn size(self) -> usize {
+        match self {
+            Scalar::I8 | Scalar::U8 => 1,
+            Scalar::I16 | Scalar::U16 => 2,
+            Scalar::I32 | Scalar::U32 | Scalar::F32 => 4,
+            Scalar::F64 => 8,
+        }
+    }
+}
+
+#[derive(Clone, Debug)]
+struct Property {
+    name: String,
+    /// `Some(count type)` for list properties.
+    list: Option<Scalar>,
+    ty: Scalar,
+}
+
+#[derive(Clone, Debug)]
+struct Element {
+    name: String,
+    count: usize,
+    props: Vec<Property>,
+}
+
+/// Reads values one at a time from the body of a PLY file.
+struct Body<R: BufRead> {
+    r: R,
+    format: Format,
+    tokens: std::vec::IntoIter<String>,
+}
+
+impl<R: BufRead> Body<R> {
+    fn value(&mut self, ty: Scalar) -> Result<f64, String> {
+        match self.format {
+            Format::Ascii => loop {
+                if let Some(t) = self.tokens.next() {
+                    return t.parse::<f64>().map_err(|_| format!("bad number `{t}`"));
+                }
+                let mut line = String::new();
+                if self.r.read_line(&mut line).map_err(|e| e.to_string())? == 0 {
+                    return Err("file ends early".into());
+                }
+                self.tokens = line
+                    .split_whitespace()
+                    .map(str::to_string)
+                    .collect::<Vec<_>>()
+                    .into_iter();
+            },
+            Format::BinaryLe | Format::BinaryBe => {
+                let mut b = [0u8; 8];
+                let n = ty.size();
+                self.r
+                    .read_exact(&mut b[..n])
+                    .map_err(|_| "file ends early".to_string())?;
+                if self.format == Format::BinaryBe {
+                    b[..n].reverse();
+                }
+                Ok(match ty {
+                    Scalar::I8 => b[0] as i8 as f64,
+                    Scalar::U8 => b[0] as f64,
+                    Scalar::I16 => i16::from_le_bytes([b[0], b[1]]) as f64,
+                    Scalar::U16 => u16::from_le_bytes([b[0], b[1]]) as f64,
+                    Scalar::I32 => i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+                    Scalar::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+                    Scalar::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+                    Scalar::F64 => f64::from_le_bytes(b),
+                })
+            }
+        }
+    }
+}
+
+/// Reads a PLY mesh.
+pub fn load_ply(path: &Path) -> Result<TriMesh, MeshError> {
+    let file = std::fs::File::open(path).map_err(|e| bad(path, e.to_string()))?;
+    parse_ply(BufReader::new(file)).map_err(|m| bad(path, m))
+}
+
+fn parse_ply<R: BufRead>(mut r: R) -> Result<TriMesh, String> {
+    let mut line = String::new();
+    let read_line = |r: &mut R, line: &mut String| -> Result<(), String> {
+        line.clear();
+        if r.read_line(line).map_err(|e| e.to_string())? == 0 {
+            return Err("header ends early (no end_header)".into());
+        }
+        Ok(())
+    };
+    read_line(&mut r, &mut line)?;
+    if line.trim() != "ply" {
+        return Err("not a PLY file (first line is not `ply`)".into());
+    }
+    let mut format = None;
+    let mut elements: Vec<Element> = Vec::new();
+    loop {
+        read_line(&mut r, &mut line)?;
+        let words: Vec<&str> = line.split_whitespace().collect();
+        match words.as_slice() {
+            ["end_header"] => break,
+            ["format", f, _] => {
+                format = Some(match *f {
+                    "ascii" => Format::Ascii,
+                    "binary_little_endian" => Format::BinaryLe,
+                    "binary_big_endian" => Format::BinaryBe,
+                    _ => return Err(format!("unknown format `{f}`")),
+                })
+            }
+            ["element", name, count] => elements.push(Element {
+                name: name.to_string(),
+                count: count.parse().map_err(|_| format!("bad element count `{count}`"))?,
+                props: Vec::new(),
+            }),
+            ["property", "list", ct, ty, name] => {
+                let e = elements.last_mut().ok_or("property before any element")?;
+                e.props.push(Property {
+                    name: name.to_string(),
+                    list: Some(Scalar::parse(ct).ok_or(format!("unknown type `{ct}`"))?),
+                    ty: Scalar::parse(ty).ok_or(format!("unknown type `{ty}`"))?,
+                });
+            }
+            ["property", ty, name] => {
+                let e = elements.last_mut().ok_or("property before any element")?;
+                e.props.push(Property {
+                    name: name.to_string(),
+                    list: None,
+                    ty: Scalar::parse(ty).ok_or(format!("unknown type `{ty}`"))?,
+                });
+            }
+            ["comment", ..] | ["obj_info", ..] | [] => {}
+            _ => return Err(format!("unexpected header line `{}`", line.trim())),
+        }
+    }
+    let format = format.ok_or("no format line")?;
+    let mut body = Body {
+        r,
+        format,
+        tokens: Vec::new().into_iter(),
+    };
+    let mut mesh = TriMesh::default();
+    let mut normals = Vec::new();
+    for e in &elements {
+        let idx = |n: &str| e.props.iter().position(|p| p.name == n);
+        let (px, py, pz) = (idx("x"), idx("y"), idx("z"));
+        let (nx, ny, nz) = (idx("nx"), idx("ny"), idx("nz"));
+        let face_prop = idx("vertex_indices").or(idx("vertex_index"));
+        if e.name == "vertex" && (px.is_none() || py.is_none() || pz.is_none()) {
+            return Err("vertex element lacks x, y or z".into());
+        }
+        let mut vals = vec![0.0f64; e.props.len()];
+        let mut list: Vec<u32> = Vec::new();
+        for _ in 0..e.count {
+            for (k, p) in e.props.iter().enumerate() {
+                match p.list {
+                    None => vals[k] = body.value(p.ty)?,
+                    Some(ct) => {
+                        let n = body.value(ct)?;
+                        if !(0.0..=1e6).contains(&n) {
+                            return Err(format!("bad list length {n}"));
+                        }
+                        let is_face = e.name == "face" && Some(k) == face_prop;
+                        if is_face {
+                            list.clear();
+                        }
+                        for _ in 0..n as usize {
+                            let v = body.value(p.ty)?;
+                            if is_face {
+                                if v < 0.0 {
+                                    return Err(format!("negative vertex index {v}"));
+                                }
+                                list.push(v as u32);
+                            }
+                        }
+                    }
+                }
+            }
+            if e.name == "vertex" {
+                let g = |i: Option<usize>| vals[i.unwrap()] as f32;
+                mesh.positions.push(Vec3::new(g(px), g(py), g(pz)));
+                if let (Some(_), Some(_), Some(_)) = (nx, ny, nz) {
+                    normals.push(Vec3::new(g(nx), g(ny), g(nz)));
+                }
+            } else if e.name == "face" {
+                if face_prop.is_none() {
+                    return Err("face element lacks vertex_indices".into());
+                }
+                for i in 1..list.len().saturating_sub(1) {
+                    mesh.indices.push([list[0], list[i], list[i + 1]]);
+                }
+            }
+        }
+    }
+    if !normals.is_empty() && normals.len() == mesh.positions.len() {
+        mesh.normals = Some(normals);
+    }
+    if mesh.indices.is_empty() {
+        return Err("no faces".into());
+    }
+    Ok(mesh)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ascii_and_binary_ply_agree() {
+        let ascii = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n";
+        let a = parse_ply(ascii.as_bytes()).unwrap();
+        assert_eq!(a.indices, vec![[0, 1, 2], [0, 2, 3]]);
+        let mut bin = b"ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n".to_vec();
+        for p in &a.positions {
+            for c in p.to_array() {
+                bin.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        bin.push(4);
+        for i in [0i32, 1, 2, 3] {
+            bin.extend_from_slice(&i.to_le_bytes());
+        }
+        let b = parse_ply(&bin[..]).unwrap();
+        assert_eq!(a.positions, b.positions);
+        assert_eq!(a.indices, b.indices);
+        assert!(parse_ply(&bin[..bin.len() - 2]).is_err());
+        assert!(parse_ply("ply\nformat ascii 1.0\nelement vertex 1\nend_header\n".as_bytes()).is_err());
+    }
+}
