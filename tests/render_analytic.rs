@@ -35,7 +35,10 @@ fn lambertian_quad_under_point_light_matches_closed_form() {
         h,
     );
     let scene = Scene {
-        accel: Accel::new(vec![instance(shapes::make_quad(Vec2::new(400.0, 400.0)), 0)]),
+        accel: Accel::new(vec![instance(
+            shapes::make_quad(Vec2::new(400.0, 400.0)),
+            0,
+        )]),
         materials: vec![Material::Lambertian { albedo: rho }],
         lights: vec![Light::Point {
             position: light,
@@ -49,7 +52,9 @@ fn lambertian_quad_under_point_light_matches_closed_form() {
         integrator: Integrator::Direct,
         seed: 3,
     };
-    let img = render(&scene, &settings, &RunOptions::default()).unwrap().image;
+    let img = render(&scene, &settings, &RunOptions::default())
+        .unwrap()
+        .image;
     for y in 0..h {
         for x in 0..w {
             // The world point under pixel centre (x + ½, y + ½): film width 160 mm over w pixels.
@@ -103,17 +108,16 @@ fn furnace_sphere_renders_one_within_three_sigma() {
         integrator: Integrator::Path { max_depth: 16 },
         seed: 11,
     };
-    let img = render(&scene, &settings, &RunOptions::default()).unwrap().image;
+    let img = render(&scene, &settings, &RunOptions::default())
+        .unwrap()
+        .image;
     let mut hit_pixels = 0;
     for (i, (c, se)) in img.beauty.iter().zip(&img.std_error).enumerate() {
         let y = xylem::math::luminance(*c);
         if img.aov[i].depth > 0.0 {
             hit_pixels += 1;
         }
-        assert!(
-            (y - 1.0).abs() <= 3.0 * se + 1e-5,
-            "pixel {i}: {y} ± {se}"
-        );
+        assert!((y - 1.0).abs() <= 3.0 * se + 1e-5, "pixel {i}: {y} ± {se}");
     }
     assert!(hit_pixels > 20, "the sphere must fill much of the image");
 }
@@ -139,7 +143,11 @@ fn one_and_two_threads_are_bit_identical() {
     };
     let (a, b) = (run(1), run(2));
     let bits = |img: &xylem::render::Image| -> Vec<u32> {
-        img.beauty.iter().flat_map(|c| c.to_array()).map(f32::to_bits).collect()
+        img.beauty
+            .iter()
+            .flat_map(|c| c.to_array())
+            .map(f32::to_bits)
+            .collect()
     };
     assert_eq!(bits(&a), bits(&b));
     assert_eq!(a, b);

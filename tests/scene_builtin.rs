@@ -19,7 +19,10 @@ fn every_builtin_scene_renders_tiny() {
         let out = render(&s.scene, &s.settings, &RunOptions::default()).unwrap();
         let img = out.image;
         assert_eq!(img.nonfinite, 0, "{}", p.display());
-        assert!(img.beauty.iter().all(|c| c.is_finite() && c.min_element() >= 0.0));
+        assert!(img
+            .beauty
+            .iter()
+            .all(|c| c.is_finite() && c.min_element() >= 0.0));
         assert!(
             img.beauty.iter().any(|c| c.max_element() > 0.0),
             "{} renders black",
@@ -52,7 +55,10 @@ fn scene_errors_name_file_field_and_allowed_values() {
     let e = err(&format!(
         "{CAMERA}[materials.m]\ntype = \"lambertian\"\nalbedo = [1.5, 0.0, 0.0]\n"
     ));
-    assert!(e.contains("materials.m.albedo") && e.contains("allowed 0 to 1"), "{e}");
+    assert!(
+        e.contains("materials.m.albedo") && e.contains("allowed 0 to 1"),
+        "{e}"
+    );
     let e = err(&format!(
         "{CAMERA}[materials.m]\ntype = \"lambertian\"\nalbedo = [0.5, 0.5, 0.5]\n[[objects]]\nshape = \"box\"\nradius = 2.0\nsize = [1.0, 1.0, 1.0]\nmaterial = \"m\"\n"
     ));
@@ -60,9 +66,15 @@ fn scene_errors_name_file_field_and_allowed_values() {
     let e = err(&format!(
         "{CAMERA}[materials.m]\ntype = \"lambertian\"\nalbedo = [0.5, 0.5, 0.5]\n[[objects]]\nshape = \"mesh\"\nfile = \"missing.obj\"\nmaterial = \"m\"\n"
     ));
-    assert!(e.contains("objects[0].file") && e.contains("missing.obj"), "{e}");
+    assert!(
+        e.contains("objects[0].file") && e.contains("missing.obj"),
+        "{e}"
+    );
     let e = err(&format!(
         "{CAMERA}[materials.m]\ntype = \"lambertian\"\nalbedo = [0.5, 0.5, 0.5]\n[[objects]]\nshape = \"box\"\nsize = [1.0, 1.0, 1.0]\nmaterial = \"wood\"\n"
     ));
-    assert!(e.contains("objects[0].material") && e.contains("\"m\""), "{e}");
+    assert!(
+        e.contains("objects[0].material") && e.contains("\"m\""),
+        "{e}"
+    );
 }

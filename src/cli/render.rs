@@ -111,6 +111,12 @@ fn write_outputs(
     exposure: f32,
 ) -> anyhow::Result<()> {
     crate::render::image_io::write_image_exr(exr, image)?;
-    crate::render::image_io::write_png_linear(png, image.width, image.height, &image.beauty, exposure)?;
+    crate::render::image_io::write_png_linear(
+        png,
+        image.width,
+        image.height,
+        &image.beauty,
+        exposure,
+    )?;
     Ok(())
 }

@@ -74,7 +74,10 @@ impl Camera {
                 let k = (0.5 * fov_y).tan();
                 let dir = (f.n + f.s * (ndc.x * k) + f.t * (ndc.y * k)).normalize();
                 if lens_radius <= 0.0 {
-                    return Ray { o: self.eye, d: dir };
+                    return Ray {
+                        o: self.eye,
+                        d: dir,
+                    };
                 }
                 // Thin lens: every ray through the lens point reaches the pinhole ray's point on
                 // the plane of focus (pbrt-v4 eq. 5.2).
@@ -108,7 +111,14 @@ mod tests {
             lens_radius: 5.0,
             focus_distance: 100.0,
         };
-        let c = Camera::look_at(Vec3::new(0.0, -100.0, 0.0), Vec3::ZERO, Vec3::Z, persp, 64, 32);
+        let c = Camera::look_at(
+            Vec3::new(0.0, -100.0, 0.0),
+            Vec3::ZERO,
+            Vec3::Z,
+            persp,
+            64,
+            32,
+        );
         for lens in [Vec2::new(0.1, 0.9), Vec2::new(0.5, 0.5)] {
             let r = c.ray(Vec2::new(32.0, 16.0), lens);
             // Every lens ray of the centre pixel passes through the focus point (the target).

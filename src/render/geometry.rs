@@ -47,7 +47,8 @@ impl TriMesh {
     /// Appends `other` (re-indexing its triangles); normals are kept only if both have them.
     pub fn append(&mut self, other: &TriMesh) {
         let base = self.positions.len() as u32;
-        let keep_normals = (self.normals.is_some() || self.positions.is_empty()) && other.normals.is_some();
+        let keep_normals =
+            (self.normals.is_some() || self.positions.is_empty()) && other.normals.is_some();
         self.normals = if keep_normals {
             let mut n = self.normals.take().unwrap_or_default();
             n.extend_from_slice(other.normals.as_ref().unwrap());
@@ -251,7 +252,7 @@ impl Accel {
         if self.tris.is_empty() {
             return None;
         }
-        let r = BvhRay::new(ray.o.into(), ray.d.into(), 0.0, t_max);
+        let r = bvh_ray(ray, t_max);
         let mut hit = RayHit::none();
         let tris = &self.tris;
         if !self
@@ -277,7 +278,7 @@ impl Accel {
         if self.tris.is_empty() {
             return true;
         }
-        let r = BvhRay::new(ray.o.into(), ray.d.into(), 0.0, t_max);
+        let r = bvh_ray(ray, t_max);
         let tris = &self.tris;
         self.bvh.ray_traverse_miss(r, |r, id| tris[id].intersect(r))
     }
@@ -318,9 +319,17 @@ impl Accel {
     }
 }
 
+/// The obvhs ray of a segment. obvhs 0.4 picks the child order from `direction < 0` but the slab
+/// signs from `1/direction`, which disagree for −0.0, so a ray like (−0, −0, −1) misses
+/// everything; adding +0.0 turns every −0.0 into +0.0 (IEEE 754: −0 + +0 = +0).
+#[inline]
+fn bvh_ray(ray: &Ray, t_max: f32) -> BvhRay {
+    BvhRay::new(ray.o.into(), (ray.d + Vec3::ZERO).into(), 0.0, t_max)
+}
+
 /// Brute-force closest hit over every world-space triangle (the reference the BVH is tested against).
 pub fn brute_force_closest(accel: &Accel, ray: &Ray, t_max: f32) -> Option<f32> {
-    let r = BvhRay::new(ray.o.into(), ray.d.into(), 0.0, t_max);
+    let r = bvh_ray(ray, t_max);
     accel
         .tris
         .iter()
@@ -363,7 +372,10 @@ mod tests {
         assert!((hit.t - 3.0).abs() < 1e-5);
         let s = accel.surface(&ray, &hit);
         // Object-space point from barycentrics must equal the ray point moved back to object space.
-        assert!((s.p_object - Vec3::new(0.3, 0.6, 0.0)).length() < 1e-5, "{s:?}");
+        assert!(
+            (s.p_object - Vec3::new(0.3, 0.6, 0.0)).length() < 1e-5,
+            "{s:?}"
+        );
         assert!((s.ng - Vec3::Z).length() < 1e-6);
         assert!(!accel.unoccluded(&ray, 10.0));
         assert!(accel.unoccluded(&ray, 2.9));

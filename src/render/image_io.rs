@@ -222,7 +222,13 @@ pub fn write_image_exr(path: &Path, image: &super::Image) -> Result<(), ImageErr
 pub fn read_exr_rgb(path: &Path) -> Result<(usize, usize, Vec<Vec3>), ImageError> {
     let img = exr::prelude::read_first_rgba_layer_from_file(
         path,
-        |res, _| (res.width(), res.height(), vec![Vec3::ZERO; res.width() * res.height()]),
+        |res, _| {
+            (
+                res.width(),
+                res.height(),
+                vec![Vec3::ZERO; res.width() * res.height()],
+            )
+        },
         |buf: &mut (usize, usize, Vec<Vec3>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
             let w = buf.0;
             buf.2[pos.y() * w + pos.x()] = Vec3::new(r, g, b);

@@ -267,7 +267,12 @@ fn shade_direct_counted(
 }
 
 /// Emission seen directly along the camera ray plus direct lighting at the first hit.
-pub fn direct_radiance(scene: &Scene, ps: &PrimarySample, lights: &[Light], rng: &mut Pcg32) -> Vec3 {
+pub fn direct_radiance(
+    scene: &Scene,
+    ps: &PrimarySample,
+    lights: &[Light],
+    rng: &mut Pcg32,
+) -> Vec3 {
     direct_radiance_counted(scene, ps, lights, rng, &mut RayCount::default())
 }
 

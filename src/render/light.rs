@@ -201,7 +201,11 @@ impl Light {
                 }
                 let rel = ray.at(t) - *corner;
                 // Coordinates in the (possibly non-orthogonal) edge basis.
-                let (uu, uv, vv) = (edge_u.dot(*edge_u), edge_u.dot(*edge_v), edge_v.dot(*edge_v));
+                let (uu, uv, vv) = (
+                    edge_u.dot(*edge_u),
+                    edge_u.dot(*edge_v),
+                    edge_v.dot(*edge_v),
+                );
                 let (ru, rv) = (rel.dot(*edge_u), rel.dot(*edge_v));
                 let det = uu * vv - uv * uv;
                 let a = (ru * vv - rv * uv) / det;
@@ -327,7 +331,11 @@ impl EnvMap {
 
     fn dir(uv: Vec2) -> Vec3 {
         let (phi, theta) = (uv.x * 2.0 * PI, uv.y * PI);
-        Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos())
+        Vec3::new(
+            theta.sin() * phi.cos(),
+            theta.sin() * phi.sin(),
+            theta.cos(),
+        )
     }
 
     pub fn lookup(&self, d: Vec3) -> Vec3 {
@@ -388,7 +396,11 @@ impl Distribution1D {
         let n = self.func.len();
         let i = (self.cdf.partition_point(|&c| c <= u).max(1) - 1).min(n - 1);
         let width = self.cdf[i + 1] - self.cdf[i];
-        let du = if width > 0.0 { (u - self.cdf[i]) / width } else { 0.5 };
+        let du = if width > 0.0 {
+            (u - self.cdf[i]) / width
+        } else {
+            0.5
+        };
         let x = ((i as f32 + du.clamp(0.0, 1.0)) / n as f32).min(1.0 - f32::EPSILON);
         (x, self.func[i] / self.integral, i)
     }
@@ -458,7 +470,12 @@ mod tests {
         for l in &lights {
             for _ in 0..100 {
                 let s = l.sample(Vec3::ZERO, rng.next_vec2()).unwrap();
-                let (t, _, pdf) = l.hit(&Ray { o: Vec3::ZERO, d: s.wi }).unwrap();
+                let (t, _, pdf) = l
+                    .hit(&Ray {
+                        o: Vec3::ZERO,
+                        d: s.wi,
+                    })
+                    .unwrap();
                 assert!((t - s.dist).abs() < 1e-3 * t, "{t} {}", s.dist);
                 assert!((pdf - s.pdf).abs() < 1e-3 * pdf, "{pdf} {}", s.pdf);
             }
@@ -482,7 +499,11 @@ mod tests {
         assert!((mean - 1.0).abs() < 0.02, "{mean}");
         for _ in 0..1000 {
             let (d, pdf) = map.sample(rng.next_vec2()).unwrap();
-            assert!((map.pdf(d) - pdf).abs() <= 1e-2 * pdf, "{} {pdf}", map.pdf(d));
+            assert!(
+                (map.pdf(d) - pdf).abs() <= 1e-2 * pdf,
+                "{} {pdf}",
+                map.pdf(d)
+            );
         }
     }
 }

@@ -14,7 +14,7 @@ pub mod light;
 
 pub use camera::{Camera, Projection};
 pub use film::{Aov, Filter, Image, PixelSum};
-pub use geometry::{Accel, Instance, Ray, TriMesh, Transform};
+pub use geometry::{Accel, Instance, Ray, Transform, TriMesh};
 pub use integrator::{
     direct_radiance, light_rng, primary_sample, sample_rngs, shade_direct, Integrator,
     PrimarySample, ShadingPoint,
@@ -170,9 +170,9 @@ fn render_tile(
                 rays.0 += 1;
                 let mut rng = light_rng(scene, pixel, s, settings.seed);
                 let l = match settings.integrator {
-                    Integrator::Direct => integrator::direct_radiance_counted(
-                        scene, &ps, lights, &mut rng, &mut rays,
-                    ),
+                    Integrator::Direct => {
+                        integrator::direct_radiance_counted(scene, &ps, lights, &mut rng, &mut rays)
+                    }
                     Integrator::Path { max_depth } => integrator::path_radiance(
                         scene, &ps, lights, &mut rng, max_depth, &mut rays,
                     ),

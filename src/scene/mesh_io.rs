@@ -53,7 +53,11 @@ pub fn load_obj(path: &Path) -> Result<TriMesh, MeshError> {
         if mesh.positions.len() % 3 != 0 || mesh.indices.len() % 3 != 0 {
             return Err(bad(path, format!("model `{}` is malformed", m.name)));
         }
-        let v3 = |f: &[f32]| f.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect::<Vec<_>>();
+        let v3 = |f: &[f32]| {
+            f.chunks_exact(3)
+                .map(|c| Vec3::new(c[0], c[1], c[2]))
+                .collect::<Vec<_>>()
+        };
         let positions = v3(&mesh.positions);
         let normals = (mesh.normals.len() == mesh.positions.len()).then(|| v3(&mesh.normals));
         let part = TriMesh {
@@ -216,7 +220,9 @@ fn parse_ply<R: BufRead>(mut r: R) -> Result<TriMesh, String> {
             }
             ["element", name, count] => elements.push(Element {
                 name: name.to_string(),
-                count: count.parse().map_err(|_| format!("bad element count `{count}`"))?,
+                count: count
+                    .parse()
+                    .map_err(|_| format!("bad element count `{count}`"))?,
                 props: Vec::new(),
             }),
             ["property", "list", ct, ty, name] => {
@@ -330,6 +336,8 @@ mod tests {
         assert_eq!(a.positions, b.positions);
         assert_eq!(a.indices, b.indices);
         assert!(parse_ply(&bin[..bin.len() - 2]).is_err());
-        assert!(parse_ply("ply\nformat ascii 1.0\nelement vertex 1\nend_header\n".as_bytes()).is_err());
+        assert!(
+            parse_ply("ply\nformat ascii 1.0\nelement vertex 1\nend_header\n".as_bytes()).is_err()
+        );
     }
 }

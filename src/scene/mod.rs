@@ -82,7 +82,12 @@ pub fn parse(text: &str, path: &str) -> Result<SceneFile, SceneError> {
 }
 
 /// Builds a scene from TOML text; `path` names it in errors and `base` resolves relative files.
-pub fn from_str(text: &str, path: &str, base: &Path, name: &str) -> Result<LoadedScene, SceneError> {
+pub fn from_str(
+    text: &str,
+    path: &str,
+    base: &Path,
+    name: &str,
+) -> Result<LoadedScene, SceneError> {
     let file = parse(text, path)?;
     Builder {
         path,
@@ -159,13 +164,28 @@ impl Builder<'_> {
         };
         let filter = match r.filter {
             FilterName::Box => Filter::Box {
-                radius: self.range("render.filter_radius", r.filter_radius.unwrap_or(0.5), 0.0, 8.0)?,
+                radius: self.range(
+                    "render.filter_radius",
+                    r.filter_radius.unwrap_or(0.5),
+                    0.0,
+                    8.0,
+                )?,
             },
             FilterName::Tent => Filter::Tent {
-                radius: self.range("render.filter_radius", r.filter_radius.unwrap_or(1.0), 0.0, 8.0)?,
+                radius: self.range(
+                    "render.filter_radius",
+                    r.filter_radius.unwrap_or(1.0),
+                    0.0,
+                    8.0,
+                )?,
             },
             FilterName::Gaussian => {
-                let radius = self.range("render.filter_radius", r.filter_radius.unwrap_or(1.5), 0.01, 8.0)?;
+                let radius = self.range(
+                    "render.filter_radius",
+                    r.filter_radius.unwrap_or(1.5),
+                    0.01,
+                    8.0,
+                )?;
                 Filter::Gaussian {
                     sigma: radius / 3.0,
                     radius,
@@ -215,10 +235,14 @@ impl Builder<'_> {
         let projection = match c.projection {
             ProjectionName::Perspective => {
                 if c.width.is_some() {
-                    return Err(self.invalid("camera.width", "only for projection = \"orthographic\""));
+                    return Err(
+                        self.invalid("camera.width", "only for projection = \"orthographic\"")
+                    );
                 }
                 Projection::Perspective {
-                    fov_y: self.range("camera.fov_deg", c.fov_deg, 0.01, 179.0)?.to_radians(),
+                    fov_y: self
+                        .range("camera.fov_deg", c.fov_deg, 0.01, 179.0)?
+                        .to_radians(),
                     lens_radius: self.range("camera.lens_radius", c.lens_radius, 0.0, 1e6)?,
                     focus_distance: self.range(
                         "camera.focus_distance",
@@ -230,7 +254,10 @@ impl Builder<'_> {
             }
             ProjectionName::Orthographic => {
                 let w = c.width.ok_or_else(|| {
-                    self.invalid("camera.width", "required for projection = \"orthographic\" (film width in mm)")
+                    self.invalid(
+                        "camera.width",
+                        "required for projection = \"orthographic\" (film width in mm)",
+                    )
                 })?;
                 Projection::Orthographic {
                     width: self.range("camera.width", w, 1e-3, 1e9)?,
@@ -240,7 +267,10 @@ impl Builder<'_> {
         Ok(Camera::look_at(eye, target, up, projection, width, height))
     }
 
-    fn lights(&self, tables: &[LightTable]) -> Result<(Vec<Light>, Vec<Option<String>>), SceneError> {
+    fn lights(
+        &self,
+        tables: &[LightTable],
+    ) -> Result<(Vec<Light>, Vec<Option<String>>), SceneError> {
         let mut lights = Vec::new();
         let mut names = Vec::new();
         for (i, t) in tables.iter().enumerate() {
@@ -299,7 +329,10 @@ impl Builder<'_> {
                     color,
                     ..
                 } => {
-                    let (u, v) = (self.finite3(&f("edge_u"), *edge_u)?, self.finite3(&f("edge_v"), *edge_v)?);
+                    let (u, v) = (
+                        self.finite3(&f("edge_u"), *edge_u)?,
+                        self.finite3(&f("edge_v"), *edge_v)?,
+                    );
                     if u.cross(v).length_squared() < 1e-12 {
                         return Err(self.invalid(f("edge_v"), "edges must span a non-zero area"));
                     }
@@ -341,7 +374,10 @@ impl Builder<'_> {
                 }
             };
             if let Some(n) = t.name() {
-                if names.iter().any(|o: &Option<String>| o.as_deref() == Some(n)) {
+                if names
+                    .iter()
+                    .any(|o: &Option<String>| o.as_deref() == Some(n))
+                {
                     return Err(self.invalid(f("name"), format!("light name `{n}` is used twice")));
                 }
             }
@@ -353,13 +389,19 @@ impl Builder<'_> {
 
     fn env_map(&self, field: &str, file: &str, rotate_deg: f32) -> Result<EnvMap, SceneError> {
         let p = self.base.join(file);
-        let (w, h, mut texels) = render::image_io::read_exr_rgb(&p)
-            .map_err(|e| self.invalid(field, e.to_string()))?;
+        let (w, h, mut texels) =
+            render::image_io::read_exr_rgb(&p).map_err(|e| self.invalid(field, e.to_string()))?;
         if w < 2 || h < 1 {
             return Err(self.invalid(field, format!("{} is too small ({w}x{h})", p.display())));
         }
-        if texels.iter().any(|t| !t.is_finite() || t.min_element() < 0.0) {
-            return Err(self.invalid(field, format!("{} holds negative or non-finite texels", p.display())));
+        if texels
+            .iter()
+            .any(|t| !t.is_finite() || t.min_element() < 0.0)
+        {
+            return Err(self.invalid(
+                field,
+                format!("{} holds negative or non-finite texels", p.display()),
+            ));
         }
         // Rotation about z: shift columns.
         let shift = ((rotate_deg / 360.0) * w as f32).round() as i64;
@@ -423,7 +465,12 @@ impl Builder<'_> {
                 }
             }
             let r = self.finite3(&f("rotate_deg"), o.rotate_deg)?;
-            let rot = Quat::from_euler(EulerRot::ZYX, r.z.to_radians(), r.y.to_radians(), r.x.to_radians());
+            let rot = Quat::from_euler(
+                EulerRot::ZYX,
+                r.z.to_radians(),
+                r.y.to_radians(),
+                r.x.to_radians(),
+            );
             let transform = Transform::new(Affine3A::from_scale_rotation_translation(
                 scale,
                 rot,
@@ -437,7 +484,9 @@ impl Builder<'_> {
                 Some(t) => Placement {
                     origin: self.finite3(&f("tree.origin"), t.origin)?,
                     axis: self.unit3(&f("tree.axis"), t.axis)?,
-                    rotation: self.range(&f("tree.rotation_deg"), t.rotation_deg, -360.0, 360.0)?.to_radians(),
+                    rotation: self
+                        .range(&f("tree.rotation_deg"), t.rotation_deg, -360.0, 360.0)?
+                        .to_radians(),
                     scale: self.range(&f("tree.scale"), t.scale, 1e-6, 1e6)?,
                 },
             };
@@ -496,7 +545,10 @@ impl Builder<'_> {
                 let s = o.size.as_ref().ok_or_else(|| need("size"))?;
                 let want = if o.shape == ShapeKind::Box { 3 } else { 2 };
                 if s.len() != want {
-                    return Err(self.invalid(f("size"), format!("shape `{kind}` takes {want} numbers (mm)")));
+                    return Err(self.invalid(
+                        f("size"),
+                        format!("shape `{kind}` takes {want} numbers (mm)"),
+                    ));
                 }
                 for x in s {
                     positive("size", *x)?;
@@ -507,7 +559,10 @@ impl Builder<'_> {
                     shapes::make_quad(Vec2::new(s[0], s[1]))
                 }
             }
-            ShapeKind::Sphere => shapes::make_sphere(positive("radius", o.radius.ok_or_else(|| need("radius"))?)?, segments),
+            ShapeKind::Sphere => shapes::make_sphere(
+                positive("radius", o.radius.ok_or_else(|| need("radius"))?)?,
+                segments,
+            ),
             ShapeKind::Cylinder => shapes::make_cylinder(
                 positive("radius", o.radius.ok_or_else(|| need("radius"))?)?,
                 positive("height", o.height.ok_or_else(|| need("height"))?)?,
@@ -548,7 +603,9 @@ impl Builder<'_> {
                     ));
                 }
                 if m.indices.is_empty() {
-                    return Err(self.invalid(f("file"), format!("{} has no valid triangles", p.display())));
+                    return Err(
+                        self.invalid(f("file"), format!("{} has no valid triangles", p.display()))
+                    );
                 }
                 if !o.smooth {
                     m.normals = None;
@@ -580,13 +637,19 @@ impl Builder<'_> {
         self.unit3("sweep.axis", s.axis)?;
         if !names.iter().any(|n| n.as_deref() == Some(s.light.as_str())) {
             let known: Vec<&str> = names.iter().flatten().map(String::as_str).collect();
-            return Err(self.invalid("sweep.light", format!("no light named `{}` (named lights: {known:?})", s.light)));
+            return Err(self.invalid(
+                "sweep.light",
+                format!("no light named `{}` (named lights: {known:?})", s.light),
+            ));
         }
         for (k, r) in s.regions.iter().enumerate() {
             if !(r.x0 < r.x1 && r.y0 < r.y1 && r.x1 <= width && r.y1 <= height) {
                 return Err(self.invalid(
                     format!("sweep.regions[{k}]"),
-                    format!("region `{}` must satisfy x0 < x1 <= {width}, y0 < y1 <= {height}", r.name),
+                    format!(
+                        "region `{}` must satisfy x0 < x1 <= {width}, y0 < y1 <= {height}",
+                        r.name
+                    ),
                 ));
             }
         }

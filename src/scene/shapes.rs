@@ -47,10 +47,17 @@ pub fn make_quad(size: Vec2) -> TriMesh {
 /// A UV sphere of `radius` with `segments` around and `segments / 2` from pole to pole,
 /// with exact normals.
 pub fn make_sphere(radius: f32, segments: u32) -> TriMesh {
-    let profile: Vec<Vec2> = (0..=segments / 2)
+    let rings = (segments / 2).max(2);
+    let profile: Vec<Vec2> = (0..=rings)
         .map(|i| {
-            let theta = PI * i as f32 / (segments / 2) as f32;
-            Vec2::new(radius * theta.sin(), -radius * theta.cos())
+            let theta = PI * i as f32 / rings as f32;
+            // Exact poles, so the pole triangles are exactly degenerate and dropped.
+            let r = if i == 0 || i == rings {
+                0.0
+            } else {
+                radius * theta.sin()
+            };
+            Vec2::new(r, -radius * theta.cos())
         })
         .collect();
     let normals: Vec<Vec2> = profile.iter().map(|p| *p / radius).collect();
@@ -116,7 +123,11 @@ fn revolve(profile: &[Vec2], normals: Option<&[Vec2]>, segments: u32) -> TriMesh
     let ring = profile.len() as u32;
     for j in 0..=segments {
         let phi = 2.0 * PI * j as f32 / segments as f32;
-        let (s, c) = if j == segments { (0.0, 1.0) } else { phi.sin_cos() };
+        let (s, c) = if j == segments {
+            (0.0, 1.0)
+        } else {
+            phi.sin_cos()
+        };
         for (i, p) in profile.iter().enumerate() {
             m.positions.push(Vec3::new(p.x * c, p.x * s, p.y));
             if let (Some(ns), Some(out)) = (normals, m.normals.as_mut()) {
@@ -166,7 +177,7 @@ mod tests {
                 let [a, b, cc] = t.map(|i| m.positions[i as usize]);
                 let ng = (b - a).cross(cc - a);
                 let ns = m.normals.as_ref().unwrap()[t[0] as usize];
-                assert!(ng.dot(ns) > 0.0);
+                assert!(ng.dot(ns) > 0.0, "{a} {b} {cc} ng {ng} ns {ns}");
             }
         }
     }
