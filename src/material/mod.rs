@@ -9,9 +9,11 @@ mod placement;
 
 pub use placement::Placement;
 
-use crate::bsdf::{Bsdf, BsdfSample, Lambertian};
+use crate::bsdf::{Bsdf, BsdfSample, Glass, Lambertian, Mirror, WoodBsdf, WoodBsdfParams};
 use crate::math::Frame;
+use crate::wood::{Needs, WoodVolume};
 use glam::{Mat3, Vec2, Vec3};
+use std::sync::Arc;
 
 /// What a material needs to know about a hit. Built by the renderer.
 #[derive(Clone, Copy, Debug)]
@@ -49,17 +51,20 @@ pub struct SurfaceAov {
 #[derive(Clone, Copy, Debug)]
 pub enum SurfaceBsdf {
     Lambertian(Lambertian),
+    Wood(WoodBsdf),
+    Mirror(Mirror),
+    Glass(Glass),
 }
 
 impl SurfaceBsdf {
     /// True when every lobe is a delta lobe (light sampling is useless there).
     pub fn is_delta(&self) -> bool {
-        false
+        matches!(self, SurfaceBsdf::Mirror(_) | SurfaceBsdf::Glass(_))
     }
 
     /// True when the BSDF transmits (the renderer must not flip the normal towards the viewer).
     pub fn is_transmissive(&self) -> bool {
-        false
+        matches!(self, SurfaceBsdf::Glass(_))
     }
 }
 
@@ -67,18 +72,27 @@ impl Bsdf for SurfaceBsdf {
     fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         match self {
             SurfaceBsdf::Lambertian(b) => b.eval(wo, wi),
+            SurfaceBsdf::Wood(b) => b.eval(wo, wi),
+            SurfaceBsdf::Mirror(b) => b.eval(wo, wi),
+            SurfaceBsdf::Glass(b) => b.eval(wo, wi),
         }
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         match self {
             SurfaceBsdf::Lambertian(b) => b.pdf(wo, wi),
+            SurfaceBsdf::Wood(b) => b.pdf(wo, wi),
+            SurfaceBsdf::Mirror(b) => b.pdf(wo, wi),
+            SurfaceBsdf::Glass(b) => b.pdf(wo, wi),
         }
     }
 
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
         match self {
             SurfaceBsdf::Lambertian(b) => b.sample(wo, uc, u),
+            SurfaceBsdf::Wood(b) => b.sample(wo, uc, u),
+            SurfaceBsdf::Mirror(b) => b.sample(wo, uc, u),
+            SurfaceBsdf::Glass(b) => b.sample(wo, uc, u),
         }
     }
 }
@@ -96,22 +110,159 @@ pub struct Shading {
 #[derive(Clone, Debug)]
 pub enum Material {
     /// Ideal diffuse reflector.
-    Lambertian { albedo: Vec3 },
+    Lambertian {
+        albedo: Vec3,
+    },
+    /// The finished-wood BSDF with the same parameters everywhere; `fiber_dir` and `ray_dir` are
+    /// in object space (for validation scenes).
+    Fiber {
+        params: WoodBsdfParams,
+    },
+    /// The procedural wood volume seen through a finish.
+    Wood(Box<WoodMaterial>),
+    Mirror {
+        reflectance: Vec3,
+    },
+    Glass {
+        eta: f32,
+        tint: Vec3,
+    },
+}
+
+/// Solid wood: the volume, the finish over it, and the bump-mapping strength.
+#[derive(Clone, Debug)]
+pub struct WoodMaterial {
+    pub volume: Arc<WoodVolume>,
+    /// Refractive index of the finish (1 = unfinished).
+    pub eta: f32,
+    /// GGX roughness of the finish.
+    pub roughness: f32,
+    /// Scale of the pore-mask bump (0 = no bump mapping, and the volume skips the bump work).
+    pub bump: f32,
 }
 
 impl Material {
     /// Evaluates the material at a hit.
     pub fn shade(&self, hit: &MaterialHit) -> Shading {
-        let frame = Frame::from_normal_tangent(hit.ns, hit.tangent);
+        let geometric_frame = || Frame::from_normal_tangent(hit.ns, hit.tangent);
         match self {
-            Material::Lambertian { albedo } => Shading {
-                bsdf: SurfaceBsdf::Lambertian(Lambertian { albedo: *albedo }),
-                frame,
+            Material::Lambertian { albedo } => lambertian(*albedo, geometric_frame()),
+            Material::Fiber { params } => {
+                let frame = geometric_frame();
+                let to_local =
+                    |d: Vec3| frame.to_local((hit.object_to_world * d).normalize_or_zero());
+                let fiber_world = (hit.object_to_world * params.fiber_dir).normalize_or_zero();
+                let local = WoodBsdfParams {
+                    fiber_dir: to_local(params.fiber_dir),
+                    ray_dir: to_local(params.ray_dir),
+                    ..*params
+                };
+                wood_shading(local, frame, fiber_world, 0.0)
+            }
+            Material::Wood(w) => w.shade(hit),
+            Material::Mirror { reflectance } => Shading {
+                bsdf: SurfaceBsdf::Mirror(Mirror {
+                    reflectance: *reflectance,
+                }),
+                frame: geometric_frame(),
                 aov: SurfaceAov {
-                    albedo: *albedo,
+                    albedo: *reflectance,
+                    ..Default::default()
+                },
+            },
+            Material::Glass { eta, tint } => Shading {
+                bsdf: SurfaceBsdf::Glass(Glass {
+                    eta: *eta,
+                    tint: *tint,
+                }),
+                frame: geometric_frame(),
+                aov: SurfaceAov {
+                    albedo: *tint,
                     ..Default::default()
                 },
             },
         }
+    }
+}
+
+fn lambertian(albedo: Vec3, frame: Frame) -> Shading {
+    Shading {
+        bsdf: SurfaceBsdf::Lambertian(Lambertian { albedo }),
+        frame,
+        aov: SurfaceAov {
+            albedo,
+            ..Default::default()
+        },
+    }
+}
+
+/// A wood BSDF from local-frame parameters; parameters the BSDF rejects (which a correct texel
+/// never produces) fall back to a Lambertian of the diffuse colour rather than a NaN.
+fn wood_shading(
+    local: WoodBsdfParams,
+    frame: Frame,
+    fiber_world: Vec3,
+    growth_time: f32,
+) -> Shading {
+    match WoodBsdf::new(local) {
+        Ok(b) => Shading {
+            bsdf: SurfaceBsdf::Wood(b),
+            frame,
+            aov: SurfaceAov {
+                albedo: local.diffuse,
+                fiber: fiber_world,
+                ray_mask: local.ray_mask,
+                growth_time,
+            },
+        },
+        Err(_) => lambertian(local.diffuse.clamp(Vec3::ZERO, Vec3::ONE), frame),
+    }
+}
+
+impl WoodMaterial {
+    /// What this material asks of the wood volume: colours and fibres always, bump only when on.
+    pub fn needs(&self) -> Needs {
+        Needs {
+            color: true,
+            fibers: true,
+            bump: self.bump != 0.0,
+        }
+    }
+
+    /// Looks the hit up in the tree and builds the finished-wood BSDF in the local frame.
+    pub fn shade(&self, hit: &MaterialHit) -> Shading {
+        let place = &hit.placement;
+        let rot = place.rotation_matrix();
+        let p_tree = place.object_to_tree().transform_point3(hit.p_object);
+        let texel = self.volume.eval(p_tree, self.needs());
+        // Tree → object directions: the transpose of the placement rotation; object → world: the
+        // instance's linear map (directions are contravariant, Liu et al. 2016 §6.2).
+        let to_world = |d: Vec3| (hit.object_to_world * (rot.transpose() * d)).normalize_or_zero();
+        let mut n = hit.ns;
+        if self.bump != 0.0 && texel.bump_grad != Vec3::ZERO {
+            // Bump mapping (Blinn 1978): h(p_object) = bump(origin + s R p), so
+            // ∇_object h = s Rᵀ ∇_tree h, and gradients (covariant) map to world by the normal
+            // matrix; the normal tilts against the surface part of the gradient.
+            let g =
+                hit.normal_to_world * (rot.transpose() * texel.bump_grad * place.scale) * self.bump;
+            let g_surface = g - n * g.dot(n);
+            let tilted = (n - g_surface).normalize_or_zero();
+            if tilted != Vec3::ZERO && tilted.is_finite() {
+                n = tilted;
+            }
+        }
+        let fiber_world = to_world(texel.fiber_dir);
+        let frame = Frame::from_normal_tangent(n, fiber_world);
+        let local = WoodBsdfParams {
+            diffuse: texel.diffuse,
+            fiber_color: texel.fiber_color,
+            fiber_dir: frame.to_local(fiber_world),
+            ray_dir: frame.to_local(to_world(texel.ray_dir)),
+            ray_mask: texel.ray_mask,
+            highlight_width: texel.highlight_width,
+            eta: self.eta,
+            roughness: self.roughness,
+        };
+        wood_shading(local, frame, fiber_world, texel.growth_time)
     }
 }

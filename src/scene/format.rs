@@ -184,7 +184,65 @@ impl LightTable {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum MaterialTable {
-    Lambertian { albedo: [f32; 3] },
+    Lambertian {
+        albedo: [f32; 3],
+    },
+    /// The finished-wood BSDF with constant parameters; directions in object space.
+    Fiber {
+        diffuse: [f32; 3],
+        fiber_color: [f32; 3],
+        fiber_dir: [f32; 3],
+        #[serde(default = "default_ray_dir")]
+        ray_dir: [f32; 3],
+        #[serde(default)]
+        ray_mask: f32,
+        #[serde(default = "default_highlight")]
+        highlight_width_deg: f32,
+        #[serde(default = "default_eta")]
+        eta: f32,
+        #[serde(default)]
+        roughness: f32,
+    },
+    /// The procedural wood volume of a species preset under a finish.
+    Wood {
+        /// Built-in preset name (see `xylem preset list`).
+        preset: Option<String>,
+        /// A preset file instead (path relative to the scene file).
+        preset_file: Option<String>,
+        /// Selects the tree.
+        #[serde(default)]
+        seed: u64,
+        #[serde(default = "default_eta")]
+        eta: f32,
+        #[serde(default)]
+        roughness: f32,
+        /// Pore bump strength (0 = off).
+        #[serde(default)]
+        bump: f32,
+    },
+    Mirror {
+        #[serde(default = "default_reflectance")]
+        reflectance: [f32; 3],
+    },
+    Glass {
+        #[serde(default = "default_eta")]
+        eta: f32,
+        #[serde(default = "white")]
+        tint: [f32; 3],
+    },
+}
+
+fn default_ray_dir() -> [f32; 3] {
+    [0.0, 0.0, 1.0]
+}
+fn default_highlight() -> f32 {
+    8.0
+}
+fn default_eta() -> f32 {
+    1.5
+}
+fn default_reflectance() -> [f32; 3] {
+    [0.95, 0.95, 0.95]
 }
 
 /// A uniform or per-axis scale.

@@ -9,7 +9,8 @@ pub mod shapes;
 
 pub use format::{SceneFile, SweepRegion, SweepTable};
 
-use crate::material::{Material, Placement};
+use crate::bsdf::{WoodBsdf, WoodBsdfParams};
+use crate::material::{Material, Placement, WoodMaterial};
 use crate::render::{
     self, Accel, Camera, EnvMap, Environment, Filter, Instance, Integrator, Light, Projection,
     RenderSettings, Transform, TriMesh,
@@ -428,6 +429,73 @@ impl Builder<'_> {
             let m = match t {
                 MaterialTable::Lambertian { albedo } => Material::Lambertian {
                     albedo: self.color(&f("albedo"), *albedo, 1.0)?,
+                },
+                MaterialTable::Fiber {
+                    diffuse,
+                    fiber_color,
+                    fiber_dir,
+                    ray_dir,
+                    ray_mask,
+                    highlight_width_deg,
+                    eta,
+                    roughness,
+                } => {
+                    let params = WoodBsdfParams {
+                        diffuse: self.color(&f("diffuse"), *diffuse, 1.0)?,
+                        fiber_color: self.color(&f("fiber_color"), *fiber_color, 1.0)?,
+                        fiber_dir: self.unit3(&f("fiber_dir"), *fiber_dir)?,
+                        ray_dir: self.unit3(&f("ray_dir"), *ray_dir)?,
+                        ray_mask: self.range(&f("ray_mask"), *ray_mask, 0.0, 1.0)?,
+                        highlight_width: self
+                            .range(&f("highlight_width_deg"), *highlight_width_deg, 0.06, 90.0)?
+                            .to_radians(),
+                        eta: self.range(&f("eta"), *eta, 1.0, 4.0)?,
+                        roughness: self.range(&f("roughness"), *roughness, 0.0, 1.0)?,
+                    };
+                    // Let the BSDF itself check the combination once, here, with a clear message.
+                    WoodBsdf::new(params).map_err(|e| self.invalid(f("type"), e.to_string()))?;
+                    Material::Fiber { params }
+                }
+                MaterialTable::Wood {
+                    preset,
+                    preset_file,
+                    seed,
+                    eta,
+                    roughness,
+                    bump,
+                } => {
+                    let params = match (preset, preset_file) {
+                        (Some(name), None) => crate::wood::preset(name)
+                            .map_err(|e| self.invalid(f("preset"), e.to_string()))?,
+                        (None, Some(file)) => {
+                            crate::wood::WoodParams::from_toml_file(self.base.join(file))
+                                .map_err(|e| self.invalid(f("preset_file"), e.to_string()))?
+                        }
+                        _ => {
+                            return Err(self.invalid(
+                                f("preset"),
+                                format!(
+                                    "give exactly one of `preset` (one of: {}) or `preset_file`",
+                                    crate::wood::PRESET_NAMES.join(", ")
+                                ),
+                            ))
+                        }
+                    };
+                    let volume = crate::wood::WoodVolume::new(params, *seed)
+                        .map_err(|e| self.invalid(f("preset"), e.to_string()))?;
+                    Material::Wood(Box::new(WoodMaterial {
+                        volume: Arc::new(volume),
+                        eta: self.range(&f("eta"), *eta, 1.0, 4.0)?,
+                        roughness: self.range(&f("roughness"), *roughness, 0.0, 1.0)?,
+                        bump: self.range(&f("bump"), *bump, 0.0, 100.0)?,
+                    }))
+                }
+                MaterialTable::Mirror { reflectance } => Material::Mirror {
+                    reflectance: self.color(&f("reflectance"), *reflectance, 1.0)?,
+                },
+                MaterialTable::Glass { eta, tint } => Material::Glass {
+                    eta: self.range(&f("eta"), *eta, 1.0, 4.0)?,
+                    tint: self.color(&f("tint"), *tint, 1.0)?,
                 },
             };
             index.insert(name.clone(), out.len() as u32);
