@@ -1,10 +1,91 @@
-//! `xylem validate bsdf`.
+//! `xylem validate bsdf`: runs the BSDF validation suite over validation/bsdf_cases.toml, prints
+//! the table, rewrites the bsdf section of validation/REPORT.md (with polar plots) and optionally
+//! writes the full results as JSON. Exits non-zero when a check fails.
 
+use crate::validate::bsdf::{load_suite, run_suite, to_markdown, write_polar_plot};
+use anyhow::Context;
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(clap::Args, Debug, Default)]
-pub struct Args {}
+pub struct Args {
+    /// Case file [default: validation/bsdf_cases.toml].
+    #[arg(long)]
+    cases: Option<PathBuf>,
+    /// Report to update (only its bsdf section) [default: validation/REPORT.md].
+    #[arg(long)]
+    report: Option<PathBuf>,
+    /// Also write every measured number as JSON here.
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Divide every sample count by this factor (a quick look; the defaults are the real check).
+    #[arg(long)]
+    reduce: Option<u32>,
+    /// Do not touch the report or write plots.
+    #[arg(long)]
+    no_report: bool,
+}
 
-pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`xylem validate bsdf` is not built yet")
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let cases = args
+        .cases
+        .unwrap_or_else(|| PathBuf::from("validation/bsdf_cases.toml"));
+    let report = args
+        .report
+        .unwrap_or_else(|| PathBuf::from("validation/REPORT.md"));
+    let mut suite = load_suite(&cases).context("loading the BSDF validation cases")?;
+    if let Some(k) = args.reduce.filter(|&k| k > 1) {
+        let s = &mut suite.settings;
+        s.furnace_samples = (s.furnace_samples / k).max(1000);
+        s.chi2_samples = (s.chi2_samples / k).max(10_000);
+        s.reciprocity_pairs = (s.reciprocity_pairs / k).max(100);
+        s.extreme_samples = (s.extreme_samples / k).max(100);
+    }
+    let bar = indicatif::ProgressBar::new(suite.cases.len() as u64).with_style(
+        indicatif::ProgressStyle::with_template(
+            "validate bsdf {bar:40} {pos}/{len} cases, {elapsed} (eta {eta})",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let result = run_suite(&suite, &|| bar.inc(1));
+    bar.finish_and_clear();
+
+    println!("{:<55} {:<6} {:>14}  case", "check", "result", "worst");
+    for c in &result.checks {
+        println!(
+            "{:<55} {:<6} {:>14.6}  {}",
+            c.check,
+            if c.passed { "pass" } else { "FAIL" },
+            c.worst,
+            c.case
+        );
+    }
+    if let Some((a, case)) = &result.published_max_albedo {
+        println!("(published lobe, not normalised: max albedo {a:.3} at {case})");
+    }
+
+    if !args.no_report {
+        let dir = report.parent().map(|p| p.to_path_buf()).unwrap_or_default();
+        let mut plots = Vec::new();
+        for (k, spec) in suite.cases.iter().filter(|c| c.plot).enumerate() {
+            let rel = format!("plots/bsdf_polar_{k}.png");
+            write_polar_plot(spec, &dir.join(&rel))
+                .with_context(|| format!("writing the polar plot of `{}`", spec.name))?;
+            plots.push((spec.name.clone(), rel));
+        }
+        crate::validate::update_report_section(&report, "bsdf", &to_markdown(&result, &plots))
+            .with_context(|| format!("writing {}", report.display()))?;
+        println!("report: {}", report.display());
+    }
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&result)?;
+        let tmp = path.with_extension("json.partial");
+        std::fs::write(&tmp, text).with_context(|| format!("writing {}", tmp.display()))?;
+        std::fs::rename(&tmp, path).with_context(|| format!("writing {}", path.display()))?;
+    }
+    Ok(if result.passed() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
 }
