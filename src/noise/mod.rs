@@ -59,17 +59,23 @@
 //!   α²·density·0.0682 for unit weights (one third of that for signed weights).
 //! - [`SparseConvolution1`] is the 1D version (half-width `width`, cell length `cell`).
 
+mod cellular;
+mod fractal;
 mod gradient;
 pub mod hash;
 mod sparse;
 mod value;
+mod warp;
 
+pub use cellular::{cellular3, feature_point, CellularSample};
+pub use fractal::{Basis, Fractal, FractalKind};
 pub use gradient::{fade, fade_d, gradient1, gradient1_grad, gradient3, gradient3_grad};
 pub use sparse::{
     band_cells, Cells, Kernel, NoiseError, SparseConvolution, SparseConvolution1, Weights,
     MAX_IMPULSES_PER_CELL,
 };
 pub use value::{value1, value1_grad, value3, value3_grad};
+pub use warp::{Warp, WarpSample};
 
 use glam::Vec3;
 

@@ -15,7 +15,12 @@ pub fn value3(p: Vec3, seed: u32) -> f32 {
 /// [`value3`] and its analytic gradient.
 #[inline]
 pub fn value3_grad(p: Vec3, seed: u32) -> (f32, Vec3) {
-    let s = mix32(seed);
+    value3_grad_s(p, mix32(seed))
+}
+
+/// [`value3_grad`] with a scrambled seed.
+#[inline(always)]
+pub(crate) fn value3_grad_s(p: Vec3, s: u32) -> (f32, Vec3) {
     let (ix, iy, iz) = (floor_i32(p.x), floor_i32(p.y), floor_i32(p.z));
     let f = Vec3::new(p.x - ix as f32, p.y - iy as f32, p.z - iz as f32);
     let xa = (ix as u32).wrapping_mul(PRIME_X);
