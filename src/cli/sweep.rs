@@ -1,8 +1,10 @@
 //! `xylem sweep`: renders a light sweep (or a slice of one) and assembles its outputs.
 
+use crate::sweep::job::{run_job, SweepJob};
+use crate::sweep::parse_arc;
 use crate::sweep::sequence::{assemble, AssembleOptions};
 use anyhow::Context;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(clap::Args, Debug)]
@@ -22,8 +24,20 @@ pub struct Args {
     /// Render only frames A..B (A to B-1) or A..=B, e.g. for a job array; assemble afterwards.
     #[arg(long)]
     pub frames_range: Option<String>,
+    /// Samples per pixel (overrides the scene's render.spp).
+    #[arg(long)]
+    pub spp: Option<u32>,
+    /// Render each frame from scratch, without the per-sweep cache (to time or check it).
+    #[arg(long)]
+    pub naive: bool,
+    /// Worker threads (0 = all cores).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    /// Do not show the progress bar.
+    #[arg(long)]
+    pub quiet: bool,
     /// Assemble contact sheet, animated PNG, CSV and viewer from the frames already in DIR.
-    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "frames", "arc", "frames_range"])]
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "frames", "arc", "frames_range", "spp", "naive"])]
     pub assemble: Option<PathBuf>,
 }
 
@@ -31,13 +45,76 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if let Some(dir) = &args.assemble {
         return assemble_dir(dir);
     }
-    anyhow::bail!(
-        "`xylem sweep SCENE` needs the renderer, which has not landed yet; `--assemble DIR` works"
-    )
+    let Some(scene) = &args.scene else {
+        anyhow::bail!("give a scene file (or --assemble DIR)");
+    };
+    let mut loaded = crate::scene::load(scene)?;
+    for w in &loaded.warnings {
+        eprintln!("warning: {w}");
+    }
+    if let Some(spp) = args.spp {
+        anyhow::ensure!(spp >= 1, "--spp 0: need at least 1 sample per pixel");
+        loaded.settings.spp = spp;
+    }
+    let arc = args
+        .arc
+        .as_deref()
+        .map(parse_arc)
+        .transpose()
+        .context("--arc")?;
+    let job = SweepJob {
+        frames: args.frames,
+        arc,
+        range: args.frames_range.clone(),
+        out: args
+            .out
+            .clone()
+            .unwrap_or_else(|| Path::new("out").join(&loaded.name)),
+        naive: args.naive,
+        run: crate::render::RunOptions {
+            threads: args.threads,
+            progress: !args.quiet,
+        },
+    };
+    let cam = &loaded.scene.camera;
+    eprintln!(
+        "{}: {}x{}, {} spp, {:?}, {}",
+        loaded.name,
+        cam.width,
+        cam.height,
+        loaded.settings.spp,
+        loaded.settings.integrator,
+        if job.naive { "naive (no cache)" } else { "cached primary samples" }
+    );
+    let report = run_job(&loaded, &job)
+        .with_context(|| format!("sweep of {}", scene.display()))?;
+    let n = report.rendered.len();
+    println!(
+        "rendered frames {}..{} of {} in {:.2} s ({:.3} s per frame) into {}",
+        report.rendered.start,
+        report.rendered.end,
+        report.total,
+        report.render_time.as_secs_f64(),
+        report.render_time.as_secs_f64() / n.max(1) as f64,
+        job.out.display()
+    );
+    match report.assembled {
+        Some(a) => {
+            for f in &a.files {
+                println!("  {}", f.display());
+            }
+        }
+        None => println!(
+            "not every frame is in {} yet; when all are: xylem sweep --assemble {}",
+            job.out.display(),
+            job.out.display()
+        ),
+    }
+    Ok(ExitCode::SUCCESS)
 }
 
 /// Assembles a folder of frames and reports what it wrote.
-fn assemble_dir(dir: &std::path::Path) -> anyhow::Result<ExitCode> {
+fn assemble_dir(dir: &Path) -> anyhow::Result<ExitCode> {
     let done = assemble(dir, &AssembleOptions::default())
         .with_context(|| format!("assembling the sweep in {}", dir.display()))?;
     println!("assembled {} frames:", done.frames);

@@ -4,16 +4,20 @@
 //! only the light-dependent part ([`direct_radiance`], or path tracing from the cached first hit)
 //! runs per frame.
 //!
-//! Work is tile-major: a worker computes one tile's primary samples (a few hundred kB) and shades
-//! them for every frame before moving on, so the cache stays small and hot whatever the image
-//! size. Every sample draws from the renderer's per-(seed, pixel, sample) streams and sums in the
+//! Work is tile-major and, within a tile, pixel → sample → frame: each primary sample is lit for
+//! every frame as soon as it is computed, so the "cache" is one sample held in registers rather
+//! than a buffer, whatever the image size. For direct lighting the BSDF-sampled ray is
+//! light-independent too and is traced once per sample (see [`direct_for_frames`]). Every sample draws from the renderer's per-(seed, pixel, sample) streams and sums in the
 //! same order as [`crate::render::render_with_lights`], so each frame is bit-identical to the
 //! naive render of that frame.
 
-use super::path::{ArcPlane, LightArc};
+use super::path::{ArcPlane, LightArc, PathError};
+use crate::scene::LoadedScene;
+use crate::bsdf::Bsdf;
+use crate::math::{power_heuristic, Pcg32};
 use crate::render::integrator::{self, light_rng, primary_sample, PrimarySample, RayCount};
 use crate::render::{
-    Aov, Image, Integrator, Light, PixelSum, RenderError, RenderSettings, RunOptions, Scene, TILE,
+    Aov, Image, Integrator, Light, PixelSum, Ray, RenderError, RenderSettings, RunOptions, Scene, TILE,
 };
 use glam::{UVec2, Vec3};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -31,7 +35,96 @@ pub struct SweepPath {
     pub radius: f32,
 }
 
+/// Why a scene's sweep cannot be set up; each names the scene and the `[sweep]` field.
+#[derive(Debug, thiserror::Error)]
+pub enum SetupError {
+    #[error("scene `{scene}` has no [sweep] table (it needs at least `light`, `arc_deg` and `radius`)")]
+    NoTable { scene: String },
+    #[error("scene `{scene}`: [sweep] light = \"{light}\" names no light; lights with names: {names}")]
+    NoLight {
+        scene: String,
+        light: String,
+        names: String,
+    },
+    #[error("scene `{scene}`: [sweep] light = \"{light}\" is an area or environment light; a sweep moves a point, spot, sphere or distant light")]
+    Immovable { scene: String, light: String },
+    #[error("scene `{scene}`: [sweep] {field}: {message}")]
+    Field {
+        scene: String,
+        field: &'static str,
+        message: String,
+    },
+    #[error("scene `{scene}`: {source}")]
+    Path { scene: String, source: PathError },
+}
+
 impl SweepPath {
+    /// The sweep of a loaded scene's `[sweep]` table, with `frames` and `arc` (degrees) overriding
+    /// the table's; returns the path and the index of the light that moves.
+    pub fn from_scene(
+        loaded: &LoadedScene,
+        frames: Option<usize>,
+        arc: Option<(f32, f32)>,
+    ) -> Result<(SweepPath, usize), SetupError> {
+        let scene = loaded.name.clone();
+        let t = loaded
+            .sweep
+            .as_ref()
+            .ok_or_else(|| SetupError::NoTable { scene: scene.clone() })?;
+        let moving = loaded
+            .light_names
+            .iter()
+            .position(|n| n.as_deref() == Some(t.light.as_str()))
+            .ok_or_else(|| SetupError::NoLight {
+                scene: scene.clone(),
+                light: t.light.clone(),
+                names: loaded
+                    .light_names
+                    .iter()
+                    .flatten()
+                    .map(|n| format!("\"{n}\""))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            })?;
+        if matches!(
+            loaded.scene.lights[moving],
+            Light::Rect { .. } | Light::Environment(_)
+        ) {
+            return Err(SetupError::Immovable {
+                scene,
+                light: t.light.clone(),
+            });
+        }
+        let field = |field, message: &str| SetupError::Field {
+            scene: scene.clone(),
+            field,
+            message: message.to_string(),
+        };
+        let radius = t.radius;
+        if !(radius.is_finite() && radius > 0.0) {
+            return Err(field("radius", &format!("{radius} must be a positive distance (mm)")));
+        }
+        let pivot = Vec3::from_array(t.pivot);
+        if !pivot.is_finite() {
+            return Err(field("pivot", "every component must be finite"));
+        }
+        let plane = ArcPlane::from_axis(Vec3::Z, Vec3::from_array(t.axis)).ok_or_else(|| {
+            field("axis", "must be a non-zero direction not parallel to +z (the zenith)")
+        })?;
+        let (from, to) = arc.unwrap_or((t.arc_deg[0], t.arc_deg[1]));
+        let arc = LightArc::new(from, to, frames.unwrap_or(t.frames as usize))
+            .map_err(|source| SetupError::Path { scene, source })?;
+        Ok((
+            SweepPath {
+                arc,
+                plane,
+                pivot,
+                radius,
+            },
+            moving,
+        ))
+    }
+
     /// `light` moved to light angle `angle_deg`: point and sphere lights move to the arc point,
     /// spot lights move there and aim at the pivot, distant lights shine from the arc direction.
     /// Other lights (area, environment) have no position on an arc and are returned unchanged.
@@ -218,8 +311,9 @@ struct TileFrames {
     frames: Vec<Image>,
 }
 
-/// One tile for every frame: its primary samples once, then the light-dependent part per frame,
-/// summed exactly as the naive renderer sums them.
+/// One tile for every frame. Each pixel sample's primary part is computed once and lit for every
+/// frame straight away (pixel → sample → frame), so nothing but the tile's pixel sums is kept;
+/// each (pixel, frame) sums its samples in the naive renderer's order.
 fn sweep_tile(
     scene: &Scene,
     lights: &[Vec<Light>],
@@ -228,45 +322,43 @@ fn sweep_tile(
 ) -> TileFrames {
     let (w, h) = (scene.camera.width, scene.camera.height);
     let (tw, th) = (TILE.min(w - origin.x), TILE.min(h - origin.y));
-    let spp = settings.spp as usize;
-    let pixels: Vec<UVec2> = (origin.y..origin.y + th)
-        .flat_map(|y| (origin.x..origin.x + tw).map(move |x| UVec2::new(x, y)))
-        .collect();
-    let cache: Vec<PrimarySample> = pixels
-        .iter()
-        .flat_map(|&p| (0..settings.spp).map(move |s| primary_sample(scene, p, s, settings.seed)))
-        .collect();
+    let n = (tw * th) as usize;
+    let mut sums = vec![vec![PixelSum::default(); n]; lights.len()];
+    let mut radiance = vec![Vec3::ZERO; lights.len()];
     let mut rays = RayCount::default();
-    let mut aov = Vec::new();
-    let frames = lights
-        .iter()
-        .map(|frame_lights| {
-            let sums: Vec<PixelSum> = pixels
-                .iter()
-                .enumerate()
-                .map(|(i, &pixel)| {
-                    let mut sum = PixelSum::default();
-                    for (s, ps) in cache[i * spp..(i + 1) * spp].iter().enumerate() {
-                        let mut rng = light_rng(scene, pixel, s as u32, settings.seed);
-                        let l = match settings.integrator {
-                            Integrator::Direct => {
-                                integrator::direct_radiance(scene, ps, frame_lights, &mut rng)
-                            }
-                            Integrator::Path { max_depth } => integrator::path_radiance(
-                                scene,
-                                ps,
-                                frame_lights,
-                                &mut rng,
-                                max_depth,
-                                &mut rays,
-                            ),
-                        };
-                        sum.add(l, &ps.aov);
+    for (i, pixel) in (origin.y..origin.y + th)
+        .flat_map(|y| (origin.x..origin.x + tw).map(move |x| UVec2::new(x, y)))
+        .enumerate()
+    {
+        for s in 0..settings.spp {
+            let ps = primary_sample(scene, pixel, s, settings.seed);
+            let rng = light_rng(scene, pixel, s, settings.seed);
+            match settings.integrator {
+                Integrator::Direct => direct_for_frames(scene, &ps, lights, &rng, &mut radiance),
+                Integrator::Path { max_depth } => {
+                    for (l, frame_lights) in radiance.iter_mut().zip(lights) {
+                        let mut r = rng.clone();
+                        *l = integrator::path_radiance(
+                            scene,
+                            &ps,
+                            frame_lights,
+                            &mut r,
+                            max_depth,
+                            &mut rays,
+                        );
                     }
-                    sum
-                })
-                .collect();
-            let mut img = Image::from_sums(tw, th, &sums);
+                }
+            }
+            for (frame_sums, l) in sums.iter_mut().zip(&radiance) {
+                frame_sums[i].add(*l, &ps.aov);
+            }
+        }
+    }
+    let mut aov = Vec::new();
+    let frames = sums
+        .iter()
+        .map(|frame_sums| {
+            let mut img = Image::from_sums(tw, th, frame_sums);
             if aov.is_empty() {
                 aov = std::mem::take(&mut img.aov);
             } else {
@@ -276,4 +368,109 @@ fn sweep_tile(
         })
         .collect();
     TileFrames { aov, frames }
+}
+
+/// [`integrator::direct_radiance`] of one primary sample for every frame's lights, into `out`.
+///
+/// The lighting stream `rng` draws two numbers per light for next-event estimation whatever the
+/// light's position, so the BSDF-sampled direction that follows — and the scene hit along it —
+/// is the same in every frame: it is traced once, and per frame only the light it may meet is
+/// tested (the MIS weighting is the renderer's `shade_direct`, step for step).
+fn direct_for_frames(
+    scene: &Scene,
+    ps: &PrimarySample,
+    lights: &[Vec<Light>],
+    rng: &Pcg32,
+    out: &mut [Vec3],
+) {
+    let mut rays = RayCount::default();
+    let mut shaded = vec![false; out.len()];
+    let mut after_nee: Option<Pcg32> = None;
+    for (k, frame_lights) in lights.iter().enumerate() {
+        // A light seen directly in front of the first hit (or on a miss) is the sample's value.
+        if let Some((_, t, le, _)) = integrator::nearest_light(frame_lights, &ps.ray, ps.t_hit) {
+            if t < ps.t_hit || ps.point.is_none() {
+                out[k] = le;
+                continue;
+            }
+        }
+        let Some(sp) = &ps.point else {
+            out[k] = Vec3::ZERO;
+            continue;
+        };
+        let mut r = rng.clone();
+        out[k] = integrator::sample_lights(scene, sp, frame_lights, &mut r, &mut rays);
+        shaded[k] = true;
+        after_nee.get_or_insert(r);
+    }
+    let (Some(sp), Some(mut r)) = (&ps.point, after_nee) else {
+        return;
+    };
+    let uc = r.next_f32();
+    let u = r.next_vec2();
+    if lights[0].iter().all(Light::is_delta) {
+        return;
+    }
+    let Some(bs) = sp.bsdf.sample(sp.wo, uc, u) else {
+        return;
+    };
+    if !(bs.pdf > 0.0) {
+        return;
+    }
+    let d = sp.frame.to_world(bs.wi);
+    let ray = Ray {
+        o: integrator::offset_origin(sp, d),
+        d,
+    };
+    let t_scene = scene
+        .accel
+        .intersect(&ray, f32::INFINITY)
+        .map_or(f32::INFINITY, |h| h.t);
+    for (k, frame_lights) in lights.iter().enumerate() {
+        if !shaded[k] {
+            continue;
+        }
+        if let Some((_, _, le, light_pdf)) = integrator::nearest_light(frame_lights, &ray, t_scene)
+        {
+            let w = if bs.is_delta {
+                1.0
+            } else {
+                power_heuristic(bs.pdf, light_pdf)
+            };
+            out[k] += bs.f * le * (bs.wi.z.abs() * w / bs.pdf);
+        }
+    }
+}
+
+/// The same frames rendered naively, one whole render per frame (nothing cached): the reference
+/// the cache is tested against and timed against.
+pub fn render_naive(
+    scene: &Scene,
+    settings: &RenderSettings,
+    path: &SweepPath,
+    moving: usize,
+    frames: Range<usize>,
+    run: &RunOptions,
+) -> Result<SweepRender, RenderError> {
+    let start = Instant::now();
+    let (mut aov, mut out) = (Vec::new(), Vec::new());
+    for index in frames {
+        let lights = path.frame_lights(&scene.lights, moving, index);
+        let img = crate::render::render_with_lights(scene, &lights, settings, run)?.image;
+        aov = img.aov;
+        out.push(SweepFrame {
+            index,
+            light_deg: path.arc.angle_deg(index),
+            beauty: img.beauty,
+            std_error: img.std_error,
+            nonfinite: img.nonfinite,
+        });
+    }
+    Ok(SweepRender {
+        width: scene.camera.width,
+        height: scene.camera.height,
+        aov,
+        frames: out,
+        elapsed: start.elapsed(),
+    })
 }

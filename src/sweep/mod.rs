@@ -1,14 +1,18 @@
 //! Light-sweep sequences: the light path, the per-sweep cache of what does not change, contact
 //! sheet and viewer.
 //!
+//! - [`cache`]: rendering the frames with the light-independent work done once;
+//! - [`job`]: a whole `xylem sweep` run (render, write, assemble);
 //! - [`path`]: the arc of light directions, frame angles and `--frames-range` slices;
 //! - [`sequence`]: per-frame records and the assembly of a folder of frames into the contact
 //!   sheet ([`contact`]), animated PNG, CSV and the HTML [`viewer`];
 //! - [`plot`]: small line plots for the validation report and the trade-off curve;
 //! - [`highlight`]: where the fibre highlight of a flat finished board peaks along the arc.
 
+pub mod cache;
 pub mod contact;
 pub mod highlight;
+pub mod job;
 pub mod path;
 pub mod plot;
 pub mod sequence;

@@ -1,0 +1,116 @@
+//! The per-sweep cache must not change the picture: every frame of a cached sweep equals the
+//! naive render of that frame (the whole scene rendered again with the light moved), for direct
+//! lighting and for path tracing, and for a slice of frames as for the whole sweep.
+
+use std::path::Path;
+use xylem::render::{render_with_lights, Integrator, RunOptions};
+use xylem::scene::{from_str, LoadedScene};
+use xylem::sweep::cache::{render_sweep, SweepPath};
+
+/// A grey box on a floor, lit by a point light that sweeps and a dim rectangle that stays.
+const SCENE: &str = r#"
+[render]
+width = 20
+height = 14
+spp = 3
+seed = 11
+
+[camera]
+eye = [0.0, -260.0, 180.0]
+target = [0.0, 0.0, 10.0]
+fov_deg = 45.0
+
+[[lights]]
+type = "point"
+name = "key"
+position = [0.0, 0.0, 300.0]
+intensity = 40000.0
+
+[[lights]]
+type = "rect"
+name = "fill"
+corner = [-100.0, 150.0, 40.0]
+edge_u = [200.0, 0.0, 0.0]
+edge_v = [0.0, 0.0, 120.0]
+radiance = 0.4
+
+[materials.grey]
+type = "lambertian"
+albedo = [0.6, 0.5, 0.4]
+
+[[objects]]
+shape = "quad"
+size = [300.0, 300.0]
+material = "grey"
+
+[[objects]]
+shape = "box"
+size = [60.0, 40.0, 50.0]
+translate = [0.0, 0.0, 25.0]
+material = "grey"
+
+[sweep]
+frames = 7
+arc_deg = [-70.0, 50.0]
+light = "key"
+radius = 300.0
+"#;
+
+fn load() -> LoadedScene {
+    from_str(SCENE, "sweep_cache_test.toml", Path::new("."), "test").unwrap()
+}
+
+fn max_relative_difference(a: &[glam::Vec3], b: &[glam::Vec3]) -> f32 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| ((*x - *y).abs().max_element()) / y.max_element().max(1e-6))
+        .fold(0.0, f32::max)
+}
+
+fn check(integrator: Integrator, frames: std::ops::Range<usize>) {
+    let loaded = load();
+    let mut settings = loaded.settings;
+    settings.integrator = integrator;
+    let (path, moving) =
+        SweepPath::from_scene(&loaded, None, None).expect("the scene's [sweep] table");
+    let run = RunOptions {
+        threads: 1,
+        progress: false,
+    };
+    let sweep = render_sweep(&loaded.scene, &settings, &path, moving, frames.clone(), &run).unwrap();
+    assert_eq!(sweep.frames.len(), frames.len());
+    let mut lit = 0;
+    for (k, f) in frames.clone().enumerate() {
+        let lights = path.frame_lights(&loaded.scene.lights, moving, f);
+        let naive = render_with_lights(&loaded.scene, &lights, &settings, &run).unwrap();
+        let cached = sweep.image(k);
+        assert_eq!(sweep.frames[k].index, f);
+        let d = max_relative_difference(&cached.beauty, &naive.image.beauty);
+        assert!(d <= 1e-5, "frame {f}: relative difference {d}");
+        assert_eq!(cached.aov, naive.image.aov, "frame {f}: AOVs");
+        lit += cached.beauty.iter().filter(|c| c.max_element() > 0.0).count();
+    }
+    assert!(lit > frames.len() * 20 * 14 / 2, "frames are mostly lit: {lit}");
+}
+
+#[test]
+fn cached_direct_lighting_equals_naive_frames() {
+    check(Integrator::Direct, 0..7);
+}
+
+#[test]
+fn cached_path_tracing_equals_naive_frames_for_a_slice() {
+    check(Integrator::Path { max_depth: 3 }, 2..5);
+}
+
+#[test]
+fn frames_differ_as_the_light_moves() {
+    let loaded = load();
+    let (path, moving) = SweepPath::from_scene(&loaded, None, None).unwrap();
+    let run = RunOptions::default();
+    let s = render_sweep(&loaded.scene, &loaded.settings, &path, moving, 0..7, &run).unwrap();
+    // The light angle runs from −70° to 50°; the first and last frames are lit differently.
+    assert!((s.frames[0].light_deg + 70.0).abs() < 1e-5);
+    assert!((s.frames[6].light_deg - 50.0).abs() < 1e-5);
+    assert!(max_relative_difference(&s.frames[0].beauty, &s.frames[6].beauty) > 0.1);
+}
