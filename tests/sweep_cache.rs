@@ -77,7 +77,15 @@ fn check(integrator: Integrator, frames: std::ops::Range<usize>) {
         threads: 1,
         progress: false,
     };
-    let sweep = render_sweep(&loaded.scene, &settings, &path, moving, frames.clone(), &run).unwrap();
+    let sweep = render_sweep(
+        &loaded.scene,
+        &settings,
+        &path,
+        moving,
+        frames.clone(),
+        &run,
+    )
+    .unwrap();
     assert_eq!(sweep.frames.len(), frames.len());
     let mut lit = 0;
     for (k, f) in frames.clone().enumerate() {
@@ -88,9 +96,16 @@ fn check(integrator: Integrator, frames: std::ops::Range<usize>) {
         let d = max_relative_difference(&cached.beauty, &naive.image.beauty);
         assert!(d <= 1e-5, "frame {f}: relative difference {d}");
         assert_eq!(cached.aov, naive.image.aov, "frame {f}: AOVs");
-        lit += cached.beauty.iter().filter(|c| c.max_element() > 0.0).count();
+        lit += cached
+            .beauty
+            .iter()
+            .filter(|c| c.max_element() > 0.0)
+            .count();
     }
-    assert!(lit > frames.len() * 20 * 14 / 2, "frames are mostly lit: {lit}");
+    assert!(
+        lit > frames.len() * 20 * 14 / 2,
+        "frames are mostly lit: {lit}"
+    );
 }
 
 #[test]

@@ -84,10 +84,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         cam.height,
         loaded.settings.spp,
         loaded.settings.integrator,
-        if job.naive { "naive (no cache)" } else { "cached primary samples" }
+        if job.naive {
+            "naive (no cache)"
+        } else {
+            "cached primary samples"
+        }
     );
-    let report = run_job(&loaded, &job)
-        .with_context(|| format!("sweep of {}", scene.display()))?;
+    let report = run_job(&loaded, &job).with_context(|| format!("sweep of {}", scene.display()))?;
     let n = report.rendered.len();
     println!(
         "rendered frames {}..{} of {} in {:.2} s ({:.3} s per frame) into {}",

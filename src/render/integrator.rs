@@ -154,7 +154,7 @@ pub fn light_rng(scene: &Scene, pixel: UVec2, sample: u32, seed: u64) -> Pcg32 {
 }
 
 /// The nearest light a ray meets before `t_max`: (light index, distance, radiance, light pdf).
-fn nearest_light(lights: &[Light], ray: &Ray, t_max: f32) -> Option<(usize, f32, Vec3, f32)> {
+pub fn nearest_light(lights: &[Light], ray: &Ray, t_max: f32) -> Option<(usize, f32, Vec3, f32)> {
     let mut best: Option<(usize, f32, Vec3, f32)> = None;
     for (i, l) in lights.iter().enumerate() {
         if let Some((t, le, pdf)) = l.hit(ray) {
@@ -168,7 +168,7 @@ fn nearest_light(lights: &[Light], ray: &Ray, t_max: f32) -> Option<(usize, f32,
     best
 }
 
-fn offset_origin(sp: &ShadingPoint, dir: Vec3) -> Vec3 {
+pub fn offset_origin(sp: &ShadingPoint, dir: Vec3) -> Vec3 {
     let side = if sp.ng.dot(dir) >= 0.0 { 1.0 } else { -1.0 };
     sp.p + sp.ng * (side * sp.eps)
 }

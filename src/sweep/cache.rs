@@ -12,13 +12,14 @@
 //! naive render of that frame.
 
 use super::path::{ArcPlane, LightArc, PathError};
-use crate::scene::LoadedScene;
 use crate::bsdf::Bsdf;
 use crate::math::{power_heuristic, Pcg32};
 use crate::render::integrator::{self, light_rng, primary_sample, PrimarySample, RayCount};
 use crate::render::{
-    Aov, Image, Integrator, Light, PixelSum, Ray, RenderError, RenderSettings, RunOptions, Scene, TILE,
+    Aov, Image, Integrator, Light, PixelSum, Ray, RenderError, RenderSettings, RunOptions, Scene,
+    TILE,
 };
+use crate::scene::LoadedScene;
 use glam::{UVec2, Vec3};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -38,9 +39,13 @@ pub struct SweepPath {
 /// Why a scene's sweep cannot be set up; each names the scene and the `[sweep]` field.
 #[derive(Debug, thiserror::Error)]
 pub enum SetupError {
-    #[error("scene `{scene}` has no [sweep] table (it needs at least `light`, `arc_deg` and `radius`)")]
+    #[error(
+        "scene `{scene}` has no [sweep] table (it needs at least `light`, `arc_deg` and `radius`)"
+    )]
     NoTable { scene: String },
-    #[error("scene `{scene}`: [sweep] light = \"{light}\" names no light; lights with names: {names}")]
+    #[error(
+        "scene `{scene}`: [sweep] light = \"{light}\" names no light; lights with names: {names}"
+    )]
     NoLight {
         scene: String,
         light: String,
@@ -67,10 +72,9 @@ impl SweepPath {
         arc: Option<(f32, f32)>,
     ) -> Result<(SweepPath, usize), SetupError> {
         let scene = loaded.name.clone();
-        let t = loaded
-            .sweep
-            .as_ref()
-            .ok_or_else(|| SetupError::NoTable { scene: scene.clone() })?;
+        let t = loaded.sweep.as_ref().ok_or_else(|| SetupError::NoTable {
+            scene: scene.clone(),
+        })?;
         let moving = loaded
             .light_names
             .iter()
@@ -102,14 +106,20 @@ impl SweepPath {
         };
         let radius = t.radius;
         if !(radius.is_finite() && radius > 0.0) {
-            return Err(field("radius", &format!("{radius} must be a positive distance (mm)")));
+            return Err(field(
+                "radius",
+                &format!("{radius} must be a positive distance (mm)"),
+            ));
         }
         let pivot = Vec3::from_array(t.pivot);
         if !pivot.is_finite() {
             return Err(field("pivot", "every component must be finite"));
         }
         let plane = ArcPlane::from_axis(Vec3::Z, Vec3::from_array(t.axis)).ok_or_else(|| {
-            field("axis", "must be a non-zero direction not parallel to +z (the zenith)")
+            field(
+                "axis",
+                "must be a non-zero direction not parallel to +z (the zenith)",
+            )
         })?;
         let (from, to) = arc.unwrap_or((t.arc_deg[0], t.arc_deg[1]));
         let arc = LightArc::new(from, to, frames.unwrap_or(t.frames as usize))
@@ -169,7 +179,13 @@ impl SweepPath {
         lights
             .iter()
             .enumerate()
-            .map(|(i, l)| if i == moving { self.place(l, angle) } else { l.clone() })
+            .map(|(i, l)| {
+                if i == moving {
+                    self.place(l, angle)
+                } else {
+                    l.clone()
+                }
+            })
             .collect()
     }
 }

@@ -82,7 +82,10 @@ pub fn write_frames(
     regions: &[Region],
 ) -> Result<(), SweepError> {
     for (k, f) in render.frames.iter().enumerate() {
-        write_image_exr(&dir.join(format!("{}.exr", frame_stem(f.index))), &render.image(k))?;
+        write_image_exr(
+            &dir.join(format!("{}.exr", frame_stem(f.index))),
+            &render.image(k),
+        )?;
         let rec = FrameRecord::measure(
             f.index,
             total,
@@ -111,7 +114,11 @@ pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepE
     if job.range.is_none() {
         clear_frames(&job.out)?;
     }
-    let render = if job.naive { render_naive } else { render_sweep };
+    let render = if job.naive {
+        render_naive
+    } else {
+        render_sweep
+    };
     let r = render(
         &loaded.scene,
         &loaded.settings,

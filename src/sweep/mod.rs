@@ -9,6 +9,7 @@
 //! - [`plot`]: small line plots for the validation report and the trade-off curve;
 //! - [`highlight`]: where the fibre highlight of a flat finished board peaks along the arc.
 
+pub mod bake;
 pub mod cache;
 pub mod contact;
 pub mod highlight;

@@ -1,0 +1,306 @@
+//! Baking a wood preset into texture maps for other tools (`xylem bake`): base colour, fibre
+//! direction as a glTF `KHR_materials_anisotropy` map, highlight width, ray mask and a normal map
+//! from the pore bump, over the top face of a board cut from the tree. The trade-off measurement
+//! (`xylem tradeoff`) also uses these maps as the "baked texture" alternative to the procedural
+//! volume, which is why they live beside the sweep code.
+//!
+//! Conventions (as glTF 2.0 and KHR_materials_anisotropy use them): texel (0, 0) is the top-left
+//! corner; tangent-space x points to the image's right (+u, along the board's length), y to the
+//! image's top, z out of the face. Data maps (anisotropy, normal) are stored linearly, not sRGB.
+
+use crate::render::image_io::{to_srgb8, write_exr_layers, write_png_rgb8, ExrLayer, ImageError};
+use crate::wood::{Needs, WoodVolume};
+use glam::{Vec2, Vec3};
+use rayon::prelude::*;
+
+/// Which face of the log the board shows (Liu et al. 2016 §7.2; the classical sawing terms).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BakeCut {
+    /// Flat-sawn: the face is tangent to the growth rings (its normal is radial).
+    Tangential,
+    /// Quartersawn: the face contains the radius (its normal is tangential, θ̂).
+    Radial,
+    /// End grain: the face is perpendicular to the pith.
+    Transverse,
+}
+
+impl std::str::FromStr for BakeCut {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "tangential" => Ok(BakeCut::Tangential),
+            "radial" => Ok(BakeCut::Radial),
+            "transverse" => Ok(BakeCut::Transverse),
+            _ => Err(format!(
+                "cut `{s}`: expected tangential, radial or transverse"
+            )),
+        }
+    }
+}
+
+/// The board and where it was cut: `size` = [length W, width H, thickness T] (mm); its centre
+/// sits `radius` mm from the pith; the baked face is the one `T/2` out along the face normal.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BoardCut {
+    pub size: [f32; 3],
+    pub cut: BakeCut,
+    pub radius: f32,
+}
+
+impl BoardCut {
+    /// The face's frame in tree space: (origin of texel (0,0)'s corner, right = +u per mm,
+    /// down = +v per mm, normal). Right × up = normal, with up = −down.
+    fn face(&self) -> (Vec3, Vec3, Vec3, Vec3) {
+        let [w, h, t] = self.size;
+        let centre = Vec3::new(0.0, self.radius, 0.0);
+        // (right, down, normal) for each cut; the grain (tree z) runs along the length where it can.
+        let (right, down, normal) = match self.cut {
+            BakeCut::Tangential => (Vec3::Z, -Vec3::X, Vec3::Y),
+            BakeCut::Radial => (Vec3::Z, Vec3::Y, Vec3::X),
+            BakeCut::Transverse => (Vec3::X, -Vec3::Y, Vec3::Z),
+        };
+        let corner = centre + 0.5 * t * normal - 0.5 * w * right - 0.5 * h * down;
+        (corner, right, down, normal)
+    }
+
+    /// Texture size for `res` texels along the length (at least 1 × 1).
+    pub fn texture_size(&self, res: u32) -> (u32, u32) {
+        let [w, h, _] = self.size;
+        let res = res.max(1);
+        (res, ((res as f32 * h / w).round() as u32).max(1))
+    }
+}
+
+/// The baked maps, row-major, top row first.
+#[derive(Clone, Debug)]
+pub struct BakedMaps {
+    pub width: u32,
+    pub height: u32,
+    /// Diffuse colour (linear RGB).
+    pub base_color: Vec<Vec3>,
+    /// KHR_materials_anisotropy texel: (x, y) direction in [−1, 1] stored as 0.5 + 0.5·d, strength.
+    pub anisotropy: Vec<Vec3>,
+    /// Fibre highlight width β (radians).
+    pub highlight_width: Vec<f32>,
+    pub ray_mask: Vec<f32>,
+    /// Tangent-space normal (unit), stored as 0.5 + 0.5·n in the PNG.
+    pub normal: Vec<Vec3>,
+}
+
+/// The anisotropy texel of a fibre direction `f` on a face with tangent-space axes `right`, `up`:
+/// the direction is f projected into the face (normalised), the strength is the length of that
+/// projection — 1 for fibres lying in the face, 0 for fibres straight out of it (end grain), where
+/// the highlight is no longer stretched along the face. Encoded as KHR_materials_anisotropy
+/// stores it: red, green = 0.5 + 0.5·direction, blue = strength.
+pub fn anisotropy_texel(f: Vec3, right: Vec3, up: Vec3) -> Vec3 {
+    let proj = Vec2::new(f.dot(right), f.dot(up));
+    let strength = proj.length().min(1.0);
+    let dir = if strength > 1e-6 {
+        proj / proj.length()
+    } else {
+        Vec2::X
+    };
+    Vec3::new(0.5 + 0.5 * dir.x, 0.5 + 0.5 * dir.y, strength)
+}
+
+/// The tangent-space normal of a height field h with tree-space gradient `g` seen on a face with
+/// axes `right`, `up`: n ∝ (−∂h/∂x, −∂h/∂y, 1) (the surface z = h(x, y)).
+pub fn bump_normal(g: Vec3, right: Vec3, up: Vec3) -> Vec3 {
+    let n = Vec3::new(-g.dot(right), -g.dot(up), 1.0);
+    let n = n.normalize_or_zero();
+    if n == Vec3::ZERO {
+        Vec3::Z
+    } else {
+        n
+    }
+}
+
+/// Bakes `volume` over the board's face at `res` texels along its length, one sample at each
+/// texel centre.
+pub fn bake(volume: &WoodVolume, board: &BoardCut, res: u32) -> BakedMaps {
+    let (w, h) = board.texture_size(res);
+    let (corner, right, down, _) = board.face();
+    let (du, dv) = (board.size[0] / w as f32, board.size[1] / h as f32);
+    let texels: Vec<_> = (0..h)
+        .into_par_iter()
+        .flat_map_iter(|y| {
+            (0..w).map(move |x| {
+                let p = corner + right * ((x as f32 + 0.5) * du) + down * ((y as f32 + 0.5) * dv);
+                volume.eval(p, Needs::ALL)
+            })
+        })
+        .collect();
+    let up = -down;
+    BakedMaps {
+        width: w,
+        height: h,
+        base_color: texels.iter().map(|t| t.diffuse).collect(),
+        anisotropy: texels
+            .iter()
+            .map(|t| anisotropy_texel(t.fiber_dir, right, up))
+            .collect(),
+        highlight_width: texels.iter().map(|t| t.highlight_width).collect(),
+        ray_mask: texels.iter().map(|t| t.ray_mask).collect(),
+        normal: texels
+            .iter()
+            .map(|t| bump_normal(t.bump_grad, right, up))
+            .collect(),
+    }
+}
+
+/// Data (not colour) texels as 8-bit codes: `v` in [0, 1] → round(255 v), no transfer curve.
+fn data8(values: impl Iterator<Item = f32>) -> Vec<u8> {
+    values
+        .map(|v| (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8)
+        .collect()
+}
+
+/// Writes every map as `NAME.png` and `NAME.exr` into `dir` and returns the files written.
+/// PNG: base colour in sRGB; anisotropy and normal as linear codes of their glTF encodings;
+/// highlight width as β / 45° (grey); ray mask as is. EXR: the same maps as 32-bit floats, with
+/// the anisotropy and normal maps *decoded* (direction components in [−1, 1], strength; unit
+/// normal) and β in radians.
+pub fn write_maps(
+    dir: &std::path::Path,
+    m: &BakedMaps,
+) -> Result<Vec<std::path::PathBuf>, ImageError> {
+    let (w, h) = (m.width, m.height);
+    let mut files = Vec::new();
+    let grey = |v: &[f32], scale: f32| data8(v.iter().flat_map(|x| [x * scale; 3]));
+    let rgb = |v: &[Vec3]| data8(v.iter().flat_map(|c| c.to_array()));
+    let beta_scale = 1.0 / 45f32.to_radians();
+    let normal_code: Vec<Vec3> = m.normal.iter().map(|n| 0.5 + 0.5 * *n).collect();
+    let pngs: [(&str, Vec<u8>); 5] = [
+        ("base_color", to_srgb8(&m.base_color, 0.0)),
+        ("anisotropy", rgb(&m.anisotropy)),
+        ("highlight_width", grey(&m.highlight_width, beta_scale)),
+        ("ray_mask", grey(&m.ray_mask, 1.0)),
+        ("normal", rgb(&normal_code)),
+    ];
+    for (name, bytes) in pngs {
+        let p = dir.join(format!("{name}.png"));
+        write_png_rgb8(&p, w, h, &bytes)?;
+        files.push(p);
+    }
+    let flat = |v: &[Vec3]| v.iter().flat_map(|c| c.to_array()).collect::<Vec<f32>>();
+    let aniso: Vec<Vec3> = m
+        .anisotropy
+        .iter()
+        .map(|a| Vec3::new(2.0 * a.x - 1.0, 2.0 * a.y - 1.0, a.z))
+        .collect();
+    let exrs: [(&str, &[&str], Vec<f32>); 5] = [
+        ("base_color", &["R", "G", "B"], flat(&m.base_color)),
+        ("anisotropy", &["R", "G", "B"], flat(&aniso)),
+        ("highlight_width", &["Y"], m.highlight_width.clone()),
+        ("ray_mask", &["Y"], m.ray_mask.clone()),
+        ("normal", &["R", "G", "B"], flat(&m.normal)),
+    ];
+    for (name, channels, data) in exrs {
+        let p = dir.join(format!("{name}.exr"));
+        write_exr_layers(
+            &p,
+            w,
+            h,
+            &[ExrLayer {
+                name: "",
+                channels,
+                data,
+            }],
+        )?;
+        files.push(p);
+    }
+    Ok(files)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn face_frames_are_right_handed_and_cut_as_named() {
+        for cut in [BakeCut::Tangential, BakeCut::Radial, BakeCut::Transverse] {
+            let b = BoardCut {
+                size: [200.0, 100.0, 20.0],
+                cut,
+                radius: 150.0,
+            };
+            let (corner, right, down, n) = b.face();
+            assert!((right.cross(-down) - n).length() < 1e-6, "{cut:?}");
+            // The board's centre sits on the +y radius.
+            let radial = Vec3::Y;
+            let face_centre = corner + 100.0 * right + 50.0 * down;
+            assert!((face_centre - (Vec3::new(0.0, 150.0, 0.0) + 10.0 * n)).length() < 1e-4);
+            match cut {
+                BakeCut::Tangential => assert!((n.dot(radial) - 1.0).abs() < 1e-6),
+                BakeCut::Radial => assert!(n.dot(radial).abs() < 1e-6 && n.z == 0.0),
+                BakeCut::Transverse => assert_eq!(n, Vec3::Z),
+            }
+        }
+        assert_eq!(
+            BoardCut {
+                size: [300.0, 100.0, 20.0],
+                cut: BakeCut::Radial,
+                radius: 100.0
+            }
+            .texture_size(512),
+            (512, 171)
+        );
+        assert!("diagonal".parse::<BakeCut>().is_err());
+    }
+
+    #[test]
+    fn anisotropy_encodes_direction_and_in_plane_strength() {
+        let (r, u) = (Vec3::X, Vec3::Y);
+        // A fibre along the image's right: direction (1, 0) → (1, 0.5), full strength.
+        assert_eq!(anisotropy_texel(Vec3::X, r, u), Vec3::new(1.0, 0.5, 1.0));
+        // Dipping 60° into the face: strength cos 60° = 0.5, direction still along x.
+        let f = Vec3::new(60f32.to_radians().cos(), 0.0, -60f32.to_radians().sin());
+        let a = anisotropy_texel(f, r, u);
+        assert!((a.z - 0.5).abs() < 1e-6 && (a.x - 1.0).abs() < 1e-6);
+        // End grain: no strength, a defined direction.
+        assert_eq!(anisotropy_texel(Vec3::Z, r, u).z, 0.0);
+        // Fibre up the image: green = 1.
+        assert!((anisotropy_texel(Vec3::Y, r, u).y - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn bump_normal_tilts_against_the_slope() {
+        // h = 0.5 x: the surface rises to the right, so its normal leans left (−x).
+        let n = bump_normal(Vec3::new(0.5, 0.0, 0.0), Vec3::X, Vec3::Y);
+        assert!((n - Vec3::new(-0.5, 0.0, 1.0).normalize()).length() < 1e-6);
+        assert_eq!(bump_normal(Vec3::ZERO, Vec3::X, Vec3::Y), Vec3::Z);
+        assert_eq!(
+            bump_normal(Vec3::splat(f32::NAN), Vec3::X, Vec3::Y),
+            Vec3::Z
+        );
+    }
+
+    #[test]
+    fn baking_a_preset_gives_finite_maps_with_rings() {
+        let v = WoodVolume::new(crate::wood::preset("walnut").unwrap(), 1).unwrap();
+        let b = BoardCut {
+            size: [120.0, 40.0, 20.0],
+            cut: BakeCut::Transverse,
+            radius: 120.0,
+        };
+        let m = bake(&v, &b, 48);
+        assert_eq!((m.width, m.height), (48, 16));
+        assert!(m
+            .base_color
+            .iter()
+            .all(|c| c.is_finite() && c.min_element() >= 0.0));
+        assert!(m.normal.iter().all(|n| (n.length() - 1.0).abs() < 1e-4));
+        // End grain: fibres leave the face, so anisotropy strength is small.
+        assert!(m.anisotropy.iter().all(|a| a.z < 0.2), "end grain");
+        // Rings vary the colour across the face.
+        let lum: Vec<f32> = m
+            .base_color
+            .iter()
+            .map(|c| crate::math::luminance(*c))
+            .collect();
+        let (lo, hi) = lum
+            .iter()
+            .fold((f32::MAX, f32::MIN), |(a, b), &l| (a.min(l), b.max(l)));
+        assert!(hi > 1.2 * lo, "rings visible: {lo}..{hi}");
+    }
+}
