@@ -2,6 +2,9 @@
 
 use crate::wood;
 use anyhow::Context;
+use crate::render::image_io::write_png_linear;
+use crate::wood::{render_slice, Plane, Slice};
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(clap::Args, Debug)]
@@ -16,6 +19,27 @@ enum What {
     List,
     /// Print a preset's TOML (a starting point for `--preset-file`).
     Show { name: String },
+    /// Write each preset's three cuts (transverse xy, radial xz, tangential yz) as PNGs, plus a
+    /// contact sheet of all of them.
+    Cuts {
+        /// Output folder.
+        #[arg(long, default_value = "out/presets")]
+        out: PathBuf,
+        /// Image side in pixels.
+        #[arg(long, default_value_t = 192)]
+        res: u32,
+        /// Side of each cut in mm.
+        #[arg(long, default_value_t = 100.0)]
+        size: f32,
+        /// Only these presets (default: all).
+        #[arg(long)]
+        only: Vec<String>,
+        /// Plain diffuse colour instead of shading by fibre direction.
+        #[arg(long)]
+        flat: bool,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -27,6 +51,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             }
         }
         What::Show { name } => print!("{}", wood::preset_text(&name)?),
+        What::Cuts {
+            out,
+            res,
+            size,
+            only,
+            flat,
+            seed,
+        } => cuts(&out, res, size, &only, !flat, seed)?,
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -60,4 +92,40 @@ fn features(p: &wood::WoodParams) -> Vec<&'static str> {
     .into_iter()
     .filter_map(|(on, name)| on.then_some(name))
     .collect()
+}
+
+/// The three cuts of each preset, one PNG per cut, and `sheet.png` (rows: presets; columns: xy, xz, yz).
+fn cuts(out: &Path, res: u32, size: f32, only: &[String], shade: bool, seed: u64) -> anyhow::Result<()> {
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let names: Vec<&str> = if only.is_empty() {
+        wood::PRESET_NAMES.to_vec()
+    } else {
+        only.iter().map(String::as_str).collect()
+    };
+    let bar = indicatif::ProgressBar::new(3 * names.len() as u64);
+    let mut sheet = vec![glam::Vec3::ZERO; (3 * res * res) as usize * names.len()];
+    for (row, name) in names.iter().enumerate() {
+        let volume = wood::WoodVolume::new(wood::preset(name)?, seed)?;
+        for (col, (plane, tag)) in [(Plane::Xy, "xy"), (Plane::Xz, "xz"), (Plane::Yz, "yz")]
+            .into_iter()
+            .enumerate()
+        {
+            let px = render_slice(&volume, &Slice::standard(plane, size), res, shade);
+            let path = out.join(format!("{name}_{tag}.png"));
+            write_png_linear(&path, res, res, &px, 0.0)
+                .with_context(|| format!("writing {}", path.display()))?;
+            for j in 0..res {
+                let dst = ((row as u32 * res + j) * 3 * res + col as u32 * res) as usize;
+                let src = (j * res) as usize;
+                sheet[dst..dst + res as usize].copy_from_slice(&px[src..src + res as usize]);
+            }
+            bar.inc(1);
+        }
+    }
+    bar.finish_and_clear();
+    let path = out.join("sheet.png");
+    write_png_linear(&path, 3 * res, res * names.len() as u32, &sheet, 0.0)
+        .with_context(|| format!("writing {}", path.display()))?;
+    println!("wrote {} cuts and {}", 3 * names.len(), path.display());
+    Ok(())
 }

@@ -10,6 +10,9 @@ use super::params::KnotParams;
 use crate::math::{Pcg32, PI};
 use glam::Vec3;
 
+/// The golden angle π (3 − √5), radians.
+const GOLDEN_ANGLE: f32 = 2.399_963;
+
 /// Width of the bark rim around a dead knot, mm.
 const BARK_RIM: f32 = 0.4;
 
@@ -72,10 +75,11 @@ impl Knots {
     fn branch(&self, k: i64, theta: f32) -> (Vec3, Vec3) {
         let mut rng = Pcg32::new(self.seed, k as u64);
         let step = 2.0 * PI / self.per_whorl as f32;
-        let phase = rng.next_f32() * step;
+        // Whorls turn by the golden angle (phyllotaxis), so knots of successive whorls do not line up.
+        let phase = (k as f32 * GOLDEN_ANGLE).rem_euclid(step);
         let j = ((theta - phase) / step).round();
         let az = phase + j * step;
-        let z0 = (k as f32 + (rng.next_f32() - 0.5) * 0.3) * self.spacing;
+        let z0 = (k as f32 + (rng.next_f32() - 0.5) * 0.2) * self.spacing;
         let (s, c) = az.sin_cos();
         let axis = Vec3::new(c * self.cos_rise, s * self.cos_rise, self.sin_rise);
         (Vec3::new(0.0, 0.0, z0), axis)

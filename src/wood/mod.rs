@@ -4,9 +4,11 @@
 mod board;
 mod color;
 mod error;
+mod features;
 mod growth;
 mod knots;
 mod params;
+mod slice;
 mod volume;
 
 pub use board::*;
@@ -15,6 +17,7 @@ pub use error::WoodError;
 pub use growth::{SmoothRectangleWave, SmoothTriangleWave};
 pub use knots::{smooth_min, KnotSample, Knots};
 pub use params::*;
+pub use slice::{render_slice, Plane, Slice};
 pub use volume::WoodVolume;
 
 use glam::Vec3;

@@ -331,7 +331,7 @@ impl WoodParams {
             c.range("pores.radius", p.radius, 0.005, 5.0)?;
             c.range("pores.length", p.length, 0.005, 100.0)?;
             c.positive("pores.density", p.density, 16.0)?;
-            c.range("pores.sharpness", p.sharpness, 0.0, 100.0)?;
+            c.range("pores.sharpness", p.sharpness, 0.05, 100.0)?;
             c.range("pores.ring_porosity", p.ring_porosity, 0.0, 1.0)?;
             c.range("pores.depth", p.depth, 0.0, 4.0)?;
         }

@@ -3,11 +3,13 @@
 
 use super::color::BeerColor;
 use super::error::WoodError;
+use super::features::{sub_seed, DistortionNoise, Noise1, Pores, Rays};
 use super::growth::{SmoothRectangleWave, SmoothTriangleWave};
 use super::knots::{KnotSample, Knots};
 use super::params::WoodParams;
 use super::{Needs, WoodTexel};
-use crate::field::{cylinder_frame, rotate_about_radial, Cylindrical, Distortion};
+use crate::field::{cylinder_frame, rotate_about_radial, Cylindrical, Displacement, Distortion};
+use crate::math::Frame;
 use glam::Vec3;
 
 /// A wood volume ready to evaluate: parameters turned into precomputed waves, colours and noise.
@@ -18,39 +20,106 @@ pub struct WoodVolume {
     seed: u64,
     inv_ring_width: f32,
     growth: Option<SmoothTriangleWave>,
+    growth_noise: Option<Noise1>,
+    interlock: Option<Noise1>,
+    /// Distortion magnitudes along r̂, θ̂, ẑ.
+    distortion: [Option<DistortionNoise>; 3],
     rings: SmoothRectangleWave,
     highlight: SmoothRectangleWave,
     color: BeerColor,
+    pores: Option<Pores>,
+    rays: Option<Rays>,
     knots: Option<Knots>,
 }
 
-/// Seeds of the independent noise fields, derived from the volume seed.
-const SALT_KNOTS: u64 = 0x6b6e_6f74;
+/// Salts of the independent noise fields, so each feature has its own seed.
+mod salt {
+    pub const GROWTH: u32 = 1;
+    pub const INTERLOCK: u32 = 2;
+    pub const DISTORT: [u32; 3] = [3, 4, 5];
+    pub const PORES: u32 = 6;
+    pub const RAYS: u32 = 7;
+    pub const KNOTS: u64 = 0x6b6e_6f74;
+}
+
+/// What `eval` computes at the distorted point before deciding what else it needs.
+struct Core {
+    dist: Distortion,
+    cyl: Cylindrical,
+    time: f32,
+    knot: Option<KnotSample>,
+}
 
 impl WoodVolume {
     /// Build a volume from validated parameters; `seed` selects the tree.
     pub fn new(params: WoodParams, seed: u64) -> Result<WoodVolume, WoodError> {
         params.validate("<parameters>")?;
-        let rings = SmoothRectangleWave::new(params.rings.proportions, 0.0, 1.0);
+        let p = &params;
+        let rings = SmoothRectangleWave::new(p.rings.proportions, 0.0, 1.0);
         let highlight = SmoothRectangleWave::new(
-            params.rings.proportions,
-            params.highlight.earlywood.to_radians(),
-            params.highlight.latewood.to_radians(),
+            p.rings.proportions,
+            p.highlight.earlywood.to_radians(),
+            p.highlight.latewood.to_radians(),
         );
-        let growth = params
+        let growth = p
             .growth
             .as_ref()
             .map(|g| SmoothTriangleWave::new(g.wave, g.amplitude));
-        let knots = params
+        let growth_noise = p
+            .growth
+            .as_ref()
+            .filter(|g| g.noise_amplitude > 0.0)
+            .map(|g| Noise1 {
+                amp: g.noise_amplitude,
+                inv_scale: 1.0 / g.noise_scale,
+                seed: sub_seed(seed, salt::GROWTH),
+            });
+        // gradient1 lies within ±0.5, so the helix angle is 2 · angle · n(r / period).
+        let interlock = p
+            .interlock
+            .as_ref()
+            .filter(|i| i.angle > 0.0)
+            .map(|i| Noise1 {
+                amp: 2.0 * i.angle.to_radians(),
+                inv_scale: 1.0 / i.period,
+                seed: sub_seed(seed, salt::INTERLOCK),
+            });
+        let max_tilt = interlock.map_or(0.0, |i| 0.5 * i.amp);
+        let d = &p.distortion;
+        let distortion = [&d.radial, &d.tangential, &d.longitudinal]
+            .into_iter()
+            .zip(salt::DISTORT)
+            .map(|(n, s)| {
+                n.as_ref()
+                    .filter(|n| n.magnitude > 0.0)
+                    .map(|n| DistortionNoise::new(n, sub_seed(seed, s)))
+            })
+            .collect::<Vec<_>>();
+        let distortion = [distortion[0].clone(), distortion[1].clone(), distortion[2].clone()];
+        let pores = p
+            .pores
+            .as_ref()
+            .map(|x| Pores::new(x, max_tilt, sub_seed(seed, salt::PORES)));
+        let rays = p
+            .rays
+            .as_ref()
+            .filter(|r| r.strength > 0.0)
+            .map(|r| Rays::new(r, sub_seed(seed, salt::RAYS)));
+        let knots = p
             .knots
             .as_ref()
-            .map(|k| Knots::new(k, params.rings.width, seed ^ SALT_KNOTS));
+            .map(|k| Knots::new(k, p.rings.width, seed ^ salt::KNOTS));
         Ok(WoodVolume {
-            inv_ring_width: 1.0 / params.rings.width,
+            inv_ring_width: 1.0 / p.rings.width,
             growth,
+            growth_noise,
+            interlock,
+            distortion,
             rings,
             highlight,
-            color: BeerColor::new(&params.color),
+            color: BeerColor::new(&p.color),
+            pores,
+            rays,
             knots,
             params,
             seed,
@@ -67,60 +136,155 @@ impl WoodVolume {
         self.seed
     }
 
-    /// Growth time t(r) in years (eq. 23–24): t_pre = u + w(u) with u = r / ring width, then
-    /// t = t_pre + n(t_pre).
+    /// Growth time t(r) in years and dt/dr (eq. 23–24): t_pre = u + w(u) with u = r / ring width,
+    /// then t = t_pre + n(t_pre). Monotone in r under the bounds checked by the parameters
+    /// (notes/wood.md).
     #[inline]
-    pub fn time(&self, r: f32) -> f32 {
+    pub fn time(&self, r: f32) -> (f32, f32) {
         let u = r * self.inv_ring_width;
-        match &self.growth {
-            Some(w) => u + w.eval(u).0,
-            None => u,
+        let (mut t, mut dt) = (u, self.inv_ring_width);
+        if let Some(w) = &self.growth {
+            let (wv, wd) = w.eval(u);
+            t += wv;
+            dt *= 1.0 + wd;
+        }
+        if let Some(n) = &self.growth_noise {
+            let (nv, nd) = n.eval(t);
+            t += nv;
+            dt *= 1.0 + nd;
+        }
+        (t, dt)
+    }
+
+    /// The interlocked-grain helix angle (radians) at radius r (§6.1.5): 1D gradient noise of r,
+    /// which crosses zero at every multiple of the period, so the helix reverses with radius.
+    #[inline]
+    pub fn interlock_angle(&self, r: f32) -> f32 {
+        self.interlock.map_or(0.0, |n| n.eval(r).0)
+    }
+
+    /// The distortion f(p) with its Jacobian (§5, eq. 15 and 22).
+    #[inline]
+    pub fn distortion(&self, p: Vec3) -> Distortion {
+        self.distort::<true>(p)
+    }
+
+    /// f(p), with the Jacobian only when `JACOBIAN` (colour alone needs just the point).
+    #[inline]
+    fn distort<const JACOBIAN: bool>(&self, p: Vec3) -> Distortion {
+        let mut d = Distortion::identity(p);
+        if self.distortion.iter().any(Option::is_some) {
+            let frame = cylinder_frame(p);
+            for (noise, dir) in self.distortion.iter().zip([frame.s, frame.t, frame.n]) {
+                if let Some(noise) = noise {
+                    let (m, grad_m) = noise.eval::<JACOBIAN>(p, &frame);
+                    d.add(Displacement { dir, m, grad_m });
+                }
+            }
+        }
+        d
+    }
+
+    #[inline]
+    fn core(&self, p: Vec3, needs: Needs) -> Core {
+        let dist = if needs.fibers || needs.bump {
+            self.distort::<true>(p)
+        } else {
+            self.distort::<false>(p)
+        };
+        let cyl = Cylindrical::from_point(dist.point);
+        let (mut time, _) = self.time(cyl.r);
+        let knot = self
+            .knots
+            .as_ref()
+            .and_then(|k| k.eval(dist.point, cyl.theta, cyl.r, time));
+        if let Some(k) = &knot {
+            time = k.time;
+        }
+        Core {
+            dist,
+            cyl,
+            time,
+            knot,
         }
     }
 
-    /// The interlocked-grain helix angle (radians) at radius r (§6.1.5).
+    /// The fibre frame at the distorted point q: the cylindrical frame rotated by the interlock
+    /// angle (s = r̂, t = θ̂', n = longitudinal fibre).
     #[inline]
-    pub fn interlock_angle(&self, _r: f32) -> f32 {
-        0.0
+    fn fiber_frame(&self, q: Vec3, r: f32) -> Frame {
+        let frame = cylinder_frame(q);
+        match &self.interlock {
+            Some(_) => rotate_about_radial(&frame, self.interlock_angle(r)),
+            None => frame,
+        }
     }
 
     /// Evaluate the wood at tree-space point `p` (mm), computing only what `needs` asks for.
     pub fn eval(&self, p: Vec3, needs: Needs) -> WoodTexel {
         let mut texel = WoodTexel::default();
-        // §6.2: distortion of every lookup (identity until the distortion noise is in).
-        let dist = Distortion::identity(p);
-        let q = dist.point;
-        let cyl = Cylindrical::from_point(q);
-        let mut t = self.time(cyl.r);
-        let knot: Option<KnotSample> = self
-            .knots
-            .as_ref()
-            .and_then(|k| k.eval(q, cyl.theta, cyl.r, t));
-        if let Some(k) = &knot {
-            t = k.time;
+        let c = self.core(p, needs);
+        let q = c.dist.point;
+        texel.growth_time = c.time;
+        let g = self.rings.eval(c.time);
+        let want_pores = self.pores.is_some() && (needs.color || needs.bump);
+        let want_rays = self.rays.is_some() && (needs.fibers || self.color_uses_rays());
+        let frame = if want_pores || needs.fibers {
+            self.fiber_frame(q, c.cyl.r)
+        } else {
+            Frame {
+                s: Vec3::X,
+                t: Vec3::Y,
+                n: Vec3::Z,
+            }
+        };
+        if want_pores {
+            let pores = self.pores.as_ref().expect("checked");
+            let (mask, grad) = if needs.bump {
+                pores.mask::<true>(q, &frame, g)
+            } else {
+                pores.mask::<false>(q, &frame, g)
+            };
+            texel.pore_mask = mask;
+            if needs.bump {
+                // §6.1.7: height = −depth · mask; its gradient transported covariantly (eq. 18).
+                texel.bump = -pores.depth * mask;
+                texel.bump_grad = c.dist.gradient(grad * -pores.depth);
+            }
         }
-        texel.growth_time = t;
+        if want_rays {
+            texel.ray_mask = self.rays.as_ref().expect("checked").mask(q);
+        }
         if needs.color {
-            let g = self.rings.eval(t);
-            let extra = knot.map_or(0.0, |k| {
-                let dark = self.knots.as_ref().map_or(0.0, |kn| kn.darkening);
-                dark * k.inside + 3.0 * dark * k.bark
-            });
-            let (diffuse, fiber) = self.color.colors(self.color.absorbance(g, 0.0, 0.0, extra));
+            let extra = match (&c.knot, &self.knots) {
+                (Some(k), Some(kn)) => kn.darkening * (k.inside + 3.0 * k.bark),
+                _ => 0.0,
+            };
+            let a = self
+                .color
+                .absorbance(g, texel.pore_mask, texel.ray_mask, extra);
+            let (diffuse, fiber) = self.color.colors(a);
             texel.diffuse = diffuse;
             texel.fiber_color = fiber;
         }
         if needs.fibers {
-            let frame = rotate_about_radial(&cylinder_frame(q), self.interlock_angle(cyl.r));
             let mut fiber = frame.n;
-            if let (Some(k), Some(knots)) = (&knot, &self.knots) {
+            if let (Some(k), Some(knots)) = (&c.knot, &self.knots) {
                 fiber = knots.deflect_fiber(fiber, k);
             }
-            texel.fiber_dir = normalize_or(dist.vector(fiber), Vec3::Z);
-            texel.ray_dir = normalize_or(dist.vector(frame.s), Vec3::X);
-            texel.highlight_width = self.highlight.eval(t);
+            // §5.2 eq. 17: directions looked up at f(p) are transported by J⁻¹.
+            let inv = c.dist.inverse_jacobian();
+            texel.fiber_dir = normalize_or(inv * fiber, Vec3::Z);
+            texel.ray_dir = normalize_or(inv * frame.s, Vec3::X);
+            texel.highlight_width = self.highlight.eval(c.time);
         }
         texel
+    }
+
+    /// Whether rays change the colour (a non-zero ray path length).
+    #[inline]
+    fn color_uses_rays(&self) -> bool {
+        self.params.color.ray_path != 0.0
     }
 }
 

@@ -1,10 +1,127 @@
-//! `xylem bench wood`.
+//! `xylem bench wood`: wood texels per second per core for each preset, colour only and the full
+//! model (the speed goal of issue 4; the criterion twin is benches/wood.rs).
 
+use crate::math::Pcg32;
+use crate::wood::{self, Needs, WoodVolume};
+use glam::Vec3;
 use std::process::ExitCode;
+use std::time::Instant;
 
 #[derive(clap::Args, Debug)]
-pub struct Args {}
+pub struct Args {
+    /// Points per pass (passes repeat until one CPU second is spent).
+    #[arg(long, default_value_t = 20_000)]
+    texels: usize,
+    /// Only these presets (default: all).
+    #[arg(long)]
+    only: Vec<String>,
+    /// Also time each preset with one feature switched off at a time (full model).
+    #[arg(long)]
+    breakdown: bool,
+}
 
-pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`xylem bench wood` is not built yet")
+/// Random points in a 200 mm block 30–230 mm from the pith (where boards come from).
+pub fn bench_points(n: usize) -> Vec<Vec3> {
+    let mut rng = Pcg32::new(42, 0);
+    (0..n)
+        .map(|_| {
+            let r = 30.0 + 200.0 * rng.next_f32();
+            let a = std::f32::consts::TAU * rng.next_f32();
+            Vec3::new(r * a.cos(), r * a.sin(), 1000.0 * rng.next_f32())
+        })
+        .collect()
+}
+
+/// CPU time of the calling thread in seconds (Linux: /proc/thread-self/stat, clock ticks of
+/// 10 ms); `None` elsewhere. On a shared machine this excludes the time other jobs hold the core.
+fn thread_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/thread-self/stat").ok()?;
+    let rest = &stat[stat.rfind(')')? + 2..];
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = fields.get(11)?.parse::<f64>().ok()? + fields.get(12)?.parse::<f64>().ok()?;
+    Some(ticks / 100.0)
+}
+
+/// Texels per CPU second of `volume` over `points` (one thread; wall clock where thread CPU time
+/// is unavailable). Repeats the pass until at least a second of CPU time has been spent.
+pub fn texels_per_second(volume: &WoodVolume, points: &[Vec3], needs: Needs) -> f64 {
+    let (wall, cpu0) = (Instant::now(), thread_cpu_seconds());
+    let mut sink = 0.0f32;
+    let mut done = 0usize;
+    loop {
+        for &p in points {
+            let t = volume.eval(p, needs);
+            sink += t.diffuse.x + t.fiber_dir.z + t.bump;
+        }
+        done += points.len();
+        let spent = match (cpu0, thread_cpu_seconds()) {
+            (Some(a), Some(b)) => b - a,
+            _ => wall.elapsed().as_secs_f64(),
+        };
+        if spent >= 1.0 {
+            std::hint::black_box(sink);
+            return done as f64 / spent;
+        }
+    }
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let points = bench_points(args.texels);
+    let names: Vec<&str> = if args.only.is_empty() {
+        wood::PRESET_NAMES.to_vec()
+    } else {
+        args.only.iter().map(String::as_str).collect()
+    };
+    println!("| preset | colour (M texels/s) | colour + fibres | everything | colour / everything |");
+    println!("| --- | ---: | ---: | ---: | ---: |");
+    for name in names {
+        let volume = WoodVolume::new(wood::preset(name)?, 1)?;
+        // Warm-up, then measure each level of `needs`.
+        texels_per_second(&volume, &points[..points.len() / 10], Needs::COLOR);
+        let c = texels_per_second(&volume, &points, Needs::COLOR);
+        let cf = texels_per_second(&volume, &points, Needs::COLOR_FIBERS);
+        let all = texels_per_second(&volume, &points, Needs::ALL);
+        println!(
+            "| {name} | {:.2} | {:.2} | {:.2} | {:.1}× |",
+            c / 1e6,
+            cf / 1e6,
+            all / 1e6,
+            c / all
+        );
+        if args.breakdown {
+            breakdown(volume.params(), &points)?;
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Full-model speed with each feature switched off in turn: the saving is that feature's cost.
+fn breakdown(params: &wood::WoodParams, points: &[Vec3]) -> anyhow::Result<()> {
+    let variants: [(&str, fn(&mut wood::WoodParams)); 7] = [
+        ("no growth noise", |p| p.growth = None),
+        ("no interlock", |p| p.interlock = None),
+        ("no distortion", |p| p.distortion = Default::default()),
+        ("no pores", |p| p.pores = None),
+        ("no rays", |p| p.rays = None),
+        ("no knots", |p| p.knots = None),
+        ("rings + colour only", |p| {
+            *p = wood::WoodParams {
+                growth: None,
+                interlock: None,
+                distortion: Default::default(),
+                pores: None,
+                rays: None,
+                knots: None,
+                ..p.clone()
+            }
+        }),
+    ];
+    for (label, edit) in variants {
+        let mut p = params.clone();
+        edit(&mut p);
+        let v = WoodVolume::new(p, 1)?;
+        let all = texels_per_second(&v, points, Needs::ALL);
+        println!("|   {label} | | | {:.2} | |", all / 1e6);
+    }
+    Ok(())
 }

@@ -1,0 +1,225 @@
+//! The noise-driven parts of the model, each built once from its parameters: distortion
+//! magnitudes (§6.2), pores and rays (§6.1.6), growth-rate noise (eq. 24) and the interlock angle
+//! (§6.1.5). All noise comes from `crate::noise`.
+
+use super::params::{NoiseParams, PoreParams, RayParams};
+use crate::math::Frame;
+use crate::noise::{gradient1_grad, Cells, Kernel, SparseConvolution, Weights};
+use glam::Vec3;
+
+/// Cell size in units of the kernel's (fitted) semi-axes: cells as large as the kernel's diameter
+/// mean each query visits 2 cells per axis (8 in all) instead of 3 (27), holding more impulses
+/// each; measured faster for every preset (notes/wood.md).
+const CELL_SCALE: f32 = 1.0;
+const RAY_ARC_CELLS: f32 = 2.0;
+
+/// A sub-seed for one noise field from the volume seed and a salt.
+pub fn sub_seed(seed: u64, salt: u32) -> u32 {
+    use crate::noise::hash::mix32;
+    mix32(mix32(seed as u32 ^ salt) ^ mix32((seed >> 32) as u32).wrapping_add(salt))
+}
+
+/// A distortion magnitude: multiband sparse convolution noise with the Wyvill kernel and signed
+/// weights (zero mean), envelope `[r, θ, z]` oriented by the cylindrical frame at the query (§4.5).
+/// Cartesian cells as wide as the larger of the r and θ semi-axes fit the kernel at any rotation
+/// about ẑ, so the eq. 11 shrink never applies.
+#[derive(Clone, Debug)]
+pub struct DistortionNoise {
+    noise: SparseConvolution,
+    seed: u32,
+}
+
+impl DistortionNoise {
+    pub fn new(p: &NoiseParams, seed: u32) -> Self {
+        let env = Vec3::from(p.size);
+        let xy = env.x.max(env.y);
+        DistortionNoise {
+            noise: SparseConvolution {
+                kernel: Kernel::Wyvill,
+                density: p.density,
+                envelope: env,
+                cell: CELL_SCALE * Vec3::new(xy, xy, env.z),
+                magnitude: p.magnitude,
+                weights: Weights::Signed,
+                cells: Cells::Cartesian,
+                bands: p.bands,
+                size_factor: p.size_factor,
+                dropoff: p.dropoff,
+            },
+            seed,
+        }
+    }
+
+    /// (m, ∇m) at `p`, kernels aligned with the cylindrical frame `cyl` at `p`; without `GRAD`
+    /// the gradient is zero (enough for the lookup point f(p)).
+    #[inline]
+    pub fn eval<const GRAD: bool>(&self, p: Vec3, cyl: &Frame) -> (f32, Vec3) {
+        if GRAD {
+            self.noise.eval_oriented_grad(p, cyl, self.seed)
+        } else {
+            (self.noise.eval_oriented(p, cyl, self.seed), Vec3::ZERO)
+        }
+    }
+}
+
+/// Pores (vessels): bump-kernel noise with unit weights, kernels elongated along the fibre frame.
+/// Ring porosity scales each pore's size by s = 1 − porosity · g (§6.1.6: "modulate the pore sizes
+/// using one minus the growth ring volume", interpolated towards uniform size).
+#[derive(Clone, Debug)]
+pub struct Pores {
+    noise: SparseConvolution,
+    sharpness: f32,
+    ring_porosity: f32,
+    /// Bump depth at full mask, mm (depth fraction × radius, §6.1.7).
+    pub depth: f32,
+    seed: u32,
+}
+
+impl Pores {
+    /// `max_tilt`: the largest angle (radians) between the fibre frame and ẑ (the interlock
+    /// angle), so the Cartesian cells hold the tilted kernel's bounding box (eq. 9) unshrunk.
+    pub fn new(p: &PoreParams, max_tilt: f32, seed: u32) -> Self {
+        let env = Vec3::new(p.radius, p.radius, 0.5 * p.length);
+        let xy = (env.x * env.x + (env.z * max_tilt.sin()).powi(2)).sqrt() * 1.001;
+        Pores {
+            noise: SparseConvolution {
+                kernel: Kernel::Bump {
+                    sharpness: p.sharpness,
+                },
+                density: p.density,
+                envelope: env,
+                cell: CELL_SCALE * Vec3::new(xy, xy, env.z * 1.001),
+                magnitude: 1.0,
+                weights: Weights::Unit,
+                cells: Cells::Cartesian,
+                bands: 1,
+                size_factor: 0.5,
+                dropoff: 1.0,
+            },
+            sharpness: p.sharpness.max(1e-3),
+            ring_porosity: p.ring_porosity,
+            depth: p.depth * p.radius,
+            seed,
+        }
+    }
+
+    /// Pore mask in [0, 1] and its gradient at `q` for growth-ring value `g`, kernels along `fiber`
+    /// (s, t across the fibre, n along it).
+    #[inline]
+    pub fn mask<const GRAD: bool>(&self, q: Vec3, fiber: &Frame, g: f32) -> (f32, Vec3) {
+        let size = 1.0 - self.ring_porosity * g;
+        if size <= 1e-3 {
+            return (0.0, Vec3::ZERO);
+        }
+        let (v, grad) = if GRAD {
+            self.noise.eval_oriented_grad(q, fiber, self.seed)
+        } else {
+            (self.noise.eval_oriented(q, fiber, self.seed), Vec3::ZERO)
+        };
+        resize_bump(v, grad, size, self.sharpness)
+    }
+}
+
+/// Re-size a bump-kernel value: for one kernel v = K(q) = exp(−s q/(1−q)) at q = r² (Liu 2016
+/// eq. 6), the same kernel scaled by `size` has value K(q / size²). Inverting K,
+/// q = L / (s + L) with L = −ln v. Exact where pores do not overlap (low density); overlapping
+/// kernels are clamped to a full mask first. Returns the new value and the chain-ruled gradient.
+#[inline]
+pub fn resize_bump(v: f32, grad: Vec3, size: f32, s: f32) -> (f32, Vec3) {
+    if v <= 1e-12 {
+        return (0.0, Vec3::ZERO);
+    }
+    if v >= 1.0 {
+        return (1.0, Vec3::ZERO);
+    }
+    if size >= 0.999 {
+        return (v, grad);
+    }
+    let l = -v.ln();
+    let q = l / (s + l);
+    let q2 = q / (size * size);
+    if q2 >= 1.0 {
+        return (0.0, Vec3::ZERO);
+    }
+    let a = 1.0 - q2;
+    let v2 = (-s * q2 / a).exp();
+    // dv2/dv = v2 · s² / (a² size² (s + L)² v)
+    let d = v2 * s * s / (a * a * size * size * (s + l) * (s + l) * v);
+    (v2, grad * d)
+}
+
+/// Rays: bump-kernel noise with unit weights on cylindrical cells (§4.2), kernels thin in θ,
+/// tall in z and long in r, aligned with (r̂, θ̂, ẑ).
+#[derive(Clone, Debug)]
+pub struct Rays {
+    noise: SparseConvolution,
+    strength: f32,
+    seed: u32,
+}
+
+impl Rays {
+    pub fn new(p: &RayParams, seed: u32) -> Self {
+        let env = Vec3::new(0.5 * p.length, 0.5 * p.width, 0.5 * p.height);
+        Rays {
+            noise: SparseConvolution {
+                kernel: Kernel::Bump {
+                    sharpness: p.sharpness,
+                },
+                density: p.density,
+                envelope: env,
+                // Arc cells wider than the ray: the search window along θ is set by the longest
+                // semi-axis anyway (notes/noise.md), so thin cells would only add cells.
+                cell: Vec3::new(env.x, RAY_ARC_CELLS * env.y, env.z),
+                magnitude: 1.0,
+                weights: Weights::Unit,
+                cells: Cells::Cylindrical,
+                bands: 1,
+                size_factor: 0.5,
+                dropoff: 1.0,
+            },
+            strength: p.strength,
+            seed,
+        }
+    }
+
+    /// Ray mask in [0, strength] at `q`.
+    #[inline]
+    pub fn mask(&self, q: Vec3) -> f32 {
+        self.noise.eval(q, self.seed).min(1.0) * self.strength
+    }
+}
+
+/// 1D gradient noise scaled to amplitude `amp` over feature length `1 / inv_scale` (value and
+/// derivative with respect to x).
+#[derive(Clone, Copy, Debug)]
+pub struct Noise1 {
+    pub amp: f32,
+    pub inv_scale: f32,
+    pub seed: u32,
+}
+
+impl Noise1 {
+    #[inline]
+    pub fn eval(&self, x: f32) -> (f32, f32) {
+        let (v, d) = gradient1_grad(x * self.inv_scale, self.seed);
+        (self.amp * v, self.amp * self.inv_scale * d)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn resize_bump_matches_a_scaled_kernel() {
+        let s = 1.3;
+        let k = |q: f32| if q < 1.0 { (-s * q / (1.0 - q)).exp() } else { 0.0 };
+        for r in [0.0, 0.2, 0.5, 0.7, 0.9] {
+            for size in [0.3, 0.6, 0.95] {
+                let (v, _) = resize_bump(k(r * r), Vec3::ZERO, size, s);
+                let expect = k((r / size) * (r / size));
+                assert!((v - expect).abs() < 1e-4, "r {r} size {size}: {v} vs {expect}");
+            }
+        }
+    }
+}
