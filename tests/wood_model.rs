@@ -81,7 +81,10 @@ fn interlock_angle_changes_sign_with_radius() {
         // Gradient noise crosses zero at every lattice point with a non-zero slope: about one
         // reversal per period; demand at least a third of that.
         let expect = 300.0 / period;
-        assert!(changes as f32 >= expect / 3.0, "{name}: {changes} reversals, ~{expect} expected");
+        assert!(
+            changes as f32 >= expect / 3.0,
+            "{name}: {changes} reversals, ~{expect} expected"
+        );
     }
 }
 
@@ -93,7 +96,10 @@ fn stripe_presets_alternate_fibre_tilt_across_radius() {
         let (mut pos, mut neg, mut changes, mut prev) = (0, 0, 0, 0.0f32);
         for i in 0..3000 {
             let r = 20.0 + i as f32 * 0.1;
-            let tilt = v.eval(Vec3::new(r, 0.0, 50.0), Needs::COLOR_FIBERS).fiber_dir.y;
+            let tilt = v
+                .eval(Vec3::new(r, 0.0, 50.0), Needs::COLOR_FIBERS)
+                .fiber_dir
+                .y;
             if tilt > 0.02 {
                 pos += 1;
             } else if tilt < -0.02 {
@@ -106,8 +112,14 @@ fn stripe_presets_alternate_fibre_tilt_across_radius() {
                 prev = tilt;
             }
         }
-        assert!(pos > 300 && neg > 300, "{name}: {pos} tilted one way, {neg} the other");
-        assert!(changes >= 10, "{name}: only {changes} alternations over 300 mm");
+        assert!(
+            pos > 300 && neg > 300,
+            "{name}: {pos} tilted one way, {neg} the other"
+        );
+        assert!(
+            changes >= 10,
+            "{name}: only {changes} alternations over 300 mm"
+        );
     }
 }
 
@@ -144,9 +156,15 @@ fn ring_porous_pores_are_earlywood_diffuse_porous_uniform() {
         let (early, late) = pore_means(name);
         assert!(early > 0.0, "{name}: no pores at all");
         if pores.ring_porosity >= 0.99 {
-            assert!(early >= 3.0 * late, "{name}: earlywood {early}, latewood {late}");
+            assert!(
+                early >= 3.0 * late,
+                "{name}: earlywood {early}, latewood {late}"
+            );
         } else if pores.ring_porosity == 0.0 {
-            assert!((late / early - 1.0).abs() <= 0.2, "{name}: earlywood {early}, latewood {late}");
+            assert!(
+                (late / early - 1.0).abs() <= 0.2,
+                "{name}: earlywood {early}, latewood {late}"
+            );
         }
     }
 }
@@ -167,7 +185,10 @@ fn time_is_monotone_in_radius() {
         for i in 1..100_000 {
             let r = i as f32 * 0.004;
             let (t, dt) = v.time(r);
-            assert!(t > prev && dt > 0.0, "time decreases at r = {r}: {prev} → {t}, dt {dt}");
+            assert!(
+                t > prev && dt > 0.0,
+                "time decreases at r = {r}: {prev} → {t}, dt {dt}"
+            );
             prev = t;
         }
     }
@@ -226,7 +247,10 @@ fn fibres_are_tangent_to_the_distorted_growth_surfaces() {
                 worst_fd = worst_fd.max((t.fiber_dir.dot(gt) / gt.length()).abs());
             }
         }
-        assert!(worst_fd < 0.12, "{name}: fibre leaves the growth surface by asin {worst_fd}");
+        assert!(
+            worst_fd < 0.12,
+            "{name}: fibre leaves the growth surface by asin {worst_fd}"
+        );
     }
 }
 
@@ -235,10 +259,17 @@ fn colour_alone_equals_colour_of_the_full_model() {
     for name in PRESET_NAMES {
         let v = volume(name);
         for i in 0..500 {
-            let p = Vec3::new(30.0 + i as f32 * 0.37, -20.0 + i as f32 * 0.11, i as f32 * 1.3);
+            let p = Vec3::new(
+                30.0 + i as f32 * 0.37,
+                -20.0 + i as f32 * 0.11,
+                i as f32 * 1.3,
+            );
             let c = v.eval(p, Needs::COLOR);
             let a = v.eval(p, Needs::ALL);
-            assert!((c.diffuse - a.diffuse).abs().max_element() < 1e-6, "{name} at {p}");
+            assert!(
+                (c.diffuse - a.diffuse).abs().max_element() < 1e-6,
+                "{name} at {p}"
+            );
             assert_eq!(c.growth_time, a.growth_time);
         }
     }
@@ -270,7 +301,11 @@ fn thin_cylindrical_ray_kernels_are_continuous_around_the_tree() {
             let p = Vec3::new(r * a.cos(), r * a.sin(), 0.3);
             let (v, g) = rays.eval_grad(p, 5);
             // Bump kernel slope ≤ 2/width per kernel; a handful overlap at most.
-            assert!((v - prev).abs() <= 0.002 * (g.length() + 40.0) + 1e-4, "jump {} at r {r}", v - prev);
+            assert!(
+                (v - prev).abs() <= 0.002 * (g.length() + 40.0) + 1e-4,
+                "jump {} at r {r}",
+                v - prev
+            );
             prev = v;
         }
     }

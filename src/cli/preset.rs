@@ -1,9 +1,9 @@
 //! `xylem preset`: the built-in species presets.
 
-use crate::wood;
-use anyhow::Context;
 use crate::render::image_io::write_png_linear;
+use crate::wood;
 use crate::wood::{render_slice, Plane, Slice};
+use anyhow::Context;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -95,7 +95,14 @@ fn features(p: &wood::WoodParams) -> Vec<&'static str> {
 }
 
 /// The three cuts of each preset, one PNG per cut, and `sheet.png` (rows: presets; columns: xy, xz, yz).
-fn cuts(out: &Path, res: u32, size: f32, only: &[String], shade: bool, seed: u64) -> anyhow::Result<()> {
+fn cuts(
+    out: &Path,
+    res: u32,
+    size: f32,
+    only: &[String],
+    shade: bool,
+    seed: u64,
+) -> anyhow::Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let names: Vec<&str> = if only.is_empty() {
         wood::PRESET_NAMES.to_vec()

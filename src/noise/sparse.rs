@@ -445,7 +445,11 @@ impl Band {
         // A kernel at k reaching p has |(p − k)·θ̂| = r_k |sin Δθ| ≤ s_b·ext_y and
         // |(p − k)·r̂| ≤ s_b·ext_x, so cos Δθ > 0 and r_k ≥ r − s_b·ext_x when r > s_b·ext_x.
         let (ex, ey) = (sb * ext.x, sb * ext.y);
-        let dtheta = if ex < r && ey < r - ex { (ey / (r - ex)).asin() } else { PI };
+        let dtheta = if ex < r && ey < r - ex {
+            (ey / (r - ex)).asin()
+        } else {
+            PI
+        };
         let (cr, ca, cz) = (self.cell.x, self.cell.y, self.cell.z);
         let pz = p.z / cz;
         let bz = floor_i32(pz);

@@ -213,12 +213,21 @@ mod tests {
     #[test]
     fn resize_bump_matches_a_scaled_kernel() {
         let s = 1.3;
-        let k = |q: f32| if q < 1.0 { (-s * q / (1.0 - q)).exp() } else { 0.0 };
+        let k = |q: f32| {
+            if q < 1.0 {
+                (-s * q / (1.0 - q)).exp()
+            } else {
+                0.0
+            }
+        };
         for r in [0.0, 0.2, 0.5, 0.7, 0.9] {
             for size in [0.3, 0.6, 0.95] {
                 let (v, _) = resize_bump(k(r * r), Vec3::ZERO, size, s);
                 let expect = k((r / size) * (r / size));
-                assert!((v - expect).abs() < 1e-4, "r {r} size {size}: {v} vs {expect}");
+                assert!(
+                    (v - expect).abs() < 1e-4,
+                    "r {r} size {size}: {v} vs {expect}"
+                );
             }
         }
     }

@@ -95,7 +95,11 @@ impl WoodVolume {
                     .map(|n| DistortionNoise::new(n, sub_seed(seed, s)))
             })
             .collect::<Vec<_>>();
-        let distortion = [distortion[0].clone(), distortion[1].clone(), distortion[2].clone()];
+        let distortion = [
+            distortion[0].clone(),
+            distortion[1].clone(),
+            distortion[2].clone(),
+        ];
         let pores = p
             .pores
             .as_ref()

@@ -72,7 +72,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     } else {
         args.only.iter().map(String::as_str).collect()
     };
-    println!("| preset | colour (M texels/s) | colour + fibres | everything | colour / everything |");
+    println!(
+        "| preset | colour (M texels/s) | colour + fibres | everything | colour / everything |"
+    );
     println!("| --- | ---: | ---: | ---: | ---: |");
     for name in names {
         let volume = WoodVolume::new(wood::preset(name)?, 1)?;
