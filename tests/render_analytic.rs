@@ -153,3 +153,72 @@ fn one_and_two_threads_are_bit_identical() {
     assert_eq!(a, b);
     assert!(a.beauty.iter().any(|c| c.max_element() > 0.0));
 }
+
+/// An orthographic view of a constant-fibre board under a distant light: every pixel must equal
+/// `eval(wo, wi)·cos θi·E` computed from the BSDF directly (the rendering equation for one
+/// delta light, Kajiya 1986). The board is rotated 30° about its normal by its instance transform,
+/// so the object-space fibre direction must be carried into the shading frame correctly; the
+/// reference evaluates the BSDF in world coordinates (the quad's normal is world +z).
+#[test]
+fn constant_fibre_board_under_distant_light_matches_bsdf() {
+    use xylem::bsdf::{Bsdf, WoodBsdf, WoodBsdfParams};
+    let params = WoodBsdfParams {
+        diffuse: Vec3::new(0.3, 0.12, 0.05),
+        fiber_color: Vec3::new(0.5, 0.3, 0.2),
+        fiber_dir: Vec3::new(1.0, 0.0, 0.15).normalize(),
+        ray_dir: Vec3::Y,
+        ray_mask: 0.0,
+        highlight_width: 6f32.to_radians(),
+        eta: 1.5,
+        roughness: 0.0,
+    };
+    let rot = glam::Quat::from_rotation_z(30f32.to_radians());
+    let view = Vec3::new(0.3, -0.5, 1.0).normalize(); // towards the camera
+    let wi = Vec3::new(-0.4, 0.2, 1.0).normalize(); // towards the light
+    let e = 2.5f32;
+    let camera = Camera::look_at(
+        view * 100.0,
+        Vec3::ZERO,
+        Vec3::Z,
+        Projection::Orthographic { width: 40.0 },
+        12,
+        10,
+    );
+    let scene = Scene {
+        accel: Accel::new(vec![Instance {
+            mesh: Arc::new(shapes::make_quad(Vec2::new(300.0, 300.0))),
+            transform: Transform::new(Affine3A::from_quat(rot)),
+            material: 0,
+            placement: Placement::default(),
+        }]),
+        materials: vec![Material::Fiber { params }],
+        lights: vec![Light::Distant {
+            direction: wi,
+            irradiance: Vec3::splat(e),
+        }],
+        camera,
+        filter: Filter::Box { radius: 0.5 },
+    };
+    let settings = RenderSettings {
+        spp: 2,
+        integrator: Integrator::Direct,
+        seed: 5,
+    };
+    let img = render(&scene, &settings, &RunOptions::default()).unwrap().image;
+    let world = WoodBsdf::new(WoodBsdfParams {
+        fiber_dir: rot * params.fiber_dir,
+        ray_dir: rot * params.ray_dir,
+        ..params
+    })
+    .unwrap();
+    let want = world.eval(view, wi) * wi.z * e;
+    assert!(want.max_element() > 0.0);
+    for (i, got) in img.beauty.iter().enumerate() {
+        assert!(
+            (*got - want).abs().max_element() <= 2e-4 * want.max_element(),
+            "pixel {i}: {got} vs {want}"
+        );
+    }
+    // And the fibre AOV is the rotated fibre direction.
+    assert!((img.aov[0].fiber - rot * params.fiber_dir).length() < 1e-4);
+}

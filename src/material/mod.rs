@@ -7,7 +7,7 @@
 
 mod placement;
 
-pub use placement::Placement;
+pub use placement::{Cutting, Placement};
 
 use crate::bsdf::{Bsdf, BsdfSample, Glass, Lambertian, Mirror, WoodBsdf, WoodBsdfParams};
 use crate::math::Frame;
@@ -20,6 +20,10 @@ use std::sync::Arc;
 pub struct MaterialHit {
     /// Object-space position (mm).
     pub p_object: Vec3,
+    /// World-space position (mm).
+    pub p_world: Vec3,
+    /// Geometric normal in object space (unit).
+    pub n_object: Vec3,
     /// Geometric normal (world, unit).
     pub ng: Vec3,
     /// Interpolated shading normal (world, unit).

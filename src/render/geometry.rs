@@ -153,6 +153,8 @@ pub struct Hit {
 pub struct SurfaceHit {
     pub p: Vec3,
     pub p_object: Vec3,
+    /// Geometric normal in object space (unit).
+    pub n_object: Vec3,
     pub ng: Vec3,
     pub ns: Vec3,
     /// A tangent along the triangle's first edge (world), for a stable shading frame.
@@ -293,7 +295,8 @@ impl Accel {
         let w = 1.0 - u - v;
         let p_object = a * w + b * u + c * v;
         let tf = &inst.transform;
-        let ng = tf.normal_to_world((b - a).cross(c - a)).normalize_or_zero();
+        let n_object = (b - a).cross(c - a).normalize_or_zero();
+        let ng = tf.normal_to_world(n_object).normalize_or_zero();
         let ns = match &mesh.normals {
             Some(n) => {
                 let n_obj = n[i0] * w + n[i1] * u + n[i2] * v;
@@ -311,6 +314,7 @@ impl Accel {
             // The ray equation is the accurate hit point; the barycentric point is in object space.
             p: ray.at(hit.t),
             p_object,
+            n_object,
             ng,
             ns,
             tangent: tf.vector_to_world(b - a).normalize_or_zero(),

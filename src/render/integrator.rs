@@ -83,6 +83,8 @@ pub fn shading_point(scene: &Scene, ray: &Ray, hit: &Hit, aov: Option<&mut Aov>)
     let material = &scene.materials[inst.material as usize];
     let mh = MaterialHit {
         p_object: s.p_object,
+        p_world: s.p,
+        n_object: s.n_object,
         ng: s.ng,
         ns: s.ns,
         tangent: s.tangent,

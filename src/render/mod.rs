@@ -5,6 +5,7 @@
 //! random numbers from streams keyed by (seed, pixel, sample) only, so the image is bit-identical
 //! for any thread count.
 
+pub mod bench;
 pub mod camera;
 pub mod film;
 pub mod geometry;

@@ -319,6 +319,20 @@ pub enum ShapeKind {
 #[derive(Debug, Clone, Copy, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TreeTable {
+    /// How the object was made: "solid" (carved from one block), "veneer" (a slice per face) or
+    /// "boards" (a floor `layout` of boards).
+    #[serde(default)]
+    pub cut: CutName,
+    /// "object" (default) or "world": the space the placement reads points in.
+    #[serde(default)]
+    pub space: SpaceName,
+    /// Board layout (cut = "boards"), e.g. { kind = "parquet", tile = 400, strip = 50 }.
+    pub layout: Option<crate::wood::BoardLayout>,
+    /// Where veneer slices and boards are cut from (cut = "veneer" / "boards").
+    pub region: Option<crate::wood::TreeRegion>,
+    /// Selects which boards / slices (cut = "veneer" / "boards").
+    #[serde(default)]
+    pub seed: u64,
     #[serde(default)]
     pub origin: [f32; 3],
     #[serde(default = "default_axis")]
@@ -327,6 +341,23 @@ pub struct TreeTable {
     pub rotation_deg: f32,
     #[serde(default = "one")]
     pub scale: f32,
+}
+
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum CutName {
+    #[default]
+    Solid,
+    Veneer,
+    Boards,
+}
+
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum SpaceName {
+    #[default]
+    Object,
+    World,
 }
 
 fn default_axis() -> [f32; 3] {

@@ -6,11 +6,13 @@
 pub mod format;
 pub mod mesh_io;
 pub mod shapes;
+pub mod teapot;
 
 pub use format::{SceneFile, SweepRegion, SweepTable};
 
 use crate::bsdf::{WoodBsdf, WoodBsdfParams};
-use crate::material::{Material, Placement, WoodMaterial};
+use crate::material::{Cutting, Material, Placement, WoodMaterial};
+use crate::wood::BoardLayout;
 use crate::render::{
     self, Accel, Camera, EnvMap, Environment, Filter, Instance, Integrator, Light, Projection,
     RenderSettings, Transform, TriMesh,
@@ -549,14 +551,7 @@ impl Builder<'_> {
             }
             let placement = match &o.tree {
                 None => Placement::default(),
-                Some(t) => Placement {
-                    origin: self.finite3(&f("tree.origin"), t.origin)?,
-                    axis: self.unit3(&f("tree.axis"), t.axis)?,
-                    rotation: self
-                        .range(&f("tree.rotation_deg"), t.rotation_deg, -360.0, 360.0)?
-                        .to_radians(),
-                    scale: self.range(&f("tree.scale"), t.scale, 1e-6, 1e6)?,
-                },
+                Some(t) => self.placement(t, i)?,
             };
             out.push(Instance {
                 mesh,
@@ -566,6 +561,59 @@ impl Builder<'_> {
             });
         }
         Ok(out)
+    }
+
+    fn placement(&self, t: &TreeTable, i: usize) -> Result<Placement, SceneError> {
+        let f = |s: &str| format!("objects[{i}].tree.{s}");
+        let region = t.region.unwrap_or_default();
+        if t.region.is_some() {
+            self.range(&f("region.r_min"), region.r_min, 0.0, 1e6)?;
+            self.range(&f("region.r_max"), region.r_max, region.r_min, 1e6)?;
+            self.range(&f("region.z_span"), region.z_span, 0.0, 1e7)?;
+        }
+        let cutting = match t.cut {
+            CutName::Solid => {
+                if t.layout.is_some() || t.region.is_some() {
+                    return Err(self.invalid(f("layout"), "`layout` and `region` are for cut = \"boards\" / \"veneer\""));
+                }
+                Cutting::Solid
+            }
+            CutName::Veneer => Cutting::Veneer {
+                region,
+                seed: t.seed,
+            },
+            CutName::Boards => {
+                let layout = t.layout.ok_or_else(|| {
+                    self.invalid(f("layout"), "required for cut = \"boards\", e.g. { kind = \"planks\", width = 90.0, length = 900.0, stagger = 0.3 } or { kind = \"parquet\", tile = 400.0, strip = 50.0 }")
+                })?;
+                match layout {
+                    BoardLayout::Planks { width, length, stagger } => {
+                        self.range(&f("layout.width"), width, 1e-3, 1e6)?;
+                        self.range(&f("layout.length"), length, 1e-3, 1e6)?;
+                        self.range(&f("layout.stagger"), stagger, 0.0, 1.0)?;
+                    }
+                    BoardLayout::Parquet { tile, strip } => {
+                        self.range(&f("layout.tile"), tile, 1e-3, 1e6)?;
+                        self.range(&f("layout.strip"), strip, 1e-3, tile / 2.0)?;
+                    }
+                }
+                Cutting::Boards {
+                    layout,
+                    region,
+                    seed: t.seed,
+                }
+            }
+        };
+        Ok(Placement {
+            origin: self.finite3(&f("origin"), t.origin)?,
+            axis: self.unit3(&f("axis"), t.axis)?,
+            rotation: self
+                .range(&f("rotation_deg"), t.rotation_deg, -360.0, 360.0)?
+                .to_radians(),
+            scale: self.range(&f("scale"), t.scale, 1e-6, 1e6)?,
+            cutting,
+            world_space: t.space == SpaceName::World,
+        })
     }
 
     /// Builds (or loads) the mesh of one object, rejecting fields its shape does not use.
@@ -649,7 +697,15 @@ impl Builder<'_> {
                 shapes::make_lathe(&pts, segments)
             }
             ShapeKind::Teapot => {
-                return Err(self.invalid(f("shape"), "the teapot is not built yet"));
+                let s = o.size.as_ref().map_or(Ok(30.0), |s| match s.as_slice() {
+                    [x] => positive("size", *x),
+                    _ => Err(self.invalid(f("size"), "shape `teapot` takes 1 number (mm per teapot unit)")),
+                })?;
+                let res = match o.resolution {
+                    None => 8,
+                    Some(r) => self.range(&f("resolution"), r as f32, 1.0, 256.0)? as u32,
+                };
+                teapot::make_teapot(s, res)
             }
             ShapeKind::Mesh => {
                 let file = o.file.as_ref().ok_or_else(|| need("file"))?;
