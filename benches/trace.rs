@@ -22,12 +22,23 @@ fn trace(c: &mut Criterion) {
     let n = 10_000;
     let mut g = c.benchmark_group("trace_250k");
     g.throughput(Throughput::Elements(n as u64));
-    for (name, rays) in [("coherent", coherent_rays(n)), ("incoherent", incoherent_rays(n, 1))] {
+    for (name, rays) in [
+        ("coherent", coherent_rays(n)),
+        ("incoherent", incoherent_rays(n, 1)),
+    ] {
         g.bench_function(format!("closest_{name}"), |b| {
-            b.iter(|| rays.iter().filter(|r| a.intersect(r, f32::INFINITY).is_some()).count())
+            b.iter(|| {
+                rays.iter()
+                    .filter(|r| a.intersect(r, f32::INFINITY).is_some())
+                    .count()
+            })
         });
         g.bench_function(format!("any_{name}"), |b| {
-            b.iter(|| rays.iter().filter(|r| a.unoccluded(r, f32::INFINITY)).count())
+            b.iter(|| {
+                rays.iter()
+                    .filter(|r| a.unoccluded(r, f32::INFINITY))
+                    .count()
+            })
         });
     }
     g.finish();

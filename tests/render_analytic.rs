@@ -204,7 +204,9 @@ fn constant_fibre_board_under_distant_light_matches_bsdf() {
         integrator: Integrator::Direct,
         seed: 5,
     };
-    let img = render(&scene, &settings, &RunOptions::default()).unwrap().image;
+    let img = render(&scene, &settings, &RunOptions::default())
+        .unwrap()
+        .image;
     let world = WoodBsdf::new(WoodBsdfParams {
         fiber_dir: rot * params.fiber_dir,
         ray_dir: rot * params.ray_dir,

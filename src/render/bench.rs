@@ -52,7 +52,10 @@ pub fn coherent_rays(count: usize) -> Vec<Ray> {
     (0..count)
         .map(|i| {
             let (x, y) = ((i % side) as f32, (i / side) as f32);
-            let ndc = Vec2::new(2.0 * (x + 0.5) / side as f32 - 1.0, 1.0 - 2.0 * (y + 0.5) / side as f32);
+            let ndc = Vec2::new(
+                2.0 * (x + 0.5) / side as f32 - 1.0,
+                1.0 - 2.0 * (y + 0.5) / side as f32,
+            );
             Ray {
                 o: eye,
                 d: (fwd + right * ndc.x * k + up * ndc.y * k).normalize(),
@@ -166,7 +169,14 @@ pub fn build_params(name: &str) -> Option<BvhBuildParams> {
 }
 
 /// Names accepted by [`build_params`].
-pub const BUILD_PRESETS: [&str; 6] = ["fastest", "very_fast", "fast", "medium", "slow", "very_slow"];
+pub const BUILD_PRESETS: [&str; 6] = [
+    "fastest",
+    "very_fast",
+    "fast",
+    "medium",
+    "slow",
+    "very_slow",
+];
 
 #[cfg(test)]
 mod tests {
@@ -175,10 +185,14 @@ mod tests {
     #[test]
     fn bumpy_sphere_has_about_the_asked_triangles_and_rays_hit_it() {
         let m = bumpy_sphere(10_000);
-        assert!((9_000..=11_000).contains(&m.indices.len()), "{}", m.indices.len());
+        assert!(
+            (9_000..=11_000).contains(&m.indices.len()),
+            "{}",
+            m.indices.len()
+        );
         let r = run_trace_benchmark(2_000, 400, BvhBuildParams::fast_build(), "fast");
-        // The camera looks at the sphere; most central rays hit it.
-        assert!(r.coherent.closest_hits > 200, "{r:?}");
+        // The sphere (radius ≈ 100 mm at 300 mm) covers π·100² / (2·300·tan 25°)² ≈ 40 % of the view.
+        assert!((120..=220).contains(&r.coherent.closest_hits), "{r:?}");
         assert!(r.incoherent.closest_hits > 0);
     }
 }

@@ -12,11 +12,11 @@ pub use format::{SceneFile, SweepRegion, SweepTable};
 
 use crate::bsdf::{WoodBsdf, WoodBsdfParams};
 use crate::material::{Cutting, Material, Placement, WoodMaterial};
-use crate::wood::BoardLayout;
 use crate::render::{
     self, Accel, Camera, EnvMap, Environment, Filter, Instance, Integrator, Light, Projection,
     RenderSettings, Transform, TriMesh,
 };
+use crate::wood::BoardLayout;
 use format::*;
 use glam::{Affine3A, EulerRot, Quat, Vec2, Vec3};
 use std::collections::{BTreeMap, HashMap};
@@ -574,7 +574,10 @@ impl Builder<'_> {
         let cutting = match t.cut {
             CutName::Solid => {
                 if t.layout.is_some() || t.region.is_some() {
-                    return Err(self.invalid(f("layout"), "`layout` and `region` are for cut = \"boards\" / \"veneer\""));
+                    return Err(self.invalid(
+                        f("layout"),
+                        "`layout` and `region` are for cut = \"boards\" / \"veneer\"",
+                    ));
                 }
                 Cutting::Solid
             }
@@ -587,7 +590,11 @@ impl Builder<'_> {
                     self.invalid(f("layout"), "required for cut = \"boards\", e.g. { kind = \"planks\", width = 90.0, length = 900.0, stagger = 0.3 } or { kind = \"parquet\", tile = 400.0, strip = 50.0 }")
                 })?;
                 match layout {
-                    BoardLayout::Planks { width, length, stagger } => {
+                    BoardLayout::Planks {
+                        width,
+                        length,
+                        stagger,
+                    } => {
                         self.range(&f("layout.width"), width, 1e-3, 1e6)?;
                         self.range(&f("layout.length"), length, 1e-3, 1e6)?;
                         self.range(&f("layout.stagger"), stagger, 0.0, 1.0)?;
@@ -699,7 +706,10 @@ impl Builder<'_> {
             ShapeKind::Teapot => {
                 let s = o.size.as_ref().map_or(Ok(30.0), |s| match s.as_slice() {
                     [x] => positive("size", *x),
-                    _ => Err(self.invalid(f("size"), "shape `teapot` takes 1 number (mm per teapot unit)")),
+                    _ => Err(self.invalid(
+                        f("size"),
+                        "shape `teapot` takes 1 number (mm per teapot unit)",
+                    )),
                 })?;
                 let res = match o.resolution {
                     None => 8,

@@ -12,12 +12,15 @@ type Patch = [[Vec3; 4]; 4];
 /// (radius, z) profiles of the surfaces of revolution, and whether the quarter patches turn
 /// counter-clockwise (the bottom) instead of clockwise.
 const REVOLVED: [([[f32; 2]; 4], bool); 6] = [
-    ([[1.4, 2.4], [1.3375, 2.53125], [1.4375, 2.53125], [1.5, 2.4]], false), // rim
-    ([[1.5, 2.4], [1.75, 1.875], [2.0, 1.35], [2.0, 0.9]], false),          // upper body
-    ([[2.0, 0.9], [2.0, 0.45], [1.5, 0.225], [1.5, 0.15]], false),          // lower body
-    ([[0.0, 3.15], [0.8, 3.15], [0.0, 2.85], [0.2, 2.7]], false),           // lid knob
-    ([[0.2, 2.7], [0.4, 2.55], [1.3, 2.55], [1.3, 2.4]], false),            // lid
-    ([[0.0, 0.0], [1.425, 0.0], [1.5, 0.075], [1.5, 0.15]], true),          // bottom
+    (
+        [[1.4, 2.4], [1.3375, 2.53125], [1.4375, 2.53125], [1.5, 2.4]],
+        false,
+    ), // rim
+    ([[1.5, 2.4], [1.75, 1.875], [2.0, 1.35], [2.0, 0.9]], false), // upper body
+    ([[2.0, 0.9], [2.0, 0.45], [1.5, 0.225], [1.5, 0.15]], false), // lower body
+    ([[0.0, 3.15], [0.8, 3.15], [0.0, 2.85], [0.2, 2.7]], false),  // lid knob
+    ([[0.2, 2.7], [0.4, 2.55], [1.3, 2.55], [1.3, 2.4]], false),   // lid
+    ([[0.0, 0.0], [1.425, 0.0], [1.5, 0.075], [1.5, 0.15]], true), // bottom
 ];
 
 /// Tubes: curve A, curve B (x, z) and the half-width of each row.
@@ -88,7 +91,12 @@ fn bernstein(t: f32) -> ([f32; 4], [f32; 4]) {
     let s = 1.0 - t;
     (
         [s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t],
-        [-3.0 * s * s, 3.0 * s * s - 6.0 * t * s, 6.0 * t * s - 3.0 * t * t, 3.0 * t * t],
+        [
+            -3.0 * s * s,
+            3.0 * s * s - 6.0 * t * s,
+            6.0 * t * s - 3.0 * t * t,
+            3.0 * t * t,
+        ],
     )
 }
 
@@ -171,7 +179,11 @@ mod tests {
                 agree += 1;
             }
         }
-        assert!(agree as f32 >= 0.99 * m.indices.len() as f32, "{agree} / {}", m.indices.len());
+        assert!(
+            agree as f32 >= 0.99 * m.indices.len() as f32,
+            "{agree} / {}",
+            m.indices.len()
+        );
         let top = m.positions.iter().map(|p| p.z).fold(0.0, f32::max);
         assert!((top - 31.5).abs() < 1e-3);
     }

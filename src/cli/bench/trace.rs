@@ -32,7 +32,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let mut reports = Vec::new();
     for name in args.build.split(',').map(str::trim) {
         let Some(params) = build_params(name) else {
-            bail!("--build {name}: unknown preset (allowed: {})", BUILD_PRESETS.join(", "));
+            bail!(
+                "--build {name}: unknown preset (allowed: {})",
+                BUILD_PRESETS.join(", ")
+            );
         };
         let r = run_trace_benchmark(args.triangles, args.rays, params, name);
         let row = |label: &str, f: &TraceFigures| {
