@@ -1,1 +1,110 @@
-//! Classic procedural solid textures (marble, ring wood, stone, clouds) behind one small trait.
+//! Classic procedural solid textures behind one small trait, constructed by name with checked
+//! parameters (the renderer's scene materials and `xylem texture` both go through [`by_name`]).
+//!
+//! | name | what | source |
+//! | --- | --- | --- |
+//! | `marble` | sine bands ½(1 + sin(ω x + γ T)) with turbulence, smooth threshold, ramp | Perlin 1985 |
+//! | `slab_marble` | white / grey / black slabs perturbed by turbulence | HyperGraph notes |
+//! | `ring_wood` | concentric cylinders, tilted axis, angular wobble with twist | HyperGraph notes |
+//! | `log_wood` | ring phase f(r + α r²), warped radius, fBm grain, tint | course report (seeds/000) |
+//! | `stone` | Worley cells, F2 − F1 cracks, layered noise | Worley 1996 |
+//! | `clouds` | warped fBm with cover threshold | Quilez, domain warping |
+//! | `worley`, `value`, `gradient`, `fbm`, `warp`, `sparse_convolution` | views of the raw noises | see `noise` |
+//!
+//! Points are in millimetres; colours are linear RGB. Every texture is a pure function of the
+//! point and its parameters (including `seed` where it has noise).
+
+mod clouds;
+mod marble;
+mod params;
+mod ramp;
+mod rings;
+mod slice;
+mod stone;
+mod views;
+
+pub use params::{ParamSpec, TextureError, Values};
+pub use ramp::{smoothstep, Ramp};
+pub use slice::{first_non_finite, Plane, Slice};
+
+use crate::noise::Basis;
+use glam::Vec3;
+use std::collections::BTreeMap;
+
+/// A solid texture: linear RGB colour at a point (mm).
+pub trait SolidTexture: Send + Sync {
+    fn eval(&self, p: Vec3) -> Vec3;
+}
+
+/// The texture names [`by_name`] accepts.
+pub const NAMES: [&str; 12] = [
+    "marble",
+    "slab_marble",
+    "ring_wood",
+    "log_wood",
+    "stone",
+    "clouds",
+    "worley",
+    "value",
+    "gradient",
+    "fbm",
+    "warp",
+    "sparse_convolution",
+];
+
+/// The parameters texture `name` accepts (with defaults and ranges), or `None` for an unknown
+/// name.
+pub fn params(name: &str) -> Option<&'static [ParamSpec]> {
+    Some(match name {
+        "marble" => marble::MARBLE_PARAMS,
+        "slab_marble" => marble::SLAB_PARAMS,
+        "ring_wood" => rings::RING_PARAMS,
+        "log_wood" => rings::LOG_PARAMS,
+        "stone" => stone::STONE_PARAMS,
+        "clouds" => clouds::CLOUD_PARAMS,
+        "worley" => views::WORLEY_PARAMS,
+        "value" | "gradient" => views::LATTICE_PARAMS,
+        "fbm" => views::FBM_PARAMS,
+        "warp" => views::WARP_PARAMS,
+        "sparse_convolution" => views::SPARSE_PARAMS,
+        _ => return None,
+    })
+}
+
+/// Builds texture `name` from `params` (missing parameters take their defaults). Errors: an
+/// unknown name (listing the valid ones), an unknown parameter (naming the allowed ones), a value
+/// out of range (with the range).
+pub fn by_name(
+    name: &str,
+    params: &BTreeMap<String, f32>,
+) -> Result<Box<dyn SolidTexture>, TextureError> {
+    let spec = self::params(name).ok_or_else(|| TextureError::UnknownTexture {
+        name: name.to_string(),
+        valid: NAMES.join(", "),
+    })?;
+    let v = Values::resolve(name, spec, params)?;
+    Ok(match name {
+        "marble" => Box::new(marble::Marble::new(&v)),
+        "slab_marble" => Box::new(marble::SlabMarble::new(&v)),
+        "ring_wood" => Box::new(rings::RingWood::new(&v)),
+        "log_wood" => Box::new(rings::LogWood::new(&v)),
+        "stone" => Box::new(stone::Stone::new(&v)),
+        "clouds" => Box::new(clouds::Clouds::new(&v)),
+        "worley" => Box::new(views::WorleyView::new(&v)),
+        "value" => Box::new(views::LatticeView::new(&v, Basis::Value)),
+        "gradient" => Box::new(views::LatticeView::new(&v, Basis::Gradient)),
+        "fbm" => Box::new(views::FbmView::new(&v)),
+        "warp" => Box::new(views::WarpView::new(&v)),
+        "sparse_convolution" => {
+            let view = views::SparseView::new(&v);
+            view.noise()
+                .validate()
+                .map_err(|source| TextureError::Noise {
+                    texture: name.to_string(),
+                    source,
+                })?;
+            Box::new(view)
+        }
+        _ => unreachable!("every name in NAMES has a parameter table"),
+    })
+}

@@ -1,0 +1,50 @@
+//! Colour helpers for the classic textures: piecewise-linear colour ramps in linear RGB and the
+//! smooth threshold (Hermite smoothstep, Ebert et al., *Texturing and Modeling*, ch. 2).
+
+use glam::Vec3;
+
+/// `smoothstep(e0, e1, x)`: 0 below e0, 1 above e1, 3t² − 2t³ between.
+#[inline]
+pub fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
+    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+/// A multi-stop colour ramp: stops `(t, colour)` with increasing t; clamps outside.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Ramp {
+    pub stops: Vec<(f32, Vec3)>,
+}
+
+impl Ramp {
+    pub fn new(stops: &[(f32, Vec3)]) -> Self {
+        Ramp {
+            stops: stops.to_vec(),
+        }
+    }
+
+    pub fn eval(&self, t: f32) -> Vec3 {
+        let t = if t.is_finite() { t } else { 0.0 };
+        let s = &self.stops;
+        if t <= s[0].0 {
+            return s[0].1;
+        }
+        for w in s.windows(2) {
+            if t <= w[1].0 {
+                let u = (t - w[0].0) / (w[1].0 - w[0].0);
+                return w[0].1.lerp(w[1].1, u);
+            }
+        }
+        s[s.len() - 1].1
+    }
+}
+
+/// Grey of a value in [0, 1] (clamped), for the noise views.
+#[inline]
+pub fn grey(v: f32) -> Vec3 {
+    Vec3::splat(if v.is_finite() {
+        v.clamp(0.0, 1.0)
+    } else {
+        0.0
+    })
+}

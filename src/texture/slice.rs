@@ -1,0 +1,74 @@
+//! Planar slices of a solid function, for looking at textures, noises and (through the same
+//! code) wood presets: a square window of side `size` centred on the axis, at `offset` along the
+//! plane's normal, sampled at pixel centres, rows in parallel.
+
+use glam::Vec3;
+use rayon::prelude::*;
+use std::str::FromStr;
+
+/// The slicing plane; the image's right and up directions are the first and second axis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Plane {
+    Xy,
+    Xz,
+    Yz,
+}
+
+impl FromStr for Plane {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.to_ascii_lowercase().as_str() {
+            "xy" => Ok(Plane::Xy),
+            "xz" => Ok(Plane::Xz),
+            "yz" => Ok(Plane::Yz),
+            _ => Err(format!("unknown plane `{s}`; valid planes: xy, xz, yz")),
+        }
+    }
+}
+
+/// A square slice: `res × res` pixels covering `size × size` (mm) centred on the plane's origin,
+/// the plane at `offset` (mm) along its normal.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Slice {
+    pub plane: Plane,
+    pub offset: f32,
+    pub size: f32,
+    pub res: u32,
+}
+
+impl Slice {
+    /// The point at the centre of pixel (column `i`, row `j`; row 0 at the top).
+    pub fn point(&self, i: u32, j: u32) -> Vec3 {
+        let step = self.size / self.res as f32;
+        let a = (i as f32 + 0.5) * step - 0.5 * self.size;
+        let b = 0.5 * self.size - (j as f32 + 0.5) * step;
+        match self.plane {
+            Plane::Xy => Vec3::new(a, b, self.offset),
+            Plane::Xz => Vec3::new(a, self.offset, b),
+            Plane::Yz => Vec3::new(self.offset, a, b),
+        }
+    }
+
+    /// Evaluates `f` at every pixel centre (rows in parallel); row-major, top row first.
+    pub fn render(&self, f: &(dyn Fn(Vec3) -> Vec3 + Sync)) -> Vec<Vec3> {
+        let n = self.res as usize;
+        let mut pixels = vec![Vec3::ZERO; n * n];
+        pixels
+            .par_chunks_mut(n.max(1))
+            .enumerate()
+            .for_each(|(j, row)| {
+                for (i, px) in row.iter_mut().enumerate() {
+                    *px = f(self.point(i as u32, j as u32));
+                }
+            });
+        pixels
+    }
+}
+
+/// The first pixel (column, row) whose colour is not finite, if any.
+pub fn first_non_finite(pixels: &[Vec3], res: u32) -> Option<(u32, u32)> {
+    pixels
+        .iter()
+        .position(|c| !c.is_finite())
+        .map(|k| ((k % res as usize) as u32, (k / res as usize) as u32))
+}
