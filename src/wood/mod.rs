@@ -52,6 +52,19 @@ const PRESET_FILES: [&str; 11] = [
     include_str!("../../scenes/presets/knotty_pine.toml"),
 ];
 
+/// `n` random points where boards come from: 30–230 mm from the pith, 0–1000 mm along it. Shared
+/// by `xylem bench wood` and `benches/wood.rs` so both time the same texels.
+pub fn sample_points(n: usize, seed: u64) -> Vec<Vec3> {
+    let mut rng = crate::math::Pcg32::new(seed, 0);
+    (0..n)
+        .map(|_| {
+            let r = 30.0 + 200.0 * rng.next_f32();
+            let a = std::f32::consts::TAU * rng.next_f32();
+            Vec3::new(r * a.cos(), r * a.sin(), 1000.0 * rng.next_f32())
+        })
+        .collect()
+}
+
 /// The TOML text of a built-in preset.
 pub fn preset_text(name: &str) -> Result<&'static str, WoodError> {
     PRESET_NAMES

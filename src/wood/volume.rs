@@ -45,7 +45,8 @@ mod salt {
 /// What `eval` computes at the distorted point before deciding what else it needs.
 struct Core {
     dist: Distortion,
-    cyl: Cylindrical,
+    /// Distance of f(p) from the pith.
+    r: f32,
     time: f32,
     knot: Option<KnotSample>,
 }
@@ -196,18 +197,20 @@ impl WoodVolume {
         } else {
             self.distort::<false>(p)
         };
-        let cyl = Cylindrical::from_point(dist.point);
-        let (mut time, _) = self.time(cyl.r);
-        let knot = self
-            .knots
-            .as_ref()
-            .and_then(|k| k.eval(dist.point, cyl.theta, cyl.r, time));
+        let q = dist.point;
+        let r = (q.x * q.x + q.y * q.y).sqrt();
+        let (mut time, _) = self.time(r);
+        // θ (an atan2) only where knots need it.
+        let knot = self.knots.as_ref().and_then(|k| {
+            let theta = Cylindrical::from_point(q).theta;
+            k.eval(q, theta, r, time)
+        });
         if let Some(k) = &knot {
             time = k.time;
         }
         Core {
             dist,
-            cyl,
+            r,
             time,
             knot,
         }
@@ -234,7 +237,7 @@ impl WoodVolume {
         let want_pores = self.pores.is_some() && (needs.color || needs.bump);
         let want_rays = self.rays.is_some() && (needs.fibers || self.color_uses_rays());
         let frame = if want_pores || needs.fibers {
-            self.fiber_frame(q, c.cyl.r)
+            self.fiber_frame(q, c.r)
         } else {
             Frame {
                 s: Vec3::X,

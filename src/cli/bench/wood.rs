@@ -1,7 +1,6 @@
 //! `xylem bench wood`: wood texels per second per core for each preset, colour only and the full
 //! model (the speed goal of issue 4; the criterion twin is benches/wood.rs).
 
-use crate::math::Pcg32;
 use crate::wood::{self, Needs, WoodVolume};
 use glam::Vec3;
 use std::process::ExitCode;
@@ -18,18 +17,6 @@ pub struct Args {
     /// Also time each preset with one feature switched off at a time (full model).
     #[arg(long)]
     breakdown: bool,
-}
-
-/// Random points in a 200 mm block 30–230 mm from the pith (where boards come from).
-pub fn bench_points(n: usize) -> Vec<Vec3> {
-    let mut rng = Pcg32::new(42, 0);
-    (0..n)
-        .map(|_| {
-            let r = 30.0 + 200.0 * rng.next_f32();
-            let a = std::f32::consts::TAU * rng.next_f32();
-            Vec3::new(r * a.cos(), r * a.sin(), 1000.0 * rng.next_f32())
-        })
-        .collect()
 }
 
 /// CPU time of the calling thread in seconds (Linux: /proc/thread-self/stat, clock ticks of
@@ -66,7 +53,7 @@ pub fn texels_per_second(volume: &WoodVolume, points: &[Vec3], needs: Needs) -> 
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let points = bench_points(args.texels);
+    let points = wood::sample_points(args.texels, 42);
     let names: Vec<&str> = if args.only.is_empty() {
         wood::PRESET_NAMES.to_vec()
     } else {
