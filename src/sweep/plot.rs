@@ -91,7 +91,15 @@ pub fn line_plot(series: &[Series], opts: &PlotOptions) -> Rgb8 {
         (y0, y1) = (y0 - 0.5, y1 + 0.5);
     }
     let pad = 0.05 * (y1 - y0);
-    let (y0, y1) = (y0 - pad, y1 + pad);
+    // Pad the range, but never below zero for data that has none (radiance, errors).
+    let (y0, y1) = (
+        if y0 >= 0.0 {
+            (y0 - pad).max(0.0)
+        } else {
+            y0 - pad
+        },
+        y1 + pad,
+    );
     let (left, right, top, bottom) = (8i64, w as i64 - 8, 14i64, h as i64 - 14);
     let px = |x: f64| left as f64 + (x - x0) / (x1 - x0) * (right - left) as f64;
     let py = |y: f64| bottom as f64 - (y - y0) / (y1 - y0) * (bottom - top) as f64;

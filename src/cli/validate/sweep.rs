@@ -1,10 +1,67 @@
-//! `xylem validate sweep`.
+//! `xylem validate sweep`: the light-sweep checks; rewrites the sweep section of
+//! validation/REPORT.md (with plots) and optionally writes every number as JSON. Exits non-zero
+//! when a check fails.
 
+use crate::validate::sweep::{run_checks, to_markdown};
+use anyhow::Context;
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(clap::Args, Debug, Default)]
-pub struct Args {}
+pub struct Args {
+    /// Report to update (only its sweep section) [default: validation/REPORT.md].
+    #[arg(long)]
+    report: Option<PathBuf>,
+    /// Also write every measured number as JSON here.
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Do not touch the report or write plots.
+    #[arg(long)]
+    no_report: bool,
+}
 
-pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`xylem validate sweep` is not built yet")
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let report = args
+        .report
+        .unwrap_or_else(|| PathBuf::from("validation/REPORT.md"));
+    let dir = report.parent().map(|p| p.to_path_buf()).unwrap_or_default();
+    let run = crate::render::RunOptions {
+        threads: 0,
+        progress: false,
+    };
+    let bar = indicatif::ProgressBar::new(6).with_style(
+        indicatif::ProgressStyle::with_template("validate sweep {bar:40} {pos}/{len} {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let plots = (!args.no_report).then_some(dir.as_path());
+    let checks = run_checks(plots, &run, &|name| {
+        bar.set_message(name.to_string());
+        bar.inc(1);
+    })?;
+    bar.finish_and_clear();
+    println!("{:<70} {:<6} measured", "check", "result");
+    for c in &checks {
+        println!(
+            "{:<70} {:<6} {}",
+            c.check,
+            if c.passed { "pass" } else { "FAIL" },
+            c.figure
+        );
+    }
+    if !args.no_report {
+        crate::validate::update_report_section(&report, "sweep", &to_markdown(&checks))
+            .with_context(|| format!("writing {}", report.display()))?;
+        println!("report: {}", report.display());
+    }
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&checks)?;
+        let tmp = path.with_extension("json.partial");
+        std::fs::write(&tmp, text).with_context(|| format!("writing {}", tmp.display()))?;
+        std::fs::rename(&tmp, path).with_context(|| format!("writing {}", path.display()))?;
+    }
+    Ok(if checks.iter().all(|c| c.passed) {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
 }
