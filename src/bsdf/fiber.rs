@@ -22,6 +22,12 @@ pub enum FiberNormalization {
 /// point there, so `sample` never returns it and `pdf` is 0 (a cap of solid angle ~3e-10 sr).
 const MIN_COS_PSI: f32 = 1e-5;
 
+/// Smallest half-width of the azimuth interval `sample` draws from. Where the arc of the cone
+/// above the surface is shorter (the cone only grazes the horizon), φ is drawn from ±MIN_ARC and
+/// directions off the arc are rejected: the density stays bounded instead of growing like 1/Δ
+/// on a sliver where f·cos vanishes anyway.
+const MIN_ARC: f32 = PI / 8.0;
+
 /// A fibre axis `u` with a frame `(v, w)` around it for the azimuth of the reflection cone.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FiberAxis {
@@ -135,8 +141,9 @@ impl FiberAxis {
     }
 
     /// Samples an interior direction: ψi from the Gaussian about −ψr (inverse CDF), φ uniform on
-    /// the arc of the cone above `z_min`. `None` when ψi falls outside (−π/2, π/2) or the arc is
-    /// empty; [`FiberAxis::pdf`] is the density of the returned directions exactly.
+    /// the arc of the cone above `z_min` (widened to at least ±[`MIN_ARC`]). `None` when ψi falls
+    /// outside (−π/2, π/2) or φ off the arc; [`FiberAxis::pdf`] is the density of the returned
+    /// directions exactly.
     pub fn sample(&self, wo: Vec3, u: Vec2, beta: f32, z_min: f32) -> Option<Vec3> {
         let psi_r = self.psi(wo);
         let x = (2.0 * u.x - 1.0).clamp(-0.999_999_9, 0.999_999_9);
@@ -152,7 +159,12 @@ impl FiberAxis {
         if delta <= 0.0 {
             return None;
         }
-        let phi = phi0 + delta * (2.0 * u.y - 1.0);
+        let width = delta.max(MIN_ARC);
+        let offset = width * (2.0 * u.y - 1.0);
+        if offset.abs() >= delta {
+            return None;
+        }
+        let phi = phi0 + offset;
         let (sp, cp) = phi.sin_cos();
         let w = sin_psi * self.frame.n + cos_psi * (cp * self.frame.s + sp * self.frame.t);
         if !(w.z > z_min) {
@@ -161,7 +173,7 @@ impl FiberAxis {
         Some(w)
     }
 
-    /// Density per unit solid angle of [`FiberAxis::sample`]: g(β, ψi + ψr) / (2Δ(ψi) cos ψi),
+    /// Density per unit solid angle of [`FiberAxis::sample`]: g(β, ψi + ψr) / (2 max(Δ(ψi), MIN_ARC) cos ψi),
     /// the Jacobian dω = cos ψ dψ dφ of the fibre's (ψ, φ) coordinates (notes/bsdf.md §3).
     pub fn pdf(&self, wo: Vec3, wi: Vec3, beta: f32, z_min: f32) -> f32 {
         if !(wi.z > z_min) {
@@ -177,7 +189,7 @@ impl FiberAxis {
         if delta <= 0.0 {
             return 0.0;
         }
-        gaussian(beta, sin_psi.asin() + psi_r) / (2.0 * delta * cos_psi)
+        gaussian(beta, sin_psi.asin() + psi_r) / (2.0 * delta.max(MIN_ARC) * cos_psi)
     }
 }
 

@@ -77,20 +77,23 @@ pub fn fresnel_diffuse_reflectance(eta: f32) -> f32 {
 /// law), the azimuth is kept.
 #[inline]
 pub fn refract_in(w: Vec3, eta: f32) -> Vec3 {
-    let t = Vec3::new(w.x / eta, w.y / eta, 0.0);
-    Vec3::new(t.x, t.y, safe_sqrt(1.0 - t.x * t.x - t.y * t.y))
+    // cos²θ' = 1 − sin²θ/η² = (η² − 1 + cos²θ)/η², written so that η = 1 returns w.z exactly
+    // (1 − x² − y² loses a grazing w.z to rounding).
+    let e2 = eta * eta;
+    Vec3::new(w.x / eta, w.y / eta, safe_sqrt((e2 - 1.0 + w.z * w.z) / e2))
 }
 
 /// Exterior direction of an interior direction `w` (inverse of [`refract_in`]); `None` when `w`
 /// lies beyond the critical angle (total internal reflection: it cannot leave the finish).
 #[inline]
 pub fn refract_out(w: Vec3, eta: f32) -> Option<Vec3> {
-    let (x, y) = (w.x * eta, w.y * eta);
-    let z2 = 1.0 - x * x - y * y;
+    // cos²θ = 1 − η² sin²θ' = 1 − η² + η² cos²θ' (exact for η = 1, see `refract_in`).
+    let e2 = eta * eta;
+    let z2 = (1.0 - e2) + e2 * w.z * w.z;
     if !(z2 > 0.0) || !(w.z > 0.0) {
         return None;
     }
-    Some(Vec3::new(x, y, z2.sqrt()))
+    Some(Vec3::new(w.x * eta, w.y * eta, z2.sqrt()))
 }
 
 /// Refraction of `wo` (pointing away from the surface) through the interface with normal `n`

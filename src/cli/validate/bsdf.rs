@@ -2,7 +2,7 @@
 //! the table, rewrites the bsdf section of validation/REPORT.md (with polar plots) and optionally
 //! writes the full results as JSON. Exits non-zero when a check fails.
 
-use crate::validate::bsdf::{load_suite, run_suite, to_markdown, write_polar_plot};
+use crate::validate::bsdf::{load_suite, run_suite, to_markdown, write_polar_plot, BsdfValidation};
 use anyhow::Context;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -24,6 +24,9 @@ pub struct Args {
     /// Do not touch the report or write plots.
     #[arg(long)]
     no_report: bool,
+    /// Rebuild the table, report and plots from a JSON file of an earlier run instead of measuring.
+    #[arg(long)]
+    from_json: Option<PathBuf>,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -41,14 +44,21 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         s.reciprocity_pairs = (s.reciprocity_pairs / k).max(100);
         s.extreme_samples = (s.extreme_samples / k).max(100);
     }
-    let bar = indicatif::ProgressBar::new(suite.cases.len() as u64).with_style(
-        indicatif::ProgressStyle::with_template(
-            "validate bsdf {bar:40} {pos}/{len} cases, {elapsed} (eta {eta})",
-        )
-        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
-    let result = run_suite(&suite, &|| bar.inc(1));
-    bar.finish_and_clear();
+    let result: BsdfValidation = if let Some(path) = &args.from_json {
+        let text =
+            std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+        serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))?
+    } else {
+        let bar = indicatif::ProgressBar::new(suite.cases.len() as u64).with_style(
+            indicatif::ProgressStyle::with_template(
+                "validate bsdf {bar:40} {pos}/{len} cases, {elapsed} (eta {eta})",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        let r = run_suite(&suite, &|| bar.inc(1));
+        bar.finish_and_clear();
+        r
+    };
 
     println!("{:<55} {:<6} {:>14}  case", "check", "result", "worst");
     for c in &result.checks {
