@@ -82,3 +82,49 @@ fn unknown_preset_lists_the_valid_ones() {
     let e = WoodParams::from_toml_file("/nonexistent/x.toml").unwrap_err();
     assert!(e.to_string().contains("/nonexistent/x.toml"));
 }
+
+#[test]
+fn xylem_texture_renders_every_preset_in_three_cuts() {
+    let dir = std::env::temp_dir().join(format!("xylem_wood_cuts_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for name in PRESET_NAMES {
+        for plane in ["xy", "xz", "yz"] {
+            let out = dir.join(format!("{name}_{plane}.png"));
+            let status = std::process::Command::new(env!("CARGO_BIN_EXE_xylem"))
+                .args([
+                    "texture", "--preset", name, "--plane", plane, "--offset", "60",
+                ])
+                .args(["--res", "24", "--out"])
+                .arg(&out)
+                .output()
+                .unwrap();
+            assert!(
+                status.status.success(),
+                "{name} {plane}: {}",
+                String::from_utf8_lossy(&status.stderr)
+            );
+            assert!(std::fs::metadata(&out).unwrap().len() > 100);
+        }
+    }
+    // A user's file with a mistake is refused, naming the file and the field.
+    let bad = dir.join("bad.toml");
+    std::fs::write(
+        &bad,
+        base().replace("ring_porosity = 1.0", "ring_porosity = 2.0"),
+    )
+    .unwrap();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_xylem"))
+        .args(["texture", "--preset-file"])
+        .arg(&bad)
+        .args(["--res", "8", "--out"])
+        .arg(dir.join("bad.png"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("bad.toml") && err.contains("pores.ring_porosity"),
+        "{err}"
+    );
+    assert!(!dir.join("bad.png").exists());
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -1,8 +1,9 @@
 //! `xylem preset`: the built-in species presets.
 
 use crate::render::image_io::write_png_linear;
+use crate::texture::{Plane, Slice};
 use crate::wood;
-use crate::wood::{render_slice, Plane, Slice};
+use crate::wood::{preview_color, Needs};
 use anyhow::Context;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -94,7 +95,8 @@ fn features(p: &wood::WoodParams) -> Vec<&'static str> {
     .collect()
 }
 
-/// The three cuts of each preset, one PNG per cut, and `sheet.png` (rows: presets; columns: xy, xz, yz).
+/// The three cuts of each preset (transverse at z = 0, radial through the pith, tangential `size`
+/// mm from the pith), one PNG per cut, and `sheet.png` (rows: presets; columns: xy, xz, yz).
 fn cuts(
     out: &Path,
     res: u32,
@@ -113,11 +115,24 @@ fn cuts(
     let mut sheet = vec![glam::Vec3::ZERO; (3 * res * res) as usize * names.len()];
     for (row, name) in names.iter().enumerate() {
         let volume = wood::WoodVolume::new(wood::preset(name)?, seed)?;
-        for (col, (plane, tag)) in [(Plane::Xy, "xy"), (Plane::Xz, "xz"), (Plane::Yz, "yz")]
-            .into_iter()
-            .enumerate()
-        {
-            let px = render_slice(&volume, &Slice::standard(plane, size), res, shade);
+        let cuts = [
+            (Plane::Xy, "xy", 0.0, glam::Vec3::Z),
+            (Plane::Xz, "xz", 0.0, glam::Vec3::Y),
+            (Plane::Yz, "yz", size, glam::Vec3::X),
+        ];
+        for (col, (plane, tag, offset, view)) in cuts.into_iter().enumerate() {
+            let slice = Slice {
+                plane,
+                offset,
+                size,
+                res,
+            };
+            let needs = if shade {
+                Needs::COLOR_FIBERS
+            } else {
+                Needs::COLOR
+            };
+            let px = slice.render(&|p| preview_color(&volume.eval(p, needs), view, shade));
             let path = out.join(format!("{name}_{tag}.png"));
             write_png_linear(&path, res, res, &px, 0.0)
                 .with_context(|| format!("writing {}", path.display()))?;

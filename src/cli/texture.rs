@@ -39,6 +39,18 @@ pub struct Args {
     /// List the textures and their parameters (default, range, meaning) and exit.
     #[arg(long)]
     pub list: bool,
+    /// Slice a wood species preset instead of a texture (`xylem preset list`).
+    #[arg(long, conflicts_with_all = ["name", "preset_file"])]
+    pub preset: Option<String>,
+    /// Slice a wood parameter file (TOML like scenes/presets/*.toml).
+    #[arg(long, conflicts_with = "name")]
+    pub preset_file: Option<PathBuf>,
+    /// Wood: seed of the tree.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Wood: plain diffuse colour, without the fibre highlight seen along the plane's normal.
+    #[arg(long)]
+    pub flat: bool,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -69,8 +81,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// What to slice: a named texture with its `--param`s.
+/// What to slice: a wood preset, or a named texture with its `--param`s.
 fn source(args: &Args) -> anyhow::Result<Box<dyn SolidTexture>> {
+    if let Some(wood) = wood_source(args)? {
+        return Ok(wood);
+    }
     let Some(name) = args.name.as_deref() else {
         bail!("name a texture: {} (or --list)", texture::NAMES.join(", "));
     };
@@ -123,4 +138,42 @@ fn list() {
             );
         }
     }
+}
+
+/// A wood volume seen as a solid texture: its preview colour along the plane's normal.
+struct WoodSlice {
+    volume: crate::wood::WoodVolume,
+    view: glam::Vec3,
+    shade: bool,
+}
+
+impl SolidTexture for WoodSlice {
+    fn eval(&self, p: glam::Vec3) -> glam::Vec3 {
+        let needs = if self.shade {
+            crate::wood::Needs::COLOR_FIBERS
+        } else {
+            crate::wood::Needs::COLOR
+        };
+        crate::wood::preview_color(&self.volume.eval(p, needs), self.view, self.shade)
+    }
+}
+
+/// The wood source of `--preset` / `--preset-file`, if one is given.
+fn wood_source(args: &Args) -> anyhow::Result<Option<Box<dyn SolidTexture>>> {
+    let params = match (&args.preset, &args.preset_file) {
+        (Some(name), _) => crate::wood::preset(name)?,
+        (None, Some(file)) => crate::wood::WoodParams::from_toml_file(file)?,
+        (None, None) => return Ok(None),
+    };
+    let volume = crate::wood::WoodVolume::new(params, args.seed)?;
+    let view = match args.plane {
+        Plane::Xy => glam::Vec3::Z,
+        Plane::Xz => glam::Vec3::Y,
+        Plane::Yz => glam::Vec3::X,
+    };
+    Ok(Some(Box::new(WoodSlice {
+        volume,
+        view,
+        shade: !args.flat,
+    })))
 }

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 #[derive(Debug, thiserror::Error)]
 pub enum WoodError {
-    #[error("cannot read wood parameters {file}: {source}")]
+    #[error("cannot read wood parameters {file}")]
     Io {
         file: PathBuf,
         source: std::io::Error,

@@ -8,7 +8,7 @@ mod features;
 mod growth;
 mod knots;
 mod params;
-mod slice;
+mod preview;
 mod volume;
 
 pub use board::*;
@@ -17,7 +17,7 @@ pub use error::WoodError;
 pub use growth::{SmoothRectangleWave, SmoothTriangleWave};
 pub use knots::{smooth_min, KnotSample, Knots};
 pub use params::*;
-pub use slice::{render_slice, Plane, Slice};
+pub use preview::preview_color;
 pub use volume::WoodVolume;
 
 use glam::Vec3;
