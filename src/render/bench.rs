@@ -96,6 +96,18 @@ pub struct TraceReport {
     pub build_total_s: f64,
     pub coherent: TraceFigures,
     pub incoherent: TraceFigures,
+    /// The same mesh and rays through Embree 3 (feature `embree-anchor`).
+    pub embree: Option<EmbreeFigures>,
+}
+
+/// Embree's figures on the same mesh and rays, and xylem's closest-hit speed as a fraction of it.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct EmbreeFigures {
+    pub build_s: f64,
+    pub coherent: TraceFigures,
+    pub incoherent: TraceFigures,
+    pub closest_ratio_coherent: f64,
+    pub closest_ratio_incoherent: f64,
 }
 
 /// Traces `rays` closest-hit and any-hit on the calling thread and times both.
@@ -134,6 +146,7 @@ pub fn run_trace_benchmark(
     name: &str,
 ) -> TraceReport {
     let mesh = Arc::new(bumpy_sphere(triangles));
+    let (coherent, incoherent) = (coherent_rays(rays), incoherent_rays(rays, 1));
     let t = Instant::now();
     let accel = Accel::with_params(
         vec![Instance {
@@ -145,13 +158,30 @@ pub fn run_trace_benchmark(
         params,
     );
     let build_total_s = t.elapsed().as_secs_f64();
+    let c = time_rays(&accel, &coherent);
+    let i = time_rays(&accel, &incoherent);
+    #[cfg(feature = "embree-anchor")]
+    let embree = super::embree::EmbreeScene::new(&accel.instances[0].mesh).map(|e| {
+        let ec = super::embree::time_rays(&e, &coherent, true);
+        let ei = super::embree::time_rays(&e, &incoherent, false);
+        EmbreeFigures {
+            build_s: e.build_time.as_secs_f64(),
+            closest_ratio_coherent: c.closest_mrays_per_s / ec.closest_mrays_per_s,
+            closest_ratio_incoherent: i.closest_mrays_per_s / ei.closest_mrays_per_s,
+            coherent: ec,
+            incoherent: ei,
+        }
+    });
+    #[cfg(not(feature = "embree-anchor"))]
+    let embree = None;
     TraceReport {
         triangles: accel.triangle_count(),
         build_params: name.to_string(),
         build_core_s: accel.build_time.as_secs_f64(),
         build_total_s,
-        coherent: time_rays(&accel, &coherent_rays(rays)),
-        incoherent: time_rays(&accel, &incoherent_rays(rays, 1)),
+        coherent: c,
+        incoherent: i,
+        embree,
     }
 }
 

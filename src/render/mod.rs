@@ -7,6 +7,8 @@
 
 pub mod bench;
 pub mod camera;
+#[cfg(feature = "embree-anchor")]
+pub mod embree;
 pub mod film;
 pub mod geometry;
 pub mod image_io;

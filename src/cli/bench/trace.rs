@@ -50,6 +50,21 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         );
         row("coherent", &r.coherent);
         row("incoherent", &r.incoherent);
+        match &r.embree {
+            Some(e) => {
+                println!(
+                    "Embree 3 (high-quality build {:.3} s, all cores); tracing on 1 core:",
+                    e.build_s
+                );
+                row("coherent", &e.coherent);
+                row("incoherent", &e.incoherent);
+                println!(
+                    "  xylem / Embree closest-hit: coherent {:.2}x, incoherent {:.2}x",
+                    e.closest_ratio_coherent, e.closest_ratio_incoherent
+                );
+            }
+            None => println!("  (Embree comparison: build with --features embree-anchor)"),
+        }
         reports.push(r);
     }
     if let Some(path) = &args.json {
