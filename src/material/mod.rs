@@ -131,6 +131,22 @@ pub enum Material {
         eta: f32,
         tint: Vec3,
     },
+    /// A classic solid texture (marble, stone, …) as the albedo of a Lambertian surface, looked
+    /// up at the object's placement point (a solid cutting's texture space).
+    Texture(TextureMaterial),
+}
+
+/// A solid texture shared between hits.
+#[derive(Clone)]
+pub struct TextureMaterial {
+    pub name: String,
+    pub texture: Arc<dyn crate::texture::SolidTexture>,
+}
+
+impl std::fmt::Debug for TextureMaterial {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "TextureMaterial({})", self.name)
+    }
 }
 
 /// Solid wood: the volume, the finish over it, and the bump-mapping strength.
@@ -174,6 +190,22 @@ impl Material {
                     ..Default::default()
                 },
             },
+            Material::Texture(t) => {
+                let place = &hit.placement;
+                let (p, n) = if place.world_space {
+                    (hit.p_world, hit.ng)
+                } else {
+                    (hit.p_object, hit.n_object)
+                };
+                let c = t.texture.eval(place.to_tree(p, n).0);
+                // A texture colour outside [0, 1] (or NaN) would break energy conservation.
+                let albedo = if c.is_finite() {
+                    c.clamp(Vec3::ZERO, Vec3::ONE)
+                } else {
+                    Vec3::ZERO
+                };
+                lambertian(albedo, geometric_frame())
+            }
             Material::Glass { eta, tint } => Shading {
                 bsdf: SurfaceBsdf::Glass(Glass {
                     eta: *eta,

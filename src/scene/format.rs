@@ -220,6 +220,15 @@ pub enum MaterialTable {
         #[serde(default)]
         bump: f32,
     },
+    /// A classic solid texture as a Lambertian albedo.
+    Texture {
+        /// Texture name (see `xylem texture --help`): marble, slab_marble, ring_wood, log_wood,
+        /// stone, clouds, …
+        texture: String,
+        /// The texture's parameters (missing ones take their defaults).
+        #[serde(default)]
+        params: BTreeMap<String, f32>,
+    },
     Mirror {
         #[serde(default = "default_reflectance")]
         reflectance: [f32; 3],

@@ -11,7 +11,7 @@ pub mod teapot;
 pub use format::{SceneFile, SweepRegion, SweepTable};
 
 use crate::bsdf::{WoodBsdf, WoodBsdfParams};
-use crate::material::{Cutting, Material, Placement, WoodMaterial};
+use crate::material::{Cutting, Material, Placement, TextureMaterial, WoodMaterial};
 use crate::render::{
     self, Accel, Camera, EnvMap, Environment, Filter, Instance, Integrator, Light, Projection,
     RenderSettings, Transform, TriMesh,
@@ -491,6 +491,14 @@ impl Builder<'_> {
                         roughness: self.range(&f("roughness"), *roughness, 0.0, 1.0)?,
                         bump: self.range(&f("bump"), *bump, 0.0, 100.0)?,
                     }))
+                }
+                MaterialTable::Texture { texture, params } => {
+                    let t = crate::texture::by_name(texture, params)
+                        .map_err(|e| self.invalid(f("texture"), e.to_string()))?;
+                    Material::Texture(TextureMaterial {
+                        name: texture.clone(),
+                        texture: Arc::from(t),
+                    })
                 }
                 MaterialTable::Mirror { reflectance } => Material::Mirror {
                     reflectance: self.color(&f("reflectance"), *reflectance, 1.0)?,

@@ -424,7 +424,10 @@ pub fn mahogany_stripes(
     // Both families share the diffuse lobe's cosine fall-off, which dominates the raw curves; the
     // stripe figure is each family's brightness relative to the board, frame by frame.
     let relative = |c: &[f64]| -> Vec<f64> {
-        c.iter().zip(&board).map(|(v, b)| v / b.max(1e-12)).collect()
+        c.iter()
+            .zip(&board)
+            .map(|(v, b)| v / b.max(1e-12))
+            .collect()
     };
     let (ca, cb) = (relative(&raw_a), relative(&raw_b));
     let min_pixels = tilt.len() / 20;
