@@ -483,6 +483,29 @@ mod tests {
     }
 
     #[test]
+    fn spot_light_is_a_point_light_inside_its_cone_and_dark_outside() {
+        let (i, pos) = (Vec3::splat(50.0), Vec3::new(0.0, 0.0, 10.0));
+        let spot = Light::Spot {
+            position: pos,
+            direction: -Vec3::Z,
+            intensity: i,
+            cos_inner: 20f32.to_radians().cos(),
+            cos_outer: 30f32.to_radians().cos(),
+        };
+        // 10° off axis: full intensity, E = I / d² (inverse-square law).
+        let p = Vec3::new(10.0 * 10f32.to_radians().tan(), 0.0, 0.0);
+        let s = spot.sample(p, Vec2::ZERO).unwrap();
+        assert!((s.li - i / (pos - p).length_squared()).abs().max_element() < 1e-6);
+        // 40° off axis: outside the cone.
+        let q = Vec3::new(10.0 * 40f32.to_radians().tan(), 0.0, 0.0);
+        assert_eq!(spot.sample(q, Vec2::ZERO).unwrap().li, Vec3::ZERO);
+        // 25°: inside the smooth edge, strictly between.
+        let r = Vec3::new(10.0 * 25f32.to_radians().tan(), 0.0, 0.0);
+        let e = spot.sample(r, Vec2::ZERO).unwrap().li.x * (pos - r).length_squared() / i.x;
+        assert!(e > 0.0 && e < 1.0, "{e}");
+    }
+
+    #[test]
     fn env_map_pdf_integrates_to_one_and_matches_sampling() {
         let (w, h) = (16, 8);
         let texels = (0..w * h)
