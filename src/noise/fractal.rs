@@ -79,9 +79,11 @@ impl Fractal {
 
     #[inline]
     pub fn eval(&self, p: Vec3, seed: u32) -> f32 {
-        match (self.kind, self.basis) {
-            (FractalKind::Fbm, Basis::Gradient) => self.fbm_gradient(p, seed),
-            _ => self.sum::<false>(p, seed).0,
+        match (self.basis, self.kind) {
+            (Basis::Gradient, FractalKind::Fbm) => self.gradient_lanes(p, seed, |n| n),
+            (Basis::Gradient, FractalKind::Turbulence) => self.gradient_lanes(p, seed, f32::abs),
+            (Basis::Gradient, FractalKind::Ridged) => self.gradient_lanes(p, seed, ridge),
+            (Basis::Value, _) => self.sum::<false, _>(p, seed, value3_grad_s).0,
         }
     }
 
@@ -89,14 +91,31 @@ impl Fractal {
     /// turbulence and ridged sums have a crease where the gradient is one-sided).
     #[inline]
     pub fn eval_grad(&self, p: Vec3, seed: u32) -> (f32, Vec3) {
-        self.sum::<true>(p, seed)
+        match self.basis {
+            Basis::Gradient => self.sum::<true, _>(p, seed, gradient3_grad_s),
+            Basis::Value => self.sum::<true, _>(p, seed, value3_grad_s),
+        }
     }
 
-    /// The hot path: fBm of gradient noise. Octaves are independent, so four at a time go
-    /// through the 4-lane kernel (lane k = octave i + k); octave seeds are one add apart on the
-    /// scrambled seed. Same points, seeds and summation order as the scalar path.
-    #[inline]
-    fn fbm_gradient(&self, p: Vec3, seed: u32) -> f32 {
+    /// (fold(n), d fold / dn) of this sum's kind.
+    #[inline(always)]
+    fn fold(&self, n: f32) -> (f32, f32) {
+        match self.kind {
+            FractalKind::Fbm => (n, 1.0),
+            FractalKind::Turbulence => (n.abs(), n.signum()),
+            FractalKind::Ridged => {
+                let r = 1.0 - n.abs();
+                (r * r, -2.0 * r * n.signum())
+            }
+        }
+    }
+
+    /// The hot path: sums of gradient noise. Octaves are independent, so four at a time go
+    /// through the 4-lane kernel (lane k = octave i + k), each folded by `fold` (identity, |n|,
+    /// ridge); octave seeds are one add apart on the scrambled seed. Same points, seeds and
+    /// summation order as the scalar path.
+    #[inline(always)]
+    fn gradient_lanes(&self, p: Vec3, seed: u32, fold: impl Fn(f32) -> f32) -> f32 {
         let mut s = mix32(seed);
         let (mut freq, mut amp, mut total) = (1.0f32, 1.0f32, 0.0f32);
         let mut shift = Vec3::ZERO;
@@ -115,49 +134,37 @@ impl Fractal {
                 s = s.wrapping_add(OCTAVE_SEED_STEP);
             }
             let n = gradient3_x4_affine(p, f, sh, seeds);
-            total += amps[0] * n[0];
-            total += amps[1] * n[1];
-            total += amps[2] * n[2];
-            total += amps[3] * n[3];
+            total += amps[0] * fold(n[0]);
+            total += amps[1] * fold(n[1]);
+            total += amps[2] * fold(n[2]);
+            total += amps[3] * fold(n[3]);
             left = left.saturating_sub(4);
         }
         if left == 1 {
-            total += amp * gradient3_s(p * freq + shift, s);
+            total += amp * fold(gradient3_s(p * freq + shift, s));
         }
         total
     }
 
-    fn sum<const GRAD: bool>(&self, p: Vec3, seed: u32) -> (f32, Vec3) {
+    /// The general sum over a basis returning (value, gradient), with the fold of `kind`.
+    #[inline]
+    fn sum<const GRAD: bool, B: Fn(Vec3, u32) -> (f32, Vec3)>(
+        &self,
+        p: Vec3,
+        seed: u32,
+        basis: B,
+    ) -> (f32, Vec3) {
         let mut s = mix32(seed);
         let (mut freq, mut amp) = (1.0f32, 1.0f32);
         let (mut total, mut grad) = (0.0f32, Vec3::ZERO);
         let mut shift = Vec3::ZERO;
         for _ in 0..self.octaves {
-            let q = p * freq + shift;
-            let (n, g) = if GRAD {
-                match self.basis {
-                    Basis::Gradient => gradient3_grad_s(q, s),
-                    Basis::Value => value3_grad_s(q, s),
-                }
-            } else {
-                let n = match self.basis {
-                    Basis::Gradient => gradient3_s(q, s),
-                    Basis::Value => value3_grad_s(q, s).0,
-                };
-                (n, Vec3::ZERO)
-            };
-            // d/dp of n(freq p + shift) = freq ∇n.
-            let (v, dv) = match self.kind {
-                FractalKind::Fbm => (n, g),
-                FractalKind::Turbulence => (n.abs(), g * n.signum()),
-                FractalKind::Ridged => {
-                    let r = 1.0 - n.abs();
-                    (r * r, g * (-2.0 * r * n.signum()))
-                }
-            };
+            let (n, g) = basis(p * freq + shift, s);
+            let (v, dv) = self.fold(n);
             total += amp * v;
             if GRAD {
-                grad += (amp * freq) * dv;
+                // d/dp of fold(n(freq p + shift)) = fold'(n) freq ∇n.
+                grad += (amp * freq * dv) * g;
             }
             freq *= self.lacunarity;
             amp *= self.gain;
@@ -166,4 +173,11 @@ impl Fractal {
         }
         (total, grad)
     }
+}
+
+/// The ridged fold (1 − |n|)².
+#[inline(always)]
+fn ridge(n: f32) -> f32 {
+    let r = 1.0 - n.abs();
+    r * r
 }

@@ -14,11 +14,11 @@ use std::time::Instant;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Points per pass.
-    #[arg(long, default_value_t = 4096)]
+    /// Points per pass (short passes fit between other jobs' time slices on a shared machine).
+    #[arg(long, default_value_t = 256)]
     points: usize,
     /// Passes per function (the best one is reported).
-    #[arg(long, default_value_t = 30)]
+    #[arg(long, default_value_t = 400)]
     passes: usize,
 }
 
