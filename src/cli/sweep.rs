@@ -27,6 +27,10 @@ pub struct Args {
     /// Samples per pixel (overrides the scene's render.spp).
     #[arg(long)]
     pub spp: Option<u32>,
+    /// Speed/accuracy preset measured in validation/TRADEOFF.md (spp and wood-model knobs);
+    /// `--spp` still overrides its sample count.
+    #[arg(long, value_enum)]
+    pub quality: Option<crate::sweep::tradeoff::Quality>,
     /// Render each frame from scratch, without the per-sweep cache (to time or check it).
     #[arg(long)]
     pub naive: bool,
@@ -37,7 +41,7 @@ pub struct Args {
     #[arg(long)]
     pub quiet: bool,
     /// Assemble contact sheet, animated PNG, CSV and viewer from the frames already in DIR.
-    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "frames", "arc", "frames_range", "spp", "naive"])]
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "frames", "arc", "frames_range", "spp", "naive", "quality"])]
     pub assemble: Option<PathBuf>,
 }
 
@@ -51,6 +55,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let mut loaded = crate::scene::load(scene)?;
     for w in &loaded.warnings {
         eprintln!("warning: {w}");
+    }
+    if let Some(q) = args.quality {
+        crate::sweep::tradeoff::apply(&mut loaded, &q.knobs())
+            .with_context(|| format!("applying --quality {q:?}"))?;
     }
     if let Some(spp) = args.spp {
         anyhow::ensure!(spp >= 1, "--spp 0: need at least 1 sample per pixel");

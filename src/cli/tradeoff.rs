@@ -1,10 +1,204 @@
-//! `xylem tradeoff`.
+//! `xylem tradeoff SCENE.toml`: measures every speed/accuracy knob against a reference render and
+//! writes validation/TRADEOFF.md with an error-against-time plot.
 
+use crate::sweep::plot::{line_plot, PlotOptions, Series, PALETTE};
+use crate::sweep::tradeoff::{relative_mse, render_with, settings, ssim, Knobs, Measurement};
+use anyhow::Context;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(clap::Args, Debug)]
-pub struct Args {}
+pub struct Args {
+    /// Scene file (TOML).
+    pub scene: PathBuf,
+    /// Image width for the measurements (the height keeps the scene's aspect ratio).
+    #[arg(long, default_value_t = 160)]
+    pub width: u32,
+    /// Samples per pixel of the reference render (full model).
+    #[arg(long, default_value_t = 256)]
+    pub reference_spp: u32,
+    /// Report to write.
+    #[arg(long, default_value = "validation/TRADEOFF.md")]
+    pub out: PathBuf,
+    /// Also write every number as JSON here.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Worker threads (0 = all cores).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+}
 
-pub fn run(_args: Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("`xylem tradeoff` is not built yet")
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    anyhow::ensure!(
+        (8..=4096).contains(&args.width),
+        "--width {}: allowed 8 to 4096",
+        args.width
+    );
+    anyhow::ensure!(
+        args.reference_spp >= 1,
+        "--reference-spp must be at least 1"
+    );
+    let probe = crate::scene::load(&args.scene)?;
+    let (w0, h0) = (probe.scene.camera.width, probe.scene.camera.height);
+    let (w, h) = (
+        args.width,
+        ((args.width as f32 * h0 as f32 / w0 as f32).round() as u32).max(1),
+    );
+    let exposure = probe.exposure;
+    let name = probe.name.clone();
+    drop(probe);
+    let scene_path = args.scene.clone();
+    let base = move || -> Result<crate::scene::LoadedScene, String> {
+        let mut l = crate::scene::load(&scene_path).map_err(|e| e.to_string())?;
+        l.scene.camera = l.scene.camera.with_resolution(w, h);
+        Ok(l)
+    };
+    let run = crate::render::RunOptions {
+        threads: args.threads,
+        progress: false,
+    };
+    let all = settings();
+    let bar = indicatif::ProgressBar::new(all.len() as u64 + 1).with_style(
+        indicatif::ProgressStyle::with_template("tradeoff {bar:40} {pos}/{len} {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar.set_message(format!("reference, {} spp", args.reference_spp));
+    let (reference, ref_secs) = render_with(&base, &Knobs::full(args.reference_spp), &run)
+        .map_err(anyhow::Error::msg)
+        .context("reference render")?;
+    bar.inc(1);
+    let mut rows = Vec::new();
+    for (knob, setting, knobs) in all {
+        bar.set_message(setting.clone());
+        let (img, secs) = render_with(&base, &knobs, &run)
+            .map_err(anyhow::Error::msg)
+            .with_context(|| format!("render with {setting}"))?;
+        rows.push(Measurement {
+            knob,
+            setting,
+            knobs,
+            seconds: secs,
+            relative_mse: relative_mse(&img, &reference),
+            ssim: ssim(&img, &reference, w as usize, h as usize, exposure),
+        });
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    let dir = args.out.parent().map(Path::to_path_buf).unwrap_or_default();
+    let plot_rel = "plots/tradeoff_error_vs_time.png";
+    write_plot(&dir.join(plot_rel), &rows)?;
+    let md = markdown(&name, &args, (w, h), ref_secs, &rows, plot_rel);
+    crate::sweep::sequence::write_text_atomic(&args.out, &md)?;
+    for r in &rows {
+        println!(
+            "{:<18} {:<24} {:>8.3} s  rel. MSE {:>10.3e}  SSIM {:.4}",
+            r.knob, r.setting, r.seconds, r.relative_mse, r.ssim
+        );
+    }
+    println!("report: {}", args.out.display());
+    if let Some(p) = &args.json {
+        let text = serde_json::to_string_pretty(&rows)?;
+        crate::sweep::sequence::write_text_atomic(p, &text)?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn write_plot(path: &Path, rows: &[Measurement]) -> anyhow::Result<()> {
+    let mut knobs: Vec<&str> = Vec::new();
+    for r in rows {
+        if !knobs.contains(&r.knob.as_str()) {
+            knobs.push(&r.knob);
+        }
+    }
+    let series: Vec<Series> = knobs
+        .iter()
+        .enumerate()
+        .map(|(k, name)| Series {
+            points: rows
+                .iter()
+                .filter(|r| r.knob == *name)
+                .map(|r| (r.seconds, r.relative_mse))
+                .collect(),
+            color: PALETTE[k % PALETTE.len()],
+            markers: true,
+        })
+        .collect();
+    let opts = PlotOptions {
+        width: 560,
+        height: 300,
+        log_x: true,
+        log_y: true,
+    };
+    let img = line_plot(&series, &opts);
+    if let Some(p) = path.parent() {
+        std::fs::create_dir_all(p)?;
+    }
+    crate::render::image_io::write_png_rgb8(path, img.width, img.height, &img.data)?;
+    Ok(())
+}
+
+/// The cheapest measured setting whose SSIM reaches `min_ssim`.
+fn cheapest(rows: &[Measurement], min_ssim: f64) -> Option<&Measurement> {
+    rows.iter()
+        .filter(|r| r.knob != "--quality" && r.ssim >= min_ssim)
+        .min_by(|a, b| a.seconds.total_cmp(&b.seconds))
+}
+
+fn markdown(
+    name: &str,
+    args: &Args,
+    (w, h): (u32, u32),
+    ref_secs: f64,
+    rows: &[Measurement],
+    plot: &str,
+) -> String {
+    let mut s = format!(
+        "# Speed against accuracy: `{name}`\n\nRegenerated by `xylem tradeoff {} --width {}` \
+         ({w}×{h} pixels, one frame with the scene's own lights, {} threads; a reference of {} spp \
+         with the full model took {ref_secs:.2} s). Error against the reference: relative MSE \
+         (Σ|x − r|² / Σ|r|² over RGB) and mean SSIM (Wang et al. 2004, 8×8 windows, stride 4, on \
+         sRGB luminance). Times are wall clock on a shared machine (other jobs running), so \
+         compare them within this table only. Model knobs are measured at 16 spp, so their error \
+         includes the 16-spp noise of the first table's row.\n\n",
+        args.scene.display(),
+        args.width,
+        if args.threads == 0 {
+            "all".to_string()
+        } else {
+            args.threads.to_string()
+        },
+        args.reference_spp
+    );
+    s += "| knob | setting | time (s) | relative MSE | SSIM |\n| --- | --- | --- | --- | --- |\n";
+    for r in rows {
+        s += &format!(
+            "| {} | {} | {:.3} | {:.3e} | {:.4} |\n",
+            r.knob, r.setting, r.seconds, r.relative_mse, r.ssim
+        );
+    }
+    s += &format!(
+        "\n![relative MSE (vertical, log) against render time in seconds (horizontal, log); one colour \
+         per knob in the table's order: blue spp, red noise bands, green impulse density, orange \
+         pores and rays, purple the --quality presets]({plot})\n\n## Recommended settings\n\n"
+    );
+    for (label, t) in [("draft", 0.9), ("default", 0.97), ("final", 0.99)] {
+        match cheapest(rows, t) {
+            Some(r) => {
+                s += &format!(
+                    "- **{label}** (cheapest with SSIM ≥ {t}): {} — {:.3} s, SSIM {:.4}\n",
+                    r.setting, r.seconds, r.ssim
+                )
+            }
+            None => s += &format!("- **{label}**: no measured setting reaches SSIM ≥ {t}\n"),
+        }
+    }
+    s += "\n`--quality draft|default|final` (on `xylem sweep`) applies the presets in \
+          `src/sweep/tradeoff.rs` (`Quality::knobs`), rows `--quality` above.\n\n\
+          ## Not measured\n\n\
+          - exact versus simplified distortion Jacobian, closed-form versus single-bounce finish, \
+          and footprint band-limiting: the wood model and BSDF expose no switch for them (yet), so \
+          they cannot be timed here;\n\
+          - baked textures: the renderer has no image-texture material, so baked maps \
+          (`xylem bake`) are not compared in rendered images.\n";
+    s
 }

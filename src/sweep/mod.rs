@@ -7,6 +7,8 @@
 //! - [`sequence`]: per-frame records and the assembly of a folder of frames into the contact
 //!   sheet ([`contact`]), animated PNG, CSV and the HTML [`viewer`];
 //! - [`plot`]: small line plots for the validation report and the trade-off curve;
+//! - [`tradeoff`]: the speed/accuracy measurements behind `--quality`;
+//! - [`bake`]: texture maps of a preset for other tools;
 //! - [`highlight`]: where the fibre highlight of a flat finished board peaks along the arc.
 
 pub mod bake;
@@ -17,6 +19,7 @@ pub mod job;
 pub mod path;
 pub mod plot;
 pub mod sequence;
+pub mod tradeoff;
 pub mod viewer;
 
 pub use path::{parse_arc, parse_frames_range, ArcPlane, LightArc, PathError};

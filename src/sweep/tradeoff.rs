@@ -1,0 +1,289 @@
+//! Measuring the speed/accuracy trade (`xylem tradeoff`): render one frame of a scene with each
+//! setting of each knob the renderer and the wood model expose, time it, and measure its error
+//! against a high-quality reference (relative MSE and SSIM). The named `--quality` presets are
+//! chosen from these measurements (validation/TRADEOFF.md).
+
+use crate::material::Material;
+use crate::math::luminance;
+use crate::render::image_io::linear_to_srgb;
+use crate::render::{render, RunOptions};
+use crate::scene::LoadedScene;
+use crate::wood::{NoiseParams, WoodParams, WoodVolume};
+use serde::Serialize;
+use std::sync::Arc;
+
+/// One setting of the model knobs.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Knobs {
+    pub spp: u32,
+    /// Keep at most this many bands of every multiband noise (None: the preset's).
+    pub max_bands: Option<u32>,
+    /// Scale of every sparse-convolution impulse density (1 = the preset's).
+    pub density_scale: f32,
+    /// Keep pores and rays (false: drop them, "model only what the scene needs").
+    pub pores_and_rays: bool,
+}
+
+impl Knobs {
+    pub const fn full(spp: u32) -> Knobs {
+        Knobs {
+            spp,
+            max_bands: None,
+            density_scale: 1.0,
+            pores_and_rays: true,
+        }
+    }
+}
+
+/// The named quality presets, chosen from the measurements in validation/TRADEOFF.md: the
+/// cheapest measured setting reaching SSIM ≥ 0.9 (draft), ≥ 0.97 (default) and ≥ 0.99 (final)
+/// on the board scene.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, Serialize)]
+pub enum Quality {
+    Draft,
+    Default,
+    Final,
+}
+
+impl Quality {
+    pub fn knobs(self) -> Knobs {
+        match self {
+            Quality::Draft => Knobs {
+                spp: 4,
+                max_bands: Some(1),
+                density_scale: 1.0,
+                pores_and_rays: true,
+            },
+            Quality::Default => Knobs::full(16),
+            Quality::Final => Knobs::full(64),
+        }
+    }
+}
+
+fn limit_noise(n: &mut NoiseParams, k: &Knobs) {
+    if let Some(b) = k.max_bands {
+        n.bands = n.bands.min(b.max(1));
+    }
+    n.density *= k.density_scale;
+}
+
+/// The wood parameters with the knobs applied.
+pub fn apply_to_params(p: &WoodParams, k: &Knobs) -> WoodParams {
+    let mut p = p.clone();
+    for n in [
+        &mut p.distortion.radial,
+        &mut p.distortion.tangential,
+        &mut p.distortion.longitudinal,
+    ]
+    .into_iter()
+    .flatten()
+    {
+        limit_noise(n, k);
+    }
+    if let Some(pores) = &mut p.pores {
+        pores.density *= k.density_scale;
+    }
+    if let Some(rays) = &mut p.rays {
+        rays.density *= k.density_scale;
+    }
+    if !k.pores_and_rays {
+        p.pores = None;
+        p.rays = None;
+    }
+    p
+}
+
+/// Applies the knobs to a loaded scene: its spp and every wood material's volume.
+pub fn apply(loaded: &mut LoadedScene, k: &Knobs) -> Result<(), crate::wood::WoodError> {
+    loaded.settings.spp = k.spp.max(1);
+    for m in &mut loaded.scene.materials {
+        if let Material::Wood(w) = m {
+            let params = apply_to_params(w.volume.params(), k);
+            w.volume = Arc::new(WoodVolume::new(params, w.volume.seed())?);
+        }
+    }
+    Ok(())
+}
+
+/// Relative mean squared error Σ|x − r|² / Σ|r|² over RGB.
+pub fn relative_mse(x: &[glam::Vec3], r: &[glam::Vec3]) -> f64 {
+    let (mut num, mut den) = (0.0f64, 0.0f64);
+    for (a, b) in x.iter().zip(r) {
+        num += (*a - *b).length_squared() as f64;
+        den += b.length_squared() as f64;
+    }
+    num / den.max(1e-30)
+}
+
+/// Mean SSIM (Wang, Bovik, Sheikh, Simoncelli 2004, eq. 13, C1 = (0.01 L)², C2 = (0.03 L)², L = 1)
+/// of the sRGB-encoded luminance of two images, over 8 × 8 windows with stride 4.
+pub fn ssim(x: &[glam::Vec3], r: &[glam::Vec3], width: usize, height: usize, exposure: f32) -> f64 {
+    let scale = exposure.exp2();
+    let enc = |v: &[glam::Vec3]| -> Vec<f64> {
+        v.iter()
+            .map(|c| linear_to_srgb(luminance(*c) * scale) as f64)
+            .collect()
+    };
+    let (a, b) = (enc(x), enc(r));
+    let (c1, c2) = (0.01f64.powi(2), 0.03f64.powi(2));
+    let (win, stride) = (8usize.min(width), 4usize);
+    let win_h = 8usize.min(height);
+    let (mut total, mut count) = (0.0, 0usize);
+    let mut y = 0;
+    while y + win_h <= height {
+        let mut x0 = 0;
+        while x0 + win <= width {
+            let n = (win * win_h) as f64;
+            let (mut ma, mut mb) = (0.0, 0.0);
+            for yy in y..y + win_h {
+                for xx in x0..x0 + win {
+                    ma += a[yy * width + xx];
+                    mb += b[yy * width + xx];
+                }
+            }
+            ma /= n;
+            mb /= n;
+            let (mut va, mut vb, mut cov) = (0.0, 0.0, 0.0);
+            for yy in y..y + win_h {
+                for xx in x0..x0 + win {
+                    let (da, db) = (a[yy * width + xx] - ma, b[yy * width + xx] - mb);
+                    va += da * da;
+                    vb += db * db;
+                    cov += da * db;
+                }
+            }
+            let (va, vb, cov) = (va / (n - 1.0), vb / (n - 1.0), cov / (n - 1.0));
+            total += ((2.0 * ma * mb + c1) * (2.0 * cov + c2))
+                / ((ma * ma + mb * mb + c1) * (va + vb + c2));
+            count += 1;
+            x0 += stride;
+        }
+        y += stride;
+    }
+    if count == 0 {
+        1.0
+    } else {
+        total / count as f64
+    }
+}
+
+/// One measured setting.
+#[derive(Clone, Debug, Serialize)]
+pub struct Measurement {
+    /// Which knob this row varies.
+    pub knob: String,
+    pub setting: String,
+    pub knobs: Knobs,
+    pub seconds: f64,
+    pub relative_mse: f64,
+    pub ssim: f64,
+}
+
+/// The settings measured, knob by knob (spp with the full model; each model knob at 16 spp).
+pub fn settings() -> Vec<(String, String, Knobs)> {
+    let mut v = Vec::new();
+    for spp in [1, 4, 16, 64] {
+        v.push((
+            "samples per pixel".into(),
+            format!("{spp} spp"),
+            Knobs::full(spp),
+        ));
+    }
+    for bands in [1, 2] {
+        v.push((
+            "noise bands".into(),
+            format!("≤ {bands} band(s), 16 spp"),
+            Knobs {
+                max_bands: Some(bands),
+                ..Knobs::full(16)
+            },
+        ));
+    }
+    for scale in [0.25, 0.5] {
+        v.push((
+            "impulse density".into(),
+            format!("× {scale}, 16 spp"),
+            Knobs {
+                density_scale: scale,
+                ..Knobs::full(16)
+            },
+        ));
+    }
+    v.push((
+        "pores and rays".into(),
+        "dropped, 16 spp".into(),
+        Knobs {
+            pores_and_rays: false,
+            ..Knobs::full(16)
+        },
+    ));
+    for q in [Quality::Draft, Quality::Default, Quality::Final] {
+        v.push((
+            "--quality".into(),
+            format!("{q:?}").to_lowercase(),
+            q.knobs(),
+        ));
+    }
+    v
+}
+
+/// Renders the scene (its own lights, as built) with `knobs`; returns the beauty and seconds.
+pub fn render_with(
+    base: &dyn Fn() -> Result<LoadedScene, String>,
+    knobs: &Knobs,
+    run: &RunOptions,
+) -> Result<(Vec<glam::Vec3>, f64), String> {
+    let mut loaded = base()?;
+    apply(&mut loaded, knobs).map_err(|e| e.to_string())?;
+    let out = render(&loaded.scene, &loaded.settings, run).map_err(|e| e.to_string())?;
+    Ok((out.image.beauty, out.elapsed.as_secs_f64()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn identical_images_have_no_error_and_unit_ssim() {
+        let img: Vec<Vec3> = (0..64 * 32)
+            .map(|i| Vec3::splat((i % 7) as f32 / 7.0))
+            .collect();
+        assert_eq!(relative_mse(&img, &img), 0.0);
+        assert!((ssim(&img, &img, 64, 32, 0.0) - 1.0).abs() < 1e-12);
+        // Noise lowers SSIM and raises the error.
+        let mut rng = crate::math::Pcg32::new(1, 1);
+        let noisy: Vec<Vec3> = img
+            .iter()
+            .map(|c| *c + Vec3::splat(0.2 * (rng.next_f32() - 0.5)))
+            .collect();
+        assert!(ssim(&noisy, &img, 64, 32, 0.0) < 0.95);
+        let e = relative_mse(&noisy, &img);
+        assert!(e > 0.0 && e < 0.1, "{e}");
+    }
+
+    #[test]
+    fn knobs_limit_bands_and_scale_density() {
+        let p = crate::wood::preset("curly_maple").unwrap();
+        let k = Knobs {
+            max_bands: Some(1),
+            density_scale: 0.5,
+            ..Knobs::full(4)
+        };
+        let q = apply_to_params(&p, &k);
+        let all = |p: &WoodParams| {
+            [
+                p.distortion.radial.clone(),
+                p.distortion.tangential.clone(),
+                p.distortion.longitudinal.clone(),
+            ]
+        };
+        for (a, b) in all(&p).iter().zip(all(&q).iter()) {
+            if let (Some(a), Some(b)) = (a, b) {
+                assert_eq!(b.bands, 1.min(a.bands).max(1));
+                assert!((b.density - 0.5 * a.density).abs() < 1e-6);
+            }
+        }
+        assert!(WoodVolume::new(q, 1).is_ok());
+    }
+}
