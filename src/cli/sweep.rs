@@ -43,11 +43,14 @@ pub struct Args {
     /// Assemble contact sheet, animated PNG, CSV and viewer from the frames already in DIR.
     #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "frames", "arc", "frames_range", "spp", "naive", "quality"])]
     pub assemble: Option<PathBuf>,
+    /// Largest thumbnail width on the contact sheet, in pixels.
+    #[arg(long, default_value_t = 240)]
+    pub thumb_width: u32,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if let Some(dir) = &args.assemble {
-        return assemble_dir(dir);
+        return assemble_dir(dir, args.thumb_width);
     }
     let Some(scene) = &args.scene else {
         anyhow::bail!("give a scene file (or --assemble DIR)");
@@ -125,8 +128,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 }
 
 /// Assembles a folder of frames and reports what it wrote.
-fn assemble_dir(dir: &Path) -> anyhow::Result<ExitCode> {
-    let done = assemble(dir, &AssembleOptions::default())
+fn assemble_dir(dir: &Path, thumb_width: u32) -> anyhow::Result<ExitCode> {
+    let opts = AssembleOptions {
+        thumb_width: thumb_width.max(8),
+        ..Default::default()
+    };
+    let done = assemble(dir, &opts)
         .with_context(|| format!("assembling the sweep in {}", dir.display()))?;
     println!("assembled {} frames:", done.frames);
     for f in &done.files {
