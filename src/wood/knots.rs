@@ -227,6 +227,37 @@ mod tests {
     }
 
     #[test]
+    fn dead_knots_stop_growing_and_have_bark_live_knots_keep_growing() {
+        let w = 4.0;
+        let (dead, live) = (
+            Knots::new(&params(Some(10.0)), w, 1),
+            Knots::new(&params(None), w, 1),
+        );
+        let (o, a) = dead.branch(0, 0.0);
+        let side = a.cross(Vec3::Z).normalize();
+        let at = |k: &Knots, s: f32, rho: f32| {
+            let q = o + a * s + side * rho;
+            let r = (q.x * q.x + q.y * q.y).sqrt();
+            k.eval(q, q.y.atan2(q.x), r, r / w).unwrap()
+        };
+        // Far out (trunk time ≈ 45 years ≫ 10), the dead knot is a cylinder of radius w_b · 10.
+        let s = 190.0;
+        let rd = at(&dead, s, 0.0).radius;
+        let wb = 6f32.to_radians().tan() * w / 20f32.to_radians().cos();
+        assert!((rd - 10.0 * wb).abs() < 1e-3, "dead radius {rd}");
+        assert_eq!(at(&dead, s, 0.5 * rd).inside, 1.0);
+        assert_eq!(at(&dead, s, rd + 0.2).bark, 1.0, "bark rim");
+        assert_eq!(
+            at(&dead, s, rd + 1.0).inside + at(&dead, s, rd + 1.0).bark,
+            0.0
+        );
+        // The live knot is still growing there: wider, no bark.
+        let live_in = at(&live, s, 2.0 * rd);
+        assert_eq!((live_in.inside, live_in.bark), (1.0, 0.0));
+        assert!(live_in.radius > 3.0 * rd);
+    }
+
+    #[test]
     fn deflected_fibre_is_tangent_on_the_boundary() {
         let knots = Knots::new(&params(None), 4.0, 1);
         let k = KnotSample {
