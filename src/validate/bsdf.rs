@@ -1012,7 +1012,7 @@ pub fn to_markdown(v: &BsdfValidation, plots: &[(String, String)]) -> String {
     md += &markdown_table(&["case", "p-value", "dof"], &rows);
     if !plots.is_empty() {
         md += "\nPolar plots of f·cos θi in the incidence plane (x = sin θi, y = cos θi, radius = value \
-                normalised per plot; ωo on the left at θo = 0°, 30°, 60°, 80° in blue, red, green, orange; \
+                normalised per curve; ωo on the left at θo = 0°, 30°, 60°, 80° in blue, red, green, orange; \
                 grey: unit circle; the delta reflection of a smooth finish is not drawn):\n\n";
         for (name, path) in plots {
             md += &format!("- {name}\n\n  ![{name}]({path})\n");
@@ -1022,7 +1022,7 @@ pub fn to_markdown(v: &BsdfValidation, plots: &[(String, String)]) -> String {
 }
 
 /// Writes the polar plot of `spec` (f·cos θi in the incidence plane at θo = 0°, 30°, 60°, 80°,
-/// normalised to the largest value) as a PNG.
+/// each curve normalised to its own maximum, so lobe shapes compare across angles) as a PNG.
 pub fn write_polar_plot(spec: &CaseSpec, path: &Path) -> anyhow::Result<()> {
     use crate::sweep::plot::{line_plot, PlotOptions, Series, PALETTE};
     let b = spec.bsdf()?;
@@ -1030,12 +1030,6 @@ pub fn write_polar_plot(spec: &CaseSpec, path: &Path) -> anyhow::Result<()> {
         .iter()
         .map(|t| incidence_plane_curve(&b, t.to_radians(), 721))
         .collect();
-    let max = curves
-        .iter()
-        .flatten()
-        .map(|(x, y)| x.hypot(*y))
-        .fold(0.0f64, f64::max)
-        .max(1e-30);
     let mut series: Vec<Series> = vec![Series {
         points: (0..=180)
             .map(|k| {
@@ -1047,6 +1041,11 @@ pub fn write_polar_plot(spec: &CaseSpec, path: &Path) -> anyhow::Result<()> {
         markers: false,
     }];
     for (k, c) in curves.iter().enumerate() {
+        let max = c
+            .iter()
+            .map(|(x, y)| x.hypot(*y))
+            .fold(0.0f64, f64::max)
+            .max(1e-30);
         series.push(Series {
             points: c.iter().map(|(x, y)| (x / max, y / max)).collect(),
             color: PALETTE[k % PALETTE.len()],
