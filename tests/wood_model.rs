@@ -310,3 +310,33 @@ fn thin_cylindrical_ray_kernels_are_continuous_around_the_tree() {
         }
     }
 }
+
+#[test]
+fn strong_distortion_stays_finite_and_unit() {
+    // Far beyond any preset: 15 mm displacements from 2 mm kernels in all three directions
+    // (‖∇m‖ ≫ 1, where eq. 21 fails and only the eq. 22 compression keeps J invertible).
+    let mut p = wood::preset("quilted_maple").unwrap();
+    let strong = wood::NoiseParams {
+        magnitude: 15.0,
+        size: [2.0, 2.0, 2.0],
+        density: 4.0,
+        bands: 2,
+        size_factor: 0.5,
+        dropoff: 1.0,
+    };
+    p.distortion.radial = Some(strong.clone());
+    p.distortion.tangential = Some(strong.clone());
+    p.distortion.longitudinal = Some(strong);
+    let v = WoodVolume::new(p, 9).unwrap();
+    for i in 0..20 {
+        for j in 0..20 {
+            for k in 0..20 {
+                let q = Vec3::new(i as f32 - 10.0, j as f32 - 10.0, k as f32) * 1.7;
+                let t = v.eval(q, Needs::ALL);
+                assert!(t.diffuse.is_finite() && t.bump_grad.is_finite(), "at {q}");
+                assert!((t.fiber_dir.length() - 1.0).abs() < 1e-4, "at {q}");
+                assert!((t.ray_dir.length() - 1.0).abs() < 1e-4, "at {q}");
+            }
+        }
+    }
+}
