@@ -24,7 +24,8 @@ pub struct WoodBsdf {
     fiber: FiberAxis,
     ray: FiberAxis,
     /// ρ'/(1 − ρ' F̄_int): the diffuse albedo including the closed-form series of internal
-    /// reflections under the finish (notes/bsdf.md §1.3), with ρ' = min(ρ, 1 − k_f).
+    /// reflections under the finish (notes/bsdf.md §1.3), with ρ' = s ρ scaled just enough that
+    /// ρ' ≤ 1 − k_f in every channel (notes/bsdf.md §2.3).
     diffuse_eff: Vec3,
     /// 1 − F̄_int = (1 − F̄_ext)/η²: fraction of Lambertian light from the substrate that leaves.
     escape: f32,
@@ -89,6 +90,20 @@ fn check_range(
     }
 }
 
+/// The diffuse albedo scaled uniformly, s = min(1, min_c (1 − k_f,c)/ρ_c), so that diffuse plus
+/// fibre albedo stays ≤ 1 per channel (notes/bsdf.md §2.3). A uniform scale keeps the wood's hue;
+/// clamping each channel to 1 − k_f would shift it (a bright fibre colour turned maple teal).
+fn bounded_diffuse(rho: Vec3, kf: Vec3) -> Vec3 {
+    let room = Vec3::ONE - kf;
+    let mut s = 1.0f32;
+    for c in 0..3 {
+        if rho[c] > room[c] {
+            s = s.min(room[c] / rho[c]);
+        }
+    }
+    rho * s
+}
+
 /// Which lobe `sample` picked.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Lobe {
@@ -132,7 +147,7 @@ impl WoodBsdf {
         let f_ext = fresnel_diffuse_reflectance(eta);
         let escape = (1.0 - f_ext) / (eta * eta);
         let f_int = 1.0 - escape;
-        let rho = params.diffuse.min(Vec3::ONE - params.fiber_color);
+        let rho = bounded_diffuse(params.diffuse, params.fiber_color);
         let diffuse_eff = rho / (Vec3::ONE - rho * f_int);
         Ok(WoodBsdf {
             params,
@@ -600,5 +615,23 @@ mod tests {
                 assert!(a <= 1.0 + 0.01, "{fiber_dir} {wo}: {a}");
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod bounded_diffuse_tests {
+    use super::bounded_diffuse;
+    use glam::Vec3;
+
+    #[test]
+    fn keeps_hue_and_bounds_each_channel() {
+        let rho = Vec3::new(0.8, 0.6, 0.35);
+        let kf = Vec3::new(0.6, 0.5, 0.4);
+        let b = bounded_diffuse(rho, kf);
+        assert!((b + kf).max_element() <= 1.0 + 1e-6);
+        // Same hue: every channel scaled by the same factor (0.4 / 0.8 = 0.5 from red).
+        assert!((b / rho - Vec3::splat(0.5)).abs().max_element() < 1e-6);
+        // Colours that already fit are unchanged.
+        assert_eq!(bounded_diffuse(Vec3::splat(0.3), kf), Vec3::splat(0.3));
     }
 }
