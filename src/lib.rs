@@ -5,6 +5,7 @@
 //! path tracer. Module layout and dependency direction: `../shared/DESIGN.md`
 //! (arrows point down the list below; only `cli` may use everything).
 
+pub mod bake;
 pub mod bsdf;
 pub mod cli;
 pub mod field;

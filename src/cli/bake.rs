@@ -1,6 +1,6 @@
 //! `xylem bake`: texture maps of a preset over a board's face, for other tools.
 
-use crate::sweep::bake::{bake, write_maps, BakeCut, BoardCut};
+use crate::bake::{bake, write_maps, BakeCut, BoardCut};
 use anyhow::Context;
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -8,10 +8,8 @@
 //!   sheet ([`contact`]), animated PNG, CSV and the HTML [`viewer`];
 //! - [`plot`]: small line plots for the validation report and the trade-off curve;
 //! - [`tradeoff`]: the speed/accuracy measurements behind `--quality`;
-//! - [`bake`]: texture maps of a preset for other tools;
 //! - [`highlight`]: where the fibre highlight of a flat finished board peaks along the arc.
 
-pub mod bake;
 pub mod cache;
 pub mod contact;
 pub mod highlight;

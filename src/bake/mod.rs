@@ -1,8 +1,8 @@
 //! Baking a wood preset into texture maps for other tools (`xylem bake`): base colour, fibre
 //! direction as a glTF `KHR_materials_anisotropy` map, highlight width, ray mask and a normal map
 //! from the pore bump, over the top face of a board cut from the tree. The trade-off measurement
-//! (`xylem tradeoff`) also uses these maps as the "baked texture" alternative to the procedural
-//! volume, which is why they live beside the sweep code.
+//! (`xylem tradeoff`) may use these maps as the "baked texture" alternative to the procedural
+//! volume. Uses `wood` and `render::image_io`; nothing below it uses it.
 //!
 //! Conventions (as glTF 2.0 and KHR_materials_anisotropy use them): texel (0, 0) is the top-left
 //! corner; tangent-space x points to the image's right (+u, along the board's length), y to the
