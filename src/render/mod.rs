@@ -86,13 +86,12 @@ pub fn render(
     render_with_lights(scene, &scene.lights, settings, run)
 }
 
-/// Renders the scene lit by `lights` instead of its own.
-pub fn render_with_lights(
+/// What every tiled render starts with: the image size checked, a pool of `run.threads`
+/// threads, and the origins of the TILE×TILE tiles covering the image (row-major).
+pub fn tiled_job(
     scene: &Scene,
-    lights: &[Light],
-    settings: &RenderSettings,
     run: &RunOptions,
-) -> Result<RenderOutput, RenderError> {
+) -> Result<(rayon::ThreadPool, Vec<UVec2>), RenderError> {
     let (w, h) = (scene.camera.width, scene.camera.height);
     if w == 0 || h == 0 {
         return Err(RenderError::EmptyImage {
@@ -110,6 +109,18 @@ pub fn render_with_lights(
     let tiles: Vec<UVec2> = (0..h.div_ceil(TILE))
         .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| UVec2::new(tx, ty) * TILE))
         .collect();
+    Ok((pool, tiles))
+}
+
+/// Renders the scene lit by `lights` instead of its own.
+pub fn render_with_lights(
+    scene: &Scene,
+    lights: &[Light],
+    settings: &RenderSettings,
+    run: &RunOptions,
+) -> Result<RenderOutput, RenderError> {
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let (pool, tiles) = tiled_job(scene, run)?;
     let bar = if run.progress {
         let b = ProgressBar::new(tiles.len() as u64);
         b.set_style(

@@ -236,25 +236,10 @@ pub fn render_sweep(
     run: &RunOptions,
 ) -> Result<SweepRender, RenderError> {
     let (w, h) = (scene.camera.width, scene.camera.height);
-    if w == 0 || h == 0 {
-        return Err(RenderError::EmptyImage {
-            width: w,
-            height: h,
-        });
-    }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(run.threads)
-        .build()
-        .map_err(|e| RenderError::Threads {
-            threads: run.threads,
-            message: e.to_string(),
-        })?;
+    let (pool, tiles) = crate::render::tiled_job(scene, run)?;
     let lights: Vec<Vec<Light>> = frames
         .clone()
         .map(|f| path.frame_lights(&scene.lights, moving, f))
-        .collect();
-    let tiles: Vec<UVec2> = (0..h.div_ceil(TILE))
-        .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| UVec2::new(tx, ty) * TILE))
         .collect();
     let bar = progress_bar(run.progress, tiles.len() as u64, lights.len());
     let start = Instant::now();
