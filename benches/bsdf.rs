@@ -3,47 +3,11 @@
 //! Run: cargo bench --bench bsdf -- --warm-up-time 1 --measurement-time 3
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use glam::Vec3;
-use xylem::bsdf::{Bsdf, WoodBsdf, WoodBsdfParams};
-use xylem::math::{cosine_hemisphere, Pcg32};
-
-fn configs() -> [(&'static str, WoodBsdfParams); 3] {
-    let base = WoodBsdfParams::default();
-    [
-        ("smooth", base),
-        (
-            "rough",
-            WoodBsdfParams {
-                roughness: 0.3,
-                ..base
-            },
-        ),
-        (
-            "ray_blend",
-            WoodBsdfParams {
-                ray_mask: 0.5,
-                fiber_dir: Vec3::new(1.0, 0.0, -0.3).normalize(),
-                ray_dir: Vec3::new(0.0, 0.8, -0.6),
-                ..base
-            },
-        ),
-    ]
-}
+use xylem::bsdf::{workload, Bsdf, WoodBsdf};
 
 fn bench(c: &mut Criterion) {
-    let mut rng = Pcg32::new(1, 0);
-    let dirs: Vec<(Vec3, Vec3)> = (0..1024)
-        .map(|_| {
-            (
-                cosine_hemisphere(rng.next_vec2()),
-                cosine_hemisphere(rng.next_vec2()),
-            )
-        })
-        .collect();
-    let us: Vec<(f32, glam::Vec2)> = (0..1024)
-        .map(|_| (rng.next_f32(), rng.next_vec2()))
-        .collect();
-    for (name, p) in configs() {
+    let (dirs, us) = workload::inputs();
+    for (name, p) in workload::cases() {
         let b = WoodBsdf::new(p).unwrap();
         let mut i = 0usize;
         c.bench_function(&format!("wood_{name}_new"), |bn| {

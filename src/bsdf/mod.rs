@@ -7,6 +7,7 @@ mod ggx;
 mod lambertian;
 mod specular;
 mod wood;
+pub mod workload;
 
 pub use fiber::{erf_inv, gaussian, FiberAxis, FiberNormalization};
 pub use fresnel::{

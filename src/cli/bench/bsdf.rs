@@ -1,9 +1,7 @@
 //! `xylem bench bsdf`: nanoseconds per call of WoodBsdf construction, eval, pdf and sample on one
 //! thread (the workload of benches/bsdf.rs, timed with a plain loop: median of 7 runs).
 
-use crate::bsdf::{Bsdf, WoodBsdf, WoodBsdfParams};
-use crate::math::{cosine_hemisphere, Pcg32};
-use glam::{Vec2, Vec3};
+use crate::bsdf::{workload, Bsdf, WoodBsdf};
 use std::hint::black_box;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -33,38 +31,8 @@ fn time(calls: u32, mut f: impl FnMut(usize) -> f32) -> f64 {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let mut rng = Pcg32::new(1, 0);
-    let dirs: Vec<(Vec3, Vec3)> = (0..1024)
-        .map(|_| {
-            (
-                cosine_hemisphere(rng.next_vec2()),
-                cosine_hemisphere(rng.next_vec2()),
-            )
-        })
-        .collect();
-    let us: Vec<(f32, Vec2)> = (0..1024)
-        .map(|_| (rng.next_f32(), rng.next_vec2()))
-        .collect();
-    let base = WoodBsdfParams::default();
-    let configs = [
-        ("smooth", base),
-        (
-            "rough",
-            WoodBsdfParams {
-                roughness: 0.3,
-                ..base
-            },
-        ),
-        (
-            "ray_blend",
-            WoodBsdfParams {
-                ray_mask: 0.5,
-                fiber_dir: Vec3::new(1.0, 0.0, -0.3).normalize(),
-                ray_dir: Vec3::new(0.0, 0.8, -0.6),
-                ..base
-            },
-        ),
-    ];
+    let (dirs, us) = workload::inputs();
+    let configs = workload::cases();
     println!(
         "{:<10} {:>9} {:>9} {:>9} {:>9}   (ns per call, one thread)",
         "case", "new", "eval", "pdf", "sample"
