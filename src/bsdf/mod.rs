@@ -16,7 +16,7 @@ pub use fresnel::{
 pub use ggx::Ggx;
 pub use lambertian::Lambertian;
 pub use specular::{Glass, Mirror};
-pub use wood::WoodBsdf;
+pub use wood::{FinishModel, WoodBsdf};
 
 use glam::{Vec2, Vec3};
 

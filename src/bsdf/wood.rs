@@ -33,6 +33,20 @@ pub struct WoodBsdf {
     /// cos of the critical angle inside the finish: interior directions with z ≤ this cannot leave.
     z_crit: f32,
     ggx: Option<Ggx>,
+    finish: FinishModel,
+}
+
+/// How the diffuse light reflected back down by the finish is counted (notes/bsdf.md §1.3): the
+/// closed-form geometric series ρ/(1 − ρ F̄_int) of every internal bounce, or only the first pass
+/// ρ (light the finish reflects back is dropped). Both cost the same per evaluation; the knob
+/// exists so `xylem tradeoff` can measure what the series changes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FinishModel {
+    /// Σₖ (ρ F̄_int)ᵏ = 1/(1 − ρ F̄_int): all internal reflections (the default).
+    #[default]
+    ClosedForm,
+    /// k = 0 only: one pass through the finish, no internal reflections.
+    SingleBounce,
 }
 
 fn check_unit_interval(field: &'static str, v: f32) -> Result<(), BsdfError> {
@@ -150,6 +164,7 @@ impl WoodBsdf {
         let rho = bounded_diffuse(params.diffuse, params.fiber_color);
         let diffuse_eff = rho / (Vec3::ONE - rho * f_int);
         Ok(WoodBsdf {
+            finish: FinishModel::ClosedForm,
             params,
             norm: FiberNormalization::EnergyBounded,
             fiber: FiberAxis::new(fiber_dir),
@@ -168,6 +183,25 @@ impl WoodBsdf {
     pub fn with_normalization(mut self, norm: FiberNormalization) -> Self {
         self.norm = norm;
         self
+    }
+
+    /// The same BSDF with the internal reflections of the diffuse part counted by `finish`.
+    pub fn with_finish(mut self, finish: FinishModel) -> Self {
+        if finish == self.finish {
+            return self;
+        }
+        let rho = bounded_diffuse(self.params.diffuse, self.params.fiber_color);
+        self.diffuse_eff = match finish {
+            // ρ'' = ρ'/(1 − ρ' F̄_int), F̄_int = 1 − escape (notes/bsdf.md eq. 1.3).
+            FinishModel::ClosedForm => rho / (Vec3::ONE - rho * (1.0 - self.escape)),
+            FinishModel::SingleBounce => rho,
+        };
+        self.finish = finish;
+        self
+    }
+
+    pub fn finish(&self) -> FinishModel {
+        self.finish
     }
 
     pub fn params(&self) -> &WoodBsdfParams {

@@ -31,7 +31,8 @@ pub struct Displacement {
 pub struct Distortion {
     /// f(p), where every volume is looked up.
     pub point: Vec3,
-    /// J ≈ I + Σ aᵢ ⊗ ∇mᵢ / (1 + ‖∇mᵢ‖) (eq. 22, the m J_a term of eq. 20 omitted as in the paper).
+    /// J ≈ I + Σ aᵢ ⊗ ∇mᵢ / (1 + ‖∇mᵢ‖) (eq. 22, the m J_a term of eq. 20 omitted as in the paper),
+    /// or the exact J where a volume uses [`JacobianModel::Exact`].
     pub jacobian: Mat3,
 }
 
@@ -92,6 +93,18 @@ impl Distortion {
     pub fn gradient(&self, g: Vec3) -> Vec3 {
         self.jacobian.transpose() * g
     }
+}
+
+/// Which Jacobian of the distortion transports fibre directions and gradients (notes/wood.md §5).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum JacobianModel {
+    /// Liu et al. 2016 eq. 22: J ≈ I + Σ aᵢ ⊗ ∇mᵢ / (1 + ‖∇mᵢ‖), the mᵢ ∂aᵢ/∂p terms of eq. 20
+    /// dropped and each gradient compressed so one term can never fold J over (the default).
+    #[default]
+    Simplified,
+    /// The full derivative of f(p) = p + Σ mᵢ aᵢ(p) ([`exact_jacobian`]: eq. 19–20 with the
+    /// frame's rotation), uncompressed; J⁻¹ falls back to I where it is singular.
+    Exact,
 }
 
 /// The outer product a ⊗ b as a matrix: (a ⊗ b)ᵢⱼ = aᵢ bⱼ.

@@ -7,5 +7,5 @@ mod distortion;
 mod interlock;
 
 pub use cylindrical::{cylinder_frame, Cylindrical, PITH_EPSILON};
-pub use distortion::{exact_jacobian, Displacement, Distortion, Magnitude};
+pub use distortion::{exact_jacobian, Displacement, Distortion, JacobianModel, Magnitude};
 pub use interlock::rotate_about_radial;

@@ -9,7 +9,9 @@ mod placement;
 
 pub use placement::{Cutting, Placement};
 
-use crate::bsdf::{Bsdf, BsdfSample, Glass, Lambertian, Mirror, WoodBsdf, WoodBsdfParams};
+use crate::bsdf::{
+    Bsdf, BsdfSample, FinishModel, Glass, Lambertian, Mirror, WoodBsdf, WoodBsdfParams,
+};
 use crate::math::Frame;
 use crate::wood::{Needs, WoodVolume};
 use glam::{Mat3, Vec2, Vec3};
@@ -159,6 +161,16 @@ pub struct WoodMaterial {
     pub roughness: f32,
     /// Scale of the pore-mask bump (0 = no bump mapping, and the volume skips the bump work).
     pub bump: f32,
+    /// Speed/accuracy switches (`xylem tradeoff`); the default is the full model.
+    pub switches: ShadingSwitches,
+}
+
+/// Speed/accuracy switches of a wood material, measured by `xylem tradeoff`
+/// (validation/TRADEOFF.md). `Default` is the full model.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ShadingSwitches {
+    /// Internal reflections under the finish: closed-form series or one pass.
+    pub finish: FinishModel,
 }
 
 impl Material {
@@ -177,7 +189,7 @@ impl Material {
                     ray_dir: to_local(params.ray_dir),
                     ..*params
                 };
-                wood_shading(local, frame, fiber_world, 0.0)
+                wood_shading(local, frame, fiber_world, 0.0, FinishModel::ClosedForm)
             }
             Material::Wood(w) => w.shade(hit),
             Material::Mirror { reflectance } => Shading {
@@ -239,10 +251,11 @@ fn wood_shading(
     frame: Frame,
     fiber_world: Vec3,
     growth_time: f32,
+    finish: FinishModel,
 ) -> Shading {
     match WoodBsdf::new(local) {
         Ok(b) => Shading {
-            bsdf: SurfaceBsdf::Wood(b),
+            bsdf: SurfaceBsdf::Wood(b.with_finish(finish)),
             frame,
             aov: SurfaceAov {
                 albedo: local.diffuse,
@@ -299,6 +312,12 @@ impl WoodMaterial {
             eta: self.eta,
             roughness: self.roughness,
         };
-        wood_shading(local, frame, fiber_world, texel.growth_time)
+        wood_shading(
+            local,
+            frame,
+            fiber_world,
+            texel.growth_time,
+            self.switches.finish,
+        )
     }
 }

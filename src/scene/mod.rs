@@ -490,6 +490,7 @@ impl Builder<'_> {
                         eta: self.range(&f("eta"), *eta, 1.0, 4.0)?,
                         roughness: self.range(&f("roughness"), *roughness, 0.0, 1.0)?,
                         bump: self.range(&f("bump"), *bump, 0.0, 100.0)?,
+                        switches: Default::default(),
                     }))
                 }
                 MaterialTable::Texture { texture, params } => {

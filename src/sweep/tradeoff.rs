@@ -3,6 +3,8 @@
 //! against a high-quality reference (relative MSE and SSIM). The named `--quality` presets are
 //! chosen from these measurements (validation/TRADEOFF.md).
 
+use crate::bsdf::FinishModel;
+use crate::field::JacobianModel;
 use crate::material::Material;
 use crate::math::luminance;
 use crate::render::image_io::linear_to_srgb;
@@ -22,15 +24,37 @@ pub struct Knobs {
     pub density_scale: f32,
     /// Keep pores and rays (false: drop them, "model only what the scene needs").
     pub pores_and_rays: bool,
+    /// Distortion Jacobian: the paper's simplified eq. 22 or the exact derivative.
+    #[serde(serialize_with = "debug_name")]
+    pub jacobian: JacobianModel,
+    /// Internal reflections under the finish: closed-form series or a single pass.
+    #[serde(serialize_with = "debug_name")]
+    pub finish: FinishModel,
+}
+
+fn debug_name<T: std::fmt::Debug, S: serde::Serializer>(v: &T, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(&format!("{v:?}"))
 }
 
 impl Knobs {
+    /// Today's default model (what a scene renders with when no knob is set) at `spp`.
     pub const fn full(spp: u32) -> Knobs {
         Knobs {
             spp,
             max_bands: None,
             density_scale: 1.0,
             pores_and_rays: true,
+            jacobian: JacobianModel::Simplified,
+            finish: FinishModel::ClosedForm,
+        }
+    }
+
+    /// The most accurate setting of every knob at `spp`: the reference the others are measured
+    /// against (the exact Jacobian instead of the simplified default).
+    pub const fn reference(spp: u32) -> Knobs {
+        Knobs {
+            jacobian: JacobianModel::Exact,
+            ..Knobs::full(spp)
         }
     }
 }
@@ -49,10 +73,8 @@ impl Quality {
     pub fn knobs(self) -> Knobs {
         match self {
             Quality::Draft => Knobs {
-                spp: 4,
                 max_bands: Some(1),
-                density_scale: 1.0,
-                pores_and_rays: true,
+                ..Knobs::full(4)
             },
             Quality::Default => Knobs::full(16),
             Quality::Final => Knobs::full(64),
@@ -99,7 +121,9 @@ pub fn apply(loaded: &mut LoadedScene, k: &Knobs) -> Result<(), crate::wood::Woo
     for m in &mut loaded.scene.materials {
         if let Material::Wood(w) = m {
             let params = apply_to_params(w.volume.params(), k);
-            w.volume = Arc::new(WoodVolume::new(params, w.volume.seed())?);
+            w.volume =
+                Arc::new(WoodVolume::new(params, w.volume.seed())?.with_jacobian(k.jacobian));
+            w.switches.finish = k.finish;
         }
     }
     Ok(())
@@ -177,6 +201,10 @@ pub struct Measurement {
     pub seconds: f64,
     pub relative_mse: f64,
     pub ssim: f64,
+    /// Relative MSE against the reference model rendered at the same spp with the same seeds:
+    /// the error the model knobs add, without the Monte Carlo noise both renders share.
+    pub model_mse: f64,
+    pub model_ssim: f64,
 }
 
 /// The settings measured, knob by knob (spp with the full model; each model knob at 16 spp).
@@ -214,6 +242,24 @@ pub fn settings() -> Vec<(String, String, Knobs)> {
         "dropped, 16 spp".into(),
         Knobs {
             pores_and_rays: false,
+            ..Knobs::full(16)
+        },
+    ));
+    v.push((
+        "distortion Jacobian".into(),
+        "simplified (eq. 22), 16 spp".into(),
+        Knobs::full(16),
+    ));
+    v.push((
+        "distortion Jacobian".into(),
+        "exact, 16 spp".into(),
+        Knobs::reference(16),
+    ));
+    v.push((
+        "finish".into(),
+        "single bounce, 16 spp".into(),
+        Knobs {
+            finish: FinishModel::SingleBounce,
             ..Knobs::full(16)
         },
     ));

@@ -8,7 +8,10 @@ use super::growth::{SmoothRectangleWave, SmoothTriangleWave};
 use super::knots::{KnotSample, Knots};
 use super::params::WoodParams;
 use super::{Needs, WoodTexel};
-use crate::field::{cylinder_frame, rotate_about_radial, Cylindrical, Displacement, Distortion};
+use crate::field::{
+    cylinder_frame, exact_jacobian, rotate_about_radial, Cylindrical, Displacement, Distortion,
+    JacobianModel,
+};
 use crate::math::Frame;
 use glam::Vec3;
 
@@ -30,6 +33,7 @@ pub struct WoodVolume {
     pores: Option<Pores>,
     rays: Option<Rays>,
     knots: Option<Knots>,
+    jacobian: JacobianModel,
 }
 
 /// Salts of the independent noise fields, so each feature has its own seed.
@@ -128,7 +132,20 @@ impl WoodVolume {
             knots,
             params,
             seed,
+            jacobian: JacobianModel::Simplified,
         })
+    }
+
+    /// The same volume with fibre directions and gradients transported by `jacobian`
+    /// (a speed/accuracy switch measured by `xylem tradeoff`).
+    pub fn with_jacobian(mut self, jacobian: JacobianModel) -> Self {
+        self.jacobian = jacobian;
+        self
+    }
+
+    /// The Jacobian model this volume transports with.
+    pub fn jacobian_model(&self) -> JacobianModel {
+        self.jacobian
     }
 
     /// The parameters this volume was built from.
@@ -180,11 +197,22 @@ impl WoodVolume {
         let mut d = Distortion::identity(p);
         if self.distortion.iter().any(Option::is_some) {
             let frame = cylinder_frame(p);
-            for (noise, dir) in self.distortion.iter().zip([frame.s, frame.t, frame.n]) {
+            let exact = JACOBIAN && self.jacobian == JacobianModel::Exact;
+            let mut terms = [(0.0, Vec3::ZERO); 3];
+            for ((noise, dir), term) in self
+                .distortion
+                .iter()
+                .zip([frame.s, frame.t, frame.n])
+                .zip(&mut terms)
+            {
                 if let Some(noise) = noise {
                     let (m, grad_m) = noise.eval::<JACOBIAN>(p, &frame);
                     d.add(Displacement { dir, m, grad_m });
+                    *term = (m, grad_m);
                 }
+            }
+            if exact {
+                d.jacobian = exact_jacobian(p, &frame, terms);
             }
         }
         d

@@ -1,0 +1,173 @@
+//! The speed/accuracy switches `xylem tradeoff` measures (validation/TRADEOFF.md): each one must
+//! be a no-op where its approximation is exact and must change the result where it is not.
+
+use glam::{Mat3, Vec3};
+use xylem::bsdf::{fresnel_dielectric, Bsdf, FinishModel, WoodBsdf, WoodBsdfParams};
+use xylem::field::JacobianModel;
+use xylem::wood::{preset, sample_points, Needs, WoodParams, WoodVolume};
+
+fn dir(theta_deg: f32, phi_deg: f32) -> Vec3 {
+    let (t, p) = (theta_deg.to_radians(), phi_deg.to_radians());
+    Vec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
+}
+
+/// F̄_int = 1 − (1 − F̄_ext)/η² with F̄_ext = 2∫₀¹ F(μ) μ dμ by a 20 000-point midpoint rule
+/// (independent of the BSDF's Gauss–Legendre quadrature).
+fn internal_reflectance(eta: f32) -> f64 {
+    let n = 20_000;
+    let mut ext = 0.0f64;
+    for i in 0..n {
+        let mu = (i as f64 + 0.5) / n as f64;
+        ext += 2.0 * fresnel_dielectric(mu as f32, eta) as f64 * mu / n as f64;
+    }
+    1.0 - (1.0 - ext) / (eta as f64 * eta as f64)
+}
+
+/// Directional albedo ∫ f cos θi dωi (no delta lobe) by a midpoint rule in (cos θ, φ).
+fn albedo(b: &WoodBsdf, wo: Vec3) -> Vec3 {
+    let (nt, np) = (200, 200);
+    let mut a = Vec3::ZERO;
+    for i in 0..nt {
+        let mu = (i as f32 + 0.5) / nt as f32;
+        let s = (1.0 - mu * mu).sqrt();
+        for j in 0..np {
+            let phi = std::f32::consts::TAU * (j as f32 + 0.5) / np as f32;
+            let wi = Vec3::new(s * phi.cos(), s * phi.sin(), mu);
+            a += b.eval(wo, wi) * mu;
+        }
+    }
+    a * (std::f32::consts::TAU / (nt * np) as f32)
+}
+
+#[test]
+fn single_bounce_finish_drops_exactly_the_internal_reflection_series() {
+    // Diffuse only (k_f = 0): closed form ρ/(1 − ρF̄_int) against ρ, so at every pair of directions
+    // single / closed = 1 − ρ F̄_int per channel (notes/bsdf.md §1.3).
+    let rho = Vec3::new(0.45, 0.22, 0.10);
+    for eta in [1.3f32, 1.5, 2.0] {
+        let p = WoodBsdfParams {
+            diffuse: rho,
+            fiber_color: Vec3::ZERO,
+            eta,
+            ..WoodBsdfParams::default()
+        };
+        let closed = WoodBsdf::new(p).unwrap();
+        let single = closed.with_finish(FinishModel::SingleBounce);
+        let f_int = internal_reflectance(eta);
+        for (wo, wi) in [(dir(10.0, 0.0), dir(40.0, 120.0)), (dir(70.0, 30.0), dir(5.0, 200.0))] {
+            let (c, s) = (closed.eval(wo, wi), single.eval(wo, wi));
+            for ch in 0..3 {
+                let want = 1.0 - rho[ch] as f64 * f_int;
+                let got = (s[ch] / c[ch]) as f64;
+                assert!((got - want).abs() < 1e-4, "η {eta} ch {ch}: {got} vs {want}");
+            }
+        }
+    }
+}
+
+#[test]
+fn single_bounce_albedo_is_at_most_closed_form_and_equal_without_internal_reflection() {
+    let configs = [
+        WoodBsdfParams::default(),
+        WoodBsdfParams {
+            diffuse: Vec3::new(0.8, 0.7, 0.5),
+            fiber_color: Vec3::new(0.2, 0.2, 0.2),
+            fiber_dir: Vec3::new(1.0, 0.0, -0.4).normalize(),
+            ray_mask: 0.3,
+            eta: 1.8,
+            ..WoodBsdfParams::default()
+        },
+    ];
+    for p in configs {
+        let closed = WoodBsdf::new(p).unwrap();
+        let single = closed.with_finish(FinishModel::SingleBounce);
+        for wo in [dir(0.0, 0.0), dir(45.0, 30.0), dir(80.0, 180.0)] {
+            let (ac, as_) = (albedo(&closed, wo), albedo(&single, wo));
+            assert!(as_.cmple(ac + Vec3::splat(1e-6)).all(), "{as_} > {ac}");
+            // A finish with η > 1 reflects some diffuse light back: measurably less.
+            assert!(ac.x - as_.x > 1e-3, "{wo}: {ac} vs {as_}");
+        }
+        // η = 1: no finish, F̄_int = 0, the two models are the same BSDF.
+        let bare = WoodBsdf::new(WoodBsdfParams { eta: 1.0, ..p }).unwrap();
+        let bare1 = bare.with_finish(FinishModel::SingleBounce);
+        for (wo, wi) in [(dir(10.0, 0.0), dir(40.0, 120.0)), (dir(70.0, 30.0), dir(5.0, 200.0))] {
+            let (a, b) = (bare.eval(wo, wi), bare1.eval(wo, wi));
+            assert!((a - b).abs().max_element() <= 1e-6 * a.max_element(), "{a} {b}");
+        }
+    }
+}
+
+/// `params` with every distortion magnitude multiplied by `k`.
+fn scaled_distortion(mut p: WoodParams, k: f32) -> WoodParams {
+    for n in [
+        &mut p.distortion.radial,
+        &mut p.distortion.tangential,
+        &mut p.distortion.longitudinal,
+    ]
+    .into_iter()
+    .flatten()
+    {
+        n.magnitude *= k;
+    }
+    p
+}
+
+fn volumes(p: WoodParams) -> (WoodVolume, WoodVolume) {
+    let simple = WoodVolume::new(p, 3).unwrap();
+    let exact = simple.clone().with_jacobian(JacobianModel::Exact);
+    assert_eq!(simple.jacobian_model(), JacobianModel::Simplified);
+    (simple, exact)
+}
+
+/// Mean angle (radians) between the fibre directions of two volumes at `points`.
+fn mean_fiber_angle(a: &WoodVolume, b: &WoodVolume, points: &[Vec3]) -> f64 {
+    let mut s = 0.0f64;
+    for p in points {
+        let (fa, fb) = (a.eval(*p, Needs::ALL).fiber_dir, b.eval(*p, Needs::ALL).fiber_dir);
+        s += fa.dot(fb).clamp(-1.0, 1.0).acos() as f64;
+    }
+    s / points.len() as f64
+}
+
+#[test]
+fn exact_and_simplified_jacobian_agree_for_gentle_distortion_and_differ_for_steep() {
+    // Curly maple: tangential distortion with steep, narrow kernels (the curl).
+    let base = preset("curly_maple").unwrap();
+    let points = sample_points(3000, 11);
+    let (s0, e0) = volumes(scaled_distortion(base.clone(), 1e-3));
+    let gentle = mean_fiber_angle(&s0, &e0, &points);
+    let (s1, e1) = volumes(scaled_distortion(base, 1.0));
+    let steep = mean_fiber_angle(&s1, &e1, &points);
+    // ‖∇m‖ → 0: both are I + a ⊗ ∇m to first order; the m ∂a/∂p terms are O(m / r).
+    assert!(gentle < 1e-4, "gentle distortion: mean angle {gentle}");
+    // Steep distortion: the compression 1/(1 + ‖∇m‖) and the m ∂a/∂p terms turn fibres visibly.
+    assert!(steep > 1e-2, "steep distortion: mean angle {steep}");
+    assert!(steep > 100.0 * gentle);
+}
+
+#[test]
+fn exact_jacobian_is_closer_to_finite_differences_of_the_lookup_point() {
+    // J_fd by central differences of the volume's own f(p) (h = 1e-3 of the smallest kernel
+    // axis). Both models share the oriented-kernel gradient of Liu 2016 eq. 14, so neither is
+    // exact; the exact model must still be the closer one on average.
+    let base = preset("curly_maple").unwrap();
+    let (simple, exact) = volumes(base);
+    let h = 2e-3f32;
+    let (mut err_s, mut err_e) = (0.0f64, 0.0f64);
+    for p in sample_points(500, 5) {
+        let mut cols = [Vec3::ZERO; 3];
+        for (i, e) in [Vec3::X, Vec3::Y, Vec3::Z].into_iter().enumerate() {
+            let f = |q: Vec3| simple.distortion(q).point.as_dvec3();
+            cols[i] = ((f(p + e * h) - f(p - e * h)) / (2.0 * h as f64)).as_vec3();
+        }
+        let fd = Mat3::from_cols(cols[0], cols[1], cols[2]);
+        let frob = |m: Mat3| {
+            let d = m - fd;
+            (d.x_axis.length_squared() + d.y_axis.length_squared() + d.z_axis.length_squared())
+                .sqrt() as f64
+        };
+        err_s += frob(simple.distortion(p).jacobian);
+        err_e += frob(exact.distortion(p).jacobian);
+    }
+    assert!(err_e < 0.8 * err_s, "exact {err_e} vs simplified {err_s}");
+}
