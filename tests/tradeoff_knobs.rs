@@ -54,12 +54,18 @@ fn single_bounce_finish_drops_exactly_the_internal_reflection_series() {
         let closed = WoodBsdf::new(p).unwrap();
         let single = closed.with_finish(FinishModel::SingleBounce);
         let f_int = internal_reflectance(eta);
-        for (wo, wi) in [(dir(10.0, 0.0), dir(40.0, 120.0)), (dir(70.0, 30.0), dir(5.0, 200.0))] {
+        for (wo, wi) in [
+            (dir(10.0, 0.0), dir(40.0, 120.0)),
+            (dir(70.0, 30.0), dir(5.0, 200.0)),
+        ] {
             let (c, s) = (closed.eval(wo, wi), single.eval(wo, wi));
             for ch in 0..3 {
                 let want = 1.0 - rho[ch] as f64 * f_int;
                 let got = (s[ch] / c[ch]) as f64;
-                assert!((got - want).abs() < 1e-4, "η {eta} ch {ch}: {got} vs {want}");
+                assert!(
+                    (got - want).abs() < 1e-4,
+                    "η {eta} ch {ch}: {got} vs {want}"
+                );
             }
         }
     }
@@ -90,9 +96,15 @@ fn single_bounce_albedo_is_at_most_closed_form_and_equal_without_internal_reflec
         // η = 1: no finish, F̄_int = 0, the two models are the same BSDF.
         let bare = WoodBsdf::new(WoodBsdfParams { eta: 1.0, ..p }).unwrap();
         let bare1 = bare.with_finish(FinishModel::SingleBounce);
-        for (wo, wi) in [(dir(10.0, 0.0), dir(40.0, 120.0)), (dir(70.0, 30.0), dir(5.0, 200.0))] {
+        for (wo, wi) in [
+            (dir(10.0, 0.0), dir(40.0, 120.0)),
+            (dir(70.0, 30.0), dir(5.0, 200.0)),
+        ] {
             let (a, b) = (bare.eval(wo, wi), bare1.eval(wo, wi));
-            assert!((a - b).abs().max_element() <= 1e-6 * a.max_element(), "{a} {b}");
+            assert!(
+                (a - b).abs().max_element() <= 1e-6 * a.max_element(),
+                "{a} {b}"
+            );
         }
     }
 }
@@ -123,7 +135,10 @@ fn volumes(p: WoodParams) -> (WoodVolume, WoodVolume) {
 fn mean_fiber_angle(a: &WoodVolume, b: &WoodVolume, points: &[Vec3]) -> f64 {
     let mut s = 0.0f64;
     for p in points {
-        let (fa, fb) = (a.eval(*p, Needs::ALL).fiber_dir, b.eval(*p, Needs::ALL).fiber_dir);
+        let (fa, fb) = (
+            a.eval(*p, Needs::ALL).fiber_dir,
+            b.eval(*p, Needs::ALL).fiber_dir,
+        );
         s += fa.dot(fb).clamp(-1.0, 1.0).acos() as f64;
     }
     s / points.len() as f64

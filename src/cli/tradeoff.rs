@@ -81,7 +81,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 .with_context(|| format!("reference model at {} spp", knobs.spp))?;
             same_spp.push((knobs.spp, r));
         }
-        let model_ref = &same_spp.iter().find(|(s, _)| *s == knobs.spp).expect("pushed").1;
+        let model_ref = &same_spp
+            .iter()
+            .find(|(s, _)| *s == knobs.spp)
+            .expect("pushed")
+            .1;
         rows.push(Measurement {
             knob,
             setting,
