@@ -2,12 +2,17 @@
 //! crate (Perlin, Fbm<Perlin>) and `fastnoise-lite` (Perlin, FBm) over the same random points, one
 //! thread, plus xylem's sparse convolution noise. Results: target/criterion/noise/<function>/<id>/.
 //! Table and machine: notes/noise.md.
+//!
+//! `gradient3/xylem` times the batch call `gradient3_many` over the 4096 points (the lane kernel
+//! on 16, 8 or 4 points at once, whichever of AVX-512 / AVX2 / SSE2 the CPU has, the same values
+//! as `gradient3`); `gradient3/xylem-scalar` times one `gradient3` call per point, like the peers'
+//! rows. `fbm5/xylem` is one `Fractal::eval` call per point (its octaves share the lanes).
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 use fastnoise_lite::{FastNoiseLite, FractalType, NoiseType};
 use noise::{Fbm, MultiFractal, NoiseFn, Perlin};
 use xylem::math::{Pcg32, Vec3};
-use xylem::noise::{gradient3, Fractal, SparseConvolution};
+use xylem::noise::{gradient3, gradient3_many, Fractal, SparseConvolution};
 
 const POINTS: usize = 4096;
 
@@ -42,7 +47,14 @@ fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("noise");
     g.throughput(Throughput::Elements(POINTS as u64));
 
+    let mut out = vec![0.0f32; POINTS];
     g.bench_function("gradient3/xylem", |b| {
+        b.iter(|| {
+            gradient3_many(black_box(&p), 7, &mut out);
+            out.iter().sum::<f32>()
+        })
+    });
+    g.bench_function("gradient3/xylem-scalar", |b| {
         b.iter(|| p.iter().map(|&x| gradient3(black_box(x), 7)).sum::<f32>())
     });
     let perlin = Perlin::new(7);

@@ -5,7 +5,12 @@
 //! follows I. Quilez, "Gradient noise derivatives" (2017). A 4-lane SSE2 kernel
 //! ([`gradient3_x4`]) evaluates four points at once — fBm uses it across octaves.
 
+#[cfg(target_arch = "x86_64")]
+use super::hash::KNUTH;
 use super::hash::{lattice, mix32, signed_f32, PRIME_X, PRIME_Y, PRIME_Z};
+#[cfg(target_arch = "x86_64")]
+use super::lanes::Lanes;
+use super::lanes::Simd;
 use glam::Vec3;
 
 /// Perlin 2002 quintic fade.
@@ -222,177 +227,145 @@ pub fn gradient1_grad(x: f32, seed: u32) -> (f32, f32) {
     (a + u * (b - a), g0 + u * (g1 - g0) + fade_d(t) * (b - a))
 }
 
-/// Four gradient-noise evaluations at once (points `x[i], y[i], z[i]`, scrambled seeds `s[i]`),
-/// bit-identical to four calls of the scalar kernel. SSE2 (baseline on x86-64): lanes are the
-/// points, so every instruction is vertical; g·d is formed from the hash bits by sign flips and
-/// masks (see [`GRADS`]). Elsewhere it falls back to the scalar kernel.
-#[allow(dead_code)]
-#[inline(always)]
-pub(crate) fn gradient3_x4(x: [f32; 4], y: [f32; 4], z: [f32; 4], s: [u32; 4]) -> [f32; 4] {
-    #[cfg(target_arch = "x86_64")]
-    {
-        // SAFETY: SSE2 is part of the x86-64 baseline; the intrinsics only touch registers.
-        unsafe {
-            use std::arch::x86_64::_mm_loadu_ps as load;
-            sse2::kernel(load(x.as_ptr()), load(y.as_ptr()), load(z.as_ptr()), s)
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        std::array::from_fn(|i| gradient3_xyz(x[i], y[i], z[i], s[i]))
-    }
+/// [`gradient3`] at every point of `points`, written to `out` (same length): the batch form for
+/// callers with many points (image slices, benchmarks). Runs the lane kernel on 16 (AVX-512),
+/// 8 (AVX2) or 4 (SSE2, the x86-64 baseline) points at once, whichever the CPU has (checked at
+/// run time, [`Simd::best`]); the last `len % lanes` points and non-x86 targets use the scalar
+/// kernel. Every path gives the values of [`gradient3`] (tested; a zero may differ in sign).
+///
+/// # Panics
+/// If `points.len() != out.len()`.
+pub fn gradient3_many(points: &[Vec3], seed: u32, out: &mut [f32]) {
+    gradient3_many_with(Simd::best(), points, seed, out)
 }
 
-/// [`gradient3_x4`] at the four points `p · f[i] + shift[·][i]` (the octaves of a fractal sum),
-/// formed in the same order as the scalar `p * f + shift`.
-#[inline(always)]
-pub(crate) fn gradient3_x4_affine(
-    p: Vec3,
-    f: [f32; 4],
-    shift: [[f32; 4]; 3],
-    s: [u32; 4],
-) -> [f32; 4] {
-    #[cfg(target_arch = "x86_64")]
-    {
-        // SAFETY: SSE2 is part of the x86-64 baseline; the intrinsics only touch registers.
-        unsafe {
-            use std::arch::x86_64::*;
-            let f = _mm_loadu_ps(f.as_ptr());
-            let axis = |c: f32, sh: &[f32; 4]| {
-                _mm_add_ps(_mm_mul_ps(_mm_set1_ps(c), f), _mm_loadu_ps(sh.as_ptr()))
-            };
-            sse2::kernel(
-                axis(p.x, &shift[0]),
-                axis(p.y, &shift[1]),
-                axis(p.z, &shift[2]),
-                s,
-            )
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        std::array::from_fn(|i| {
-            let q = p * f[i] + Vec3::new(shift[0][i], shift[1][i], shift[2][i]);
-            gradient3_xyz(q.x, q.y, q.z, s[i])
-        })
+/// [`gradient3_many`] on the instruction set `simd`, or the best one the CPU has if it lacks it
+/// (for comparing the paths; [`gradient3_many`] picks the best).
+pub fn gradient3_many_with(simd: Simd, points: &[Vec3], seed: u32, out: &mut [f32]) {
+    assert_eq!(
+        points.len(),
+        out.len(),
+        "gradient3_many: {} points but {} outputs",
+        points.len(),
+        out.len()
+    );
+    let s = mix32(seed);
+    let done = match simd.min(Simd::best()) {
+        Simd::Scalar => 0,
+        // SAFETY: each arm runs only where `Simd::best` detected its instruction set.
+        #[cfg(target_arch = "x86_64")]
+        Simd::Sse2 => unsafe { many_sse2(points, s, out) },
+        #[cfg(target_arch = "x86_64")]
+        Simd::Avx2 => unsafe { many_avx2(points, s, out) },
+        #[cfg(target_arch = "x86_64")]
+        Simd::Avx512 => unsafe { many_avx512(points, s, out) },
+        #[cfg(not(target_arch = "x86_64"))]
+        _ => 0,
+    };
+    for (p, o) in points[done..].iter().zip(&mut out[done..]) {
+        *o = gradient3_xyz(p.x, p.y, p.z, s);
     }
 }
 
 #[cfg(target_arch = "x86_64")]
-mod sse2 {
-    use super::super::hash::{KNUTH, PRIME_X, PRIME_Y, PRIME_Z};
-    use std::arch::x86_64::*;
+unsafe fn many_sse2(points: &[Vec3], s: u32, out: &mut [f32]) -> usize {
+    many::<std::arch::x86_64::__m128>(points, s, out)
+}
 
-    /// Low 32 bits of a lane-wise u32 product (SSE2 has only the 32×32→64 `pmuludq`).
-    #[inline(always)]
-    unsafe fn mul_lo(a: __m128i, k: __m128i) -> __m128i {
-        let even = _mm_mul_epu32(a, k);
-        let odd = _mm_mul_epu32(_mm_srli_epi64(a, 32), _mm_srli_epi64(k, 32));
-        _mm_unpacklo_epi32(
-            _mm_shuffle_epi32(even, 0b10_00_10_00),
-            _mm_shuffle_epi32(odd, 0b10_00_10_00),
-        )
-    }
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn many_avx2(points: &[Vec3], s: u32, out: &mut [f32]) -> usize {
+    many::<std::arch::x86_64::__m256>(points, s, out)
+}
 
-    /// The scalar `lattice` hash on four lanes: `(x ^ y ^ z ^ s)·K`, then `h ^ (h >> 15)`.
-    #[inline(always)]
-    unsafe fn hash(x: __m128i, y: __m128i, z: __m128i, s: __m128i) -> __m128i {
-        let h = mul_lo(
-            _mm_xor_si128(_mm_xor_si128(x, y), _mm_xor_si128(z, s)),
-            _mm_set1_epi32(KNUTH as i32),
-        );
-        _mm_xor_si128(h, _mm_srli_epi32(h, 15))
-    }
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn many_avx512(points: &[Vec3], s: u32, out: &mut [f32]) -> usize {
+    many::<std::arch::x86_64::__m512>(points, s, out)
+}
 
-    /// g·d for the gradient picked by the top 5 bits of `h` (layout of `GRADS`): sign flips by
-    /// xor into the float sign bit, the dropped axis masked to +0.
-    #[inline(always)]
-    unsafe fn gdot(h: __m128i, dx: __m128, dy: __m128, dz: __m128) -> __m128 {
-        let sign = _mm_set1_epi32(i32::MIN);
-        let sx = _mm_and_si128(h, sign);
-        let sy = _mm_and_si128(_mm_slli_epi32(h, 1), sign);
-        let sz = _mm_and_si128(_mm_slli_epi32(h, 2), sign);
-        let b = _mm_and_si128(_mm_srli_epi32(h, 27), _mm_set1_epi32(3));
-        let kx = _mm_cmpeq_epi32(b, _mm_setzero_si128());
-        let ky = _mm_cmpeq_epi32(b, _mm_set1_epi32(1));
-        let kz = _mm_cmpeq_epi32(b, _mm_set1_epi32(2));
-        let tx = _mm_andnot_si128(kx, _mm_xor_si128(_mm_castps_si128(dx), sx));
-        let ty = _mm_andnot_si128(ky, _mm_xor_si128(_mm_castps_si128(dy), sy));
-        let tz = _mm_andnot_si128(kz, _mm_xor_si128(_mm_castps_si128(dz), sz));
-        _mm_add_ps(
-            _mm_add_ps(_mm_castsi128_ps(tx), _mm_castsi128_ps(ty)),
-            _mm_castsi128_ps(tz),
-        )
+/// The lane kernel over whole groups of `L::N` points; returns how many points it wrote.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn many<L: Lanes>(points: &[Vec3], s: u32, out: &mut [f32]) -> usize {
+    let s = L::splat_i(s);
+    let groups = points.len() / L::N;
+    for (p, o) in points.chunks_exact(L::N).zip(out.chunks_exact_mut(L::N)) {
+        let (x, y, z) = L::load_xyz(p);
+        kernel(x, y, z, s).store(o);
     }
+    groups * L::N
+}
 
-    #[inline(always)]
-    unsafe fn fade(t: __m128) -> __m128 {
-        let inner = _mm_add_ps(
-            _mm_mul_ps(
-                t,
-                _mm_sub_ps(_mm_mul_ps(t, _mm_set1_ps(6.0)), _mm_set1_ps(15.0)),
-            ),
-            _mm_set1_ps(10.0),
-        );
-        _mm_mul_ps(_mm_mul_ps(_mm_mul_ps(t, t), t), inner)
-    }
+/// The scalar `lattice` hash on lanes: `(x ^ y ^ z ^ s)·K`, then `h ^ (h >> 15)`.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn hash<L: Lanes>(x: L::I, y: L::I, z: L::I, s: L::I) -> L::I {
+    let h = L::mul_lo(L::xor_i(L::xor_i(x, y), L::xor_i(z, s)), L::splat_i(KNUTH));
+    L::xor_i(h, L::shr(h, 15))
+}
 
-    #[inline(always)]
-    unsafe fn lerp(a: __m128, b: __m128, t: __m128) -> __m128 {
-        _mm_add_ps(a, _mm_mul_ps(t, _mm_sub_ps(b, a)))
-    }
+/// g·d for the gradient picked by the top 5 bits of `h` (layout of [`GRADS`]): sign flips by xor
+/// into the float sign bit, the dropped axis masked to +0; summed in the scalar `dot`'s order.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn gdot<L: Lanes>(h: L::I, dx: L, dy: L, dz: L) -> L {
+    let axis = L::and_i(L::shr(h, 27), L::splat_i(3));
+    let tx = dx.flip_sign(h).zero_where_eq(axis, 0);
+    let ty = dy.flip_sign(L::shl(h, 1)).zero_where_eq(axis, 1);
+    let tz = dz.flip_sign(L::shl(h, 2)).zero_where_eq(axis, 2);
+    tx.add(ty).add(tz)
+}
 
-    /// Cell index (truncation minus sign bit, as `cell_of`) and the fraction.
-    #[inline(always)]
-    unsafe fn cell(p: __m128) -> (__m128i, __m128) {
-        let i = _mm_add_epi32(_mm_cvttps_epi32(p), _mm_srai_epi32(_mm_castps_si128(p), 31));
-        (i, _mm_sub_ps(p, _mm_cvtepi32_ps(i)))
-    }
+/// [`fade`] on lanes, in the same operation order.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn fade_lanes<L: Lanes>(t: L) -> L {
+    let inner = t
+        .mul(t.mul(L::splat(6.0)).sub(L::splat(15.0)))
+        .add(L::splat(10.0));
+    t.mul(t).mul(t).mul(inner)
+}
 
-    #[inline(always)]
-    pub(super) unsafe fn kernel(x: __m128, y: __m128, z: __m128, s: [u32; 4]) -> [f32; 4] {
-        let (ix, x0) = cell(x);
-        let (iy, y0) = cell(y);
-        let (iz, z0) = cell(z);
-        let one = _mm_set1_ps(1.0);
-        let (x1, y1, z1) = (
-            _mm_sub_ps(x0, one),
-            _mm_sub_ps(y0, one),
-            _mm_sub_ps(z0, one),
-        );
-        let (px, py, pz) = (
-            _mm_set1_epi32(PRIME_X as i32),
-            _mm_set1_epi32(PRIME_Y as i32),
-            _mm_set1_epi32(PRIME_Z as i32),
-        );
-        let xa = mul_lo(ix, px);
-        let ya = mul_lo(iy, py);
-        let za = mul_lo(iz, pz);
-        let (xb, yb, zb) = (
-            _mm_add_epi32(xa, px),
-            _mm_add_epi32(ya, py),
-            _mm_add_epi32(za, pz),
-        );
-        let s = _mm_loadu_si128(s.as_ptr() as *const __m128i);
-        let n000 = gdot(hash(xa, ya, za, s), x0, y0, z0);
-        let n100 = gdot(hash(xb, ya, za, s), x1, y0, z0);
-        let n010 = gdot(hash(xa, yb, za, s), x0, y1, z0);
-        let n110 = gdot(hash(xb, yb, za, s), x1, y1, z0);
-        let n001 = gdot(hash(xa, ya, zb, s), x0, y0, z1);
-        let n101 = gdot(hash(xb, ya, zb, s), x1, y0, z1);
-        let n011 = gdot(hash(xa, yb, zb, s), x0, y1, z1);
-        let n111 = gdot(hash(xb, yb, zb, s), x1, y1, z1);
-        let (u, v, w) = (fade(x0), fade(y0), fade(z0));
-        let a = lerp(n000, n100, u);
-        let b = lerp(n010, n110, u);
-        let c = lerp(n001, n101, u);
-        let d = lerp(n011, n111, u);
-        let e = lerp(a, b, v);
-        let f = lerp(c, d, v);
-        let mut out = [0.0f32; 4];
-        _mm_storeu_ps(out.as_mut_ptr(), lerp(e, f, w));
-        out
-    }
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn lerp<L: Lanes>(a: L, b: L, t: L) -> L {
+    a.add(t.mul(b.sub(a)))
+}
+
+/// [`gradient3_xyz`] on `L::N` points at once (lanes are points, every instruction vertical),
+/// scrambled seeds `s` per lane. Same operations in the same order as the scalar kernel.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub(crate) unsafe fn kernel<L: Lanes>(x: L, y: L, z: L, s: L::I) -> L {
+    let (ix, x0) = x.cell();
+    let (iy, y0) = y.cell();
+    let (iz, z0) = z.cell();
+    let one = L::splat(1.0);
+    let (x1, y1, z1) = (x0.sub(one), y0.sub(one), z0.sub(one));
+    let (px, py, pz) = (
+        L::splat_i(PRIME_X),
+        L::splat_i(PRIME_Y),
+        L::splat_i(PRIME_Z),
+    );
+    let (xa, ya, za) = (L::mul_lo(ix, px), L::mul_lo(iy, py), L::mul_lo(iz, pz));
+    let (xb, yb, zb) = (L::add_i(xa, px), L::add_i(ya, py), L::add_i(za, pz));
+    let n000 = gdot(hash::<L>(xa, ya, za, s), x0, y0, z0);
+    let n100 = gdot(hash::<L>(xb, ya, za, s), x1, y0, z0);
+    let n010 = gdot(hash::<L>(xa, yb, za, s), x0, y1, z0);
+    let n110 = gdot(hash::<L>(xb, yb, za, s), x1, y1, z0);
+    let n001 = gdot(hash::<L>(xa, ya, zb, s), x0, y0, z1);
+    let n101 = gdot(hash::<L>(xb, ya, zb, s), x1, y0, z1);
+    let n011 = gdot(hash::<L>(xa, yb, zb, s), x0, y1, z1);
+    let n111 = gdot(hash::<L>(xb, yb, zb, s), x1, y1, z1);
+    let (u, v, w) = (fade_lanes(x0), fade_lanes(y0), fade_lanes(z0));
+    let a = lerp(n000, n100, u);
+    let b = lerp(n010, n110, u);
+    let c = lerp(n001, n101, u);
+    let d = lerp(n011, n111, u);
+    let e = lerp(a, b, v);
+    let f = lerp(c, d, v);
+    lerp(e, f, w)
 }
 
 #[cfg(test)]
@@ -400,23 +373,62 @@ mod tests {
     use super::*;
     use crate::math::Pcg32;
 
+    /// Test points: random over ±1000 (every sign and many cells) plus values where the cell
+    /// rule matters: integers, negative integers, ±0, values just below an integer.
+    fn awkward_points(n: usize, seed: u64) -> Vec<Vec3> {
+        let mut r = Pcg32::new(seed, 0);
+        let special = [
+            0.0f32,
+            -0.0,
+            1.0,
+            -1.0,
+            -3.0,
+            2.5,
+            -2.5,
+            0.999_999_9,
+            -1e-7,
+            1e-30,
+        ];
+        (0..n)
+            .map(|i| {
+                let mut c = [0.0f32; 3];
+                for v in c.iter_mut() {
+                    *v = if r.next_u32() % 4 == 0 {
+                        special[(r.next_u32() % special.len() as u32) as usize]
+                    } else {
+                        (r.next_f32() - 0.5) * 2000.0 * if i % 2 == 0 { 1.0 } else { 1e-3 }
+                    };
+                }
+                Vec3::from(c)
+            })
+            .collect()
+    }
+
     #[test]
-    fn four_lane_kernel_equals_scalar() {
-        let mut r = Pcg32::new(1, 0);
-        for _ in 0..20_000 {
-            let mut c = [[0.0f32; 4]; 3];
-            for axis in c.iter_mut() {
-                for v in axis.iter_mut() {
-                    *v = (r.next_f32() - 0.5) * 2000.0;
+    fn every_simd_path_equals_scalar() {
+        // Same operations in the same order, so the same numbers (a zero's sign may differ: the
+        // lane kernel masks a dropped axis to +0 where the scalar one multiplies by 0). Lengths
+        // that are not multiples of the lane count exercise the scalar tail.
+        for simd in [Simd::Scalar, Simd::Sse2, Simd::Avx2, Simd::Avx512] {
+            if simd > Simd::best() {
+                eprintln!("{simd:?} not on this CPU: not tested here");
+                continue;
+            }
+            for (len, seed) in [(0usize, 1u32), (1, 2), (15, 3), (33, 4), (20_003, 5)] {
+                let pts = awkward_points(len, seed as u64);
+                let mut out = vec![f32::NAN; len];
+                gradient3_many_with(simd, &pts, seed, &mut out);
+                for (p, &v) in pts.iter().zip(&out) {
+                    assert_eq!(v, gradient3(*p, seed), "{simd:?} at {p}");
                 }
             }
-            let s = [r.next_u32(), r.next_u32(), r.next_u32(), r.next_u32()];
-            let v = gradient3_x4(c[0], c[1], c[2], s);
-            for k in 0..4 {
-                // Equal as numbers (a zero's sign may differ: the kernel masks to +0).
-                assert_eq!(v[k], gradient3_xyz(c[0][k], c[1][k], c[2][k], s[k]));
-            }
         }
+    }
+
+    #[test]
+    #[should_panic(expected = "3 points but 2 outputs")]
+    fn batch_lengths_must_match() {
+        gradient3_many(&[Vec3::ZERO; 3], 1, &mut [0.0; 2]);
     }
 
     #[test]

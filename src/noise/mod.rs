@@ -76,13 +76,18 @@ mod cellular;
 mod fractal;
 mod gradient;
 pub mod hash;
+mod lanes;
 mod sparse;
 mod value;
 mod warp;
 
 pub use cellular::{cellular3, feature_point, CellularSample};
 pub use fractal::{Basis, Fractal, FractalKind};
-pub use gradient::{fade, fade_d, gradient1, gradient1_grad, gradient3, gradient3_grad};
+pub use gradient::{
+    fade, fade_d, gradient1, gradient1_grad, gradient3, gradient3_grad, gradient3_many,
+    gradient3_many_with,
+};
+pub use lanes::Simd;
 pub use sparse::{
     band_cells, Cells, Kernel, NoiseError, SparseConvolution, SparseConvolution1, Weights,
     MAX_IMPULSES_PER_CELL,

@@ -1,12 +1,13 @@
 //! `xylem bench noise`: evaluations per second (one thread) of each noise over the same random
-//! points as the criterion bench (`cargo bench --bench noise`, which also times the peers
+//! points as the criterion bench (the batch `gradient3_many` on each instruction set the CPU has,
+//! then one call per point for the rest) (`cargo bench --bench noise`, which also times the peers
 //! noise-rs and fastnoise-lite). Best of several passes, so a shared machine's interruptions
 //! count less; figures in notes/noise.md.
 
 use crate::math::{Frame, Pcg32};
 use crate::noise::{
-    cellular3, gradient3, gradient3_grad, value3, Cells, Fractal, FractalKind, Kernel,
-    SparseConvolution, Warp, Weights,
+    cellular3, gradient3, gradient3_grad, gradient3_many_with, value3, Cells, Fractal, FractalKind,
+    Kernel, Simd, SparseConvolution, Warp, Weights,
 };
 use glam::Vec3;
 use std::process::ExitCode;
@@ -28,6 +29,19 @@ pub fn bench_points(n: usize) -> Vec<Vec3> {
     (0..n)
         .map(|_| Vec3::new(r.next_f32(), r.next_f32(), r.next_f32()) * 64.0)
         .collect()
+}
+
+/// Million points per second of the batch call `gradient3_many_with(simd, ..)`, best of `passes`.
+fn batch_rate(points: &[Vec3], passes: usize, simd: Simd) -> f64 {
+    let mut out = vec![0.0f32; points.len()];
+    let mut best = f64::INFINITY;
+    for _ in 0..passes.max(1) {
+        let t = Instant::now();
+        gradient3_many_with(simd, std::hint::black_box(points), 7, &mut out);
+        best = best.min(t.elapsed().as_secs_f64());
+        std::hint::black_box(&out);
+    }
+    points.len() as f64 / best / 1e6
 }
 
 /// Million evaluations per second of `f` over `points`, best of `passes`.
@@ -75,7 +89,17 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         ..sparse
     };
     let frame = Frame::from_normal(Vec3::new(0.2, 0.1, 1.0).normalize());
-    let rows: Vec<(&str, f64)> = vec![
+    // The batch call on every instruction set this CPU has, widest first (the first row is
+    // what `gradient3_many` uses).
+    let mut rows: Vec<(String, f64)> = [Simd::Avx512, Simd::Avx2, Simd::Sse2, Simd::Scalar]
+        .into_iter()
+        .filter(|&s| s <= Simd::best())
+        .map(|s| {
+            let name = format!("gradient3_many ({}, {} lanes)", s.name(), s.lanes());
+            (name, batch_rate(&pts, n, s))
+        })
+        .collect();
+    let single: Vec<(&str, f64)> = vec![
         ("gradient3", rate(&pts, n, |p| gradient3(p, 7))),
         ("gradient3_grad", rate(&pts, n, |p| gradient3_grad(p, 7).0)),
         ("value3", rate(&pts, n, |p| value3(p, 7))),
@@ -101,6 +125,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             rate(&pts, n, |p| rays.eval(p + Vec3::new(40.0, 0.0, 0.0), 7)),
         ),
     ];
+    rows.extend(single.into_iter().map(|(k, v)| (k.to_string(), v)));
     println!("| function (one thread) | M evals/s |");
     println!("| --- | ---: |");
     for (name, r) in rows {
