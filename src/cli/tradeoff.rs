@@ -215,7 +215,6 @@ fn markdown(
     s += "\n`--quality draft|default|final` (on `xylem sweep`) applies the presets in \
           `src/sweep/tradeoff.rs` (`Quality::knobs`), rows `--quality` above.\n\n\
           ## Not measured\n\n\
-          - footprint band-limiting: the wood model exposes no switch for it (yet);\n\
           - baked textures: the renderer has no image-texture material, so baked maps \
           (`xylem bake`) are not compared in rendered images.\n";
     s

@@ -38,6 +38,9 @@ pub struct MaterialHit {
     pub normal_to_world: Mat3,
     /// Where the object sits in the tree.
     pub placement: Placement,
+    /// Width (world mm) of the camera pixel's footprint on the surface at a first hit; 0 where
+    /// unknown (later bounces), which switches footprint filtering off.
+    pub footprint: f32,
 }
 
 /// First-hit values the film records as AOV layers besides the beauty image.
@@ -171,6 +174,8 @@ pub struct WoodMaterial {
 pub struct ShadingSwitches {
     /// Internal reflections under the finish: closed-form series or one pass.
     pub finish: FinishModel,
+    /// Band-limit the wood by the pixel footprint (`WoodVolume::eval_filtered`).
+    pub footprint_filter: bool,
 }
 
 impl Material {
@@ -283,7 +288,14 @@ impl WoodMaterial {
         let place = &hit.placement;
         let rot = place.rotation_matrix();
         let p_tree = place.object_to_tree().transform_point3(hit.p_object);
-        let texel = self.volume.eval(p_tree, self.needs());
+        let texel = if self.switches.footprint_filter && hit.footprint > 0.0 {
+            // World mm → object units (|det|^⅓ of the instance map) → tree mm.
+            let to_object = hit.object_to_world.determinant().abs().cbrt().max(1e-12);
+            let footprint = hit.footprint / to_object * place.scale;
+            self.volume.eval_filtered(p_tree, self.needs(), footprint)
+        } else {
+            self.volume.eval(p_tree, self.needs())
+        };
         // Tree → object directions: the transpose of the placement rotation; object → world: the
         // instance's linear map (directions are contravariant, Liu et al. 2016 §6.2).
         let to_world = |d: Vec3| (hit.object_to_world * (rot.transpose() * d)).normalize_or_zero();

@@ -91,6 +91,14 @@ pub fn shading_point(scene: &Scene, ray: &Ray, hit: &Hit, aov: Option<&mut Aov>)
         object_to_world: Mat3::from(inst.transform.to_world.matrix3),
         normal_to_world: inst.transform.normal_to_world,
         placement: inst.placement,
+        // Only the camera's first hit (the one that records AOVs) has a pixel footprint; the
+        // ellipse it makes on the surface, stretched by 1/cos, is taken at its geometric mean.
+        footprint: match aov {
+            Some(_) => {
+                scene.camera.pixel_footprint(ray, hit.t) / s.ng.dot(ray.d).abs().max(0.05).sqrt()
+            }
+            None => 0.0,
+        },
     };
     let shading = material.shade(&mh);
     let mut frame = shading.frame;

@@ -30,6 +30,8 @@ pub struct Knobs {
     /// Internal reflections under the finish: closed-form series or a single pass.
     #[serde(serialize_with = "debug_name")]
     pub finish: FinishModel,
+    /// Band-limit the wood by the pixel footprint (drop features narrower than a pixel).
+    pub footprint_filter: bool,
 }
 
 fn debug_name<T: std::fmt::Debug, S: serde::Serializer>(v: &T, s: S) -> Result<S::Ok, S::Error> {
@@ -46,6 +48,7 @@ impl Knobs {
             pores_and_rays: true,
             jacobian: JacobianModel::Simplified,
             finish: FinishModel::ClosedForm,
+            footprint_filter: false,
         }
     }
 
@@ -124,6 +127,7 @@ pub fn apply(loaded: &mut LoadedScene, k: &Knobs) -> Result<(), crate::wood::Woo
             w.volume =
                 Arc::new(WoodVolume::new(params, w.volume.seed())?.with_jacobian(k.jacobian));
             w.switches.finish = k.finish;
+            w.switches.footprint_filter = k.footprint_filter;
         }
     }
     Ok(())
@@ -263,6 +267,16 @@ pub fn settings() -> Vec<(String, String, Knobs)> {
             ..Knobs::full(16)
         },
     ));
+    for spp in [1, 4, 16] {
+        v.push((
+            "footprint band-limit".into(),
+            format!("on, {spp} spp"),
+            Knobs {
+                footprint_filter: true,
+                ..Knobs::full(spp)
+            },
+        ));
+    }
     for q in [Quality::Draft, Quality::Default, Quality::Final] {
         v.push((
             "--quality".into(),

@@ -60,6 +60,63 @@ impl DistortionNoise {
             (self.noise.eval_oriented(p, cyl, self.seed), Vec3::ZERO)
         }
     }
+
+    /// How many bands (from the largest) have kernels at least `footprint` mm across: band i has
+    /// semi-axes βⁱ Sₑ (Liu 2016 eq. 8), so its narrowest diameter is 2 βⁱ min(Sₑ).
+    #[inline]
+    pub fn bands_above(&self, footprint: f32) -> u32 {
+        let mut d = 2.0 * self.noise.envelope.min_element();
+        let mut n = 0;
+        while n < self.noise.bands && d >= footprint {
+            n += 1;
+            d *= self.noise.size_factor;
+        }
+        n
+    }
+
+    /// [`DistortionNoise::eval`] with only the first `bands` bands (the finer ones dropped: their
+    /// mean is zero, signed weights); all bands give exactly `eval`.
+    #[inline]
+    pub fn eval_bands<const GRAD: bool>(&self, p: Vec3, cyl: &Frame, bands: u32) -> (f32, Vec3) {
+        if bands >= self.noise.bands {
+            return self.eval::<GRAD>(p, cyl);
+        }
+        if bands == 0 {
+            return (0.0, Vec3::ZERO);
+        }
+        let noise = SparseConvolution {
+            bands,
+            ..self.noise
+        };
+        if GRAD {
+            noise.eval_oriented_grad(p, cyl, self.seed)
+        } else {
+            (noise.eval_oriented(p, cyl, self.seed), Vec3::ZERO)
+        }
+    }
+}
+
+/// 3∫₀¹ r² K(r²) dr for the bump kernel K(q) = exp(−s q/(1 − q)) (Liu 2016 eq. 6): the mean of
+/// the kernel over its unit ball. With unit weights and on average `density` kernels overlapping
+/// a point (λ V = density), the mean of the summed mask is density × this (Campbell's theorem,
+/// notes/sweep.md "Footprint"). 512-point midpoint rule.
+pub fn bump_kernel_mean(sharpness: f32) -> f32 {
+    let n = 512;
+    let mut sum = 0.0f64;
+    for i in 0..n {
+        let r = (i as f64 + 0.5) / n as f64;
+        let q = r * r;
+        sum += r * r * (-(sharpness as f64) * q / (1.0 - q)).exp();
+    }
+    (3.0 * sum / n as f64) as f32
+}
+
+/// Weight of a feature `size` mm across seen through a pixel footprint `footprint` mm wide:
+/// 1 (kept) up to footprint = size, 0 (replaced by its mean) from footprint = 2 size, linear in
+/// between so the change is not a visible seam (notes/sweep.md "Footprint").
+#[inline]
+pub fn footprint_weight(size: f32, footprint: f32) -> f32 {
+    (2.0 - footprint / size).clamp(0.0, 1.0)
 }
 
 /// Pores (vessels): bump-kernel noise with unit weights, kernels elongated along the fibre frame.
@@ -72,6 +129,10 @@ pub struct Pores {
     ring_porosity: f32,
     /// Bump depth at full mask, mm (depth fraction × radius, §6.1.7).
     pub depth: f32,
+    /// Narrowest diameter of a pore (2 × radius), mm.
+    pub diameter: f32,
+    /// Mean mask at full pore size, min(1, density · bump_kernel_mean(s)).
+    mean_full: f32,
     seed: u32,
 }
 
@@ -99,7 +160,22 @@ impl Pores {
             sharpness: p.sharpness.max(1e-3),
             ring_porosity: p.ring_porosity,
             depth: p.depth * p.radius,
+            diameter: 2.0 * p.radius,
+            mean_full: (p.density * bump_kernel_mean(p.sharpness)).min(1.0),
             seed,
+        }
+    }
+
+    /// The mean of [`Pores::mask`] at growth-ring value `g`: every pore scaled by
+    /// size = 1 − porosity · g in all three axes keeps its count, so the covered fraction scales
+    /// by size³ (exact where pores do not overlap, like `resize_bump`).
+    #[inline]
+    pub fn mean_mask(&self, g: f32) -> f32 {
+        let size = 1.0 - self.ring_porosity * g;
+        if size <= 1e-3 {
+            0.0
+        } else {
+            self.mean_full * size.min(1.0).powi(3)
         }
     }
 
@@ -154,6 +230,10 @@ pub fn resize_bump(v: f32, grad: Vec3, size: f32, s: f32) -> (f32, Vec3) {
 pub struct Rays {
     noise: SparseConvolution,
     strength: f32,
+    /// Ray width (its narrowest extent), mm.
+    pub width: f32,
+    /// Mean of [`Rays::mask`]: strength · min(1, density · bump_kernel_mean(s)).
+    pub mean_mask: f32,
     seed: u32,
 }
 
@@ -178,6 +258,8 @@ impl Rays {
                 dropoff: 1.0,
             },
             strength: p.strength,
+            width: p.width,
+            mean_mask: p.strength * (p.density * bump_kernel_mean(p.sharpness)).min(1.0),
             seed,
         }
     }

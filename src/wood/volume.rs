@@ -3,7 +3,7 @@
 
 use super::color::BeerColor;
 use super::error::WoodError;
-use super::features::{sub_seed, DistortionNoise, Noise1, Pores, Rays};
+use super::features::{footprint_weight, sub_seed, DistortionNoise, Noise1, Pores, Rays};
 use super::growth::{SmoothRectangleWave, SmoothTriangleWave};
 use super::knots::{KnotSample, Knots};
 use super::params::WoodParams;
@@ -188,12 +188,13 @@ impl WoodVolume {
     /// The distortion f(p) with its Jacobian (§5, eq. 15 and 22).
     #[inline]
     pub fn distortion(&self, p: Vec3) -> Distortion {
-        self.distort::<true>(p)
+        self.distort::<true>(p, 0.0)
     }
 
-    /// f(p), with the Jacobian only when `JACOBIAN` (colour alone needs just the point).
+    /// f(p), with the Jacobian only when `JACOBIAN` (colour alone needs just the point); bands
+    /// narrower than `footprint` mm are dropped (0: every band).
     #[inline]
-    fn distort<const JACOBIAN: bool>(&self, p: Vec3) -> Distortion {
+    fn distort<const JACOBIAN: bool>(&self, p: Vec3, footprint: f32) -> Distortion {
         let mut d = Distortion::identity(p);
         if self.distortion.iter().any(Option::is_some) {
             let frame = cylinder_frame(p);
@@ -206,7 +207,11 @@ impl WoodVolume {
                 .zip(&mut terms)
             {
                 if let Some(noise) = noise {
-                    let (m, grad_m) = noise.eval::<JACOBIAN>(p, &frame);
+                    let (m, grad_m) = if footprint > 0.0 {
+                        noise.eval_bands::<JACOBIAN>(p, &frame, noise.bands_above(footprint))
+                    } else {
+                        noise.eval::<JACOBIAN>(p, &frame)
+                    };
                     d.add(Displacement { dir, m, grad_m });
                     *term = (m, grad_m);
                 }
@@ -219,11 +224,11 @@ impl WoodVolume {
     }
 
     #[inline]
-    fn core(&self, p: Vec3, needs: Needs) -> Core {
+    fn core(&self, p: Vec3, needs: Needs, footprint: f32) -> Core {
         let dist = if needs.fibers || needs.bump {
-            self.distort::<true>(p)
+            self.distort::<true>(p, footprint)
         } else {
-            self.distort::<false>(p)
+            self.distort::<false>(p, footprint)
         };
         let q = dist.point;
         let r = (q.x * q.x + q.y * q.y).sqrt();
@@ -257,8 +262,16 @@ impl WoodVolume {
 
     /// Evaluate the wood at tree-space point `p` (mm), computing only what `needs` asks for.
     pub fn eval(&self, p: Vec3, needs: Needs) -> WoodTexel {
+        self.eval_filtered(p, needs, 0.0)
+    }
+
+    /// [`WoodVolume::eval`] band-limited by a pixel footprint `footprint` mm wide (tree space):
+    /// distortion bands narrower than the footprint are dropped, and pores and rays fade to their
+    /// mean mask as the footprint grows from their width to twice it (and are not evaluated at
+    /// all beyond). A footprint below the smallest feature (or 0) gives exactly `eval`.
+    pub fn eval_filtered(&self, p: Vec3, needs: Needs, footprint: f32) -> WoodTexel {
         let mut texel = WoodTexel::default();
-        let c = self.core(p, needs);
+        let c = self.core(p, needs, footprint);
         let q = c.dist.point;
         texel.growth_time = c.time;
         let g = self.rings.eval(c.time);
@@ -275,11 +288,19 @@ impl WoodVolume {
         };
         if want_pores {
             let pores = self.pores.as_ref().expect("checked");
-            let (mask, grad) = if needs.bump {
+            let w = footprint_weight(pores.diameter, footprint);
+            let (mut mask, mut grad) = if w <= 0.0 {
+                (0.0, Vec3::ZERO)
+            } else if needs.bump {
                 pores.mask::<true>(q, &frame, g)
             } else {
                 pores.mask::<false>(q, &frame, g)
             };
+            if w < 1.0 {
+                // Linear filtering: the pore detail fades to its mean (which has no gradient).
+                mask = w * mask + (1.0 - w) * pores.mean_mask(g);
+                grad *= w;
+            }
             texel.pore_mask = mask;
             if needs.bump {
                 // §6.1.7: height = −depth · mask; its gradient transported covariantly (eq. 18).
@@ -288,7 +309,15 @@ impl WoodVolume {
             }
         }
         if want_rays {
-            texel.ray_mask = self.rays.as_ref().expect("checked").mask(q);
+            let rays = self.rays.as_ref().expect("checked");
+            let w = footprint_weight(rays.width, footprint);
+            texel.ray_mask = if w >= 1.0 {
+                rays.mask(q)
+            } else if w <= 0.0 {
+                rays.mean_mask
+            } else {
+                w * rays.mask(q) + (1.0 - w) * rays.mean_mask
+            };
         }
         if needs.color {
             let extra = match (&c.knot, &self.knots) {
