@@ -169,16 +169,28 @@ pub fn write_exr_layers(
 /// Writes a rendered image as EXR: beauty `R G B` plus the AOV layers `albedo` (RGB), `normal`
 /// (XYZ), `depth` (Z), `fiber` (XYZ), `ray_mask` (Y), `growth_time` (Y) and `std_error` (Y).
 pub fn write_image_exr(path: &Path, image: &super::Image) -> Result<(), ImageError> {
+    let mut layers = vec![ExrLayer {
+        name: "",
+        channels: &["R", "G", "B"],
+        data: image.beauty.iter().flat_map(|c| c.to_array()).collect(),
+    }];
+    layers.extend(aov_layers(&image.aov));
+    layers.push(ExrLayer {
+        name: "std_error",
+        channels: &["Y"],
+        data: image.std_error.clone(),
+    });
+    write_exr_layers(path, image.width, image.height, &layers)
+}
+
+/// The AOV layers of [`write_image_exr`] (`albedo` … `growth_time`), e.g. for a file of AOVs that
+/// several images share.
+pub fn aov_layers(aov: &[super::Aov]) -> Vec<ExrLayer<'static>> {
     let v3 = |f: &dyn Fn(&super::Aov) -> Vec3| -> Vec<f32> {
-        image.aov.iter().flat_map(|a| f(a).to_array()).collect()
+        aov.iter().flat_map(|a| f(a).to_array()).collect()
     };
-    let s = |f: &dyn Fn(&super::Aov) -> f32| -> Vec<f32> { image.aov.iter().map(f).collect() };
-    let layers = [
-        ExrLayer {
-            name: "",
-            channels: &["R", "G", "B"],
-            data: image.beauty.iter().flat_map(|c| c.to_array()).collect(),
-        },
+    let s = |f: &dyn Fn(&super::Aov) -> f32| -> Vec<f32> { aov.iter().map(f).collect() };
+    vec![
         ExrLayer {
             name: "albedo",
             channels: &["R", "G", "B"],
@@ -209,13 +221,7 @@ pub fn write_image_exr(path: &Path, image: &super::Image) -> Result<(), ImageErr
             channels: &["Y"],
             data: s(&|a| a.growth_time),
         },
-        ExrLayer {
-            name: "std_error",
-            channels: &["Y"],
-            data: image.std_error.clone(),
-        },
-    ];
-    write_exr_layers(path, image.width, image.height, &layers)
+    ]
 }
 
 /// Reads the RGB channels of the first layer of an EXR (alpha ignored): (width, height, pixels).

@@ -8,7 +8,8 @@ use super::sequence::{
     assemble, frame_stem, read_records, write_frame, AssembleOptions, Assembled, FrameRecord,
     Region, SequenceError,
 };
-use crate::render::image_io::{write_image_exr, ImageError};
+use crate::render::image_io::{aov_layers, write_exr_layers, ExrLayer, ImageError};
+use rayon::prelude::*;
 use crate::render::{RenderError, RunOptions};
 use crate::scene::LoadedScene;
 use std::ops::Range;
@@ -73,7 +74,12 @@ pub fn scene_regions(loaded: &LoadedScene) -> Vec<Region> {
         .collect()
 }
 
-/// Writes every frame of `render` (EXR with AOVs, PNG, record) into `dir`.
+/// The file holding the first-hit AOV layers that every frame of a sweep shares.
+pub const AOV_FILE: &str = "aov.exr";
+
+/// Writes every frame of `render` (EXR of radiance and standard error, PNG, record) into `dir`,
+/// frames in parallel, and the AOVs they share once into [`AOV_FILE`] (the camera and geometry
+/// do not move, so the AOVs are the same in every frame).
 pub fn write_frames(
     dir: &Path,
     render: &SweepRender,
@@ -81,22 +87,31 @@ pub fn write_frames(
     exposure: f32,
     regions: &[Region],
 ) -> Result<(), SweepError> {
-    for (k, f) in render.frames.iter().enumerate() {
-        write_image_exr(
+    let (w, h) = (render.width, render.height);
+    write_exr_layers(&dir.join(AOV_FILE), w, h, &aov_layers(&render.aov))?;
+    render.frames.par_iter().try_for_each(|f| {
+        let layers = [
+            ExrLayer {
+                name: "",
+                channels: &["R", "G", "B"],
+                data: f.beauty.iter().flat_map(|c| c.to_array()).collect(),
+            },
+            ExrLayer {
+                name: "std_error",
+                channels: &["Y"],
+                data: f.std_error.clone(),
+            },
+        ];
+        write_exr_layers(
             &dir.join(format!("{}.exr", frame_stem(f.index))),
-            &render.image(k),
+            w,
+            h,
+            &layers,
         )?;
-        let rec = FrameRecord::measure(
-            f.index,
-            total,
-            f.light_deg,
-            (render.width, render.height),
-            &f.beauty,
-            regions,
-        );
+        let rec = FrameRecord::measure(f.index, total, f.light_deg, (w, h), &f.beauty, regions);
         write_frame(dir, &rec, &f.beauty, exposure)?;
-    }
-    Ok(())
+        Ok(())
+    })
 }
 
 /// Runs a sweep job on a loaded scene.

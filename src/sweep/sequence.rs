@@ -7,6 +7,7 @@ use super::contact::{contact_sheet, Rgb8};
 use super::viewer::viewer_html;
 use crate::math::{luminance, Vec3};
 use crate::render::image_io::{write_png_linear, write_png_rgb8, ImageError};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::io::BufWriter;
 use std::ops::Range;
@@ -423,39 +424,45 @@ pub struct Assembled {
 /// Builds the contact sheet, the animated PNG, the CSV and the viewer from the frames in `dir`.
 pub fn assemble(dir: &Path, opts: &AssembleOptions) -> Result<Assembled, SequenceError> {
     let records = read_records(dir)?;
-    let mut images = Vec::with_capacity(records.len());
-    for r in &records {
-        let path = dir.join(format!("{}.png", frame_stem(r.index)));
-        let img = read_png_rgb8(&path)?;
-        if (img.width, img.height) != (r.width, r.height) {
-            return Err(SequenceError::Mismatch {
-                path: path.display().to_string(),
-                what: format!(
-                    "is {}x{} but its record says {}x{}",
-                    img.width, img.height, r.width, r.height
-                ),
-            });
-        }
-        images.push(img);
-    }
+    // Decoding and shrinking are per frame: in parallel, each frame giving its thumbnail and its
+    // animation frame.
+    let shrunk: Vec<(Rgb8, Rgb8)> = records
+        .par_iter()
+        .map(|r| {
+            let path = dir.join(format!("{}.png", frame_stem(r.index)));
+            let img = read_png_rgb8(&path)?;
+            if (img.width, img.height) != (r.width, r.height) {
+                return Err(SequenceError::Mismatch {
+                    path: path.display().to_string(),
+                    what: format!(
+                        "is {}x{} but its record says {}x{}",
+                        img.width, img.height, r.width, r.height
+                    ),
+                });
+            }
+            Ok((
+                img.shrink_to_width(opts.thumb_width),
+                img.shrink_to_width(opts.animation_width),
+            ))
+        })
+        .collect::<Result<_, _>>()?;
+    let (thumbs, anim): (Vec<Rgb8>, Vec<Rgb8>) = shrunk.into_iter().unzip();
     let labels: Vec<String> = records
         .iter()
         .map(|r| format!("{:.1}°", r.light_deg))
         .collect();
-    let thumbs: Vec<Rgb8> = images
-        .iter()
-        .map(|i| i.shrink_to_width(opts.thumb_width))
-        .collect();
-    let sheet = contact_sheet(&thumbs, &labels, 4);
     let sheet_path = dir.join(CONTACT_SHEET);
-    write_png_rgb8(&sheet_path, sheet.width, sheet.height, &sheet.data)?;
-
-    let anim: Vec<Rgb8> = images
-        .iter()
-        .map(|i| i.shrink_to_width(opts.animation_width))
-        .collect();
     let anim_path = dir.join(ANIMATION);
-    write_apng(&anim_path, &anim, opts.fps)?;
+    // The two PNG encodings are independent.
+    let (sheet, animation) = rayon::join(
+        || {
+            let sheet = contact_sheet(&thumbs, &labels, 4);
+            write_png_rgb8(&sheet_path, sheet.width, sheet.height, &sheet.data)
+        },
+        || write_apng(&anim_path, &anim, opts.fps),
+    );
+    sheet?;
+    animation?;
 
     let csv_path = dir.join(CSV);
     write_text_atomic(&csv_path, &csv_table(&records))?;
