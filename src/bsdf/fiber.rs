@@ -28,6 +28,13 @@ const MIN_COS_PSI: f32 = 1e-5;
 /// on a sliver where f·cos vanishes anyway.
 const MIN_ARC: f32 = PI / 8.0;
 
+/// ψr = asin(ωo·u) and cos ψr of one outgoing direction, for [`FiberAxis::eval_pdf_at`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FiberAtWo {
+    psi_r: f32,
+    cos_psi_r: f32,
+}
+
 /// A fibre axis `u` with a frame `(v, w)` around it for the azimuth of the reflection cone.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FiberAxis {
@@ -116,28 +123,81 @@ impl FiberAxis {
         }
     }
 
+    /// What [`FiberAxis::eval_pdf_at`] needs of `wo` alone, worked out once for many `wi`.
+    #[inline]
+    pub fn at_wo(&self, wo: Vec3) -> FiberAtWo {
+        let psi_r = self.psi(wo);
+        FiberAtWo {
+            psi_r,
+            cos_psi_r: psi_r.cos(),
+        }
+    }
+
+    /// `(eval(wo, wi, beta, norm), pdf(wo, wi, beta, z_min))` for the `wo` of `at`, sharing
+    /// ψi and the Gaussian g(β, ψi + ψr) between the two; the same values as the two calls.
+    pub fn eval_pdf_at(
+        &self,
+        at: &FiberAtWo,
+        wi: Vec3,
+        beta: f32,
+        norm: FiberNormalization,
+        z_min: f32,
+    ) -> (f32, f32) {
+        let psi_i = self.psi(wi);
+        let g = gaussian(beta, psi_i + at.psi_r);
+        let f = match norm {
+            FiberNormalization::EnergyBounded => {
+                let c = psi_i.cos().max(at.cos_psi_r).max(MIN_COS_PSI);
+                g / (2.0 * PI * c)
+            }
+            FiberNormalization::Published => {
+                let c = (0.5 * (at.psi_r - psi_i)).cos();
+                g / (c * c).max(MIN_COS_PSI * MIN_COS_PSI)
+            }
+        };
+        if !(wi.z > z_min) {
+            return (f, 0.0);
+        }
+        // As in `pdf`: sin ψi clamped, ψi = asin of it (= `psi(wi)`), so g is the same.
+        let sin_psi = wi.dot(self.frame.n).clamp(-1.0, 1.0);
+        let cos_psi = safe_sqrt(1.0 - sin_psi * sin_psi);
+        if cos_psi < MIN_COS_PSI {
+            return (f, 0.0);
+        }
+        let delta = self.half_width(sin_psi, cos_psi, z_min);
+        if delta <= 0.0 {
+            return (f, 0.0);
+        }
+        (f, g / (2.0 * delta.max(MIN_ARC) * cos_psi))
+    }
+
     /// Half-width Δ of the azimuth arc of the cone at longitudinal angle ψ whose directions have
     /// z > `z_min` (those that can leave the finish): z(φ) = sinψ u_z + cosψ h cos(φ − φ0),
     /// with h = |(v_z, w_z)|. Returns (Δ, φ0); Δ = 0 when no part of the cone qualifies.
     #[inline]
     fn arc(&self, sin_psi: f32, cos_psi: f32, z_min: f32) -> (f32, f32) {
+        let (v, w) = (self.frame.s, self.frame.t);
+        (self.half_width(sin_psi, cos_psi, z_min), w.z.atan2(v.z))
+    }
+
+    /// Δ of [`FiberAxis::arc`] alone.
+    #[inline]
+    fn half_width(&self, sin_psi: f32, cos_psi: f32, z_min: f32) -> f32 {
         let (u, v, w) = (self.frame.n, self.frame.s, self.frame.t);
         let h = (v.z * v.z + w.z * w.z).sqrt();
-        let phi0 = w.z.atan2(v.z);
         let a = sin_psi * u.z;
         let b = cos_psi * h;
         if b < 1e-7 {
-            return (if a > z_min { PI } else { 0.0 }, phi0);
+            return if a > z_min { PI } else { 0.0 };
         }
         let t = (z_min - a) / b;
-        let delta = if t <= -1.0 {
+        if t <= -1.0 {
             PI
         } else if t >= 1.0 {
             0.0
         } else {
             t.acos()
-        };
-        (delta, phi0)
+        }
     }
 
     /// Samples an interior direction: ψi from the Gaussian about −ψr (inverse CDF), φ uniform on
@@ -185,7 +245,7 @@ impl FiberAxis {
         if cos_psi < MIN_COS_PSI {
             return 0.0;
         }
-        let (delta, _) = self.arc(sin_psi, cos_psi, z_min);
+        let delta = self.half_width(sin_psi, cos_psi, z_min);
         if delta <= 0.0 {
             return 0.0;
         }

@@ -9,14 +9,14 @@ mod specular;
 mod wood;
 pub mod workload;
 
-pub use fiber::{erf_inv, gaussian, FiberAxis, FiberNormalization};
+pub use fiber::{erf_inv, gaussian, FiberAtWo, FiberAxis, FiberNormalization};
 pub use fresnel::{
     fresnel_dielectric, fresnel_diffuse_reflectance, refract, refract_in, refract_out,
 };
 pub use ggx::Ggx;
 pub use lambertian::Lambertian;
 pub use specular::{Glass, Mirror};
-pub use wood::{FinishModel, WoodBsdf};
+pub use wood::{FinishModel, WoodAtWo, WoodBsdf};
 
 use glam::{Vec2, Vec3};
 

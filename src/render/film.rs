@@ -110,8 +110,14 @@ pub struct PixelSum {
 impl PixelSum {
     /// Adds one sample; non-finite radiance is counted and dropped (it contributes zero).
     pub fn add(&mut self, radiance: Vec3, aov: &Aov) {
-        self.count += 1;
         self.aov.add(aov);
+        self.add_radiance(radiance);
+    }
+
+    /// Adds one sample's radiance only (a light sweep keeps the AOVs, the same in every frame,
+    /// in one sum of its own).
+    pub fn add_radiance(&mut self, radiance: Vec3) {
+        self.count += 1;
         if radiance.is_finite() {
             self.sum += radiance;
             let y = crate::math::luminance(radiance) as f64;

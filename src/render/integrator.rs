@@ -11,9 +11,9 @@
 
 use super::film::Aov;
 use super::geometry::{Hit, Ray};
-use super::light::Light;
+use super::light::{Light, LightSample};
 use super::Scene;
-use crate::bsdf::Bsdf;
+use crate::bsdf::{Bsdf, WoodAtWo};
 use crate::material::{MaterialHit, SurfaceBsdf};
 use crate::math::{power_heuristic, Frame, Pcg32};
 use glam::{Mat3, UVec2, Vec2, Vec3};
@@ -183,6 +183,43 @@ pub fn offset_origin(sp: &ShadingPoint, dir: Vec3) -> Vec3 {
     sp.p + sp.ng * (side * sp.eps)
 }
 
+/// A shading point's BSDF with `wo` fixed, for lighting it by many light samples: the wood BSDF
+/// with its `wo`-only terms worked out once ([`WoodBsdf::at_wo`]), any other BSDF as it is.
+/// Values identical to `eval` and `pdf`.
+#[derive(Clone, Copy, Debug)]
+pub enum BsdfAtWo<'a> {
+    Wood(WoodAtWo<'a>),
+    Other(&'a SurfaceBsdf, Vec3),
+}
+
+impl<'a> BsdfAtWo<'a> {
+    pub fn new(sp: &'a ShadingPoint) -> Self {
+        match &sp.bsdf {
+            SurfaceBsdf::Wood(b) => BsdfAtWo::Wood(b.at_wo(sp.wo)),
+            other => BsdfAtWo::Other(other, sp.wo),
+        }
+    }
+
+    /// `(eval(wo, wi), pdf(wo, wi))`, the density only when `with_pdf` (else 0).
+    #[inline]
+    pub fn eval_pdf(&self, wi: Vec3, with_pdf: bool) -> (Vec3, f32) {
+        match self {
+            BsdfAtWo::Wood(w) => w.eval_pdf(wi, with_pdf),
+            BsdfAtWo::Other(b, wo) => {
+                let f = b.eval(*wo, wi);
+                (
+                    f,
+                    if with_pdf && f != Vec3::ZERO {
+                        b.pdf(*wo, wi)
+                    } else {
+                        0.0
+                    },
+                )
+            }
+        }
+    }
+}
+
 /// Next-event estimation: one sample of every light, weighted against BSDF sampling by the power
 /// heuristic (delta lights take weight 1). Returns reflected radiance towards `wo`.
 pub fn sample_lights(
@@ -196,38 +233,53 @@ pub fn sample_lights(
     if sp.bsdf.is_delta() {
         return l;
     }
+    let bsdf = BsdfAtWo::new(sp);
     for light in lights {
         let u = rng.next_vec2();
-        let Some(ls) = light.sample(sp.p, u) else {
-            continue;
-        };
-        if !(ls.pdf > 0.0) || ls.li == Vec3::ZERO {
-            continue;
-        }
-        let wi = sp.frame.to_local(ls.wi);
-        let f = sp.bsdf.eval(sp.wo, wi);
-        if f == Vec3::ZERO {
-            continue;
-        }
-        let o = offset_origin(sp, ls.wi);
-        let shadow = Ray { o, d: ls.wi };
-        rays.0 += 1;
-        let t_max = if ls.dist.is_finite() {
-            ls.dist * (1.0 - 1e-4)
-        } else {
-            f32::INFINITY
-        };
-        if !scene.accel.unoccluded(&shadow, t_max) {
-            continue;
-        }
-        let w = if ls.is_delta {
-            1.0
-        } else {
-            power_heuristic(ls.pdf, sp.bsdf.pdf(sp.wo, wi))
-        };
-        l += f * ls.li * (wi.z.abs() * w / ls.pdf);
+        l += light_term(scene, sp, &bsdf, light.sample(sp.p, u), rays);
     }
     l
+}
+
+/// The term of one light sample `ls` in [`sample_lights`]: f · Li · |cos θi| · w / pdf when
+/// the light is unoccluded, w the power heuristic against BSDF sampling (1 for delta lights);
+/// zero when the sample failed, the BSDF vanishes or the light is occluded.
+#[inline]
+pub fn light_term(
+    scene: &Scene,
+    sp: &ShadingPoint,
+    bsdf: &BsdfAtWo,
+    ls: Option<LightSample>,
+    rays: &mut RayCount,
+) -> Vec3 {
+    let Some(ls) = ls else {
+        return Vec3::ZERO;
+    };
+    if !(ls.pdf > 0.0) || ls.li == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    let wi = sp.frame.to_local(ls.wi);
+    let (f, bsdf_pdf) = bsdf.eval_pdf(wi, !ls.is_delta);
+    if f == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    let o = offset_origin(sp, ls.wi);
+    let shadow = Ray { o, d: ls.wi };
+    rays.0 += 1;
+    let t_max = if ls.dist.is_finite() {
+        ls.dist * (1.0 - 1e-4)
+    } else {
+        f32::INFINITY
+    };
+    if !scene.accel.unoccluded(&shadow, t_max) {
+        return Vec3::ZERO;
+    }
+    let w = if ls.is_delta {
+        1.0
+    } else {
+        power_heuristic(ls.pdf, bsdf_pdf)
+    };
+    f * ls.li * (wi.z.abs() * w / ls.pdf)
 }
 
 /// The light-dependent part of direct lighting at a shading point: next-event estimation over all

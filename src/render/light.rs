@@ -6,7 +6,7 @@
 //! (any consistent unit works; the film records radiance).
 
 use super::geometry::Ray;
-use crate::math::{uniform_cone, uniform_sphere, Frame, PI, UNIFORM_SPHERE_PDF};
+use crate::math::{uniform_sphere, Frame, PI, UNIFORM_SPHERE_PDF};
 use glam::{Vec2, Vec3};
 use std::sync::Arc;
 
@@ -85,6 +85,9 @@ impl Light {
     }
 
     /// Samples incident light at `p` with uniform numbers `u`.
+    ///
+    /// Same as `sample_at(p, &LightU::new(u))`; a caller that samples many placements of one
+    /// light with the same numbers (a light sweep) makes the [`LightU`] once.
     pub fn sample(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
         match self {
             Light::Point {
@@ -142,27 +145,7 @@ impl Light {
                 center,
                 radius,
                 radiance,
-            } => {
-                let to = *center - p;
-                let d2 = to.length_squared();
-                let r2 = radius * radius;
-                if d2 <= r2 {
-                    return None;
-                }
-                // Uniform in the cone of directions the sphere subtends (pbrt-v4 §6.2.3).
-                let cos_max = (1.0 - r2 / d2).max(0.0).sqrt();
-                let frame = Frame::from_normal(to / d2.sqrt());
-                let wi = frame.to_world(uniform_cone(u, cos_max));
-                let t = intersect_sphere(&Ray { o: p, d: wi }, *center, *radius)
-                    .unwrap_or(d2.sqrt() - radius);
-                Some(LightSample {
-                    wi,
-                    dist: t,
-                    li: *radiance,
-                    pdf: 1.0 / (2.0 * PI * (1.0 - cos_max)),
-                    is_delta: false,
-                })
-            }
+            } => sample_sphere(p, *center, *radius, *radiance, u.x, azimuth(u.y)),
             Light::Environment(env) => {
                 let (wi, pdf) = match &env.map {
                     None => (uniform_sphere(u), UNIFORM_SPHERE_PDF),
@@ -176,6 +159,19 @@ impl Light {
                     is_delta: false,
                 })
             }
+        }
+    }
+
+    /// [`Light::sample`] with the uniform numbers prepared: for a sphere light the azimuth's sine
+    /// and cosine come from `u` (identical results; the trigonometry is done once per `u`).
+    pub fn sample_at(&self, p: Vec3, u: &LightU) -> Option<LightSample> {
+        match self {
+            Light::Sphere {
+                center,
+                radius,
+                radiance,
+            } => sample_sphere(p, *center, *radius, *radiance, u.u.x, u.azimuth),
+            _ => self.sample(p, u.u),
         }
     }
 
@@ -240,6 +236,67 @@ impl Light {
             _ => None,
         }
     }
+}
+
+/// A light sample's two uniform numbers with what [`Light::sample`] derives from them alone: the
+/// (sin, cos) of the azimuth φ = 2π u.y of a sphere light's cone sample.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightU {
+    pub u: Vec2,
+    azimuth: (f32, f32),
+}
+
+impl LightU {
+    pub fn new(u: Vec2) -> Self {
+        LightU {
+            u,
+            azimuth: azimuth(u.y),
+        }
+    }
+}
+
+/// (sin φ, cos φ) of the azimuth φ = 2π·v.
+#[inline]
+fn azimuth(v: f32) -> (f32, f32) {
+    (2.0 * PI * v).sin_cos()
+}
+
+/// Uniform sampling of the cone of directions a sphere (centre at distance d, radius r)
+/// subtends from `p` (pbrt-v4 §6.2.4, `Sphere::Sample`): cos θ uniform in [cos θmax, 1] with
+/// sin²θmax = r²/d², azimuth given as `(sin φ, cos φ)`, solid-angle density
+/// 1 / (2π (1 − cos θmax)). The distance to the sphere along the sampled direction ω is the
+/// nearer root of |tω − (c − p)|² = r², i.e. t² − 2t d cos θ + d² − r² = 0:
+/// t = d cos θ − √(r² − d² sin²θ) (as pbrt-v4 computes it), no ray–sphere intersection needed.
+#[inline]
+fn sample_sphere(
+    p: Vec3,
+    center: Vec3,
+    radius: f32,
+    radiance: Vec3,
+    ux: f32,
+    (sin_phi, cos_phi): (f32, f32),
+) -> Option<LightSample> {
+    let to = center - p;
+    let d2 = to.length_squared();
+    let r2 = radius * radius;
+    if d2 <= r2 {
+        return None;
+    }
+    let cos_max = (1.0 - r2 / d2).max(0.0).sqrt();
+    let d = d2.sqrt();
+    let frame = Frame::from_normal(to / d);
+    let cos_t = 1.0 - ux * (1.0 - cos_max);
+    let sin2_t = (1.0 - cos_t * cos_t).max(0.0);
+    let sin_t = sin2_t.sqrt();
+    let wi = frame.to_world(Vec3::new(sin_t * cos_phi, sin_t * sin_phi, cos_t));
+    let dist = d * cos_t - (r2 - d2 * sin2_t).max(0.0).sqrt();
+    Some(LightSample {
+        wi,
+        dist,
+        li: radiance,
+        pdf: 1.0 / (2.0 * PI * (1.0 - cos_max)),
+        is_delta: false,
+    })
 }
 
 fn delta_point(p: Vec3, position: Vec3, intensity: Vec3) -> Option<LightSample> {

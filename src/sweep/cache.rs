@@ -14,7 +14,10 @@
 use super::path::{ArcPlane, LightArc, PathError};
 use crate::bsdf::Bsdf;
 use crate::math::{power_heuristic, Pcg32};
-use crate::render::integrator::{self, light_rng, primary_sample, PrimarySample, RayCount};
+use crate::render::integrator::{
+    self, light_rng, primary_sample, BsdfAtWo, PrimarySample, RayCount,
+};
+use crate::render::light::LightU;
 use crate::render::{
     Aov, Image, Integrator, Light, PixelSum, Ray, RenderError, RenderSettings, RunOptions, Scene,
     TILE,
@@ -247,7 +250,7 @@ pub fn render_sweep(
         tiles
             .par_iter()
             .map(|&origin| {
-                let r = (origin, sweep_tile(scene, &lights, settings, origin));
+                let r = (origin, sweep_tile(scene, &lights, moving, settings, origin));
                 bar.inc(1);
                 r
             })
@@ -314,10 +317,12 @@ struct TileFrames {
 
 /// One tile for every frame. Each pixel sample's primary part is computed once and lit for every
 /// frame straight away (pixel → sample → frame), so nothing but the tile's pixel sums is kept;
-/// each (pixel, frame) sums its samples in the naive renderer's order.
+/// each (pixel, frame) sums its samples in the naive renderer's order. The AOVs, the same in
+/// every frame, are summed once.
 fn sweep_tile(
     scene: &Scene,
     lights: &[Vec<Light>],
+    moving: usize,
     settings: &RenderSettings,
     origin: UVec2,
 ) -> TileFrames {
@@ -325,7 +330,9 @@ fn sweep_tile(
     let (tw, th) = (TILE.min(w - origin.x), TILE.min(h - origin.y));
     let n = (tw * th) as usize;
     let mut sums = vec![vec![PixelSum::default(); n]; lights.len()];
+    let mut aov_sums = vec![PixelSum::default(); n];
     let mut radiance = vec![Vec3::ZERO; lights.len()];
+    let mut scratch = FrameScratch::default();
     let mut rays = RayCount::default();
     for (i, pixel) in (origin.y..origin.y + th)
         .flat_map(|y| (origin.x..origin.x + tw).map(move |x| UVec2::new(x, y)))
@@ -335,7 +342,15 @@ fn sweep_tile(
             let ps = primary_sample(scene, pixel, s, settings.seed);
             let rng = light_rng(scene, pixel, s, settings.seed);
             match settings.integrator {
-                Integrator::Direct => direct_for_frames(scene, &ps, lights, &rng, &mut radiance),
+                Integrator::Direct => direct_for_frames(
+                    scene,
+                    &ps,
+                    lights,
+                    moving,
+                    &rng,
+                    &mut scratch,
+                    &mut radiance,
+                ),
                 Integrator::Path { max_depth } => {
                     for (l, frame_lights) in radiance.iter_mut().zip(lights) {
                         let mut r = rng.clone();
@@ -351,42 +366,57 @@ fn sweep_tile(
                 }
             }
             for (frame_sums, l) in sums.iter_mut().zip(&radiance) {
-                frame_sums[i].add(*l, &ps.aov);
+                frame_sums[i].add_radiance(*l);
             }
+            aov_sums[i].add(Vec3::ZERO, &ps.aov);
         }
     }
-    let mut aov = Vec::new();
+    let aov = Image::from_sums(tw, th, &aov_sums).aov;
     let frames = sums
         .iter()
         .map(|frame_sums| {
             let mut img = Image::from_sums(tw, th, frame_sums);
-            if aov.is_empty() {
-                aov = std::mem::take(&mut img.aov);
-            } else {
-                img.aov = Vec::new();
-            }
+            img.aov = Vec::new();
             img
         })
         .collect();
     TileFrames { aov, frames }
 }
 
-/// [`integrator::direct_radiance`] of one primary sample for every frame's lights, into `out`.
+/// Per-sample buffers of [`direct_for_frames`], reused across samples.
+#[derive(Default)]
+struct FrameScratch {
+    /// Whether each frame's sample is shaded at the first hit (not a light seen in front).
+    shaded: Vec<bool>,
+    /// The light-sample numbers of each light (the same in every frame).
+    us: Vec<LightU>,
+    /// Each light's next-event term; those of the lights that do not move hold for every frame.
+    terms: Vec<Vec3>,
+}
+
+/// [`integrator::direct_radiance`] of one primary sample for every frame's lights, into `out`;
+/// light `moving` is the only one whose place differs between frames.
 ///
 /// The lighting stream `rng` draws two numbers per light for next-event estimation whatever the
-/// light's position, so the BSDF-sampled direction that follows — and the scene hit along it —
-/// is the same in every frame: it is traced once, and per frame only the light it may meet is
-/// tested (the MIS weighting is the renderer's `shade_direct`, step for step).
+/// lights' positions, so the numbers — and hence the next-event terms of the lights that do not
+/// move — are the same in every frame and are computed once; per frame only the moving light is
+/// sampled, with the BSDF prepared for this `wo` once ([`BsdfAtWo`]). The BSDF-sampled direction
+/// that follows, and the scene hit along it, are also the same in every frame: traced once, and
+/// per frame only the light it may meet is tested. Sums run in the renderer's order
+/// (`sample_lights`, `shade_direct`), so each frame equals the naive render.
 fn direct_for_frames(
     scene: &Scene,
     ps: &PrimarySample,
     lights: &[Vec<Light>],
+    moving: usize,
     rng: &Pcg32,
+    scratch: &mut FrameScratch,
     out: &mut [Vec3],
 ) {
     let mut rays = RayCount::default();
-    let mut shaded = vec![false; out.len()];
-    let mut after_nee: Option<Pcg32> = None;
+    let FrameScratch { shaded, us, terms } = scratch;
+    shaded.clear();
+    shaded.resize(out.len(), false);
     for (k, frame_lights) in lights.iter().enumerate() {
         // A light seen directly in front of the first hit (or on a miss) is the sample's value.
         if let Some((_, t, le, _)) = integrator::nearest_light(frame_lights, &ps.ray, ps.t_hit) {
@@ -395,21 +425,50 @@ fn direct_for_frames(
                 continue;
             }
         }
-        let Some(sp) = &ps.point else {
+        shaded[k] = ps.point.is_some();
+        if !shaded[k] {
             out[k] = Vec3::ZERO;
-            continue;
-        };
-        let mut r = rng.clone();
-        out[k] = integrator::sample_lights(scene, sp, frame_lights, &mut r, &mut rays);
-        shaded[k] = true;
-        after_nee.get_or_insert(r);
+        }
     }
-    let (Some(sp), Some(mut r)) = (&ps.point, after_nee) else {
+    let (Some(sp), Some(first)) = (&ps.point, shaded.iter().position(|&s| s)) else {
         return;
     };
+    // Next-event estimation, as `sample_lights` does it in each frame.
+    let mut r = rng.clone();
+    if sp.bsdf.is_delta() {
+        for (l, _) in out.iter_mut().zip(shaded.iter()).filter(|(_, &s)| s) {
+            *l = Vec3::ZERO;
+        }
+    } else {
+        let bsdf = BsdfAtWo::new(sp);
+        us.clear();
+        terms.clear();
+        for (j, light) in lights[first].iter().enumerate() {
+            let u = LightU::new(r.next_vec2());
+            us.push(u);
+            terms.push(if j == moving {
+                Vec3::ZERO
+            } else {
+                integrator::light_term(scene, sp, &bsdf, light.sample_at(sp.p, &u), &mut rays)
+            });
+        }
+        for (k, frame_lights) in lights.iter().enumerate() {
+            if !shaded[k] {
+                continue;
+            }
+            let m = &frame_lights[moving];
+            let term_m =
+                integrator::light_term(scene, sp, &bsdf, m.sample_at(sp.p, &us[moving]), &mut rays);
+            let mut l = Vec3::ZERO;
+            for (j, t) in terms.iter().enumerate() {
+                l += if j == moving { term_m } else { *t };
+            }
+            out[k] = l;
+        }
+    }
     let uc = r.next_f32();
     let u = r.next_vec2();
-    if lights[0].iter().all(Light::is_delta) {
+    if lights[first].iter().all(Light::is_delta) {
         return;
     }
     let Some(bs) = sp.bsdf.sample(sp.wo, uc, u) else {

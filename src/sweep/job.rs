@@ -9,9 +9,9 @@ use super::sequence::{
     Region, SequenceError,
 };
 use crate::render::image_io::{aov_layers, write_exr_layers, ExrLayer, ImageError};
-use rayon::prelude::*;
 use crate::render::{RenderError, RunOptions};
 use crate::scene::LoadedScene;
+use rayon::prelude::*;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
