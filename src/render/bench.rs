@@ -1,11 +1,16 @@
 //! The tracing benchmark behind `xylem bench trace` and benches/trace.rs: a bumpy sphere of about
 //! N triangles, a fixed set of coherent (pinhole camera) and incoherent (random) rays, BVH build
-//! time and closest-hit / any-hit rays per second on one core.
+//! time and closest-hit / any-hit rays per second on one core, for xylem's wide BVH and, on the
+//! same mesh and rays, obvhs's CWBVH traversal (and Embree 3 with the feature `embree-anchor`).
 
 use super::geometry::{Accel, Instance, Ray, Transform, TriMesh};
 use crate::material::Placement;
 use crate::math::{uniform_sphere, Pcg32, PI};
 use glam::{Vec2, Vec3};
+use obvhs::cwbvh::{builder::build_cwbvh_from_tris, CwBvh};
+use obvhs::ray::{Ray as BvhRay, RayHit};
+use obvhs::rt_triangle::RtTriangle;
+use obvhs::triangle::Triangle;
 use obvhs::BvhBuildParams;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -96,8 +101,86 @@ pub struct TraceReport {
     pub build_total_s: f64,
     pub coherent: TraceFigures,
     pub incoherent: TraceFigures,
+    /// The same mesh, build parameters and rays through obvhs's own CWBVH build and traversal
+    /// (what the renderer used before the wide BVH), for comparison.
+    pub obvhs_cwbvh: CwBvhFigures,
     /// The same mesh and rays through Embree 3 (feature `embree-anchor`).
     pub embree: Option<EmbreeFigures>,
+}
+
+/// obvhs CWBVH figures: core build time and both ray sets.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct CwBvhFigures {
+    pub build_core_s: f64,
+    pub coherent: TraceFigures,
+    pub incoherent: TraceFigures,
+}
+
+/// obvhs's own CWBVH build and traversal of a mesh (object space = world space), with
+/// `RtTriangle`s in BVH primitive order: the renderer's tracer before the wide BVH.
+pub struct ObvhsCwBvh {
+    bvh: CwBvh,
+    tris: Vec<RtTriangle>,
+    pub build_time: Duration,
+}
+
+impl ObvhsCwBvh {
+    pub fn new(mesh: &TriMesh, params: BvhBuildParams) -> Self {
+        let world: Vec<Triangle> = (mesh.indices.iter())
+            .map(|t| {
+                let [a, b, c] = t.map(|i| mesh.positions[i as usize].into());
+                Triangle {
+                    v0: a,
+                    v1: b,
+                    v2: c,
+                }
+            })
+            .collect();
+        let mut build_time = Duration::ZERO;
+        let bvh = build_cwbvh_from_tris(&world, params, &mut build_time);
+        let tris = (bvh.primitive_indices.iter())
+            .map(|&i| RtTriangle::from(&world[i as usize]))
+            .collect();
+        ObvhsCwBvh {
+            bvh,
+            tris,
+            build_time,
+        }
+    }
+
+    /// Times `ray_traverse` (closest hit) and `ray_traverse_miss` (any hit) over `rays`.
+    pub fn time_rays(&self, rays: &[Ray]) -> TraceFigures {
+        // +0.0 turns −0.0 direction components into +0.0 (obvhs mishandles −0.0).
+        let ray = |r: &Ray| BvhRay::new(r.o.into(), (r.d + Vec3::ZERO).into(), 0.0, f32::INFINITY);
+        let tris = &self.tris;
+        let t0 = ThreadTimer::start();
+        let mut hits = 0usize;
+        for r in rays {
+            let mut hit = RayHit::none();
+            hits +=
+                (self.bvh).ray_traverse(ray(r), &mut hit, |r, id| tris[id].intersect(r)) as usize;
+        }
+        let closest = t0.elapsed();
+        let t1 = ThreadTimer::start();
+        for r in rays {
+            std::hint::black_box(
+                self.bvh
+                    .ray_traverse_miss(ray(r), |r, id| tris[id].intersect(r)),
+            );
+        }
+        figures(rays.len(), hits, closest, t1.elapsed())
+    }
+}
+
+/// Rays per second from counts and times.
+pub fn figures(rays: usize, hits: usize, closest: Duration, any: Duration) -> TraceFigures {
+    let rate = |d: Duration| rays as f64 / d.as_secs_f64().max(1e-12) / 1e6;
+    TraceFigures {
+        rays,
+        closest_hits: hits,
+        closest_mrays_per_s: rate(closest),
+        any_hit_mrays_per_s: rate(any),
+    }
 }
 
 /// Embree's figures on the same mesh and rays, and xylem's closest-hit speed as a fraction of it.
@@ -110,9 +193,50 @@ pub struct EmbreeFigures {
     pub closest_ratio_incoherent: f64,
 }
 
+/// A stopwatch over the calling thread's CPU time (`CLOCK_THREAD_CPUTIME_ID` on Linux, wall time
+/// elsewhere): on a shared machine the time the tracing thread waits descheduled is not counted,
+/// for xylem and Embree alike.
+#[derive(Clone, Copy)]
+pub struct ThreadTimer(Duration);
+
+impl ThreadTimer {
+    pub fn start() -> Self {
+        ThreadTimer(thread_time())
+    }
+
+    pub fn elapsed(&self) -> Duration {
+        thread_time().saturating_sub(self.0)
+    }
+}
+
+#[cfg(target_os = "linux")]
+fn thread_time() -> Duration {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid timespec for clock_gettime to write.
+    let ok = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) } == 0;
+    if ok {
+        Duration::new(ts.tv_sec as u64, ts.tv_nsec as u32)
+    } else {
+        wall_time()
+    }
+}
+
+#[cfg(not(target_os = "linux"))]
+fn thread_time() -> Duration {
+    wall_time()
+}
+
+fn wall_time() -> Duration {
+    static START: std::sync::OnceLock<Instant> = std::sync::OnceLock::new();
+    START.get_or_init(Instant::now).elapsed()
+}
+
 /// Traces `rays` closest-hit and any-hit on the calling thread and times both.
 pub fn time_rays(accel: &Accel, rays: &[Ray]) -> TraceFigures {
-    let t0 = Instant::now();
+    let t0 = ThreadTimer::start();
     let mut hits = 0usize;
     for r in rays {
         if accel.intersect(r, f32::INFINITY).is_some() {
@@ -120,7 +244,7 @@ pub fn time_rays(accel: &Accel, rays: &[Ray]) -> TraceFigures {
         }
     }
     let closest = t0.elapsed();
-    let t1 = Instant::now();
+    let t1 = ThreadTimer::start();
     let mut free = 0usize;
     for r in rays {
         if accel.unoccluded(r, f32::INFINITY) {
@@ -129,26 +253,24 @@ pub fn time_rays(accel: &Accel, rays: &[Ray]) -> TraceFigures {
     }
     let any = t1.elapsed();
     debug_assert_eq!(free + hits, rays.len());
-    let rate = |d: Duration| rays.len() as f64 / d.as_secs_f64().max(1e-12) / 1e6;
-    TraceFigures {
-        rays: rays.len(),
-        closest_hits: hits,
-        closest_mrays_per_s: rate(closest),
-        any_hit_mrays_per_s: rate(any),
+    figures(rays.len(), hits, closest, any)
+}
+
+/// Keeps the faster of two measurements per figure: on a shared machine the least disturbed run
+/// is the best estimate.
+fn keep_best(best: &mut Option<TraceFigures>, r: TraceFigures) {
+    match best {
+        Some(b) => {
+            b.closest_mrays_per_s = b.closest_mrays_per_s.max(r.closest_mrays_per_s);
+            b.any_hit_mrays_per_s = b.any_hit_mrays_per_s.max(r.any_hit_mrays_per_s);
+        }
+        None => *best = Some(r),
     }
 }
 
-/// The fastest of `n` runs per figure: on a shared machine the minimum time is the least
-/// disturbed estimate.
-pub fn best_of(n: usize, mut f: impl FnMut() -> TraceFigures) -> TraceFigures {
-    let mut best = f();
-    for _ in 1..n {
-        let r = f();
-        best.closest_mrays_per_s = best.closest_mrays_per_s.max(r.closest_mrays_per_s);
-        best.any_hit_mrays_per_s = best.any_hit_mrays_per_s.max(r.any_hit_mrays_per_s);
-    }
-    best
-}
+/// Timing rounds: each figure is the best of these, and every round times all tracers one after
+/// the other, so that a burst of load from other processes hits them alike.
+pub const ROUNDS: usize = 3;
 
 /// Builds the mesh's BVH with `params` (named `name` in the report) and times both ray sets.
 pub fn run_trace_benchmark(
@@ -170,22 +292,47 @@ pub fn run_trace_benchmark(
         params,
     );
     let build_total_s = t.elapsed().as_secs_f64();
-    let c = best_of(3, || time_rays(&accel, &coherent));
-    let i = best_of(3, || time_rays(&accel, &incoherent));
+    let mesh = &accel.instances[0].mesh;
+    let cwbvh = ObvhsCwBvh::new(mesh, params);
     #[cfg(feature = "embree-anchor")]
-    let embree = super::embree::EmbreeScene::new(&accel.instances[0].mesh).map(|e| {
-        let ec = best_of(3, || super::embree::time_rays(&e, &coherent, true));
-        let ei = best_of(3, || super::embree::time_rays(&e, &incoherent, false));
-        EmbreeFigures {
+    let embree_scene = super::embree::EmbreeScene::new(mesh);
+    // [xylem, obvhs CWBVH, Embree] × [coherent, incoherent]
+    let mut best: [[Option<TraceFigures>; 2]; 3] = Default::default();
+    for _ in 0..ROUNDS {
+        for (set, rays) in [&coherent, &incoherent].into_iter().enumerate() {
+            keep_best(&mut best[0][set], time_rays(&accel, rays));
+            keep_best(&mut best[1][set], cwbvh.time_rays(rays));
+            #[cfg(feature = "embree-anchor")]
+            if let Some(e) = &embree_scene {
+                keep_best(
+                    &mut best[2][set],
+                    super::embree::time_rays(e, rays, set == 0),
+                );
+            }
+        }
+    }
+    let [[c, i], [cw_c, cw_i], [e_c, e_i]] = best;
+    let (c, i) = (c.expect("ROUNDS > 0"), i.expect("ROUNDS > 0"));
+    let obvhs_cwbvh = CwBvhFigures {
+        build_core_s: cwbvh.build_time.as_secs_f64(),
+        coherent: cw_c.expect("ROUNDS > 0"),
+        incoherent: cw_i.expect("ROUNDS > 0"),
+    };
+    #[cfg(feature = "embree-anchor")]
+    let embree = embree_scene
+        .zip(e_c.zip(e_i))
+        .map(|(e, (ec, ei))| EmbreeFigures {
             build_s: e.build_time.as_secs_f64(),
             closest_ratio_coherent: c.closest_mrays_per_s / ec.closest_mrays_per_s,
             closest_ratio_incoherent: i.closest_mrays_per_s / ei.closest_mrays_per_s,
             coherent: ec,
             incoherent: ei,
-        }
-    });
+        });
     #[cfg(not(feature = "embree-anchor"))]
-    let embree = None;
+    let embree = {
+        let _ = (e_c, e_i);
+        None
+    };
     TraceReport {
         triangles: accel.triangle_count(),
         build_params: name.to_string(),
@@ -193,6 +340,7 @@ pub fn run_trace_benchmark(
         build_total_s,
         coherent: c,
         incoherent: i,
+        obvhs_cwbvh,
         embree,
     }
 }

@@ -197,26 +197,20 @@ impl Drop for EmbreeScene {
 
 /// Times Embree on the same rays as [`super::bench::time_rays`].
 pub fn time_rays(scene: &EmbreeScene, rays: &[Ray], coherent: bool) -> super::bench::TraceFigures {
-    let t0 = Instant::now();
+    let t0 = super::bench::ThreadTimer::start();
     let hits = rays
         .iter()
         .filter(|r| scene.intersect(r, coherent).is_some())
         .count();
     let closest = t0.elapsed();
-    let t1 = Instant::now();
+    let t1 = super::bench::ThreadTimer::start();
     let free = rays
         .iter()
         .filter(|r| scene.unoccluded(r, f32::INFINITY, coherent))
         .count();
     let any = t1.elapsed();
     debug_assert_eq!(free + hits, rays.len());
-    let rate = |d: Duration| rays.len() as f64 / d.as_secs_f64().max(1e-12) / 1e6;
-    super::bench::TraceFigures {
-        rays: rays.len(),
-        closest_hits: hits,
-        closest_mrays_per_s: rate(closest),
-        any_hit_mrays_per_s: rate(any),
-    }
+    super::bench::figures(rays.len(), hits, closest, any)
 }
 
 #[cfg(test)]

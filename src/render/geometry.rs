@@ -1,16 +1,20 @@
 //! Triangle meshes, instances with affine transforms, and the acceleration structure: every
-//! instance is flattened into world space and put into one obvhs compressed wide BVH (CWBVH,
-//! Ylitie et al. 2017), the builder and CPU traversal obvhs recommends for speed.
+//! instance is flattened into world space, obvhs builds one BVH2 over all triangles (PLOC +
+//! reinsertion, its recommended builder), and [`WideBvh`] collapses it into the 8-wide layout the
+//! renderer traverses (faster than obvhs's CWBVH traversal here: notes/render.md).
 
+use super::wide_bvh::WideBvh;
 use crate::material::Placement;
 use glam::{Affine3A, Mat3, Vec2, Vec3, Vec3A};
-use obvhs::cwbvh::{builder::build_cwbvh_from_tris, CwBvh};
-use obvhs::ray::{Ray as BvhRay, RayHit};
+use obvhs::bvh2::{reinsertion::ReinsertionOptimizer, Bvh2};
+use obvhs::ploc::PlocBuilder;
+use obvhs::ray::Ray as BvhRay;
 use obvhs::rt_triangle::RtTriangle;
+use obvhs::splits::split_aabbs_preset;
 use obvhs::triangle::Triangle;
 use obvhs::BvhBuildParams;
 use std::sync::Arc;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 /// An indexed triangle mesh in object space (millimetres).
 #[derive(Clone, Debug, Default)]
@@ -162,23 +166,20 @@ pub struct SurfaceHit {
     pub instance: u32,
 }
 
-/// All instances flattened into world-space triangles in one CWBVH.
+/// All instances flattened into world-space triangles in one wide BVH.
 pub struct Accel {
-    bvh: CwBvh,
-    /// Triangles in BVH primitive order (so traversal needs no index indirection).
-    tris: Vec<RtTriangle>,
-    /// Global triangle id of each BVH primitive.
-    prim_tri: Vec<u32>,
+    bvh: WideBvh,
     /// First global triangle id of each instance (prefix sums), plus the total at the end.
     offsets: Vec<u32>,
     pub instances: Vec<Instance>,
-    /// Time spent in the obvhs core build.
+    /// Time spent building: obvhs's BVH2 (PLOC, reinsertion) and its collapse to the wide BVH.
     pub build_time: Duration,
     bounds_radius: f32,
 }
 
 /// The BVH build parameters used by the renderer (`medium_build`: PLOC with reinsertion; measured
-/// against the others in notes/render.md).
+/// against the others in notes/render.md). Only the BVH2 settings matter (leaf size and the
+/// CWBVH/BVH2 collapse settings are not used: the wide BVH makes leaves of up to 4 triangles).
 pub const BUILD_PARAMS: BvhBuildParams = BvhBuildParams::medium_build();
 
 impl Accel {
@@ -204,37 +205,27 @@ impl Accel {
             }));
         }
         offsets.push(world.len() as u32);
-        let mut build_time = Duration::ZERO;
         let mut bounds_radius = 1.0f32;
         for t in &world {
             for v in [t.v0, t.v1, t.v2] {
                 bounds_radius = bounds_radius.max(v.abs().max_element());
             }
         }
-        if world.is_empty() {
-            return Accel {
-                bvh: CwBvh::default(),
-                tris: Vec::new(),
-                prim_tri: Vec::new(),
-                offsets,
-                instances,
-                build_time,
-                bounds_radius,
-            };
-        }
-        let bvh = build_cwbvh_from_tris(&world, params, &mut build_time);
-        let prim_tri = bvh.primitive_indices.clone();
-        let tris = prim_tri
-            .iter()
-            .map(|&i| RtTriangle::from(&world[i as usize]))
-            .collect();
+        let start = Instant::now();
+        let bvh = if world.is_empty() {
+            WideBvh::default()
+        } else {
+            let corners: Vec<[Vec3; 3]> = world
+                .iter()
+                .map(|t| [t.v0.into(), t.v1.into(), t.v2.into()])
+                .collect();
+            WideBvh::from_bvh2(&build_bvh2(&world, &params), &corners)
+        };
         Accel {
             bvh,
-            tris,
-            prim_tri,
             offsets,
             instances,
-            build_time,
+            build_time: start.elapsed(),
             bounds_radius,
         }
     }
@@ -249,40 +240,27 @@ impl Accel {
         self.bounds_radius
     }
 
-    /// Closest hit with `t` in (0, t_max).
+    /// Closest hit with `t` in [0, t_max).
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
-        if self.tris.is_empty() {
-            return None;
-        }
-        let r = bvh_ray(ray, t_max);
-        let mut hit = RayHit::none();
-        let tris = &self.tris;
-        if !self
-            .bvh
-            .ray_traverse(r, &mut hit, |r, id| tris[id].intersect(r))
-        {
-            return None;
-        }
-        let prim = hit.primitive_id as usize;
-        let uv = self.tris[prim].compute_barycentric(&r);
-        let global = self.prim_tri[prim];
+        let hit = self.bvh.closest(ray.o, ray.d, t_max)?;
+        let global = hit.triangle;
         let instance = self.offsets.partition_point(|&o| o <= global) as u32 - 1;
         Some(Hit {
             t: hit.t,
             instance,
             triangle: global - self.offsets[instance as usize],
-            uv,
+            uv: hit.uv,
         })
     }
 
-    /// True when nothing blocks the segment `o + t·d`, t in (0, t_max) (early-out shadow query).
+    /// True when nothing blocks the segment `o + t·d`, t in [0, t_max) (early-out shadow query).
     pub fn unoccluded(&self, ray: &Ray, t_max: f32) -> bool {
-        if self.tris.is_empty() {
-            return true;
-        }
-        let r = bvh_ray(ray, t_max);
-        let tris = &self.tris;
-        self.bvh.ray_traverse_miss(r, |r, id| tris[id].intersect(r))
+        self.bvh.unoccluded(ray.o, ray.d, t_max)
+    }
+
+    /// The wide BVH (for the benchmark and the test that its AVX2 and portable paths agree).
+    pub fn wide_bvh(&self) -> &WideBvh {
+        &self.bvh
     }
 
     /// Position, normals and object-space point of a hit.
@@ -323,20 +301,55 @@ impl Accel {
     }
 }
 
-/// The obvhs ray of a segment. obvhs 0.4 picks the child order from `direction < 0` but the slab
-/// signs from `1/direction`, which disagree for −0.0, so a ray like (−0, −0, −1) misses
-/// everything; adding +0.0 turns every −0.0 into +0.0 (IEEE 754: −0 + +0 = +0).
-#[inline]
-fn bvh_ray(ray: &Ray, t_max: f32) -> BvhRay {
-    BvhRay::new(ray.o.into(), (ray.d + Vec3::ZERO).into(), 0.0, t_max)
+/// obvhs's BVH2 over `world`, built as its `build_cwbvh_from_tris` helper does up to the BVH2:
+/// optional spatial pre-splits, PLOC (one primitive per leaf), reinsertion.
+pub fn build_bvh2(world: &[Triangle], params: &BvhBuildParams) -> Bvh2 {
+    let mut indices: Vec<u32> = (0..world.len() as u32).collect();
+    let mut bvh2 = if params.pre_split {
+        let mut aabbs: Vec<_> = world.iter().map(|t| t.aabb()).collect();
+        let half_areas = aabbs.iter().map(|a| a.half_area());
+        let largest = half_areas.clone().fold(0.0f32, f32::max);
+        let average = half_areas.sum::<f32>() / world.len() as f32;
+        split_aabbs_preset(&mut aabbs, &mut indices, world, average, largest);
+        PlocBuilder::with_capacity(aabbs.len()).build(
+            params.ploc_search_distance,
+            &aabbs,
+            indices,
+            params.sort_precision,
+            params.search_depth_threshold,
+        )
+    } else {
+        PlocBuilder::with_capacity(world.len()).build(
+            params.ploc_search_distance,
+            world,
+            indices,
+            params.sort_precision,
+            params.search_depth_threshold,
+        )
+    };
+    bvh2.uses_spatial_splits = params.pre_split;
+    ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
+    bvh2
 }
 
-/// Brute-force closest hit over every world-space triangle (the reference the BVH is tested against).
+/// Brute-force closest hit over every world-space triangle with obvhs's own triangle test
+/// (`RtTriangle::intersect`), the independent reference the BVH is tested against.
 pub fn brute_force_closest(accel: &Accel, ray: &Ray, t_max: f32) -> Option<f32> {
-    let r = bvh_ray(ray, t_max);
+    // +0.0 turns a −0.0 direction component into +0.0 (obvhs's ray setup mishandles −0.0).
+    let r = BvhRay::new(ray.o.into(), (ray.d + Vec3::ZERO).into(), 0.0, t_max);
     accel
-        .tris
+        .instances
         .iter()
+        .flat_map(|inst| {
+            let p: Vec<Vec3A> = (inst.mesh.positions.iter())
+                .map(|&v| inst.transform.point_to_world(v).into())
+                .collect();
+            inst.mesh
+                .indices
+                .iter()
+                .map(move |t| RtTriangle::new(p[t[0] as usize], p[t[1] as usize], p[t[2] as usize]))
+                .collect::<Vec<_>>()
+        })
         .map(|t| t.intersect(&r))
         .filter(|t| *t < t_max)
         .min_by(|a, b| a.total_cmp(b))

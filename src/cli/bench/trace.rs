@@ -45,11 +45,17 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             )
         };
         println!(
-            "obvhs CWBVH, build `{name}`: {} triangles, build {:.3} s core / {:.3} s total (all cores); tracing on 1 core:",
+            "xylem wide BVH (obvhs BVH2 build `{name}`): {} triangles, build {:.3} s core / {:.3} s total (all cores); tracing on 1 core:",
             r.triangles, r.build_core_s, r.build_total_s
         );
         row("coherent", &r.coherent);
         row("incoherent", &r.incoherent);
+        println!(
+            "obvhs CWBVH traversal (same build preset, build {:.3} s core); tracing on 1 core:",
+            r.obvhs_cwbvh.build_core_s
+        );
+        row("coherent", &r.obvhs_cwbvh.coherent);
+        row("incoherent", &r.obvhs_cwbvh.incoherent);
         match &r.embree {
             Some(e) => {
                 println!(
