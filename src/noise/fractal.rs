@@ -92,6 +92,79 @@ impl Fractal {
         }
     }
 
+    /// [`Fractal::eval`] at every point of `points`, written to `out` (same length). For the
+    /// gradient basis the lanes are points — 16, 8 or 4 at once ([`Simd::best`]) — and the
+    /// octaves a loop, so no lane idles whatever the octave count; the value basis and the last
+    /// `len % lanes` points go one at a time. Values equal to `eval` (tested).
+    ///
+    /// # Panics
+    /// If `points.len() != out.len()`.
+    pub fn eval_many(&self, points: &[Vec3], seed: u32, out: &mut [f32]) {
+        self.eval_many_with(Simd::best(), points, seed, out)
+    }
+
+    /// [`Fractal::eval_many`] on `simd`, or the best the CPU has if it lacks it.
+    pub fn eval_many_with(&self, simd: Simd, points: &[Vec3], seed: u32, out: &mut [f32]) {
+        assert_eq!(
+            points.len(),
+            out.len(),
+            "Fractal::eval_many: {} points but {} outputs",
+            points.len(),
+            out.len()
+        );
+        let simd = match self.basis {
+            Basis::Gradient => simd.min(Simd::best()),
+            Basis::Value => Simd::Scalar,
+        };
+        // SAFETY: `simd` is no wider than `Simd::best()`.
+        #[cfg(target_arch = "x86_64")]
+        let done = match simd {
+            Simd::Scalar => 0,
+            Simd::Sse2 => unsafe { self.many::<std::arch::x86_64::__m128>(points, seed, out) },
+            Simd::Avx2 => unsafe { many_avx2(self, points, seed, out) },
+            Simd::Avx512 => unsafe { many_avx512(self, points, seed, out) },
+        };
+        #[cfg(not(target_arch = "x86_64"))]
+        let done = 0;
+        for (p, o) in points[done..].iter().zip(&mut out[done..]) {
+            *o = self.eval(*p, seed);
+        }
+    }
+
+    /// Gradient-basis sums on whole groups of `L::N` points; returns how many points it wrote.
+    /// Per octave and lane: `p · freq + shift`, the kernel, the fold, `total += amp · fold` —
+    /// the scalar sum's operations in its order.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    unsafe fn many<L: Lanes>(&self, points: &[Vec3], seed: u32, out: &mut [f32]) -> usize {
+        for (p, o) in points.chunks_exact(L::N).zip(out.chunks_exact_mut(L::N)) {
+            let (x, y, z) = L::load_xyz(p);
+            let mut oct = Octaves::new(self, seed);
+            let mut total = L::splat(0.0);
+            while oct.left > 0 {
+                let f = L::splat(oct.freq);
+                let n = kernel(
+                    x.mul(f).add(L::splat(oct.shift.x)),
+                    y.mul(f).add(L::splat(oct.shift.y)),
+                    z.mul(f).add(L::splat(oct.shift.z)),
+                    L::splat_i(oct.s),
+                );
+                let folded = match self.kind {
+                    FractalKind::Fbm => n,
+                    FractalKind::Turbulence => n.abs(),
+                    FractalKind::Ridged => {
+                        let r = L::splat(1.0).sub(n.abs());
+                        r.mul(r)
+                    }
+                };
+                total = total.add(L::splat(oct.amp).mul(folded));
+                oct.step();
+            }
+            total.store(o);
+        }
+        points.len() / L::N * L::N
+    }
+
     /// Value and analytic gradient (the chain rule through |·| uses sign(n); at n = 0 the
     /// turbulence and ridged sums have a crease where the gradient is one-sided).
     #[inline]
@@ -285,6 +358,42 @@ mod tests {
     use crate::math::Pcg32;
 
     #[test]
+    fn every_simd_batch_path_equals_eval() {
+        // Same operations in the same order per point, so equal values; 37 points leave a
+        // scalar tail on every lane width, both bases and all kinds.
+        let mut r = Pcg32::new(12, 0);
+        let pts: Vec<Vec3> = (0..37)
+            .map(|_| {
+                Vec3::new(r.next_f32(), r.next_f32(), r.next_f32()) * 400.0 - Vec3::splat(200.0)
+            })
+            .collect();
+        for basis in [Basis::Gradient, Basis::Value] {
+            for kind in [
+                FractalKind::Fbm,
+                FractalKind::Turbulence,
+                FractalKind::Ridged,
+            ] {
+                for octaves in [1, 5, 9] {
+                    let fr = Fractal {
+                        kind,
+                        basis,
+                        octaves,
+                        lacunarity: 2.1,
+                        gain: 0.45,
+                    };
+                    for simd in [Simd::Scalar, Simd::Sse2, Simd::Avx2, Simd::Avx512] {
+                        let mut out = vec![f32::NAN; pts.len()];
+                        fr.eval_many_with(simd, &pts, 77, &mut out);
+                        for (p, v) in pts.iter().zip(out) {
+                            assert_eq!(v, fr.eval(*p, 77), "{simd:?} {basis:?} {kind:?} {octaves}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
     fn every_simd_octave_path_equals_scalar_sum() {
         // The lane paths and the scalar `sum` over the scalar kernel evaluate the same octaves
         // (points, seeds) with the same operations in the same order, so equal values; 1–17 octaves cover partial and several lane groups.
@@ -318,4 +427,16 @@ mod tests {
             }
         }
     }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn many_avx2(f: &Fractal, points: &[Vec3], seed: u32, out: &mut [f32]) -> usize {
+    f.many::<std::arch::x86_64::__m256>(points, seed, out)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn many_avx512(f: &Fractal, points: &[Vec3], seed: u32, out: &mut [f32]) -> usize {
+    f.many::<std::arch::x86_64::__m512>(points, seed, out)
 }

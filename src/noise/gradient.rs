@@ -311,9 +311,9 @@ unsafe fn hash<L: Lanes>(x: L::I, y: L::I, z: L::I, s: L::I) -> L::I {
 #[inline(always)]
 unsafe fn gdot<L: Lanes>(h: L::I, dx: L, dy: L, dz: L) -> L {
     let axis = L::and_i(L::shr(h, 27), L::splat_i(3));
-    let tx = dx.flip_sign(h).zero_where_eq(axis, 0);
-    let ty = dy.flip_sign(L::shl(h, 1)).zero_where_eq(axis, 1);
-    let tz = dz.flip_sign(L::shl(h, 2)).zero_where_eq(axis, 2);
+    let tx = dx.flip_sign(h, 31).zero_where_eq(axis, 0);
+    let ty = dy.flip_sign(h, 30).zero_where_eq(axis, 1);
+    let tz = dz.flip_sign(h, 29).zero_where_eq(axis, 2);
     tx.add(ty).add(tz)
 }
 

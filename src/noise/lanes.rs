@@ -83,18 +83,21 @@ pub(crate) trait Lanes: Copy {
     unsafe fn add(self, b: Self) -> Self;
     unsafe fn sub(self, b: Self) -> Self;
     unsafe fn mul(self, b: Self) -> Self;
+    /// |self| (sign bit cleared, as `f32::abs`).
+    unsafe fn abs(self) -> Self;
     unsafe fn add_i(a: Self::I, b: Self::I) -> Self::I;
     unsafe fn xor_i(a: Self::I, b: Self::I) -> Self::I;
     unsafe fn and_i(a: Self::I, b: Self::I) -> Self::I;
     /// Low 32 bits of the lane-wise product (wrapping multiply).
     unsafe fn mul_lo(a: Self::I, b: Self::I) -> Self::I;
-    /// Logical shifts by `k` bits (a constant after inlining, so an immediate shift).
+    /// Logical right shift by `k` bits (a constant after inlining, so an immediate shift).
     unsafe fn shr(a: Self::I, k: i32) -> Self::I;
-    unsafe fn shl(a: Self::I, k: i32) -> Self::I;
     /// The lattice cell `trunc(x) − signbit(x)` (as `gradient::cell_of`) and `x − cell`.
     unsafe fn cell(self) -> (Self::I, Self);
-    /// `self` with its sign bit flipped where bit 31 of `bits` is set.
-    unsafe fn flip_sign(self, bits: Self::I) -> Self;
+    /// `self` with its sign bit flipped where bit `bit` of `bits` is set. (By a bit test, not a
+    /// shift of the bit to the sign: LLVM turns a left shift of the hash product into a second
+    /// vector multiply, which is slower.)
+    unsafe fn flip_sign(self, bits: Self::I, bit: u32) -> Self;
     /// `self` with the lanes where `a == b` replaced by +0.
     unsafe fn zero_where_eq(self, a: Self::I, b: u32) -> Self;
 }
@@ -145,6 +148,10 @@ impl Lanes for __m128 {
         _mm_mul_ps(self, b)
     }
     #[inline(always)]
+    unsafe fn abs(self) -> Self {
+        _mm_and_ps(self, _mm_castsi128_ps(_mm_set1_epi32(i32::MAX)))
+    }
+    #[inline(always)]
     unsafe fn add_i(a: __m128i, b: __m128i) -> __m128i {
         _mm_add_epi32(a, b)
     }
@@ -171,10 +178,6 @@ impl Lanes for __m128 {
         _mm_srl_epi32(a, _mm_cvtsi32_si128(k))
     }
     #[inline(always)]
-    unsafe fn shl(a: __m128i, k: i32) -> __m128i {
-        _mm_sll_epi32(a, _mm_cvtsi32_si128(k))
-    }
-    #[inline(always)]
     unsafe fn cell(self) -> (__m128i, Self) {
         let i = _mm_add_epi32(
             _mm_cvttps_epi32(self),
@@ -183,8 +186,10 @@ impl Lanes for __m128 {
         (i, _mm_sub_ps(self, _mm_cvtepi32_ps(i)))
     }
     #[inline(always)]
-    unsafe fn flip_sign(self, bits: __m128i) -> Self {
-        let sign = _mm_and_si128(bits, _mm_set1_epi32(i32::MIN));
+    unsafe fn flip_sign(self, bits: __m128i, bit: u32) -> Self {
+        let b = _mm_set1_epi32((1u32 << bit) as i32);
+        let set = _mm_cmpeq_epi32(_mm_and_si128(bits, b), b);
+        let sign = _mm_and_si128(set, _mm_set1_epi32(i32::MIN));
         _mm_xor_ps(self, _mm_castsi128_ps(sign))
     }
     #[inline(always)]
@@ -253,6 +258,10 @@ impl Lanes for __m256 {
         _mm256_mul_ps(self, b)
     }
     #[inline(always)]
+    unsafe fn abs(self) -> Self {
+        _mm256_and_ps(self, _mm256_castsi256_ps(_mm256_set1_epi32(i32::MAX)))
+    }
+    #[inline(always)]
     unsafe fn add_i(a: __m256i, b: __m256i) -> __m256i {
         _mm256_add_epi32(a, b)
     }
@@ -273,10 +282,6 @@ impl Lanes for __m256 {
         _mm256_srl_epi32(a, _mm_cvtsi32_si128(k))
     }
     #[inline(always)]
-    unsafe fn shl(a: __m256i, k: i32) -> __m256i {
-        _mm256_sll_epi32(a, _mm_cvtsi32_si128(k))
-    }
-    #[inline(always)]
     unsafe fn cell(self) -> (__m256i, Self) {
         let i = _mm256_add_epi32(
             _mm256_cvttps_epi32(self),
@@ -285,8 +290,10 @@ impl Lanes for __m256 {
         (i, _mm256_sub_ps(self, _mm256_cvtepi32_ps(i)))
     }
     #[inline(always)]
-    unsafe fn flip_sign(self, bits: __m256i) -> Self {
-        let sign = _mm256_and_si256(bits, _mm256_set1_epi32(i32::MIN));
+    unsafe fn flip_sign(self, bits: __m256i, bit: u32) -> Self {
+        let b = _mm256_set1_epi32((1u32 << bit) as i32);
+        let set = _mm256_cmpeq_epi32(_mm256_and_si256(bits, b), b);
+        let sign = _mm256_and_si256(set, _mm256_set1_epi32(i32::MIN));
         _mm256_xor_ps(self, _mm256_castsi256_ps(sign))
     }
     #[inline(always)]
@@ -350,6 +357,13 @@ impl Lanes for __m512 {
         _mm512_mul_ps(self, b)
     }
     #[inline(always)]
+    unsafe fn abs(self) -> Self {
+        _mm512_castsi512_ps(_mm512_and_si512(
+            _mm512_castps_si512(self),
+            _mm512_set1_epi32(i32::MAX),
+        ))
+    }
+    #[inline(always)]
     unsafe fn add_i(a: __m512i, b: __m512i) -> __m512i {
         _mm512_add_epi32(a, b)
     }
@@ -370,10 +384,6 @@ impl Lanes for __m512 {
         _mm512_srl_epi32(a, _mm_cvtsi32_si128(k))
     }
     #[inline(always)]
-    unsafe fn shl(a: __m512i, k: i32) -> __m512i {
-        _mm512_sll_epi32(a, _mm_cvtsi32_si128(k))
-    }
-    #[inline(always)]
     unsafe fn cell(self) -> (__m512i, Self) {
         let i = _mm512_add_epi32(
             _mm512_cvttps_epi32(self),
@@ -382,9 +392,15 @@ impl Lanes for __m512 {
         (i, _mm512_sub_ps(self, _mm512_cvtepi32_ps(i)))
     }
     #[inline(always)]
-    unsafe fn flip_sign(self, bits: __m512i) -> Self {
-        let sign = _mm512_and_si512(bits, _mm512_set1_epi32(i32::MIN));
-        _mm512_castsi512_ps(_mm512_xor_si512(_mm512_castps_si512(self), sign))
+    unsafe fn flip_sign(self, bits: __m512i, bit: u32) -> Self {
+        let set = _mm512_test_epi32_mask(bits, _mm512_set1_epi32((1u32 << bit) as i32));
+        let v = _mm512_castps_si512(self);
+        _mm512_castsi512_ps(_mm512_mask_xor_epi32(
+            v,
+            set,
+            v,
+            _mm512_set1_epi32(i32::MIN),
+        ))
     }
     #[inline(always)]
     unsafe fn zero_where_eq(self, a: __m512i, b: u32) -> Self {

@@ -14,6 +14,10 @@
 //! | [`value3`], [`value3_grad`] | value noise, quintic fade | [−1, 1) |
 //! | [`value1`], [`value1_grad`] | 1D value noise | [−1, 1) |
 //!
+//! Many points at once: [`gradient3_many`]`(&points, seed, &mut out)` runs the kernel on 16 / 8 /
+//! 4 points per call (AVX-512 / AVX2 / SSE2, detected at run time — [`Simd::best`]; scalar
+//! elsewhere), with the values of [`gradient3`]; [`Fractal::eval_many`] likewise.
+//!
 //! `*_grad` returns `(value, ∇value)` with the analytic gradient. The [`Noise3`] trait wraps
 //! them ([`Gradient`], [`Value`]) and [`SparseConvolution`] for code generic over the noise.
 //! Gradient noise at lattice points is 0; its variance is 0.0820 (value noise: 0.1604), derived
@@ -22,7 +26,8 @@
 //! # Sums, cells and warps
 //! - [`Fractal`] `{ kind: Fbm | Turbulence | Ridged, basis: Gradient | Value, octaves,
 //!   lacunarity, gain }` with `eval(p, seed)` / `eval_grad(p, seed)`; `Fractal::fbm(n)` is the
-//!   usual fBm (lacunarity 2, gain ½). Gradient-basis sums evaluate four octaves per SSE2 call.
+//!   usual fBm (lacunarity 2, gain ½). Gradient-basis sums evaluate their octaves in SIMD lanes
+//!   (8 per AVX2 call, else 4 per SSE2 call); `eval_many` puts points in the lanes instead.
 //! - [`cellular3`]`(p, jitter, seed)` → [`CellularSample`] `{ f1, f2, id, grad_f1, grad_f2,
 //!   nearest }` (`edge()` = F2 − F1); [`feature_point`] gives a cell's point.
 //! - [`Warp`] `{ fractal, strength, levels }`: Quilez's q / r domain warp, `sample` also returns

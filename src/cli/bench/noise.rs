@@ -1,6 +1,6 @@
 //! `xylem bench noise`: evaluations per second (one thread) of each noise over the same random
-//! points as the criterion bench (the batch `gradient3_many` on each instruction set the CPU has,
-//! then one call per point for the rest) (`cargo bench --bench noise`, which also times the peers
+//! points as the criterion bench (the batch calls `gradient3_many` and `Fractal::eval_many` on
+//! each instruction set the CPU has, then one call per point) (`cargo bench --bench noise`, which also times the peers
 //! noise-rs and fastnoise-lite). Best of several passes, so a shared machine's interruptions
 //! count less; figures in notes/noise.md.
 
@@ -31,13 +31,13 @@ pub fn bench_points(n: usize) -> Vec<Vec3> {
         .collect()
 }
 
-/// Million points per second of the batch call `gradient3_many_with(simd, ..)`, best of `passes`.
-fn batch_rate(points: &[Vec3], passes: usize, simd: Simd) -> f64 {
+/// Million points per second of a batch call `f(points, out)`, best of `passes`.
+fn batch_rate(points: &[Vec3], passes: usize, f: impl Fn(&[Vec3], &mut [f32])) -> f64 {
     let mut out = vec![0.0f32; points.len()];
     let mut best = f64::INFINITY;
     for _ in 0..passes.max(1) {
         let t = Instant::now();
-        gradient3_many_with(simd, std::hint::black_box(points), 7, &mut out);
+        f(std::hint::black_box(points), &mut out);
         best = best.min(t.elapsed().as_secs_f64());
         std::hint::black_box(&out);
     }
@@ -89,21 +89,32 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         ..sparse
     };
     let frame = Frame::from_normal(Vec3::new(0.2, 0.1, 1.0).normalize());
-    // The batch call on every instruction set this CPU has, widest first (the first row is
-    // what `gradient3_many` uses).
-    let mut rows: Vec<(String, f64)> = [Simd::Avx512, Simd::Avx2, Simd::Sse2, Simd::Scalar]
+    // The batch calls on every instruction set this CPU has, widest first (the first row of each
+    // is what `gradient3_many` / `Fractal::eval_many` use).
+    let isas: Vec<Simd> = [Simd::Avx512, Simd::Avx2, Simd::Sse2, Simd::Scalar]
         .into_iter()
         .filter(|&s| s <= Simd::best())
-        .map(|s| {
-            let name = format!("gradient3_many ({}, {} lanes)", s.name(), s.lanes());
-            (name, batch_rate(&pts, n, s))
-        })
         .collect();
+    let mut rows: Vec<(String, f64)> = Vec::new();
+    for &s in &isas {
+        let name = match s {
+            Simd::Scalar => "gradient3_many (scalar)".to_string(),
+            _ => format!("gradient3_many ({}, {} lanes)", s.name(), s.lanes()),
+        };
+        let r = batch_rate(&pts, n, |p, o| gradient3_many_with(s, p, 7, o));
+        rows.push((name, r));
+    }
+    // (Without lanes `eval_many` is the per-point `eval`, its own row below.)
+    for &s in isas.iter().filter(|&&s| s != Simd::Scalar) {
+        let name = format!("fbm5 eval_many ({}, {} lanes)", s.name(), s.lanes());
+        let r = batch_rate(&pts, n, |p, o| fbm5.eval_many_with(s, p, 7, o));
+        rows.push((name, r));
+    }
     let single: Vec<(&str, f64)> = vec![
         ("gradient3", rate(&pts, n, |p| gradient3(p, 7))),
         ("gradient3_grad", rate(&pts, n, |p| gradient3_grad(p, 7).0)),
         ("value3", rate(&pts, n, |p| value3(p, 7))),
-        ("fbm5", rate(&pts, n, |p| fbm5.eval(p, 7))),
+        ("fbm5 (eval per point)", rate(&pts, n, |p| fbm5.eval(p, 7))),
         ("fbm5 eval_grad", rate(&pts, n, |p| fbm5.eval_grad(p, 7).0)),
         ("turbulence5", rate(&pts, n, |p| turb5.eval(p, 7))),
         ("cellular3", rate(&pts, n, |p| cellular3(p, 1.0, 7).f1)),
