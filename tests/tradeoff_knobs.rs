@@ -289,3 +289,152 @@ fn footprint_filtering_removes_the_aliasing_of_pores() {
         "filtered {err_filtered} vs point {err_point}"
     );
 }
+
+mod baked {
+    use super::*;
+    use glam::{Affine3A, Vec2};
+    use xylem::bake::{bake_face, BakeCut, BoardCut};
+    use xylem::material::{
+        BakedFibers, BakedWoodMaterial, FaceRect, Material, MaterialHit, Placement,
+    };
+
+    fn board() -> (WoodVolume, FaceRect) {
+        let v = WoodVolume::new(preset("walnut").unwrap(), 2).unwrap();
+        let cut = BoardCut {
+            size: [120.0, 40.0, 20.0],
+            cut: BakeCut::Tangential,
+            radius: 140.0,
+        };
+        (v, cut.rect())
+    }
+
+    /// Mean |baked − procedural| of the diffuse colour over random points of the face.
+    fn colour_error(v: &WoodVolume, face: &FaceRect, res: u32) -> f64 {
+        let maps = bake_face(v, face, Affine3A::IDENTITY, res);
+        let mut rng = xylem::math::Pcg32::new(5, 5);
+        let n = 4000;
+        let mut e = 0.0f64;
+        for _ in 0..n {
+            let uv = rng.next_vec2();
+            let want = v.eval(face.point(uv), Needs::ALL).diffuse;
+            e += (maps.lookup(uv).base_color - want).abs().max_element() as f64;
+        }
+        e / n as f64
+    }
+
+    #[test]
+    fn baked_texture_converges_to_the_procedural_colour() {
+        // Rings and figure without pores and rays (which stay sub-texel up to 0.1 mm texels):
+        // bilinear interpolation of a smooth field errs by O(h²), so 16× finer texels must cut
+        // the mean error far more than the 4× an O(h) (nearest-texel) lookup would.
+        let mut p = preset("walnut").unwrap();
+        p.pores = None;
+        p.rays = None;
+        let v = WoodVolume::new(p, 2).unwrap();
+        let face = board().1;
+        let coarse = colour_error(&v, &face, 64);
+        let fine = colour_error(&v, &face, 1024);
+        assert!(
+            fine < coarse / 16.0,
+            "1024 texels {fine} vs 64 texels {coarse}"
+        );
+    }
+
+    #[test]
+    fn baked_material_reproduces_the_volume_at_texel_centres() {
+        let (v, face) = board();
+        let res = 96;
+        let maps = bake_face(&v, &face, Affine3A::IDENTITY, res);
+        let (w, h) = (maps.width, maps.height);
+        let mat = Material::BakedWood(Box::new(BakedWoodMaterial {
+            maps: std::sync::Arc::new(maps),
+            face,
+            fiber_saturation: preset("walnut").unwrap().color.fiber_saturation,
+            fibers: BakedFibers::Anisotropy,
+            eta: 1.5,
+            roughness: 0.0,
+            bump: 0.0,
+            switches: Default::default(),
+        }));
+        let n = face.normal();
+        let mut checked = 0;
+        for (x, y) in [(0, 0), (17, 5), (50, 20), (w - 1, h - 1)] {
+            let uv = Vec2::new((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
+            let p = face.point(uv);
+            let hit = MaterialHit {
+                p_object: p,
+                p_world: p,
+                n_object: n,
+                ng: n,
+                ns: n,
+                tangent: face.right,
+                object_to_world: Mat3::IDENTITY,
+                normal_to_world: Mat3::IDENTITY,
+                placement: Placement::default(),
+                footprint: 0.0,
+            };
+            let s = mat.shade(&hit);
+            let t = v.eval(p, Needs::ALL);
+            assert!(
+                (s.aov.albedo - t.diffuse).abs().max_element() < 1e-5,
+                "({x}, {y})"
+            );
+            // The fibre axis: same in-face direction (up to sign), same tilt out of the face.
+            let (fb, fp) = (s.aov.fiber, t.fiber_dir);
+            let in_face = |f: Vec3| (f - n * f.dot(n)).normalize();
+            assert!(
+                in_face(fb).dot(in_face(fp)).abs() > 0.9999,
+                "({x}, {y}): {fb} {fp}"
+            );
+            assert!((fb.dot(n).abs() - fp.dot(n).abs()).abs() < 1e-4);
+            checked += 1;
+        }
+        assert_eq!(checked, 4);
+    }
+}
+
+#[test]
+fn fibre_direction_map_keeps_the_interlock_tilt_the_anisotropy_map_loses() {
+    // Quartersawn mahogany: interlocked fibres tilt out of the face by ±φ, alternating with
+    // radius (the ribbon figure). The KHR anisotropy texel stores only |cos| of the tilt.
+    use glam::{Affine3A, Vec2};
+    use xylem::bake::{bake_face, BakeCut, BoardCut};
+    use xylem::material::{fiber_from_anisotropy, FaceRect};
+    let v = WoodVolume::new(preset("african_mahogany").unwrap(), 7).unwrap();
+    let face: FaceRect = BoardCut {
+        size: [100.0, 60.0, 20.0],
+        cut: BakeCut::Radial,
+        radius: 120.0,
+    }
+    .rect();
+    let maps = bake_face(&v, &face, Affine3A::IDENTITY, 64);
+    let (w, h) = (maps.width, maps.height);
+    let (mut tilted, mut lost) = (0, 0);
+    for y in 0..h {
+        for x in 0..w {
+            let uv = Vec2::new((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
+            let t = maps.lookup(uv);
+            let f = v.eval(face.point(uv), Needs::ALL).fiber_dir;
+            let want = Vec3::new(f.dot(face.right), -f.dot(face.down), f.dot(face.normal()));
+            assert!(
+                (t.fiber - want).length() < 1e-4,
+                "({x}, {y}): {} vs {want}",
+                t.fiber
+            );
+            if want.z.abs() > 0.05 {
+                tilted += 1;
+                let a = fiber_from_anisotropy(t.anisotropy);
+                // Same axis up to the sign of the out-of-face part, which is lost where > 0.
+                if (a.z - want.z).abs() > 0.05 && (a.z + want.z).abs() < 1e-3 {
+                    lost += 1;
+                }
+            }
+        }
+    }
+    let n = (w * h) as usize;
+    assert!(tilted > n / 4, "interlock tilts {tilted} of {n} texels");
+    assert!(
+        lost > tilted / 4,
+        "sign lost at {lost} of {tilted} tilted texels"
+    );
+}

@@ -8,9 +8,10 @@
 //! corner; tangent-space x points to the image's right (+u, along the board's length), y to the
 //! image's top, z out of the face. Data maps (anisotropy, normal) are stored linearly, not sRGB.
 
+pub use crate::material::{BakedMaps, FaceRect};
 use crate::render::image_io::{to_srgb8, write_exr_layers, write_png_rgb8, ExrLayer, ImageError};
 use crate::wood::{Needs, WoodVolume};
-use glam::{Vec2, Vec3};
+use glam::{Affine3A, Vec2, Vec3};
 use rayon::prelude::*;
 
 /// Which face of the log the board shows (Liu et al. 2016 §7.2; the classical sawing terms).
@@ -63,28 +64,21 @@ impl BoardCut {
         (corner, right, down, normal)
     }
 
+    /// The baked face as a rectangle in tree space.
+    pub fn rect(&self) -> FaceRect {
+        let (corner, right, down, _) = self.face();
+        FaceRect {
+            corner,
+            right,
+            down,
+            size: Vec2::new(self.size[0], self.size[1]),
+        }
+    }
+
     /// Texture size for `res` texels along the length (at least 1 × 1).
     pub fn texture_size(&self, res: u32) -> (u32, u32) {
-        let [w, h, _] = self.size;
-        let res = res.max(1);
-        (res, ((res as f32 * h / w).round() as u32).max(1))
+        self.rect().texture_size(res)
     }
-}
-
-/// The baked maps, row-major, top row first.
-#[derive(Clone, Debug)]
-pub struct BakedMaps {
-    pub width: u32,
-    pub height: u32,
-    /// Diffuse colour (linear RGB).
-    pub base_color: Vec<Vec3>,
-    /// KHR_materials_anisotropy texel: (x, y) direction in [−1, 1] stored as 0.5 + 0.5·d, strength.
-    pub anisotropy: Vec<Vec3>,
-    /// Fibre highlight width β (radians).
-    pub highlight_width: Vec<f32>,
-    pub ray_mask: Vec<f32>,
-    /// Tangent-space normal (unit), stored as 0.5 + 0.5·n in the PNG.
-    pub normal: Vec<Vec3>,
 }
 
 /// The anisotropy texel of a fibre direction `f` on a face with tangent-space axes `right`, `up`:
@@ -118,32 +112,46 @@ pub fn bump_normal(g: Vec3, right: Vec3, up: Vec3) -> Vec3 {
 /// Bakes `volume` over the board's face at `res` texels along its length, one sample at each
 /// texel centre.
 pub fn bake(volume: &WoodVolume, board: &BoardCut, res: u32) -> BakedMaps {
-    let (w, h) = board.texture_size(res);
-    let (corner, right, down, _) = board.face();
-    let (du, dv) = (board.size[0] / w as f32, board.size[1] / h as f32);
+    bake_face(volume, &board.rect(), Affine3A::IDENTITY, res)
+}
+
+/// Bakes `volume` over `face`, a rectangle in a space that `to_tree` maps into the tree (an
+/// object's space and its placement, or tree space itself), one sample at each texel centre.
+/// Fibre directions go back contravariantly (L⁻¹ f, L the linear part of `to_tree`) and the bump
+/// gradient covariantly (Lᵀ g), as the renderer's materials transport them (Liu et al. 2016 §6.2).
+pub fn bake_face(volume: &WoodVolume, face: &FaceRect, to_tree: Affine3A, res: u32) -> BakedMaps {
+    let (w, h) = face.texture_size(res);
+    let l = glam::Mat3::from(to_tree.matrix3);
+    let l_inv = l.inverse();
     let texels: Vec<_> = (0..h)
         .into_par_iter()
         .flat_map_iter(|y| {
             (0..w).map(move |x| {
-                let p = corner + right * ((x as f32 + 0.5) * du) + down * ((y as f32 + 0.5) * dv);
-                volume.eval(p, Needs::ALL)
+                let uv = Vec2::new((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
+                volume.eval(to_tree.transform_point3(face.point(uv)), Needs::ALL)
             })
         })
         .collect();
-    let up = -down;
+    let (right, up) = (face.right, -face.down);
+    let normal = right.cross(up);
+    let tangent = |f: Vec3| {
+        let f = (l_inv * f).normalize_or_zero();
+        Vec3::new(f.dot(right), f.dot(up), f.dot(normal))
+    };
     BakedMaps {
+        fiber: texels.iter().map(|t| tangent(t.fiber_dir)).collect(),
         width: w,
         height: h,
         base_color: texels.iter().map(|t| t.diffuse).collect(),
         anisotropy: texels
             .iter()
-            .map(|t| anisotropy_texel(t.fiber_dir, right, up))
+            .map(|t| anisotropy_texel((l_inv * t.fiber_dir).normalize_or_zero(), right, up))
             .collect(),
         highlight_width: texels.iter().map(|t| t.highlight_width).collect(),
         ray_mask: texels.iter().map(|t| t.ray_mask).collect(),
         normal: texels
             .iter()
-            .map(|t| bump_normal(t.bump_grad, right, up))
+            .map(|t| bump_normal(l.transpose() * t.bump_grad, right, up))
             .collect(),
     }
 }
@@ -156,7 +164,8 @@ fn data8(values: impl Iterator<Item = f32>) -> Vec<u8> {
 }
 
 /// Writes every map as `NAME.png` and `NAME.exr` into `dir` and returns the files written.
-/// PNG: base colour in sRGB; anisotropy and normal as linear codes of their glTF encodings;
+/// PNG: base colour in sRGB; anisotropy, normal and fibre direction (0.5 + 0.5·f, a tangent-space
+/// unit vector like the normal map) as linear codes;
 /// highlight width as β / 45° (grey); ray mask as is. EXR: the same maps as 32-bit floats, with
 /// the anisotropy and normal maps *decoded* (direction components in [−1, 1], strength; unit
 /// normal) and β in radians.
@@ -170,12 +179,14 @@ pub fn write_maps(
     let rgb = |v: &[Vec3]| data8(v.iter().flat_map(|c| c.to_array()));
     let beta_scale = 1.0 / 45f32.to_radians();
     let normal_code: Vec<Vec3> = m.normal.iter().map(|n| 0.5 + 0.5 * *n).collect();
-    let pngs: [(&str, Vec<u8>); 5] = [
+    let fiber_code: Vec<Vec3> = m.fiber.iter().map(|f| 0.5 + 0.5 * *f).collect();
+    let pngs: [(&str, Vec<u8>); 6] = [
         ("base_color", to_srgb8(&m.base_color, 0.0)),
         ("anisotropy", rgb(&m.anisotropy)),
         ("highlight_width", grey(&m.highlight_width, beta_scale)),
         ("ray_mask", grey(&m.ray_mask, 1.0)),
         ("normal", rgb(&normal_code)),
+        ("fiber_direction", rgb(&fiber_code)),
     ];
     for (name, bytes) in pngs {
         let p = dir.join(format!("{name}.png"));
@@ -188,12 +199,13 @@ pub fn write_maps(
         .iter()
         .map(|a| Vec3::new(2.0 * a.x - 1.0, 2.0 * a.y - 1.0, a.z))
         .collect();
-    let exrs: [(&str, &[&str], Vec<f32>); 5] = [
+    let exrs: [(&str, &[&str], Vec<f32>); 6] = [
         ("base_color", &["R", "G", "B"], flat(&m.base_color)),
         ("anisotropy", &["R", "G", "B"], flat(&aniso)),
         ("highlight_width", &["Y"], m.highlight_width.clone()),
         ("ray_mask", &["Y"], m.ray_mask.clone()),
         ("normal", &["R", "G", "B"], flat(&m.normal)),
+        ("fiber_direction", &["R", "G", "B"], flat(&m.fiber)),
     ];
     for (name, channels, data) in exrs {
         let p = dir.join(format!("{name}.exr"));

@@ -23,6 +23,9 @@ pub struct Args {
     /// Also write every number as JSON here.
     #[arg(long)]
     pub json: Option<PathBuf>,
+    /// Also write every render (reference and each row) as a PNG into this folder.
+    #[arg(long)]
+    pub images: Option<PathBuf>,
     /// Worker threads (0 = all cores).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
@@ -63,24 +66,43 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
     bar.set_message(format!("reference, {} spp", args.reference_spp));
-    let (reference, ref_secs) = render_with(&base, &Knobs::reference(args.reference_spp), &run)
+    let (reference, ref_secs, _) = render_with(&base, &Knobs::reference(args.reference_spp), &run)
         .map_err(anyhow::Error::msg)
         .context("reference render")?;
     bar.inc(1);
+    let save = |name: &str, img: &[glam::Vec3]| -> anyhow::Result<()> {
+        if let Some(dir) = &args.images {
+            std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+            let file: String = name
+                .chars()
+                .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+                .collect();
+            crate::render::image_io::write_png_linear(
+                &dir.join(format!("{file}.png")),
+                w,
+                h,
+                img,
+                exposure,
+            )?;
+        }
+        Ok(())
+    };
+    save("reference", &reference)?;
     let mut rows = Vec::new();
     // The reference model at each measured spp (same seeds), rendered once per spp.
     let mut same_spp: Vec<(u32, Vec<glam::Vec3>)> = Vec::new();
     for (knob, setting, knobs) in all {
         bar.set_message(setting.clone());
-        let (img, secs) = render_with(&base, &knobs, &run)
+        let (img, secs, prep) = render_with(&base, &knobs, &run)
             .map_err(anyhow::Error::msg)
             .with_context(|| format!("render with {setting}"))?;
         if !same_spp.iter().any(|(s, _)| *s == knobs.spp) {
-            let (r, _) = render_with(&base, &Knobs::reference(knobs.spp), &run)
+            let (r, _, _) = render_with(&base, &Knobs::reference(knobs.spp), &run)
                 .map_err(anyhow::Error::msg)
                 .with_context(|| format!("reference model at {} spp", knobs.spp))?;
             same_spp.push((knobs.spp, r));
         }
+        save(&format!("{knob} {setting}"), &img)?;
         let model_ref = &same_spp
             .iter()
             .find(|(s, _)| *s == knobs.spp)
@@ -91,6 +113,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             setting,
             knobs,
             seconds: secs,
+            prep_seconds: prep,
             relative_mse: relative_mse(&img, &reference),
             ssim: ssim(&img, &reference, w as usize, h as usize, exposure),
             model_mse: relative_mse(&img, model_ref),
@@ -106,8 +129,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     crate::sweep::sequence::write_text_atomic(&args.out, &md)?;
     for r in &rows {
         println!(
-            "{:<18} {:<24} {:>8.3} s  rel. MSE {:>10.3e}  SSIM {:.4}",
-            r.knob, r.setting, r.seconds, r.relative_mse, r.ssim
+            "{:<20} {:<28} {:>8.3} s (+{:.3} s)  rel. MSE {:>10.3e}  SSIM {:.4}  model {:>10.3e} {:.4}",
+            r.knob, r.setting, r.seconds, r.prep_seconds, r.relative_mse, r.ssim, r.model_mse, r.model_ssim
         );
     }
     println!("report: {}", args.out.display());
@@ -188,12 +211,19 @@ fn markdown(
         },
         args.reference_spp
     );
-    s += "| knob | setting | time (s) | relative MSE | SSIM | model rel. MSE | model SSIM |\n\
-          | --- | --- | --- | --- | --- | --- | --- |\n";
+    s += "| knob | setting | time (s) | prep (s) | relative MSE | SSIM | model rel. MSE | model SSIM |\n\
+          | --- | --- | --- | --- | --- | --- | --- | --- |\n";
     for r in rows {
         s += &format!(
-            "| {} | {} | {:.3} | {:.3e} | {:.4} | {:.3e} | {:.4} |\n",
-            r.knob, r.setting, r.seconds, r.relative_mse, r.ssim, r.model_mse, r.model_ssim
+            "| {} | {} | {:.3} | {:.3} | {:.3e} | {:.4} | {:.3e} | {:.4} |\n",
+            r.knob,
+            r.setting,
+            r.seconds,
+            r.prep_seconds,
+            r.relative_mse,
+            r.ssim,
+            r.model_mse,
+            r.model_ssim
         );
     }
     s += &format!(

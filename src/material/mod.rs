@@ -5,8 +5,12 @@
 //! textures live in *tree space* (mm, pith along +z); [`Placement`] says where the object sits
 //! in the tree, so the same log can be cut along different planes.
 
+mod baked;
 mod placement;
 
+pub use baked::{
+    fiber_from_anisotropy, BakedFibers, BakedMaps, BakedTexel, BakedWoodMaterial, FaceRect,
+};
 pub use placement::{Cutting, Placement};
 
 use crate::bsdf::{
@@ -129,6 +133,9 @@ pub enum Material {
     },
     /// The procedural wood volume seen through a finish.
     Wood(Box<WoodMaterial>),
+    /// Wood from baked texture maps on one flat face (the procedural volume's image-texture
+    /// counterpart, for `xylem tradeoff`).
+    BakedWood(Box<BakedWoodMaterial>),
     Mirror {
         reflectance: Vec3,
     },
@@ -197,6 +204,7 @@ impl Material {
                 wood_shading(local, frame, fiber_world, 0.0, FinishModel::ClosedForm)
             }
             Material::Wood(w) => w.shade(hit),
+            Material::BakedWood(b) => b.shade(hit),
             Material::Mirror { reflectance } => Shading {
                 bsdf: SurfaceBsdf::Mirror(Mirror {
                     reflectance: *reflectance,

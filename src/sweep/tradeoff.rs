@@ -5,7 +5,7 @@
 
 use crate::bsdf::FinishModel;
 use crate::field::JacobianModel;
-use crate::material::Material;
+use crate::material::{BakedFibers, BakedWoodMaterial, FaceRect, Material};
 use crate::math::luminance;
 use crate::render::image_io::linear_to_srgb;
 use crate::render::{render, RunOptions};
@@ -32,6 +32,11 @@ pub struct Knobs {
     pub finish: FinishModel,
     /// Band-limit the wood by the pixel footprint (drop features narrower than a pixel).
     pub footprint_filter: bool,
+    /// Replace each wood material by its maps baked at this many texels along the object's top
+    /// face (None: the procedural volume).
+    pub baked_res: Option<u32>,
+    /// Which baked map gives the fibre direction.
+    pub baked_fibers: BakedFibers,
 }
 
 fn debug_name<T: std::fmt::Debug, S: serde::Serializer>(v: &T, s: S) -> Result<S::Ok, S::Error> {
@@ -49,6 +54,8 @@ impl Knobs {
             jacobian: JacobianModel::Simplified,
             finish: FinishModel::ClosedForm,
             footprint_filter: false,
+            baked_res: None,
+            baked_fibers: BakedFibers::Anisotropy,
         }
     }
 
@@ -118,19 +125,74 @@ pub fn apply_to_params(p: &WoodParams, k: &Knobs) -> WoodParams {
     p
 }
 
-/// Applies the knobs to a loaded scene: its spp and every wood material's volume.
-pub fn apply(loaded: &mut LoadedScene, k: &Knobs) -> Result<(), crate::wood::WoodError> {
+/// Why the knobs could not be applied to a scene.
+#[derive(Debug, thiserror::Error)]
+pub enum TradeoffError {
+    #[error(transparent)]
+    Wood(#[from] crate::wood::WoodError),
+    #[error(
+        "baking: wood material #{material} is used by {objects} objects; a baked texture covers \
+         one object's top face, so each wood material must be used by exactly one object"
+    )]
+    SharedMaterial { material: usize, objects: usize },
+}
+
+/// Applies the knobs to a loaded scene: its spp and every wood material's volume and switches.
+pub fn apply(loaded: &mut LoadedScene, k: &Knobs) -> Result<(), TradeoffError> {
     loaded.settings.spp = k.spp.max(1);
-    for m in &mut loaded.scene.materials {
+    let scene = &mut loaded.scene;
+    for (index, m) in scene.materials.iter_mut().enumerate() {
         if let Material::Wood(w) = m {
             let params = apply_to_params(w.volume.params(), k);
             w.volume =
                 Arc::new(WoodVolume::new(params, w.volume.seed())?.with_jacobian(k.jacobian));
             w.switches.finish = k.finish;
             w.switches.footprint_filter = k.footprint_filter;
+            if let Some(res) = k.baked_res {
+                let users: Vec<_> = scene
+                    .accel
+                    .instances
+                    .iter()
+                    .filter(|i| i.material as usize == index)
+                    .collect();
+                if users.len() != 1 {
+                    return Err(TradeoffError::SharedMaterial {
+                        material: index,
+                        objects: users.len(),
+                    });
+                }
+                let face = top_face(&users[0].mesh.positions);
+                let to_tree = users[0].placement.object_to_tree();
+                let maps = crate::bake::bake_face(&w.volume, &face, to_tree, res);
+                *m = Material::BakedWood(Box::new(BakedWoodMaterial {
+                    maps: Arc::new(maps),
+                    face,
+                    fiber_saturation: w.volume.params().color.fiber_saturation,
+                    fibers: k.baked_fibers,
+                    eta: w.eta,
+                    roughness: w.roughness,
+                    bump: w.bump,
+                    switches: w.switches,
+                }));
+            }
         }
     }
     Ok(())
+}
+
+/// The +z face of the bounding box of object-space `points`, seen from above with x to the
+/// right and y up (a board lying on the xy plane).
+pub fn top_face(points: &[glam::Vec3]) -> FaceRect {
+    let (lo, hi) = points.iter().fold(
+        (glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    FaceRect {
+        corner: glam::Vec3::new(lo.x, hi.y, hi.z),
+        right: glam::Vec3::X,
+        down: -glam::Vec3::Y,
+        size: glam::Vec2::new(hi.x - lo.x, hi.y - lo.y).max(glam::Vec2::splat(1e-6)),
+    }
 }
 
 /// Relative mean squared error Σ|x − r|² / Σ|r|² over RGB.
@@ -202,7 +264,10 @@ pub struct Measurement {
     pub knob: String,
     pub setting: String,
     pub knobs: Knobs,
+    /// Render time.
     pub seconds: f64,
+    /// Time to prepare the scene for these knobs (rebuilding volumes, baking maps).
+    pub prep_seconds: f64,
     pub relative_mse: f64,
     pub ssim: f64,
     /// Relative MSE against the reference model rendered at the same spp with the same seeds:
@@ -267,6 +332,22 @@ pub fn settings() -> Vec<(String, String, Knobs)> {
             ..Knobs::full(16)
         },
     ));
+    for (fibers, label) in [
+        (BakedFibers::Anisotropy, "glTF anisotropy map"),
+        (BakedFibers::Direction, "fibre direction map"),
+    ] {
+        for res in [256, 512, 1024, 2048] {
+            v.push((
+                format!("baked texture ({label})"),
+                format!("{res} texels, 16 spp"),
+                Knobs {
+                    baked_res: Some(res),
+                    baked_fibers: fibers,
+                    ..Knobs::full(16)
+                },
+            ));
+        }
+    }
     for spp in [1, 4, 16] {
         v.push((
             "footprint band-limit".into(),
@@ -287,16 +368,19 @@ pub fn settings() -> Vec<(String, String, Knobs)> {
     v
 }
 
-/// Renders the scene (its own lights, as built) with `knobs`; returns the beauty and seconds.
+/// Renders the scene (its own lights, as built) with `knobs`; returns the beauty, the render
+/// seconds and the seconds spent applying the knobs.
 pub fn render_with(
     base: &dyn Fn() -> Result<LoadedScene, String>,
     knobs: &Knobs,
     run: &RunOptions,
-) -> Result<(Vec<glam::Vec3>, f64), String> {
+) -> Result<(Vec<glam::Vec3>, f64, f64), String> {
     let mut loaded = base()?;
+    let prep = std::time::Instant::now();
     apply(&mut loaded, knobs).map_err(|e| e.to_string())?;
+    let prep = prep.elapsed().as_secs_f64();
     let out = render(&loaded.scene, &loaded.settings, run).map_err(|e| e.to_string())?;
-    Ok((out.image.beauty, out.elapsed.as_secs_f64()))
+    Ok((out.image.beauty, out.elapsed.as_secs_f64(), prep))
 }
 
 #[cfg(test)]

@@ -1,0 +1,273 @@
+//! Wood read from baked texture maps (what `xylem bake` writes) on a flat face: the image-texture
+//! counterpart of the procedural volume, so `xylem tradeoff` can compare the two in rendered
+//! images. The maps hold what glTF-style materials carry — base colour, fibre direction as a
+//! KHR_materials_anisotropy texel, highlight width, ray mask, tangent-space normal — and are
+//! filtered bilinearly (clamped at the edges).
+//!
+//! What the maps cannot carry, and this material therefore approximates (notes/sweep.md
+//! "Baked textures"): the sign of the fibre's tilt out of the face (the anisotropy strength is
+//! |cos|, so fibres are assumed to dip *into* the face), the ray direction (taken in the face,
+//! across the fibre, as on a quartersawn face), and the fibre colour, rebuilt from the base colour
+//! as c^s with the preset's fibre saturation s (exact for the Beer's-law colours of
+//! `wood::BeerColor`, whose fibre colour is exp(−s a) = c^s).
+
+use super::{wood_shading, MaterialHit, Shading, ShadingSwitches};
+use crate::bsdf::WoodBsdfParams;
+use crate::math::{safe_sqrt, Frame};
+use glam::{Vec2, Vec3};
+use std::sync::Arc;
+
+/// Baked maps, row-major, top row first; texel (0, 0) is the top-left corner (glTF).
+#[derive(Clone, Debug)]
+pub struct BakedMaps {
+    pub width: u32,
+    pub height: u32,
+    /// Diffuse colour (linear RGB).
+    pub base_color: Vec<Vec3>,
+    /// KHR_materials_anisotropy texel: (x, y) direction in [−1, 1] stored as 0.5 + 0.5·d, strength.
+    pub anisotropy: Vec<Vec3>,
+    /// Fibre highlight width β (radians).
+    pub highlight_width: Vec<f32>,
+    pub ray_mask: Vec<f32>,
+    /// Tangent-space normal (unit), stored as 0.5 + 0.5·n in the PNG.
+    pub normal: Vec<Vec3>,
+    /// Tangent-space fibre direction (unit, x right, y up, z out of the face), stored as
+    /// 0.5 + 0.5·f: unlike the anisotropy texel it keeps the sign of the tilt out of the face.
+    pub fiber: Vec<Vec3>,
+}
+
+/// Which map gives a baked material its fibre direction.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub enum BakedFibers {
+    /// The glTF KHR_materials_anisotropy texel (the tilt out of the face taken as "into").
+    #[default]
+    Anisotropy,
+    /// The signed tangent-space fibre direction map.
+    Direction,
+}
+
+/// A rectangle of a plane: texel (0, 0)'s corner, unit `right` (+u) and `down` (+v) axes and the
+/// size along them. Lengths in the units of the space it lives in.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FaceRect {
+    pub corner: Vec3,
+    pub right: Vec3,
+    pub down: Vec3,
+    pub size: Vec2,
+}
+
+impl FaceRect {
+    /// The face normal right × up (up = −down).
+    pub fn normal(&self) -> Vec3 {
+        self.right.cross(-self.down)
+    }
+
+    /// The point at texture coordinates `uv` ∈ [0, 1]².
+    pub fn point(&self, uv: Vec2) -> Vec3 {
+        self.corner + self.right * (uv.x * self.size.x) + self.down * (uv.y * self.size.y)
+    }
+
+    /// Texture coordinates of the projection of `p` onto the face.
+    pub fn uv(&self, p: Vec3) -> Vec2 {
+        let d = p - self.corner;
+        Vec2::new(
+            d.dot(self.right) / self.size.x,
+            d.dot(self.down) / self.size.y,
+        )
+    }
+
+    /// Texture size for `res` texels along `right` (at least 1 × 1), square texels.
+    pub fn texture_size(&self, res: u32) -> (u32, u32) {
+        let res = res.max(1);
+        (
+            res,
+            ((res as f32 * self.size.y / self.size.x).round() as u32).max(1),
+        )
+    }
+}
+
+/// Everything one bilinear lookup of the maps returns.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BakedTexel {
+    pub base_color: Vec3,
+    /// Encoded anisotropy (as stored).
+    pub anisotropy: Vec3,
+    pub highlight_width: f32,
+    pub ray_mask: f32,
+    /// Tangent-space normal (renormalised).
+    pub normal: Vec3,
+    /// Tangent-space fibre direction (renormalised).
+    pub fiber: Vec3,
+}
+
+impl BakedMaps {
+    /// Bilinear lookup at texture coordinates `uv` (texel centres at (i + ½)/W), clamped to the
+    /// edge texels outside [0, 1]².
+    pub fn lookup(&self, uv: Vec2) -> BakedTexel {
+        let (w, h) = (self.width as usize, self.height as usize);
+        let x = (uv.x * w as f32 - 0.5).clamp(0.0, (w - 1) as f32);
+        let y = (uv.y * h as f32 - 0.5).clamp(0.0, (h - 1) as f32);
+        let (x0, y0) = (x as usize, y as usize);
+        let (x1, y1) = ((x0 + 1).min(w - 1), (y0 + 1).min(h - 1));
+        let (fx, fy) = (x - x0 as f32, y - y0 as f32);
+        let weights = [
+            (y0 * w + x0, (1.0 - fx) * (1.0 - fy)),
+            (y0 * w + x1, fx * (1.0 - fy)),
+            (y1 * w + x0, (1.0 - fx) * fy),
+            (y1 * w + x1, fx * fy),
+        ];
+        let mut t = BakedTexel {
+            base_color: Vec3::ZERO,
+            anisotropy: Vec3::ZERO,
+            highlight_width: 0.0,
+            ray_mask: 0.0,
+            normal: Vec3::ZERO,
+            fiber: Vec3::ZERO,
+        };
+        for (i, k) in weights {
+            t.base_color += self.base_color[i] * k;
+            t.anisotropy += self.anisotropy[i] * k;
+            t.highlight_width += self.highlight_width[i] * k;
+            t.ray_mask += self.ray_mask[i] * k;
+            t.normal += self.normal[i] * k;
+            t.fiber += self.fiber[i] * k;
+        }
+        t.normal = unit_or(t.normal, Vec3::Z);
+        t.fiber = unit_or(t.fiber, Vec3::X);
+        t
+    }
+}
+
+fn unit_or(v: Vec3, fallback: Vec3) -> Vec3 {
+    let n = v.normalize_or_zero();
+    if n == Vec3::ZERO {
+        fallback
+    } else {
+        n
+    }
+}
+
+/// The fibre direction of an anisotropy texel in tangent space (x right, y up, z out of the
+/// face): the stored in-face direction scaled by the strength s, dipping into the face by
+/// √(1 − s²) (the sign the encoding drops is taken as "into").
+pub fn fiber_from_anisotropy(a: Vec3) -> Vec3 {
+    let d = Vec2::new(2.0 * a.x - 1.0, 2.0 * a.y - 1.0).normalize_or_zero();
+    let s = a.z.clamp(0.0, 1.0);
+    let d = if d == Vec2::ZERO { Vec2::X } else { d };
+    Vec3::new(s * d.x, s * d.y, -safe_sqrt(1.0 - s * s))
+}
+
+/// Wood from baked maps over one flat face of an object (object space), seen through a finish.
+#[derive(Clone, Debug)]
+pub struct BakedWoodMaterial {
+    pub maps: Arc<BakedMaps>,
+    /// The face the maps cover, in object space.
+    pub face: FaceRect,
+    /// Fibre colour = base colour ^ this (the preset's `color.fiber_saturation`).
+    pub fiber_saturation: f32,
+    /// Where the fibre direction comes from.
+    pub fibers: BakedFibers,
+    /// Refractive index and GGX roughness of the finish, and the normal-map strength (0 = off).
+    pub eta: f32,
+    pub roughness: f32,
+    pub bump: f32,
+    pub switches: ShadingSwitches,
+}
+
+impl BakedWoodMaterial {
+    /// Looks the hit's object-space point up in the maps (projected onto the face) and builds the
+    /// finished-wood BSDF.
+    pub fn shade(&self, hit: &MaterialHit) -> Shading {
+        let t = self.maps.lookup(self.face.uv(hit.p_object));
+        let f = &self.face;
+        let up = -f.down;
+        let to_world = |tangent: Vec3| {
+            let obj = f.right * tangent.x + up * tangent.y + f.normal() * tangent.z;
+            (hit.object_to_world * obj).normalize_or_zero()
+        };
+        let mut n = hit.ns;
+        if self.bump != 0.0 && t.normal.z > 1e-3 {
+            // The normal map stores n ∝ (−∂h/∂x, −∂h/∂y, 1): the height gradient in the face is
+            // (−n_x/n_z, −n_y/n_z); it tilts the normal as the volume's bump does (Blinn 1978).
+            let (hx, hy) = (-t.normal.x / t.normal.z, -t.normal.y / t.normal.z);
+            let g = hit.normal_to_world * (f.right * hx + up * hy) * self.bump;
+            let tilted = (n - (g - n * g.dot(n))).normalize_or_zero();
+            if tilted != Vec3::ZERO && tilted.is_finite() {
+                n = tilted;
+            }
+        }
+        let fiber_world = to_world(match self.fibers {
+            BakedFibers::Anisotropy => fiber_from_anisotropy(t.anisotropy),
+            BakedFibers::Direction => t.fiber,
+        });
+        let frame = Frame::from_normal_tangent(n, fiber_world);
+        let ray_world = frame.t;
+        let diffuse = t.base_color.clamp(Vec3::ZERO, Vec3::ONE);
+        let fiber_color = diffuse
+            .powf(self.fiber_saturation)
+            .clamp(Vec3::ZERO, Vec3::ONE);
+        let local = WoodBsdfParams {
+            diffuse,
+            fiber_color,
+            fiber_dir: frame.to_local(fiber_world),
+            ray_dir: frame.to_local(ray_world),
+            ray_mask: t.ray_mask.clamp(0.0, 1.0),
+            highlight_width: t.highlight_width.clamp(1e-3, 0.5 * std::f32::consts::PI),
+            eta: self.eta,
+            roughness: self.roughness,
+        };
+        wood_shading(local, frame, fiber_world, 0.0, self.switches.finish)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn maps_2x1() -> BakedMaps {
+        BakedMaps {
+            width: 2,
+            height: 1,
+            base_color: vec![Vec3::new(0.2, 0.1, 0.0), Vec3::new(0.6, 0.3, 0.2)],
+            anisotropy: vec![Vec3::new(1.0, 0.5, 1.0); 2],
+            highlight_width: vec![0.1, 0.3],
+            ray_mask: vec![0.0, 1.0],
+            normal: vec![Vec3::Z; 2],
+            fiber: vec![Vec3::X; 2],
+        }
+    }
+
+    #[test]
+    fn lookup_hits_texel_centres_and_interpolates_between() {
+        let m = maps_2x1();
+        assert_eq!(m.lookup(Vec2::new(0.25, 0.5)).base_color, m.base_color[0]);
+        assert_eq!(m.lookup(Vec2::new(0.75, 0.5)).base_color, m.base_color[1]);
+        let mid = m.lookup(Vec2::new(0.5, 0.5));
+        assert!((mid.highlight_width - 0.2).abs() < 1e-6 && (mid.ray_mask - 0.5).abs() < 1e-6);
+        // Clamped outside.
+        assert_eq!(m.lookup(Vec2::new(-3.0, 9.0)).base_color, m.base_color[0]);
+    }
+
+    #[test]
+    fn anisotropy_decodes_to_a_unit_fibre() {
+        let f = fiber_from_anisotropy(Vec3::new(1.0, 0.5, 1.0));
+        assert!((f - Vec3::X).length() < 1e-6);
+        // Strength ½: the in-face part has length ½ and the fibre dips into the face.
+        let g = fiber_from_anisotropy(Vec3::new(0.5, 1.0, 0.5));
+        assert!((g.length() - 1.0).abs() < 1e-6 && (g.y - 0.5).abs() < 1e-6 && g.z < 0.0);
+    }
+
+    #[test]
+    fn face_maps_points_to_uv_and_back() {
+        let f = FaceRect {
+            corner: Vec3::new(-10.0, 5.0, 2.0),
+            right: Vec3::X,
+            down: -Vec3::Y,
+            size: Vec2::new(20.0, 10.0),
+        };
+        assert_eq!(f.normal(), Vec3::Z);
+        let uv = Vec2::new(0.3, 0.8);
+        assert!((f.uv(f.point(uv)) - uv).length() < 1e-6);
+        assert_eq!(f.texture_size(64), (64, 32));
+    }
+}
