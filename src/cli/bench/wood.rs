@@ -17,6 +17,10 @@ pub struct Args {
     /// Also time each preset with one feature switched off at a time (full model).
     #[arg(long)]
     breakdown: bool,
+    /// Run exactly this many passes per level of `needs` instead of timing (a fixed workload for
+    /// instruction counts: `valgrind --tool=callgrind xylem bench wood --passes 1 ...`).
+    #[arg(long)]
+    passes: Option<usize>,
 }
 
 /// CPU time of the calling thread in seconds (Linux: /proc/thread-self/stat, clock ticks of
@@ -54,11 +58,10 @@ pub fn texels_per_second(volume: &WoodVolume, points: &[Vec3], needs: Needs) -> 
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let points = wood::sample_points(args.texels, 42);
-    let names: Vec<&str> = if args.only.is_empty() {
-        wood::PRESET_NAMES.to_vec()
-    } else {
-        args.only.iter().map(String::as_str).collect()
-    };
+    if let Some(passes) = args.passes {
+        return fixed_passes(&args, &points, passes);
+    }
+    let names = selected(&args.only);
     println!(
         "| preset | colour (M texels/s) | colour + fibres | everything | colour / everything |"
     );
@@ -79,6 +82,38 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         );
         if args.breakdown {
             breakdown(volume.params(), &points)?;
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The presets named by `--only`, or all.
+fn selected(only: &[String]) -> Vec<&str> {
+    if only.is_empty() {
+        wood::PRESET_NAMES.to_vec()
+    } else {
+        only.iter().map(String::as_str).collect()
+    }
+}
+
+/// `passes` untimed passes of every level of `needs` (for instruction counting).
+fn fixed_passes(args: &Args, points: &[Vec3], passes: usize) -> anyhow::Result<ExitCode> {
+    let names = selected(&args.only);
+    for name in names {
+        let volume = WoodVolume::new(wood::preset(name)?, 1)?;
+        for (label, needs) in [
+            ("colour", Needs::COLOR),
+            ("colour + fibres", Needs::COLOR_FIBERS),
+            ("everything", Needs::ALL),
+        ] {
+            let mut sink = 0.0f32;
+            for _ in 0..passes {
+                for &p in points {
+                    let t = volume.eval(p, needs);
+                    sink += t.diffuse.x + t.fiber_dir.z + t.bump;
+                }
+            }
+            println!("{name} {label}: {} texels, checksum {sink:.6e}", passes * points.len());
         }
     }
     Ok(ExitCode::SUCCESS)
