@@ -229,7 +229,12 @@ impl SparseConvolution {
         let mut scale = 1.0f32;
         for band in 0..self.bands.max(1) {
             // β^(γ i); band 0 skips the libm call (1^γ = 1 exactly).
-            let amp = self.magnitude * if band == 0 { 1.0 } else { scale.powf(self.dropoff) };
+            let amp = self.magnitude
+                * if band == 0 {
+                    1.0
+                } else {
+                    scale.powf(self.dropoff)
+                };
             let bseed = mix32(seed ^ mix32(band.wrapping_add(0x5bd1_e995)));
             let band = Band {
                 kernel: self.kernel,

@@ -113,7 +113,10 @@ fn fixed_passes(args: &Args, points: &[Vec3], passes: usize) -> anyhow::Result<E
                     sink += t.diffuse.x + t.fiber_dir.z + t.bump;
                 }
             }
-            println!("{name} {label}: {} texels, checksum {sink:.6e}", passes * points.len());
+            println!(
+                "{name} {label}: {} texels, checksum {sink:.6e}",
+                passes * points.len()
+            );
         }
     }
     Ok(ExitCode::SUCCESS)
