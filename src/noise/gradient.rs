@@ -5,12 +5,13 @@
 //! follows I. Quilez, "Gradient noise derivatives" (2017). A 4-lane SSE2 kernel
 //! ([`gradient3_x4`]) evaluates four points at once — fBm uses it across octaves.
 
+use super::hash::mix32;
 #[cfg(target_arch = "x86_64")]
-use super::hash::KNUTH;
-use super::hash::{lattice, mix32, signed_f32, PRIME_X, PRIME_Y, PRIME_Z};
+use super::hash::{KNUTH, PRIME_X, PRIME_Y, PRIME_Z};
 #[cfg(target_arch = "x86_64")]
 use super::lanes::Lanes;
 use super::lanes::Simd;
+use super::lattice::{corner_hashes, end_values, trilinear, trilinear_grad};
 use glam::Vec3;
 
 /// Perlin 2002 quintic fade.
@@ -106,22 +107,15 @@ pub(crate) fn gradient3_xyz(x: f32, y: f32, z: f32, s: u32) -> f32 {
     let (ix, iy, iz) = (cell_of(x), cell_of(y), cell_of(z));
     let (x0, y0, z0) = (x - ix as f32, y - iy as f32, z - iz as f32);
     let (x1, y1, z1) = (x0 - 1.0, y0 - 1.0, z0 - 1.0);
-    let xa = (ix as u32).wrapping_mul(PRIME_X);
-    let ya = (iy as u32).wrapping_mul(PRIME_Y);
-    let za = (iz as u32).wrapping_mul(PRIME_Z);
-    let (xb, yb, zb) = (
-        xa.wrapping_add(PRIME_X),
-        ya.wrapping_add(PRIME_Y),
-        za.wrapping_add(PRIME_Z),
-    );
-    let n000 = dot(grad(lattice(xa, ya, za, s)), x0, y0, z0);
-    let n100 = dot(grad(lattice(xb, ya, za, s)), x1, y0, z0);
-    let n010 = dot(grad(lattice(xa, yb, za, s)), x0, y1, z0);
-    let n110 = dot(grad(lattice(xb, yb, za, s)), x1, y1, z0);
-    let n001 = dot(grad(lattice(xa, ya, zb, s)), x0, y0, z1);
-    let n101 = dot(grad(lattice(xb, ya, zb, s)), x1, y0, z1);
-    let n011 = dot(grad(lattice(xa, yb, zb, s)), x0, y1, z1);
-    let n111 = dot(grad(lattice(xb, yb, zb, s)), x1, y1, z1);
+    let h = corner_hashes(ix, iy, iz, s);
+    let n000 = dot(grad(h[0]), x0, y0, z0);
+    let n100 = dot(grad(h[1]), x1, y0, z0);
+    let n010 = dot(grad(h[2]), x0, y1, z0);
+    let n110 = dot(grad(h[3]), x1, y1, z0);
+    let n001 = dot(grad(h[4]), x0, y0, z1);
+    let n101 = dot(grad(h[5]), x1, y0, z1);
+    let n011 = dot(grad(h[6]), x0, y1, z1);
+    let n111 = dot(grad(h[7]), x1, y1, z1);
     let (u, v, w) = (fade(x0), fade(y0), fade(z0));
     let a = n000 + u * (n100 - n000);
     let b = n010 + u * (n110 - n010);
@@ -139,71 +133,30 @@ pub fn gradient3_grad(p: Vec3, seed: u32) -> (f32, Vec3) {
     gradient3_grad_s(p, mix32(seed))
 }
 
-/// [`gradient3_grad`] with a scrambled seed.
+/// [`gradient3_grad`] with a scrambled seed. ∇n = blend of the corner gradients + fade′ times the
+/// derivative of the blend of the corner values g·(p − corner).
 #[inline(always)]
 pub(crate) fn gradient3_grad_s(p: Vec3, s: u32) -> (f32, Vec3) {
     let (ix, iy, iz) = (cell_of(p.x), cell_of(p.y), cell_of(p.z));
     let f0 = Vec3::new(p.x - ix as f32, p.y - iy as f32, p.z - iz as f32);
-    let f1 = f0 - Vec3::ONE;
-    let xa = (ix as u32).wrapping_mul(PRIME_X);
-    let ya = (iy as u32).wrapping_mul(PRIME_Y);
-    let za = (iz as u32).wrapping_mul(PRIME_Z);
-    let (xb, yb, zb) = (
-        xa.wrapping_add(PRIME_X),
-        ya.wrapping_add(PRIME_Y),
-        za.wrapping_add(PRIME_Z),
-    );
-    let g = |h: u32| {
-        let g = grad(h);
+    let h = corner_hashes(ix, iy, iz, s);
+    let g: [Vec3; 8] = std::array::from_fn(|k| {
+        let g = grad(h[k]);
         Vec3::new(g[0], g[1], g[2])
-    };
-    // Corners a..h in Quilez's order: 000, 100, 010, 110, 001, 101, 011, 111.
-    let ga = g(lattice(xa, ya, za, s));
-    let gb = g(lattice(xb, ya, za, s));
-    let gc = g(lattice(xa, yb, za, s));
-    let gd = g(lattice(xb, yb, za, s));
-    let ge = g(lattice(xa, ya, zb, s));
-    let gf = g(lattice(xb, ya, zb, s));
-    let gg = g(lattice(xa, yb, zb, s));
-    let gh = g(lattice(xb, yb, zb, s));
-    let va = ga.dot(f0);
-    let vb = gb.dot(Vec3::new(f1.x, f0.y, f0.z));
-    let vc = gc.dot(Vec3::new(f0.x, f1.y, f0.z));
-    let vd = gd.dot(Vec3::new(f1.x, f1.y, f0.z));
-    let ve = ge.dot(Vec3::new(f0.x, f0.y, f1.z));
-    let vf = gf.dot(Vec3::new(f1.x, f0.y, f1.z));
-    let vg = gg.dot(Vec3::new(f0.x, f1.y, f1.z));
-    let vh = gh.dot(f1);
+    });
+    // Corner k's offset: f0 − 1 along the axes whose bit is set in k.
+    let v: [f32; 8] = std::array::from_fn(|k| {
+        let d = Vec3::new(
+            f0.x - (k & 1) as f32,
+            f0.y - ((k >> 1) & 1) as f32,
+            f0.z - ((k >> 2) & 1) as f32,
+        );
+        g[k].dot(d)
+    });
     let u = Vec3::new(fade(f0.x), fade(f0.y), fade(f0.z));
     let du = Vec3::new(fade_d(f0.x), fade_d(f0.y), fade_d(f0.z));
-    let k1 = vb - va;
-    let k2 = vc - va;
-    let k3 = ve - va;
-    let k4 = va - vb - vc + vd;
-    let k5 = va - vc - ve + vg;
-    let k6 = va - vb - ve + vf;
-    let k7 = -va + vb + vc - vd + ve - vf - vg + vh;
-    let value = va
-        + u.x * k1
-        + u.y * k2
-        + u.z * k3
-        + u.x * u.y * k4
-        + u.y * u.z * k5
-        + u.z * u.x * k6
-        + u.x * u.y * u.z * k7;
-    let gradient = ga
-        + u.x * (gb - ga)
-        + u.y * (gc - ga)
-        + u.z * (ge - ga)
-        + u.x * u.y * (ga - gb - gc + gd)
-        + u.y * u.z * (ga - gc - ge + gg)
-        + u.z * u.x * (ga - gb - ge + gf)
-        + u.x * u.y * u.z * (-ga + gb + gc - gd + ge - gf - gg + gh)
-        + du * (Vec3::new(k1, k2, k3)
-            + Vec3::new(u.y, u.z, u.x) * Vec3::new(k4, k5, k6)
-            + Vec3::new(u.z, u.x, u.y) * Vec3::new(k6, k4, k5)
-            + k7 * Vec3::new(u.y * u.z, u.z * u.x, u.x * u.y));
-    (value, gradient)
+    let (value, dv) = trilinear_grad(&v, u, du);
+    (value, trilinear(&g, u) + dv)
 }
 
 /// 1D gradient noise: slopes uniform in [−1, 1) at the integers, quintic fade (Perlin 2002 in one
@@ -216,12 +169,9 @@ pub fn gradient1(x: f32, seed: u32) -> f32 {
 /// [`gradient1`] and its derivative.
 #[inline]
 pub fn gradient1_grad(x: f32, seed: u32) -> (f32, f32) {
-    let s = mix32(seed);
     let i = cell_of(x);
     let t = x - i as f32;
-    let xa = (i as u32).wrapping_mul(PRIME_X);
-    let g0 = signed_f32(lattice(xa, 0, 0, s));
-    let g1 = signed_f32(lattice(xa.wrapping_add(PRIME_X), 0, 0, s));
+    let (g0, g1) = end_values(i, mix32(seed));
     let (a, b) = (g0 * t, g1 * (t - 1.0));
     let u = fade(t);
     (a + u * (b - a), g0 + u * (g1 - g0) + fade_d(t) * (b - a))

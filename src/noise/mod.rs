@@ -82,6 +82,7 @@ mod fractal;
 mod gradient;
 pub mod hash;
 mod lanes;
+mod lattice;
 mod sparse;
 mod value;
 mod warp;
