@@ -230,3 +230,55 @@ fn frames_differ_as_the_light_moves() {
     assert!((s.frames[6].light_deg - 50.0).abs() < 1e-5);
     assert!(max_relative_difference(&s.frames[0].beauty, &s.frames[6].beauty) > 0.1);
 }
+
+#[test]
+fn culled_shadow_test_answers_as_the_bvh() {
+    // Segments from points just off the surfaces (offset as the renderer offsets shadow rays)
+    // and from anywhere, in random directions and lengths: the box-culled query must give the
+    // BVH's answer every time, blocked and unblocked cases both occurring.
+    use xylem::math::{uniform_sphere, Pcg32};
+    use xylem::render::integrator::ShadowTest;
+    use xylem::render::Ray;
+    let loaded = from_str(WOOD_SCENE, "sweep_cache_wood.toml", Path::new("."), "test").unwrap();
+    let accel = &loaded.scene.accel;
+    let (culled, bvh) = (ShadowTest::culled(accel), ShadowTest::bvh(accel));
+    let eps = 2e-5 * accel.scale();
+    let mut rng = Pcg32::new(17, 4);
+    let (mut blocked, mut free) = (0, 0);
+    for i in 0..20_000 {
+        let o = glam::Vec3::new(300.0, 300.0, 120.0)
+            * (2.0 * rng.next_vec2().extend(rng.next_f32()) - 1.0);
+        let probe = Ray {
+            o,
+            d: uniform_sphere(rng.next_vec2()),
+        };
+        let origin = match (i % 2 == 0)
+            .then(|| accel.intersect(&probe, f32::INFINITY))
+            .flatten()
+        {
+            Some(h) => {
+                let s = accel.surface(&probe, &h);
+                let n = if s.ng.dot(probe.d) < 0.0 { s.ng } else { -s.ng };
+                s.p + n * eps
+            }
+            None => o,
+        };
+        let ray = Ray {
+            o: origin,
+            d: uniform_sphere(rng.next_vec2()),
+        };
+        let t_max = if i % 7 == 0 {
+            f32::INFINITY
+        } else {
+            400.0 * rng.next_f32()
+        };
+        let want = bvh.unoccluded(&ray, t_max);
+        assert_eq!(culled.unoccluded(&ray, t_max), want, "{ray:?} {t_max}");
+        if want {
+            free += 1;
+        } else {
+            blocked += 1;
+        }
+    }
+    assert!(blocked > 1000 && free > 1000, "{blocked} {free}");
+}

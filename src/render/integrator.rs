@@ -10,13 +10,13 @@
 //! [`sample_rngs`], so a render that caches primary samples and one that does not are bit-identical.
 
 use super::film::Aov;
-use super::geometry::{Hit, Ray};
+use super::geometry::{Accel, Hit, Ray};
 use super::light::{Light, LightSample};
 use super::Scene;
 use crate::bsdf::{Bsdf, WoodAtWo};
 use crate::material::{MaterialHit, SurfaceBsdf};
 use crate::math::{power_heuristic, Frame, Pcg32};
-use glam::{Mat3, UVec2, Vec2, Vec3};
+use glam::{Mat3, UVec2, Vec2, Vec3, Vec3A};
 
 /// Which light transport to simulate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -220,6 +220,89 @@ impl<'a> BsdfAtWo<'a> {
     }
 }
 
+/// Shadow queries, optionally culled: with the world boxes of a scene's few objects, a shadow
+/// segment that misses every box is unoccluded without traversing the BVH; any other segment
+/// asks the BVH. Exact: the BVH reports an occluder only where the segment meets a triangle, a
+/// triangle lies inside its object's box, and the boxes are widened by a margin
+/// ([`ShadowTest::MARGIN`] of the scene scale, a quarter of the ray-origin offset) hundreds of
+/// times larger than the rounding of a hit point (≲ 1e-7 of the scene scale), so a segment the
+/// slab test finds outside every box cannot be one the BVH finds blocked.
+#[derive(Clone)]
+pub struct ShadowTest<'a> {
+    accel: &'a Accel,
+    /// Widened world boxes (min, max) of the objects; `None`: always ask the BVH.
+    boxes: Option<Vec<(Vec3A, Vec3A)>>,
+}
+
+impl<'a> ShadowTest<'a> {
+    /// Box margin as a fraction of [`Accel::scale`] (ray origins are offset by 2e-5 of it).
+    pub const MARGIN: f32 = 5e-6;
+    /// Above this many objects the boxes cost more than the BVH they would skip.
+    pub const MAX_BOXES: usize = 8;
+
+    /// No culling: every query goes to the BVH.
+    pub fn bvh(accel: &'a Accel) -> Self {
+        ShadowTest { accel, boxes: None }
+    }
+
+    /// Culling by the objects' world boxes (none when the scene has more than
+    /// [`ShadowTest::MAX_BOXES`] objects or a non-finite vertex).
+    pub fn culled(accel: &'a Accel) -> Self {
+        let margin = Vec3::splat(Self::MARGIN * accel.scale());
+        let boxes: Option<Vec<(Vec3A, Vec3A)>> = (accel.instances.len() <= Self::MAX_BOXES)
+            .then(|| {
+                accel
+                    .instances
+                    .iter()
+                    .filter(|inst| !inst.mesh.positions.is_empty())
+                    .map(|inst| {
+                        let (lo, hi) = inst.mesh.positions.iter().fold(
+                            (Vec3::INFINITY, Vec3::NEG_INFINITY),
+                            |(lo, hi), &p| {
+                                let w = inst.transform.point_to_world(p);
+                                (lo.min(w), hi.max(w))
+                            },
+                        );
+                        ((lo - margin).into(), (hi + margin).into())
+                    })
+                    .collect()
+            })
+            .filter(|b: &Vec<(Vec3A, Vec3A)>| {
+                b.iter().all(|(lo, hi)| lo.is_finite() && hi.is_finite())
+            });
+        ShadowTest { accel, boxes }
+    }
+
+    /// True when nothing blocks the segment `o + t·d`, t in (0, t_max) ([`Accel::unoccluded`]).
+    #[inline]
+    pub fn unoccluded(&self, ray: &Ray, t_max: f32) -> bool {
+        if let Some(boxes) = &self.boxes {
+            let (o, inv) = (Vec3A::from(ray.o), Vec3A::ONE / Vec3A::from(ray.d));
+            if boxes
+                .iter()
+                .all(|(lo, hi)| segment_misses_box(o, inv, t_max, *lo, *hi))
+            {
+                return true;
+            }
+        }
+        self.accel.unoccluded(ray, t_max)
+    }
+}
+
+/// Slab test (Kay & Kajiya 1986) of the segment `o + t·d`, t in [0, t_max], against a box, with
+/// `inv` = 1/d per axis (±∞ for d = 0): true only when the segment surely misses. A NaN (an
+/// origin exactly on a slab plane of an axis the ray runs parallel to) answers "may hit".
+#[inline]
+pub fn segment_misses_box(o: Vec3A, inv: Vec3A, t_max: f32, lo: Vec3A, hi: Vec3A) -> bool {
+    let (ta, tb) = ((lo - o) * inv, (hi - o) * inv);
+    if ta.is_nan_mask().any() || tb.is_nan_mask().any() {
+        return false;
+    }
+    let t0 = ta.min(tb).max_element().max(0.0);
+    let t1 = ta.max(tb).min_element().min(t_max);
+    t0 > t1
+}
+
 /// Next-event estimation: one sample of every light, weighted against BSDF sampling by the power
 /// heuristic (delta lights take weight 1). Returns reflected radiance towards `wo`.
 pub fn sample_lights(
@@ -234,9 +317,10 @@ pub fn sample_lights(
         return l;
     }
     let bsdf = BsdfAtWo::new(sp);
+    let shadow = ShadowTest::bvh(&scene.accel);
     for light in lights {
         let u = rng.next_vec2();
-        l += light_term(scene, sp, &bsdf, light.sample(sp.p, u), rays);
+        l += light_term(&shadow, sp, &bsdf, light.sample(sp.p, u), rays);
     }
     l
 }
@@ -246,7 +330,7 @@ pub fn sample_lights(
 /// zero when the sample failed, the BSDF vanishes or the light is occluded.
 #[inline]
 pub fn light_term(
-    scene: &Scene,
+    shadow: &ShadowTest,
     sp: &ShadingPoint,
     bsdf: &BsdfAtWo,
     ls: Option<LightSample>,
@@ -263,15 +347,17 @@ pub fn light_term(
     if f == Vec3::ZERO {
         return Vec3::ZERO;
     }
-    let o = offset_origin(sp, ls.wi);
-    let shadow = Ray { o, d: ls.wi };
+    let ray = Ray {
+        o: offset_origin(sp, ls.wi),
+        d: ls.wi,
+    };
     rays.0 += 1;
     let t_max = if ls.dist.is_finite() {
         ls.dist * (1.0 - 1e-4)
     } else {
         f32::INFINITY
     };
-    if !scene.accel.unoccluded(&shadow, t_max) {
+    if !shadow.unoccluded(&ray, t_max) {
         return Vec3::ZERO;
     }
     let w = if ls.is_delta {

@@ -15,7 +15,7 @@ use super::path::{ArcPlane, LightArc, PathError};
 use crate::bsdf::Bsdf;
 use crate::math::{power_heuristic, Pcg32};
 use crate::render::integrator::{
-    self, light_rng, primary_sample, BsdfAtWo, PrimarySample, RayCount,
+    self, light_rng, primary_sample, BsdfAtWo, PrimarySample, RayCount, ShadowTest,
 };
 use crate::render::light::LightU;
 use crate::render::{
@@ -23,7 +23,7 @@ use crate::render::{
     TILE,
 };
 use crate::scene::LoadedScene;
-use glam::{UVec2, Vec3};
+use glam::{UVec2, Vec3, Vec3A};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use std::ops::Range;
@@ -240,17 +240,14 @@ pub fn render_sweep(
 ) -> Result<SweepRender, RenderError> {
     let (w, h) = (scene.camera.width, scene.camera.height);
     let (pool, tiles) = crate::render::tiled_job(scene, run)?;
-    let lights: Vec<Vec<Light>> = frames
-        .clone()
-        .map(|f| path.frame_lights(&scene.lights, moving, f))
-        .collect();
-    let bar = progress_bar(run.progress, tiles.len() as u64, lights.len());
+    let lights = SweepLights::new(scene, path, moving, frames.clone());
+    let bar = progress_bar(run.progress, tiles.len() as u64, lights.frames.len());
     let start = Instant::now();
     let results: Vec<(UVec2, TileFrames)> = pool.install(|| {
         tiles
             .par_iter()
             .map(|&origin| {
-                let r = (origin, sweep_tile(scene, &lights, moving, settings, origin));
+                let r = (origin, sweep_tile(scene, &lights, settings, origin));
                 bar.inc(1);
                 r
             })
@@ -321,14 +318,14 @@ struct TileFrames {
 /// every frame, are summed once.
 fn sweep_tile(
     scene: &Scene,
-    lights: &[Vec<Light>],
-    moving: usize,
+    sweep: &SweepLights,
     settings: &RenderSettings,
     origin: UVec2,
 ) -> TileFrames {
     let (w, h) = (scene.camera.width, scene.camera.height);
     let (tw, th) = (TILE.min(w - origin.x), TILE.min(h - origin.y));
     let n = (tw * th) as usize;
+    let lights = &sweep.frames;
     let mut sums = vec![vec![PixelSum::default(); n]; lights.len()];
     let mut aov_sums = vec![PixelSum::default(); n];
     let mut radiance = vec![Vec3::ZERO; lights.len()];
@@ -342,15 +339,9 @@ fn sweep_tile(
             let ps = primary_sample(scene, pixel, s, settings.seed);
             let rng = light_rng(scene, pixel, s, settings.seed);
             match settings.integrator {
-                Integrator::Direct => direct_for_frames(
-                    scene,
-                    &ps,
-                    lights,
-                    moving,
-                    &rng,
-                    &mut scratch,
-                    &mut radiance,
-                ),
+                Integrator::Direct => {
+                    direct_for_frames(scene, sweep, &ps, &rng, &mut scratch, &mut radiance)
+                }
                 Integrator::Path { max_depth } => {
                     for (l, frame_lights) in radiance.iter_mut().zip(lights) {
                         let mut r = rng.clone();
@@ -406,30 +397,30 @@ struct FrameScratch {
 /// (`sample_lights`, `shade_direct`), so each frame equals the naive render.
 fn direct_for_frames(
     scene: &Scene,
+    sweep: &SweepLights,
     ps: &PrimarySample,
-    lights: &[Vec<Light>],
-    moving: usize,
     rng: &Pcg32,
     scratch: &mut FrameScratch,
     out: &mut [Vec3],
 ) {
+    let (lights, moving, shadow) = (&sweep.frames, sweep.moving, &sweep.shadow);
     let mut rays = RayCount::default();
     let FrameScratch { shaded, us, terms } = scratch;
     shaded.clear();
     shaded.resize(out.len(), false);
-    for (k, frame_lights) in lights.iter().enumerate() {
+    sweep.nearest_per_frame(&ps.ray, ps.t_hit, |k, hit| {
         // A light seen directly in front of the first hit (or on a miss) is the sample's value.
-        if let Some((_, t, le, _)) = integrator::nearest_light(frame_lights, &ps.ray, ps.t_hit) {
+        if let Some((_, t, le, _)) = hit {
             if t < ps.t_hit || ps.point.is_none() {
                 out[k] = le;
-                continue;
+                return;
             }
         }
         shaded[k] = ps.point.is_some();
         if !shaded[k] {
             out[k] = Vec3::ZERO;
         }
-    }
+    });
     let (Some(sp), Some(first)) = (&ps.point, shaded.iter().position(|&s| s)) else {
         return;
     };
@@ -449,7 +440,7 @@ fn direct_for_frames(
             terms.push(if j == moving {
                 Vec3::ZERO
             } else {
-                integrator::light_term(scene, sp, &bsdf, light.sample_at(sp.p, &u), &mut rays)
+                integrator::light_term(shadow, sp, &bsdf, light.sample_at(sp.p, &u), &mut rays)
             });
         }
         for (k, frame_lights) in lights.iter().enumerate() {
@@ -457,8 +448,13 @@ fn direct_for_frames(
                 continue;
             }
             let m = &frame_lights[moving];
-            let term_m =
-                integrator::light_term(scene, sp, &bsdf, m.sample_at(sp.p, &us[moving]), &mut rays);
+            let term_m = integrator::light_term(
+                shadow,
+                sp,
+                &bsdf,
+                m.sample_at(sp.p, &us[moving]),
+                &mut rays,
+            );
             let mut l = Vec3::ZERO;
             for (j, t) in terms.iter().enumerate() {
                 l += if j == moving { term_m } else { *t };
@@ -486,18 +482,97 @@ fn direct_for_frames(
         .accel
         .intersect(&ray, f32::INFINITY)
         .map_or(f32::INFINITY, |h| h.t);
-    for (k, frame_lights) in lights.iter().enumerate() {
-        if !shaded[k] {
-            continue;
-        }
-        if let Some((_, _, le, light_pdf)) = integrator::nearest_light(frame_lights, &ray, t_scene)
-        {
+    sweep.nearest_per_frame(&ray, t_scene, |k, hit| {
+        if let (true, Some((_, _, le, light_pdf))) = (shaded[k], hit) {
             let w = if bs.is_delta {
                 1.0
             } else {
                 power_heuristic(bs.pdf, light_pdf)
             };
             out[k] += bs.f * le * (bs.wi.z.abs() * w / bs.pdf);
+        }
+    });
+}
+
+/// The lights of every frame of a sweep, and what lets a frame skip work: the lights that do not
+/// move, the box the moving light stays in over all frames, and the culled shadow test.
+struct SweepLights<'a> {
+    /// Each frame's lights (the scene's, light `moving` placed on the arc).
+    frames: Vec<Vec<Light>>,
+    moving: usize,
+    /// The scene's lights without the moving one, in their order.
+    fixed: Vec<Light>,
+    /// A box holding the moving light in every frame, widened by a margin far above the rounding
+    /// of a ray–sphere test; `None` when rays cannot meet the light at all (a delta light).
+    swept: Option<(Vec3A, Vec3A)>,
+    shadow: ShadowTest<'a>,
+}
+
+impl<'a> SweepLights<'a> {
+    fn new(scene: &'a Scene, path: &SweepPath, moving: usize, frames: Range<usize>) -> Self {
+        let frames: Vec<Vec<Light>> = frames
+            .map(|f| path.frame_lights(&scene.lights, moving, f))
+            .collect();
+        let swept = frames
+            .iter()
+            .try_fold(None, |acc: Option<(Vec3, Vec3)>, fl| {
+                let Light::Sphere { center, radius, .. } = fl[moving] else {
+                    return if fl[moving].is_delta() {
+                        Some(None)
+                    } else {
+                        None
+                    };
+                };
+                // Rounding of `intersect_sphere` is ~1e-7 of the coordinates; 1e-3 of them is safe.
+                let r = Vec3::splat(radius + 1e-3 * (center.abs().max_element() + radius));
+                let (lo, hi) = acc.unwrap_or((center, center));
+                Some(Some((lo.min(center - r), hi.max(center + r))))
+            });
+        let swept = match swept {
+            Some(Some((lo, hi))) => Some((lo.into(), hi.into())),
+            // Every frame's light is delta: no ray meets it.
+            Some(None) => None,
+            // An unexpected kind of moving light: a box that every ray "may hit".
+            None => Some((Vec3A::NEG_INFINITY, Vec3A::INFINITY)),
+        };
+        let fixed = scene
+            .lights
+            .iter()
+            .enumerate()
+            .filter(|&(i, _)| i != moving)
+            .map(|(_, l)| l.clone())
+            .collect();
+        SweepLights {
+            frames,
+            moving,
+            fixed,
+            swept,
+            shadow: ShadowTest::culled(&scene.accel),
+        }
+    }
+
+    /// Calls `f(k, integrator::nearest_light(frame k's lights, ray, t_max))` for every frame k.
+    /// When the ray surely misses the moving light's box, the answer is that of the fixed lights
+    /// alone (the moving one would have returned no hit in any frame), found once.
+    fn nearest_per_frame(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        mut f: impl FnMut(usize, Option<(usize, f32, Vec3, f32)>),
+    ) {
+        let misses = self.swept.is_none_or(|(lo, hi)| {
+            let inv = Vec3A::ONE / Vec3A::from(ray.d);
+            integrator::segment_misses_box(ray.o.into(), inv, f32::INFINITY, lo, hi)
+        });
+        if misses {
+            let hit = integrator::nearest_light(&self.fixed, ray, t_max);
+            for k in 0..self.frames.len() {
+                f(k, hit);
+            }
+        } else {
+            for (k, lights) in self.frames.iter().enumerate() {
+                f(k, integrator::nearest_light(lights, ray, t_max));
+            }
         }
     }
 }
