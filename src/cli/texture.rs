@@ -63,7 +63,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         bail!("--out FILE.png is required");
     };
     let source = source(&args)?;
-    let pixels = slice.render(&|p| source.eval(p));
+    let pixels = slice.render_rows(&|p, o| source.eval_many(p, o));
     if let Some((x, y)) = first_non_finite(&pixels, slice.res) {
         bail!("the texture gave a non-finite colour at pixel ({x}, {y}); nothing written");
     }

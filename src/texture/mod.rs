@@ -34,6 +34,15 @@ use std::collections::BTreeMap;
 /// A solid texture: linear RGB colour at a point (mm).
 pub trait SolidTexture: Send + Sync {
     fn eval(&self, p: Vec3) -> Vec3;
+
+    /// [`SolidTexture::eval`] at every point of `points`, written to `out` (same length).
+    /// Textures built on a batch noise call (`gradient3_many`, `Fractal::eval_many`) override it
+    /// with the same values, faster; the rest evaluate point by point.
+    fn eval_many(&self, points: &[Vec3], out: &mut [Vec3]) {
+        for (p, o) in points.iter().zip(out) {
+            *o = self.eval(*p);
+        }
+    }
 }
 
 /// The texture names [`by_name`] accepts.

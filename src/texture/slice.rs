@@ -51,15 +51,24 @@ impl Slice {
 
     /// Evaluates `f` at every pixel centre (rows in parallel); row-major, top row first.
     pub fn render(&self, f: &(dyn Fn(Vec3) -> Vec3 + Sync)) -> Vec<Vec3> {
+        self.render_rows(&|points, out| {
+            for (p, o) in points.iter().zip(out) {
+                *o = f(*p);
+            }
+        })
+    }
+
+    /// [`Slice::render`] with a batch function: `f(points, out)` fills a row's colours from its
+    /// pixel centres (rows in parallel), so a batch noise call can fill its SIMD lanes.
+    pub fn render_rows(&self, f: &(dyn Fn(&[Vec3], &mut [Vec3]) + Sync)) -> Vec<Vec3> {
         let n = self.res as usize;
         let mut pixels = vec![Vec3::ZERO; n * n];
         pixels
             .par_chunks_mut(n.max(1))
             .enumerate()
             .for_each(|(j, row)| {
-                for (i, px) in row.iter_mut().enumerate() {
-                    *px = f(self.point(i as u32, j as u32));
-                }
+                let points: Vec<Vec3> = (0..n).map(|i| self.point(i as u32, j as u32)).collect();
+                f(&points, row);
             });
         pixels
     }

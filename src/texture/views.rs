@@ -7,8 +7,8 @@ use super::ramp::{grey, Ramp};
 use super::SolidTexture;
 use crate::noise::hash::unit_f32;
 use crate::noise::{
-    cellular3, gradient3, value3, Basis, Cells, Fractal, FractalKind, Kernel, SparseConvolution,
-    Warp, Weights,
+    cellular3, gradient3, gradient3_many, value3, Basis, Cells, Fractal, FractalKind, Kernel,
+    SparseConvolution, Warp, Weights,
 };
 use glam::Vec3;
 
@@ -44,6 +44,21 @@ impl SolidTexture for LatticeView {
             Basis::Value => value3(q, self.seed),
         };
         grey(0.5 + 0.5 * n)
+    }
+
+    fn eval_many(&self, points: &[Vec3], out: &mut [Vec3]) {
+        let q: Vec<Vec3> = points.iter().map(|&p| p / self.scale).collect();
+        let mut n = vec![0.0f32; q.len()];
+        match self.basis {
+            Basis::Gradient => gradient3_many(&q, self.seed, &mut n),
+            Basis::Value => n
+                .iter_mut()
+                .zip(&q)
+                .for_each(|(n, &q)| *n = value3(q, self.seed)),
+        }
+        for (o, n) in out.iter_mut().zip(n) {
+            *o = grey(0.5 + 0.5 * n);
+        }
     }
 }
 
@@ -110,14 +125,29 @@ impl FbmView {
     }
 }
 
-impl SolidTexture for FbmView {
-    fn eval(&self, p: Vec3) -> Vec3 {
-        let n = self.fractal.eval(p / self.scale, self.seed);
+impl FbmView {
+    /// The grey of a sum value `n`.
+    fn shade(&self, n: f32) -> Vec3 {
         grey(match self.fractal.kind {
             // ±3σ to black / white: σ = σ_n sqrt(Σ gain²ⁱ), σ_n ≈ 0.286 (notes/noise.md).
             FractalKind::Fbm => 0.5 + n / (6.0 * 0.286 * self.rms_amplitude),
             _ => n / self.fractal.amplitude_sum(),
         })
+    }
+}
+
+impl SolidTexture for FbmView {
+    fn eval(&self, p: Vec3) -> Vec3 {
+        self.shade(self.fractal.eval(p / self.scale, self.seed))
+    }
+
+    fn eval_many(&self, points: &[Vec3], out: &mut [Vec3]) {
+        let q: Vec<Vec3> = points.iter().map(|&p| p / self.scale).collect();
+        let mut n = vec![0.0f32; q.len()];
+        self.fractal.eval_many(&q, self.seed, &mut n);
+        for (o, n) in out.iter_mut().zip(n) {
+            *o = self.shade(n);
+        }
     }
 }
 
