@@ -1,8 +1,10 @@
 //! Baking a wood preset into texture maps for other tools (`xylem bake`): base colour, fibre
-//! direction as a glTF `KHR_materials_anisotropy` map, highlight width, ray mask and a normal map
-//! from the pore bump, over the top face of a board cut from the tree. The trade-off measurement
-//! (`xylem tradeoff`) may use these maps as the "baked texture" alternative to the procedural
-//! volume. Uses `wood` and `render::image_io`; nothing below it uses it.
+//! direction as a glTF `KHR_materials_anisotropy` map, highlight width, ray mask, a normal map
+//! from the pore bump and a signed tangent-space fibre-direction map (the anisotropy texel cannot
+//! hold the sign of the fibre's tilt out of the face), over the top face of a board cut from the
+//! tree. `xylem tradeoff` renders from these maps (`material::BakedWoodMaterial`, via
+//! [`bake_face`]) as the "baked texture" alternative to the procedural volume. Uses `wood`,
+//! `material` (the map type) and `render::image_io`.
 //!
 //! Conventions (as glTF 2.0 and KHR_materials_anisotropy use them): texel (0, 0) is the top-left
 //! corner; tangent-space x points to the image's right (+u, along the board's length), y to the

@@ -1,7 +1,7 @@
 //! `xylem tradeoff SCENE.toml`: measures every speed/accuracy knob against a reference render and
 //! writes validation/TRADEOFF.md with an error-against-time plot.
 
-use crate::sweep::plot::{line_plot, PlotOptions, Series, PALETTE};
+use crate::sweep::plot::{line_plot, PlotOptions, Series};
 use crate::sweep::tradeoff::{relative_mse, render_with, settings, ssim, Knobs, Measurement};
 use anyhow::Context;
 use std::path::{Path, PathBuf};
@@ -23,6 +23,10 @@ pub struct Args {
     /// Also write every number as JSON here.
     #[arg(long)]
     pub json: Option<PathBuf>,
+    /// Replace the preset of every wood material of the scene by this one (e.g. curly_maple, to
+    /// measure the distortion knobs on a strongly figured wood).
+    #[arg(long)]
+    pub preset: Option<String>,
     /// Also write every render (reference and each row) as a PNG into this folder.
     #[arg(long)]
     pub images: Option<PathBuf>,
@@ -50,10 +54,23 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let exposure = probe.exposure;
     let name = probe.name.clone();
     drop(probe);
+    let preset = match &args.preset {
+        Some(p) => Some(crate::wood::preset(p).with_context(|| format!("--preset {p}"))?),
+        None => None,
+    };
     let scene_path = args.scene.clone();
     let base = move || -> Result<crate::scene::LoadedScene, String> {
         let mut l = crate::scene::load(&scene_path).map_err(|e| e.to_string())?;
         l.scene.camera = l.scene.camera.with_resolution(w, h);
+        if let Some(params) = &preset {
+            for m in &mut l.scene.materials {
+                if let crate::material::Material::Wood(wm) = m {
+                    let v = crate::wood::WoodVolume::new(params.clone(), wm.volume.seed())
+                        .map_err(|e| e.to_string())?;
+                    wm.volume = std::sync::Arc::new(v);
+                }
+            }
+        }
         Ok(l)
     };
     let run = crate::render::RunOptions {
@@ -123,9 +140,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     bar.finish_and_clear();
     let dir = args.out.parent().map(Path::to_path_buf).unwrap_or_default();
-    let plot_rel = "plots/tradeoff_error_vs_time.png";
-    write_plot(&dir.join(plot_rel), &rows)?;
-    let md = markdown(&name, &args, (w, h), ref_secs, &rows, plot_rel);
+    let stem = args
+        .out
+        .file_stem()
+        .map(|s| s.to_string_lossy().to_lowercase())
+        .unwrap_or_else(|| "tradeoff".into());
+    let plot_rel = format!("plots/{stem}_error_vs_time.png");
+    write_plot(&dir.join(&plot_rel), &rows)?;
+    let md = markdown(&name, &args, (w, h), ref_secs, &rows, &plot_rel);
     crate::sweep::sequence::write_text_atomic(&args.out, &md)?;
     for r in &rows {
         println!(
@@ -141,13 +163,33 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn write_plot(path: &Path, rows: &[Measurement]) -> anyhow::Result<()> {
+/// One colour per knob (the plot's series, in the table's order), with its name for the legend.
+const COLOURS: [([u8; 3], &str); 10] = [
+    ([31, 119, 180], "blue"),
+    ([214, 39, 40], "red"),
+    ([44, 160, 44], "green"),
+    ([255, 127, 14], "orange"),
+    ([148, 103, 189], "purple"),
+    ([23, 190, 207], "cyan"),
+    ([140, 86, 75], "brown"),
+    ([227, 119, 194], "pink"),
+    ([127, 127, 127], "grey"),
+    ([188, 189, 34], "olive"),
+];
+
+/// The knobs in the table's order.
+fn knob_names(rows: &[Measurement]) -> Vec<&str> {
     let mut knobs: Vec<&str> = Vec::new();
     for r in rows {
         if !knobs.contains(&r.knob.as_str()) {
             knobs.push(&r.knob);
         }
     }
+    knobs
+}
+
+fn write_plot(path: &Path, rows: &[Measurement]) -> anyhow::Result<()> {
+    let knobs = knob_names(rows);
     let series: Vec<Series> = knobs
         .iter()
         .enumerate()
@@ -157,7 +199,7 @@ fn write_plot(path: &Path, rows: &[Measurement]) -> anyhow::Result<()> {
                 .filter(|r| r.knob == *name)
                 .map(|r| (r.seconds, r.relative_mse))
                 .collect(),
-            color: PALETTE[k % PALETTE.len()],
+            color: COLOURS[k % COLOURS.len()].0,
             markers: true,
         })
         .collect();
@@ -175,11 +217,22 @@ fn write_plot(path: &Path, rows: &[Measurement]) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The cheapest measured setting whose SSIM reaches `min_ssim`.
+/// Knobs that keep the scene's look for any scene (noise bands, impulse density and dropping
+/// pores change the wood itself; baking needs one flat object per material), so the presets are
+/// chosen among these.
+const PRESET_KNOBS: [&str; 4] = [
+    "samples per pixel",
+    "footprint band-limit",
+    "distortion Jacobian",
+    "finish",
+];
+
+/// The cheapest measured setting (render plus preparation time) among [`PRESET_KNOBS`] whose
+/// SSIM reaches `min_ssim`.
 fn cheapest(rows: &[Measurement], min_ssim: f64) -> Option<&Measurement> {
     rows.iter()
-        .filter(|r| r.knob != "--quality" && r.ssim >= min_ssim)
-        .min_by(|a, b| a.seconds.total_cmp(&b.seconds))
+        .filter(|r| PRESET_KNOBS.contains(&r.knob.as_str()) && r.ssim >= min_ssim)
+        .min_by(|a, b| (a.seconds + a.prep_seconds).total_cmp(&(b.seconds + b.prep_seconds)))
 }
 
 fn markdown(
@@ -191,19 +244,29 @@ fn markdown(
     plot: &str,
 ) -> String {
     let mut s = format!(
-        "# Speed against accuracy: `{name}`\n\nRegenerated by `xylem tradeoff {} --width {}` \
+        "# Speed against accuracy: `{name}`{}\n\nRegenerated by `xylem tradeoff {} --width {}{}` \
          ({w}×{h} pixels, one frame with the scene's own lights, {} threads; a reference of {} spp \
          with the most accurate setting of every knob took {ref_secs:.2} s). Error against the \
          reference: relative MSE (Σ|x − r|² / Σ|r|² over RGB) and mean SSIM (Wang et al. 2004, \
          8×8 windows, stride 4, on sRGB luminance). Times are wall clock on a shared machine \
          (other jobs running), so compare them within this table only. Model knobs are measured \
-         at 16 spp, so their error includes the 16-spp noise of the first table's row; the \
+         at 16 spp (the footprint band-limit at 1 to 64), so their error includes the noise of \
+         the same spp in the first table's rows; the \
          *model* columns compare each render with the reference model rendered at the same spp \
          with the same seeds, which cancels most of that shared noise and leaves what the knob \
          itself changes. Every row but the reference uses the simplified Jacobian (today's \
-         default) unless it says otherwise.\n\n",
+         default) unless it says otherwise. *prep* is the time to apply the knobs before \
+         rendering (rebuilding the volume; baking the maps), paid once per scene.\n\n",
+        args.preset
+            .as_ref()
+            .map(|p| format!(" with {p}"))
+            .unwrap_or_default(),
         args.scene.display(),
         args.width,
+        args.preset
+            .as_ref()
+            .map(|p| format!(" --preset {p}"))
+            .unwrap_or_default(),
         if args.threads == 0 {
             "all".to_string()
         } else {
@@ -226,26 +289,32 @@ fn markdown(
             r.model_ssim
         );
     }
+    let legend: Vec<String> = knob_names(rows)
+        .iter()
+        .enumerate()
+        .map(|(k, name)| format!("{} {name}", COLOURS[k % COLOURS.len()].1))
+        .collect();
     s += &format!(
-        "\n![relative MSE (vertical, log) against render time in seconds (horizontal, log); one colour \
-         per knob in the table's order: blue spp, red noise bands, green impulse density, orange \
-         pores and rays, purple the --quality presets]({plot})\n\n## Recommended settings\n\n"
+        "\n![relative MSE (vertical, log) against render time in seconds (horizontal, log), one \
+         colour per knob: {}]({plot})\n\n## Recommended settings\n\n\
+         Chosen among the knobs that keep any scene's look ({}): the cheapest measured setting \
+         (render plus preparation time) reaching each SSIM threshold.\n\n",
+        legend.join(", "),
+        PRESET_KNOBS.join(", ")
     );
     for (label, t) in [("draft", 0.9), ("default", 0.97), ("final", 0.99)] {
         match cheapest(rows, t) {
             Some(r) => {
                 s += &format!(
-                    "- **{label}** (cheapest with SSIM ≥ {t}): {} — {:.3} s, SSIM {:.4}\n",
-                    r.setting, r.seconds, r.ssim
+                    "- **{label}** (cheapest with SSIM ≥ {t}): {} {} — {:.3} s, SSIM {:.4}\n",
+                    r.knob, r.setting, r.seconds, r.ssim
                 )
             }
             None => s += &format!("- **{label}**: no measured setting reaches SSIM ≥ {t}\n"),
         }
     }
-    s += "\n`--quality draft|default|final` (on `xylem sweep`) applies the presets in \
-          `src/sweep/tradeoff.rs` (`Quality::knobs`), rows `--quality` above.\n\n\
-          ## Not measured\n\n\
-          - baked textures: the renderer has no image-texture material, so baked maps \
-          (`xylem bake`) are not compared in rendered images.\n";
+    s += "\n`--quality draft|default|final` (on `xylem sweep`) applies the presets of \
+          `Quality::knobs` in `src/sweep/tradeoff.rs`, fixed from this table (rows `--quality` \
+          above); rerunning on another scene or machine may recommend others.\n";
     s
 }
