@@ -8,7 +8,9 @@ use super::sequence::{
     assemble, frame_stem, read_records, write_frame, AssembleOptions, Assembled, FrameRecord,
     Region, SequenceError,
 };
-use crate::render::image_io::{aov_layers, write_exr_layers, ExrLayer, ImageError};
+use crate::render::image_io::{
+    aov_layers, write_exr_layers, write_exr_layers_with, ExrCompression, ExrLayer, ImageError,
+};
 use crate::render::{RenderError, RunOptions};
 use crate::scene::LoadedScene;
 use rayon::prelude::*;
@@ -46,6 +48,8 @@ pub struct SweepJob {
     /// Render every frame from scratch instead of caching (for timing and checking the cache).
     pub naive: bool,
     pub run: RunOptions,
+    /// Compression of each frame's EXR (the shared AOV file is always ZIP).
+    pub exr: ExrCompression,
 }
 
 /// What a job did.
@@ -86,6 +90,7 @@ pub fn write_frames(
     total: usize,
     exposure: f32,
     regions: &[Region],
+    compression: ExrCompression,
 ) -> Result<(), SweepError> {
     let (w, h) = (render.width, render.height);
     write_exr_layers(&dir.join(AOV_FILE), w, h, &aov_layers(&render.aov))?;
@@ -102,11 +107,12 @@ pub fn write_frames(
                 data: f.std_error.clone(),
             },
         ];
-        write_exr_layers(
+        write_exr_layers_with(
             &dir.join(format!("{}.exr", frame_stem(f.index))),
             w,
             h,
             &layers,
+            compression,
         )?;
         let rec = FrameRecord::measure(f.index, total, f.light_deg, (w, h), &f.beauty, regions);
         write_frame(dir, &rec, &f.beauty, exposure)?;
@@ -142,7 +148,14 @@ pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepE
         range.clone(),
         &job.run,
     )?;
-    write_frames(&job.out, &r, total, loaded.exposure, &scene_regions(loaded))?;
+    write_frames(
+        &job.out,
+        &r,
+        total,
+        loaded.exposure,
+        &scene_regions(loaded),
+        job.exr,
+    )?;
     // Assemble when the folder now holds the complete sweep (always, unless farming slices).
     let complete = match read_records(&job.out) {
         Ok(_) => true,
