@@ -292,28 +292,43 @@ impl WoodMaterial {
     }
 
     /// Looks the hit up in the tree and builds the finished-wood BSDF in the local frame.
+    ///
+    /// The placement's cutting (solid block, veneer slice per face, boards of a floor) maps the
+    /// point into the tree and gives the rotation `J` from placement space to tree space; the
+    /// placement space is the object's, or the world's for `world_space` placements.
     pub fn shade(&self, hit: &MaterialHit) -> Shading {
         let place = &hit.placement;
-        let rot = place.rotation_matrix();
-        let p_tree = place.object_to_tree().transform_point3(hit.p_object);
+        // Placement space → world: directions by `to_world_dir`, gradients by `to_world_grad`;
+        // `unit` is world mm per placement unit (|det|^⅓ of the instance map).
+        let (p, n, to_world_dir, to_world_grad, unit) = if place.world_space {
+            (hit.p_world, hit.ng, Mat3::IDENTITY, Mat3::IDENTITY, 1.0)
+        } else {
+            let unit = hit.object_to_world.determinant().abs().cbrt().max(1e-12);
+            (
+                hit.p_object,
+                hit.n_object,
+                hit.object_to_world,
+                hit.normal_to_world,
+                unit,
+            )
+        };
+        let (p_tree, j) = place.to_tree(p, n);
         let texel = if self.switches.footprint_filter && hit.footprint > 0.0 {
-            // World mm → object units (|det|^⅓ of the instance map) → tree mm.
-            let to_object = hit.object_to_world.determinant().abs().cbrt().max(1e-12);
-            let footprint = hit.footprint / to_object * place.scale;
+            // World mm → placement units → tree mm.
+            let footprint = hit.footprint / unit * place.scale;
             self.volume.eval_filtered(p_tree, self.needs(), footprint)
         } else {
             self.volume.eval(p_tree, self.needs())
         };
-        // Tree → object directions: the transpose of the placement rotation; object → world: the
-        // instance's linear map (directions are contravariant, Liu et al. 2016 §6.2).
-        let to_world = |d: Vec3| (hit.object_to_world * (rot.transpose() * d)).normalize_or_zero();
+        // Tree → placement directions: Jᵀ (J is a rotation); placement → world: the instance's
+        // linear map (directions are contravariant, Liu et al. 2016 §6.2).
+        let to_world = |d: Vec3| (to_world_dir * (j.transpose() * d)).normalize_or_zero();
         let mut n = hit.ns;
         if self.bump != 0.0 && texel.bump_grad != Vec3::ZERO {
-            // Bump mapping (Blinn 1978): h(p_object) = bump(origin + s R p), so
-            // ∇_object h = s Rᵀ ∇_tree h, and gradients (covariant) map to world by the normal
+            // Bump mapping (Blinn 1978): h(q) = bump(p_tree(q)) with ∂p_tree/∂q = s J, so
+            // ∇_q h = s Jᵀ ∇_tree h, and gradients (covariant) map to world by the normal
             // matrix; the normal tilts against the surface part of the gradient.
-            let g =
-                hit.normal_to_world * (rot.transpose() * texel.bump_grad * place.scale) * self.bump;
+            let g = to_world_grad * (j.transpose() * texel.bump_grad * place.scale) * self.bump;
             let g_surface = g - n * g.dot(n);
             let tilted = (n - g_surface).normalize_or_zero();
             if tilted != Vec3::ZERO && tilted.is_finite() {
