@@ -154,6 +154,78 @@ fn intersect_node(node: &Node, r: &RayData, t_min: f32, t_max: f32) -> (u32, [f3
     (mask, t_near)
 }
 
+/// The node test as one compilation target runs it best; every implementation does the same IEEE
+/// operations in the same order as [`intersect_node`], so all return the same bits.
+trait NodeTest {
+    fn intersect(node: &Node, r: &RayData, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]);
+}
+
+/// The baseline target: the auto-vectorised lane loop.
+struct Portable;
+
+impl NodeTest for Portable {
+    #[inline(always)]
+    fn intersect(node: &Node, r: &RayData, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]) {
+        intersect_node(node, r, t_min, t_max)
+    }
+}
+
+/// AVX2 intrinsics: LLVM builds the hit mask of the lane loop from a `bool` array with eight
+/// pack/shift/or steps; `vmovmskps` does it in one.
+#[cfg(target_arch = "x86_64")]
+struct Avx2;
+
+#[cfg(target_arch = "x86_64")]
+impl NodeTest for Avx2 {
+    #[inline(always)]
+    fn intersect(node: &Node, r: &RayData, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]) {
+        // SAFETY: `Avx2` is only used by the `#[target_feature(enable = "avx2")]` traversals,
+        // which run only when the CPU reports AVX2.
+        unsafe { intersect_node_avx2(node, r, t_min, t_max) }
+    }
+}
+
+/// [`intersect_node`] with AVX2 intrinsics: `vmaxps(a, b)` is `a > b ? a : b` and `vminps(a, b)`
+/// is `a < b ? a : b`, the portable code's `max` and `min` exactly.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+unsafe fn intersect_node_avx2(
+    node: &Node,
+    r: &RayData,
+    t_min: f32,
+    t_max: f32,
+) -> (u32, [f32; WIDTH]) {
+    use std::arch::x86_64::*;
+    let slab = |plane: &[f32; WIDTH], o: f32, inv: f32| {
+        _mm256_mul_ps(
+            _mm256_sub_ps(_mm256_loadu_ps(plane.as_ptr()), _mm256_set1_ps(o)),
+            _mm256_set1_ps(inv),
+        )
+    };
+    let [nx, ny, nz] = r.near;
+    let [ox, oy, oz] = r.o;
+    let [ix, iy, iz] = r.inv;
+    let t_near = _mm256_max_ps(
+        _mm256_max_ps(
+            slab(&node.bounds[nx][0], ox, ix),
+            slab(&node.bounds[ny][1], oy, iy),
+        ),
+        _mm256_max_ps(slab(&node.bounds[nz][2], oz, iz), _mm256_set1_ps(t_min)),
+    );
+    let t_far = _mm256_min_ps(
+        _mm256_min_ps(
+            slab(&node.bounds[1 - nx][0], ox, ix),
+            slab(&node.bounds[1 - ny][1], oy, iy),
+        ),
+        _mm256_min_ps(slab(&node.bounds[1 - nz][2], oz, iz), _mm256_set1_ps(t_max)),
+    );
+    let hit = _mm256_cmp_ps::<_CMP_LE_OQ>(t_near, _mm256_mul_ps(t_far, _mm256_set1_ps(ROBUST_FAR)));
+    let mut out = [0.0; WIDTH];
+    _mm256_storeu_ps(out.as_mut_ptr(), t_near);
+    (_mm256_movemask_ps(hit) as u32, out)
+}
+
 /// Möller–Trumbore ray/triangle test on four triangles at once (Möller & Trumbore 1997, in the
 /// form of obvhs's `RtTriangle::intersect`: with c = v0 − o and r = d × c, det = ng·d,
 /// u = r·e2 / det, v = r·e1 / det, t = ng·c / det; a hit needs u, v, 1 − u − v with a clear
@@ -348,24 +420,24 @@ impl WideBvh {
 
     /// The traversal compiled for the baseline target (the reference the AVX2 path must equal).
     pub fn closest_portable(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<WideHit> {
-        self.with_stack(|s| self.closest_in(o, d, t_max, s))
+        self.with_stack(|s| self.closest_in::<Portable>(o, d, t_max, s))
     }
 
     /// Any-hit query compiled for the baseline target.
     pub fn unoccluded_portable(&self, o: Vec3, d: Vec3, t_max: f32) -> bool {
-        self.with_stack(|s| self.unoccluded_in(o, d, t_max, s))
+        self.with_stack(|s| self.unoccluded_in::<Portable>(o, d, t_max, s))
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     unsafe fn closest_avx2(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<WideHit> {
-        self.with_stack(|s| self.closest_in(o, d, t_max, s))
+        self.with_stack(|s| self.closest_in::<Avx2>(o, d, t_max, s))
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     unsafe fn unoccluded_avx2(&self, o: Vec3, d: Vec3, t_max: f32) -> bool {
-        self.with_stack(|s| self.unoccluded_in(o, d, t_max, s))
+        self.with_stack(|s| self.unoccluded_in::<Avx2>(o, d, t_max, s))
     }
 
     /// Runs `f` with a traversal stack large enough for this tree (on the call stack when it
@@ -384,7 +456,13 @@ impl WideBvh {
     /// first with their entry distance, and a popped entry farther than the closest hit so far is
     /// skipped.
     #[inline(always)]
-    fn closest_in(&self, o: Vec3, d: Vec3, t_max: f32, stack: &mut [Entry]) -> Option<WideHit> {
+    fn closest_in<K: NodeTest>(
+        &self,
+        o: Vec3,
+        d: Vec3,
+        t_max: f32,
+        stack: &mut [Entry],
+    ) -> Option<WideHit> {
         let r = RayData::new(o, d);
         let mut best: Option<(u32, f32, f32)> = None;
         let mut t_hit = t_max;
@@ -402,7 +480,7 @@ impl WideBvh {
                     break;
                 }
                 let node = &self.nodes[cur as usize];
-                let (mut mask, t_near) = intersect_node(node, &r, 0.0, t_hit);
+                let (mut mask, t_near) = K::intersect(node, &r, 0.0, t_hit);
                 if mask == 0 {
                     break;
                 }
@@ -476,7 +554,13 @@ impl WideBvh {
 
     /// Any-hit traversal: unordered, stops at the first triangle hit in [0, t_max).
     #[inline(always)]
-    fn unoccluded_in(&self, o: Vec3, d: Vec3, t_max: f32, stack: &mut [Entry]) -> bool {
+    fn unoccluded_in<K: NodeTest>(
+        &self,
+        o: Vec3,
+        d: Vec3,
+        t_max: f32,
+        stack: &mut [Entry],
+    ) -> bool {
         let r = RayData::new(o, d);
         stack[0] = Entry {
             child: self.root,
@@ -494,7 +578,7 @@ impl WideBvh {
                 continue;
             }
             let node = &self.nodes[cur as usize];
-            let (mut mask, _) = intersect_node(node, &r, 0.0, t_max);
+            let (mut mask, _) = K::intersect(node, &r, 0.0, t_max);
             while mask != 0 {
                 let i = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
