@@ -480,6 +480,7 @@ impl WideBvh {
                     break;
                 }
                 let node = &self.nodes[cur as usize];
+                prefetch(&node.child);
                 let (mut mask, t_near) = K::intersect(node, &r, 0.0, t_hit);
                 if mask == 0 {
                     break;
@@ -578,6 +579,7 @@ impl WideBvh {
                 continue;
             }
             let node = &self.nodes[cur as usize];
+            prefetch(&node.child);
             let (mut mask, _) = K::intersect(node, &r, 0.0, t_max);
             while mask != 0 {
                 let i = mask.trailing_zeros() as usize;
