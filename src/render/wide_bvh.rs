@@ -1,20 +1,22 @@
 //! The renderer's ray traversal: an 8-wide BVH with uncompressed child bounds in SoA layout and
-//! leaves of up to four triangles stored as one 4-lane SoA packet, in the style of Embree's
+//! leaves of up to eight triangles stored as one 8-lane SoA packet, in the style of Embree's
 //! BVH8 + Triangle4 (Wald et al. 2014, "Embree: a kernel framework for efficient CPU ray
-//! tracing", §4). The tree itself comes from obvhs (PLOC + reinsertion BVH2, Meister & Bittner
-//! 2018); [`WideBvh::from_bvh2`] only collapses it: each wide node takes its BVH2 node's two
-//! children and keeps opening the child of largest surface area until it has eight (the usual
-//! BVH2 → BVH8 collapse); a subtree of at most four triangles becomes one leaf packet.
+//! tracing", §4), with 8-lane leaves so that one AVX2 test covers a leaf. The tree itself comes
+//! from obvhs (PLOC + reinsertion BVH2, Meister & Bittner 2018); [`WideBvh::from_bvh2`] only
+//! collapses it: each wide node takes its BVH2 node's two children and keeps opening the child
+//! of largest surface area until it has eight (the usual BVH2 → BVH8 collapse); a subtree of at
+//! most eight triangles becomes one leaf packet.
 //!
 //! Why not obvhs's own CWBVH traversal: measured in notes/render.md, it reached 0.37× Embree's
 //! closest-hit speed on camera rays; this layout trades memory (256-byte nodes instead of 80)
 //! for node tests without dequantisation, near-to-far ordered traversal with a distance-culled
-//! stack, and four triangles per SIMD test.
+//! stack, and eight triangles per SIMD test.
 //!
-//! The code is portable and written so that it auto-vectorises (fixed 8- and 4-lane loops, no
-//! NaN-sensitive `f32::min`/`max`). On x86-64 the same code is also compiled with AVX2 enabled
-//! and picked at run time; both paths do the same IEEE operations in the same order (Rust never
-//! contracts to FMA), so they return identical hits (tested).
+//! The portable code is written so that it auto-vectorises (fixed 8-lane loops, no
+//! NaN-sensitive `f32::min`/`max`). On x86-64 the traversal is also compiled with AVX2 enabled,
+//! with the node and leaf tests written in AVX2 intrinsics, and picked at run time; both paths do
+//! the same IEEE operations in the same order (Rust never contracts to FMA), so they return
+//! identical hits (tested).
 
 use glam::{Vec2, Vec3};
 use obvhs::bvh2::Bvh2;
@@ -22,7 +24,7 @@ use obvhs::bvh2::Bvh2;
 /// Children per node.
 const WIDTH: usize = 8;
 /// Triangles per leaf packet.
-const PACKET: usize = 4;
+const PACKET: usize = 8;
 /// Child reference flag: the child is a leaf (packet index in the low bits).
 const LEAF: u32 = 1 << 31;
 /// Child reference of an empty slot (its bounds are empty, so it is never entered).
@@ -50,7 +52,7 @@ impl Node {
     }
 }
 
-/// Four triangles in SoA form with the layout of obvhs's `RtTriangle` (v0, e1 = v0 − v1,
+/// Eight triangles in SoA form with the layout of obvhs's `RtTriangle` (v0, e1 = v0 − v1,
 /// e2 = v2 − v0, ng = e1 × e2) and their triangle ids. Unused lanes repeat lane 0.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
@@ -154,34 +156,51 @@ fn intersect_node(node: &Node, r: &RayData, t_min: f32, t_max: f32) -> (u32, [f3
     (mask, t_near)
 }
 
-/// The node test as one compilation target runs it best; every implementation does the same IEEE
-/// operations in the same order as [`intersect_node`], so all return the same bits.
-trait NodeTest {
-    fn intersect(node: &Node, r: &RayData, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]);
+/// A hit lane of a leaf packet: (lane, t, u, v).
+type LaneHit = (usize, f32, f32, f32);
+
+/// The node and packet tests as one compilation target runs them best; every implementation does
+/// the same IEEE operations in the same order as [`intersect_node`] and [`intersect_packet`],
+/// so all return the same bits.
+trait Kernel {
+    fn node(node: &Node, r: &RayData, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]);
+    fn packet(p: &Packet, r: &RayData, t_min: f32, t_max: f32) -> Option<LaneHit>;
 }
 
-/// The baseline target: the auto-vectorised lane loop.
+/// The baseline target: the auto-vectorised lane loops.
 struct Portable;
 
-impl NodeTest for Portable {
+impl Kernel for Portable {
     #[inline(always)]
-    fn intersect(node: &Node, r: &RayData, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]) {
+    fn node(node: &Node, r: &RayData, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]) {
         intersect_node(node, r, t_min, t_max)
+    }
+
+    #[inline(always)]
+    fn packet(p: &Packet, r: &RayData, t_min: f32, t_max: f32) -> Option<LaneHit> {
+        intersect_packet(p, r, t_min, t_max)
     }
 }
 
-/// AVX2 intrinsics: LLVM builds the hit mask of the lane loop from a `bool` array with eight
-/// pack/shift/or steps; `vmovmskps` does it in one.
+/// AVX2 intrinsics: LLVM builds the hit masks of the lane loops from `bool` arrays with chains
+/// of pack/shift/or steps and picks the nearest lane with scalar compares; `vmovmskps` and a
+/// vector minimum do each in a few instructions.
 #[cfg(target_arch = "x86_64")]
 struct Avx2;
 
 #[cfg(target_arch = "x86_64")]
-impl NodeTest for Avx2 {
+impl Kernel for Avx2 {
     #[inline(always)]
-    fn intersect(node: &Node, r: &RayData, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]) {
+    fn node(node: &Node, r: &RayData, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]) {
         // SAFETY: `Avx2` is only used by the `#[target_feature(enable = "avx2")]` traversals,
         // which run only when the CPU reports AVX2.
         unsafe { intersect_node_avx2(node, r, t_min, t_max) }
+    }
+
+    #[inline(always)]
+    fn packet(p: &Packet, r: &RayData, t_min: f32, t_max: f32) -> Option<LaneHit> {
+        // SAFETY: as in `node`.
+        unsafe { intersect_packet_avx2(p, r, t_min, t_max) }
     }
 }
 
@@ -226,17 +245,76 @@ unsafe fn intersect_node_avx2(
     (_mm256_movemask_ps(hit) as u32, out)
 }
 
-/// Möller–Trumbore ray/triangle test on four triangles at once (Möller & Trumbore 1997, in the
-/// form of obvhs's `RtTriangle::intersect`: with c = v0 − o and r = d × c, det = ng·d,
-/// u = r·e2 / det, v = r·e1 / det, t = ng·c / det; a hit needs u, v, 1 − u − v with a clear
-/// sign bit and t in [t_min, t_max)). Returns the nearest hit lane as (lane, t, u, v).
-#[inline(always)]
-fn intersect_packet(
+/// [`intersect_packet`] with AVX2 intrinsics on the eight lanes of a packet: the same operations
+/// in the same order (`_CMP_NEQ_UQ` is Rust's `!=`, the ordered compares its `>=` and `<`), then
+/// the first lane holding the minimum t, as the portable scan picks it.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+unsafe fn intersect_packet_avx2(
     p: &Packet,
     r: &RayData,
     t_min: f32,
     t_max: f32,
-) -> Option<(usize, f32, f32, f32)> {
+) -> Option<LaneHit> {
+    use std::arch::x86_64::*;
+    let load = |a: &[f32; PACKET]| _mm256_loadu_ps(a.as_ptr());
+    let (mul, sub, add) = (_mm256_mul_ps, _mm256_sub_ps, _mm256_add_ps);
+    let dot = |a: [__m256; 3], b: [__m256; 3]| {
+        add(add(mul(a[0], b[0]), mul(a[1], b[1])), mul(a[2], b[2]))
+    };
+    let [dx, dy, dz] = r.d.map(|x| _mm256_set1_ps(x));
+    let [ox, oy, oz] = r.o.map(|x| _mm256_set1_ps(x));
+    let c = [
+        sub(load(&p.v0[0]), ox),
+        sub(load(&p.v0[1]), oy),
+        sub(load(&p.v0[2]), oz),
+    ];
+    let rv = [
+        sub(mul(dy, c[2]), mul(dz, c[1])),
+        sub(mul(dz, c[0]), mul(dx, c[2])),
+        sub(mul(dx, c[1]), mul(dy, c[0])),
+    ];
+    let [e1, e2, ng] = [&p.e1, &p.e2, &p.ng].map(|a| [load(&a[0]), load(&a[1]), load(&a[2])]);
+    let det = dot(ng, [dx, dy, dz]);
+    let inv_det = _mm256_div_ps(_mm256_set1_ps(1.0), det);
+    let u = mul(dot(rv, e2), inv_det);
+    let v = mul(dot(rv, e1), inv_det);
+    let w = sub(sub(_mm256_set1_ps(1.0), u), v);
+    let t = mul(dot(ng, c), inv_det);
+    let signs = _mm256_castps_si256(_mm256_or_ps(_mm256_or_ps(u, v), w));
+    let ok = _mm256_and_ps(
+        _mm256_and_ps(
+            _mm256_cmp_ps::<_CMP_NEQ_UQ>(det, _mm256_setzero_ps()),
+            _mm256_castsi256_ps(_mm256_cmpgt_epi32(signs, _mm256_set1_epi32(-1))),
+        ),
+        _mm256_and_ps(
+            _mm256_cmp_ps::<_CMP_GE_OQ>(t, _mm256_set1_ps(t_min)),
+            _mm256_cmp_ps::<_CMP_LT_OQ>(t, _mm256_set1_ps(t_max)),
+        ),
+    );
+    let t = _mm256_blendv_ps(_mm256_set1_ps(f32::INFINITY), t, ok);
+    // Horizontal minimum: halves, then pairs, then neighbours.
+    let m = _mm256_min_ps(t, _mm256_permute2f128_ps::<1>(t, t));
+    let m = _mm256_min_ps(m, _mm256_permute_ps::<0b01_00_11_10>(m));
+    let m = _mm256_min_ps(m, _mm256_permute_ps::<0b10_11_00_01>(m));
+    let t_best = _mm256_cvtss_f32(m);
+    if !(t_best < t_max) {
+        return None;
+    }
+    let lane = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(t, m)).trailing_zeros() as usize;
+    let (mut us, mut vs) = ([0.0; PACKET], [0.0; PACKET]);
+    _mm256_storeu_ps(us.as_mut_ptr(), u);
+    _mm256_storeu_ps(vs.as_mut_ptr(), v);
+    Some((lane, t_best, us[lane], vs[lane]))
+}
+
+/// Möller–Trumbore ray/triangle test on eight triangles at once (Möller & Trumbore 1997, in the
+/// form of obvhs's `RtTriangle::intersect`: with c = v0 − o and r = d × c, det = ng·d,
+/// u = r·e2 / det, v = r·e1 / det, t = ng·c / det; a hit needs u, v, 1 − u − v with a clear
+/// sign bit and t in [t_min, t_max)). Returns the nearest hit lane as (lane, t, u, v).
+#[inline(always)]
+fn intersect_packet(p: &Packet, r: &RayData, t_min: f32, t_max: f32) -> Option<LaneHit> {
     let [ox, oy, oz] = r.o;
     let [dx, dy, dz] = r.d;
     let mut t = [f32::INFINITY; PACKET];
@@ -337,7 +415,7 @@ impl WideBvh {
         bvh
     }
 
-    /// Makes one leaf packet of the (at most four) triangles under BVH2 node `n2`.
+    /// Makes one leaf packet of the (at most eight) triangles under BVH2 node `n2`.
     fn leaf(
         &mut self,
         bvh2: &Bvh2,
@@ -456,7 +534,7 @@ impl WideBvh {
     /// first with their entry distance, and a popped entry farther than the closest hit so far is
     /// skipped.
     #[inline(always)]
-    fn closest_in<K: NodeTest>(
+    fn closest_in<K: Kernel>(
         &self,
         o: Vec3,
         d: Vec3,
@@ -473,7 +551,7 @@ impl WideBvh {
             loop {
                 if cur & LEAF != 0 {
                     let p = &self.packets[(cur & !LEAF) as usize];
-                    if let Some((lane, t, u, v)) = intersect_packet(p, &r, 0.0, t_hit) {
+                    if let Some((lane, t, u, v)) = K::packet(p, &r, 0.0, t_hit) {
                         t_hit = t;
                         best = Some((p.id[lane], u, v));
                     }
@@ -481,7 +559,7 @@ impl WideBvh {
                 }
                 let node = &self.nodes[cur as usize];
                 prefetch(&node.child);
-                let (mut mask, t_near) = K::intersect(node, &r, 0.0, t_hit);
+                let (mut mask, t_near) = K::node(node, &r, 0.0, t_hit);
                 if mask == 0 {
                     break;
                 }
@@ -555,13 +633,7 @@ impl WideBvh {
 
     /// Any-hit traversal: unordered, stops at the first triangle hit in [0, t_max).
     #[inline(always)]
-    fn unoccluded_in<K: NodeTest>(
-        &self,
-        o: Vec3,
-        d: Vec3,
-        t_max: f32,
-        stack: &mut [Entry],
-    ) -> bool {
+    fn unoccluded_in<K: Kernel>(&self, o: Vec3, d: Vec3, t_max: f32, stack: &mut [Entry]) -> bool {
         let r = RayData::new(o, d);
         stack[0] = Entry {
             child: self.root,
@@ -572,15 +644,14 @@ impl WideBvh {
             sp -= 1;
             let cur = stack[sp].child;
             if cur & LEAF != 0 {
-                if intersect_packet(&self.packets[(cur & !LEAF) as usize], &r, 0.0, t_max).is_some()
-                {
+                if K::packet(&self.packets[(cur & !LEAF) as usize], &r, 0.0, t_max).is_some() {
                     return false;
                 }
                 continue;
             }
             let node = &self.nodes[cur as usize];
             prefetch(&node.child);
-            let (mut mask, _) = K::intersect(node, &r, 0.0, t_max);
+            let (mut mask, _) = K::node(node, &r, 0.0, t_max);
             while mask != 0 {
                 let i = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
