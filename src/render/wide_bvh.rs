@@ -64,6 +64,35 @@ struct Packet {
     id: [u32; PACKET],
 }
 
+impl Packet {
+    /// The packet of triangles `ids` (1 to `PACKET` of them) of `triangles`.
+    fn new(ids: &[u32], triangles: &[[Vec3; 3]]) -> Self {
+        let mut p = Packet {
+            v0: [[0.0; PACKET]; 3],
+            e1: [[0.0; PACKET]; 3],
+            e2: [[0.0; PACKET]; 3],
+            ng: [[0.0; PACKET]; 3],
+            id: [0; PACKET],
+        };
+        for l in 0..PACKET {
+            let id = ids[l.min(ids.len() - 1)];
+            let [a, b, c] = triangles[id as usize];
+            let (e1, e2) = (a - b, c - a);
+            let put = |soa: &mut [[f32; PACKET]; 3], x: Vec3| {
+                soa[0][l] = x.x;
+                soa[1][l] = x.y;
+                soa[2][l] = x.z;
+            };
+            put(&mut p.v0, a);
+            put(&mut p.e1, e1);
+            put(&mut p.e2, e2);
+            put(&mut p.ng, e1.cross(e2));
+            p.id[l] = id;
+        }
+        p
+    }
+}
+
 /// A ray hit from the wide BVH: distance, triangle id (as given to the builder) and barycentrics
 /// (p = (1 − u − v)·v0 + u·v1 + v·v2).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -439,29 +468,7 @@ impl WideBvh {
             "wide BVH leaf of {} triangles (the collapse only makes leaves of subtrees with at most {PACKET})",
             prims.len()
         );
-        let mut p = Packet {
-            v0: [[0.0; PACKET]; 3],
-            e1: [[0.0; PACKET]; 3],
-            e2: [[0.0; PACKET]; 3],
-            ng: [[0.0; PACKET]; 3],
-            id: [0; PACKET],
-        };
-        for l in 0..PACKET {
-            let id = prims[l.min(prims.len() - 1)];
-            let [a, b, c] = triangles[id as usize];
-            let (e1, e2) = (a - b, c - a);
-            let put = |soa: &mut [[f32; PACKET]; 3], x: Vec3| {
-                soa[0][l] = x.x;
-                soa[1][l] = x.y;
-                soa[2][l] = x.z;
-            };
-            put(&mut p.v0, a);
-            put(&mut p.e1, e1);
-            put(&mut p.e2, e2);
-            put(&mut p.ng, e1.cross(e2));
-            p.id[l] = id;
-        }
-        self.packets.push(p);
+        self.packets.push(Packet::new(prims, triangles));
         LEAF | (self.packets.len() - 1) as u32
     }
 
@@ -744,4 +751,96 @@ fn on_huge_pages<T: Copy>(v: Vec<T>) -> Vec<T> {
     }
     out.extend_from_slice(&v);
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Pcg32;
+
+    fn point(rng: &mut Pcg32, half: f32) -> Vec3 {
+        Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * (2.0 * half) - half
+    }
+
+    /// A random direction, or (one time in four) an axis-aligned one with signed zeros.
+    fn direction(rng: &mut Pcg32) -> Vec3 {
+        if rng.next_u32() % 4 == 0 {
+            let axis = rng.next_u32() as usize % 3;
+            let mut d = [-0.0, 0.0, -0.0];
+            d[axis] = if rng.next_u32() % 2 == 0 { 1.0 } else { -1.0 };
+            Vec3::from_array(d)
+        } else {
+            point(rng, 1.0).normalize_or(Vec3::X)
+        }
+    }
+
+    /// A node with random child boxes (some empty lanes, some flat boxes).
+    fn node(rng: &mut Pcg32) -> Node {
+        let mut n = Node::empty();
+        for lane in 0..WIDTH {
+            if rng.next_u32() % 8 == 0 {
+                continue;
+            }
+            let (a, b) = (point(rng, 2.0), point(rng, 2.0));
+            let (lo, mut hi) = (a.min(b), a.max(b));
+            if rng.next_u32() % 8 == 0 {
+                hi.y = lo.y;
+            }
+            for axis in 0..3 {
+                n.bounds[0][axis][lane] = lo[axis];
+                n.bounds[1][axis][lane] = hi[axis];
+            }
+        }
+        n
+    }
+
+    /// Eight random triangles, one of them degenerate (zero area), sometimes fewer repeated.
+    fn triangles(rng: &mut Pcg32) -> Vec<[Vec3; 3]> {
+        let mut t: Vec<[Vec3; 3]> = (0..PACKET)
+            .map(|_| [point(rng, 1.0), point(rng, 1.0), point(rng, 1.0)])
+            .collect();
+        t[rng.next_u32() as usize % PACKET][1] = t[0][0];
+        t[3][2] = t[3][0];
+        t
+    }
+
+    /// The AVX2 node and packet tests return exactly the portable tests' bits: masks, entry
+    /// distances, hit lane, t and barycentrics, on random nodes, packets and rays (many aimed at
+    /// a triangle so that hits and edge cases are common) and several t ranges.
+    #[test]
+    #[cfg(target_arch = "x86_64")]
+    fn avx2_kernel_equals_portable_kernel() {
+        if !avx2_available() {
+            return;
+        }
+        let mut rng = Pcg32::new(11, 3);
+        let mut hits = 0;
+        for _ in 0..20_000 {
+            let n = node(&mut rng);
+            let tris = triangles(&mut rng);
+            let count = 1 + rng.next_u32() as usize % PACKET;
+            let ids: Vec<u32> = (0..count as u32).collect();
+            let p = Packet::new(&ids, &tris);
+            let o = point(&mut rng, 3.0);
+            let d = if rng.next_u32() % 2 == 0 {
+                let [a, b, c] = tris[rng.next_u32() as usize % count];
+                let (u, v) = (rng.next_f32(), rng.next_f32());
+                (a + (b - a) * u + (c - a) * v * (1.0 - u) - o).normalize_or(Vec3::Z)
+            } else {
+                direction(&mut rng)
+            };
+            let r = RayData::new(o, d);
+            for (t_min, t_max) in [(0.0, f32::INFINITY), (0.0, 2.0), (1.0, 3.0)] {
+                let (pm, pt) = Portable::node(&n, &r, t_min, t_max);
+                let (am, at) = Avx2::node(&n, &r, t_min, t_max);
+                assert_eq!((pm, pt.map(f32::to_bits)), (am, at.map(f32::to_bits)));
+                let bits =
+                    |h: Option<LaneHit>| h.map(|(l, t, u, v)| (l, [t, u, v].map(f32::to_bits)));
+                let portable = Portable::packet(&p, &r, t_min, t_max);
+                assert_eq!(bits(portable), bits(Avx2::packet(&p, &r, t_min, t_max)));
+                hits += portable.is_some() as usize;
+            }
+        }
+        assert!(hits > 10_000, "{hits}");
+    }
 }
