@@ -3,9 +3,9 @@
 //! BVH8 + Triangle4 (Wald et al. 2014, "Embree: a kernel framework for efficient CPU ray
 //! tracing", §4), with 8-lane leaves so that one AVX2 test covers a leaf. The tree itself comes
 //! from obvhs (PLOC + reinsertion BVH2, Meister & Bittner 2018); [`WideBvh::from_bvh2`] only
-//! collapses it, choosing which BVH2 subtrees become wide nodes and which leaf packets (of at
-//! most eight triangles) by the SAH-optimal dynamic programme of Ylitie et al. 2017
-//! ([`CollapsePlan`]).
+//! collapses it: each wide node takes its BVH2 node's two children and keeps opening the child
+//! of largest surface area until it has eight (the usual BVH2 → BVH8 collapse); a subtree of at
+//! most eight triangles becomes one leaf packet.
 //!
 //! Why not obvhs's own CWBVH traversal: measured in notes/render.md, it reached 0.37× Embree's
 //! closest-hit speed on camera rays; this layout trades memory (256-byte nodes instead of 80)
@@ -52,15 +52,17 @@ impl Node {
     }
 }
 
-/// Eight triangles in SoA form with the layout of obvhs's `RtTriangle` (v0, e1 = v0 − v1,
-/// e2 = v2 − v0, ng = e1 × e2) and their triangle ids. Unused lanes repeat lane 0.
+/// Eight triangles in SoA form with the vertex and edges of obvhs's `RtTriangle` (v0,
+/// e1 = v0 − v1, e2 = v2 − v0) and their triangle ids: 320 bytes, five cache lines. The normal
+/// e1 × e2 is recomputed in the test (six multiplies per eight triangles): storing it took seven
+/// lines, and the smaller leaves measured faster any-hit and incoherent closest-hit tracing.
+/// Unused lanes repeat the last triangle.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 struct Packet {
     v0: [[f32; PACKET]; 3],
     e1: [[f32; PACKET]; 3],
     e2: [[f32; PACKET]; 3],
-    ng: [[f32; PACKET]; 3],
     id: [u32; PACKET],
 }
 
@@ -71,7 +73,6 @@ impl Packet {
             v0: [[0.0; PACKET]; 3],
             e1: [[0.0; PACKET]; 3],
             e2: [[0.0; PACKET]; 3],
-            ng: [[0.0; PACKET]; 3],
             id: [0; PACKET],
         };
         for l in 0..PACKET {
@@ -86,7 +87,6 @@ impl Packet {
             put(&mut p.v0, a);
             put(&mut p.e1, e1);
             put(&mut p.e2, e2);
-            put(&mut p.ng, e1.cross(e2));
             p.id[l] = id;
         }
         p
@@ -304,7 +304,12 @@ unsafe fn intersect_packet_avx2(
         sub(mul(dz, c[0]), mul(dx, c[2])),
         sub(mul(dx, c[1]), mul(dy, c[0])),
     ];
-    let [e1, e2, ng] = [&p.e1, &p.e2, &p.ng].map(|a| [load(&a[0]), load(&a[1]), load(&a[2])]);
+    let [e1, e2] = [&p.e1, &p.e2].map(|a| [load(&a[0]), load(&a[1]), load(&a[2])]);
+    let ng = [
+        sub(mul(e1[1], e2[2]), mul(e2[1], e1[2])),
+        sub(mul(e1[2], e2[0]), mul(e2[2], e1[0])),
+        sub(mul(e1[0], e2[1]), mul(e2[0], e1[1])),
+    ];
     let det = dot(ng, [dx, dy, dz]);
     let inv_det = _mm256_div_ps(_mm256_set1_ps(1.0), det);
     let u = mul(dot(rv, e2), inv_det);
@@ -356,12 +361,17 @@ fn intersect_packet(p: &Packet, r: &RayData, t_min: f32, t_max: f32) -> Option<L
         let rx = dy * cz - dz * cy;
         let ry = dz * cx - dx * cz;
         let rz = dx * cy - dy * cx;
-        let det = p.ng[0][l] * dx + p.ng[1][l] * dy + p.ng[2][l] * dz;
+        // ng = e1 × e2 in glam's operation order.
+        let (e1, e2) = (&p.e1, &p.e2);
+        let ngx = e1[1][l] * e2[2][l] - e2[1][l] * e1[2][l];
+        let ngy = e1[2][l] * e2[0][l] - e2[2][l] * e1[0][l];
+        let ngz = e1[0][l] * e2[1][l] - e2[0][l] * e1[1][l];
+        let det = ngx * dx + ngy * dy + ngz * dz;
         let inv_det = 1.0 / det;
         let ul = (rx * p.e2[0][l] + ry * p.e2[1][l] + rz * p.e2[2][l]) * inv_det;
         let vl = (rx * p.e1[0][l] + ry * p.e1[1][l] + rz * p.e1[2][l]) * inv_det;
         let wl = 1.0 - ul - vl;
-        let tl = (p.ng[0][l] * cx + p.ng[1][l] * cy + p.ng[2][l] * cz) * inv_det;
+        let tl = (ngx * cx + ngy * cy + ngz * cz) * inv_det;
         let signs = ul.to_bits() | vl.to_bits() | wl.to_bits();
         let ok = det != 0.0 && signs & 0x8000_0000 == 0 && tl >= t_min && tl < t_max;
         t[l] = if ok { tl } else { f32::INFINITY };
