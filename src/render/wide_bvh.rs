@@ -518,15 +518,26 @@ impl WideBvh {
         self.with_stack(|s| self.unoccluded_in::<Avx2>(o, d, t_max, s))
     }
 
-    /// Runs `f` with a traversal stack large enough for this tree (on the call stack when it
-    /// fits, which is every tree of wide depth ≤ 13).
+    /// Runs `f` with a traversal stack large enough for this tree: on the call stack when it
+    /// fits, which is every tree of wide depth ≤ 13 (the 1M-triangle benchmark mesh has depth
+    /// 12), else a per-thread buffer that is allocated once, not per ray.
     #[inline(always)]
     fn with_stack<R>(&self, f: impl FnOnce(&mut [Entry]) -> R) -> R {
+        thread_local! {
+            static DEEP_STACK: std::cell::RefCell<Vec<Entry>> =
+                const { std::cell::RefCell::new(Vec::new()) };
+        }
         if self.stack_need <= INLINE_STACK {
             let mut s = [Entry::default(); INLINE_STACK];
             f(&mut s)
         } else {
-            f(&mut vec![Entry::default(); self.stack_need])
+            DEEP_STACK.with(|s| {
+                let mut s = s.borrow_mut();
+                if s.len() < self.stack_need {
+                    s.resize(self.stack_need, Entry::default());
+                }
+                f(&mut s)
+            })
         }
     }
 
@@ -889,6 +900,79 @@ mod tests {
         t[rng.next_u32() as usize % PACKET][1] = t[0][0];
         t[3][2] = t[3][0];
         t
+    }
+
+    /// A caterpillar BVH2 over `n + 1` triangles (inner node k has leaf k and inner node k + 1 as
+    /// children), as deep as a BVH2 gets; the triangles stand in the planes x = 0, 1, …, n.
+    fn caterpillar(n: usize) -> (Bvh2, Vec<[Vec3; 3]>) {
+        use obvhs::{aabb::Aabb, bvh2::node::Bvh2Node};
+        let tris: Vec<[Vec3; 3]> = (0..=n)
+            .map(|k| {
+                [
+                    Vec3::new(k as f32, 0.0, 0.0),
+                    Vec3::new(k as f32, 1.0, 0.0),
+                    Vec3::new(k as f32, 0.0, 1.0),
+                ]
+            })
+            .collect();
+        let bounds = |t: &[Vec3; 3]| Aabb::from_points(&t.map(Into::into));
+        let node = |aabb: Aabb, prim_count: u32, first_index: u32| Bvh2Node {
+            aabb,
+            prim_count,
+            first_index,
+            ..Default::default()
+        };
+        // Node 0 is inner node 0; inner node k's children sit at 2k + 1 (leaf k) and 2k + 2.
+        let mut nodes = vec![Bvh2Node::default(); 2 * n + 1];
+        nodes[2 * n] = node(bounds(&tris[n]), 1, n as u32);
+        for k in (0..n).rev() {
+            let leaf = node(bounds(&tris[k]), 1, k as u32);
+            let next = nodes[2 * k + 2];
+            nodes[2 * k + 1] = leaf;
+            let inner = node(leaf.aabb.union(&next.aabb), 0, 2 * k as u32 + 1);
+            nodes[if k == 0 { 0 } else { 2 * k }] = inner;
+        }
+        let bvh2 = Bvh2 {
+            nodes,
+            primitive_indices: (0..=n as u32).collect(),
+            ..Default::default()
+        };
+        (bvh2, tris)
+    }
+
+    /// A tree deeper than the inline stack (traversed with the per-thread stack) gives the
+    /// brute-force closest hit on every dispatch path, and repeated queries reuse the buffer.
+    #[test]
+    fn deep_tree_uses_the_thread_stack_and_finds_the_closest_hit() {
+        let (bvh2, tris) = caterpillar(300);
+        let bvh = WideBvh::from_bvh2(&bvh2, &tris);
+        assert!(bvh.stack_need > INLINE_STACK, "{}", bvh.stack_need);
+        let mut rng = Pcg32::new(2, 8);
+        let mut hits = 0;
+        for _ in 0..2_000 {
+            let o = Vec3::new(
+                rng.next_f32() * 320.0 - 10.0,
+                rng.next_f32(),
+                rng.next_f32(),
+            );
+            let d = (direction(&mut rng) + Vec3::X * (rng.next_f32() - 0.5)).normalize_or(Vec3::X);
+            let r = RayData::new(o, d);
+            let brute = (0..tris.len() as u32)
+                .filter_map(|i| {
+                    intersect_packet(&Packet::new(&[i], &tris), &r, 0.0, f32::INFINITY)
+                        .map(|h| (h.1, i))
+                })
+                .min_by(|a, b| a.0.total_cmp(&b.0));
+            for hit in [
+                bvh.closest(o, d, f32::INFINITY),
+                bvh.closest_portable(o, d, f32::INFINITY),
+            ] {
+                assert_eq!(hit.map(|h| (h.t, h.triangle)), brute, "{o} {d}");
+            }
+            assert_eq!(bvh.unoccluded(o, d, f32::INFINITY), brute.is_none());
+            hits += brute.is_some() as usize;
+        }
+        assert!(hits > 200, "{hits}");
     }
 
     /// The AVX2 node and packet tests return exactly the portable tests' bits: masks, entry
