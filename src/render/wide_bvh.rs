@@ -32,8 +32,6 @@ const EMPTY: u32 = u32::MAX;
 /// Slab-test tolerance: t_far is scaled by 1 + 2γ₃ so that rounding in (b − o)·(1/d) never
 /// culls a box the ray touches (Ize 2013, "Robust BVH ray traversal", §3, with γₙ = nε/(1 − nε)).
 const ROBUST_FAR: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
-/// Stack entries held on the call stack; deeper trees fall back to a heap stack.
-const INLINE_STACK: usize = 96;
 
 /// One wide node: child bounds as `bounds[min = 0 | max = 1][axis][lane]`, child references.
 #[derive(Clone, Copy, Debug)]
@@ -518,27 +516,23 @@ impl WideBvh {
         self.with_stack(|s| self.unoccluded_in::<Avx2>(o, d, t_max, s))
     }
 
-    /// Runs `f` with a traversal stack large enough for this tree: on the call stack when it
-    /// fits, which is every tree of wide depth ≤ 13 (the 1M-triangle benchmark mesh has depth
-    /// 12), else a per-thread buffer that is allocated once, not per ray.
+    /// Runs `f` with a traversal stack large enough for this tree: a per-thread buffer that
+    /// grows to the deepest tree traced on the thread. (A 96-entry array on the call stack,
+    /// zeroed on every query, measured 10–16 % slower any-hit tracing; a heap stack per query
+    /// would be slower still.)
     #[inline(always)]
     fn with_stack<R>(&self, f: impl FnOnce(&mut [Entry]) -> R) -> R {
         thread_local! {
-            static DEEP_STACK: std::cell::RefCell<Vec<Entry>> =
+            static STACK: std::cell::RefCell<Vec<Entry>> =
                 const { std::cell::RefCell::new(Vec::new()) };
         }
-        if self.stack_need <= INLINE_STACK {
-            let mut s = [Entry::default(); INLINE_STACK];
+        STACK.with(|s| {
+            let mut s = s.borrow_mut();
+            if s.len() < self.stack_need {
+                s.resize(self.stack_need, Entry::default());
+            }
             f(&mut s)
-        } else {
-            DEEP_STACK.with(|s| {
-                let mut s = s.borrow_mut();
-                if s.len() < self.stack_need {
-                    s.resize(self.stack_need, Entry::default());
-                }
-                f(&mut s)
-            })
-        }
+        })
     }
 
     /// Closest-hit traversal, near child first: the hit children of a node are pushed farthest
@@ -940,18 +934,24 @@ mod tests {
         (bvh2, tris)
     }
 
-    /// A tree deeper than the inline stack (traversed with the per-thread stack) gives the
-    /// brute-force closest hit on every dispatch path, and repeated queries reuse the buffer.
+    /// Trees of growing depth traced on one thread (so the per-thread stack must grow) give the
+    /// brute-force closest hit on every dispatch path.
     #[test]
-    fn deep_tree_uses_the_thread_stack_and_finds_the_closest_hit() {
-        let (bvh2, tris) = caterpillar(300);
-        let bvh = WideBvh::from_bvh2(&bvh2, &tris);
-        assert!(bvh.stack_need > INLINE_STACK, "{}", bvh.stack_need);
+    fn deep_trees_grow_the_thread_stack_and_find_the_closest_hit() {
+        for n in [20, 300] {
+            let (bvh2, tris) = caterpillar(n);
+            let bvh = WideBvh::from_bvh2(&bvh2, &tris);
+            assert!(bvh.stack_need > n / 2, "{}", bvh.stack_need);
+            check_against_brute_force(&bvh, &tris);
+        }
+    }
+
+    fn check_against_brute_force(bvh: &WideBvh, tris: &[[Vec3; 3]]) {
         let mut rng = Pcg32::new(2, 8);
         let mut hits = 0;
         for _ in 0..2_000 {
             let o = Vec3::new(
-                rng.next_f32() * 320.0 - 10.0,
+                rng.next_f32() * (tris.len() + 20) as f32 - 10.0,
                 rng.next_f32(),
                 rng.next_f32(),
             );
@@ -959,7 +959,7 @@ mod tests {
             let r = RayData::new(o, d);
             let brute = (0..tris.len() as u32)
                 .filter_map(|i| {
-                    intersect_packet(&Packet::new(&[i], &tris), &r, 0.0, f32::INFINITY)
+                    intersect_packet(&Packet::new(&[i], tris), &r, 0.0, f32::INFINITY)
                         .map(|h| (h.1, i))
                 })
                 .min_by(|a, b| a.0.total_cmp(&b.0));
@@ -972,7 +972,7 @@ mod tests {
             assert_eq!(bvh.unoccluded(o, d, f32::INFINITY), brute.is_none());
             hits += brute.is_some() as usize;
         }
-        assert!(hits > 200, "{hits}");
+        assert!(hits > 100, "{hits}");
     }
 
     /// The AVX2 node and packet tests return exactly the portable tests' bits: masks, entry
