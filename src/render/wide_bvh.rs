@@ -331,14 +331,13 @@ unsafe fn intersect_packet_avx2(
     let m = _mm256_min_ps(m, _mm256_permute_ps::<0b01_00_11_10>(m));
     let m = _mm256_min_ps(m, _mm256_permute_ps::<0b10_11_00_01>(m));
     let t_best = _mm256_cvtss_f32(m);
-    if !(t_best < t_max) {
-        return None;
-    }
-    let lane = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(t, m)).trailing_zeros() as usize;
-    let (mut us, mut vs) = ([0.0; PACKET], [0.0; PACKET]);
-    _mm256_storeu_ps(us.as_mut_ptr(), u);
-    _mm256_storeu_ps(vs.as_mut_ptr(), v);
-    Some((lane, t_best, us[lane], vs[lane]))
+    (t_best < t_max).then(|| {
+        let lane = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(t, m)).trailing_zeros() as usize;
+        let (mut us, mut vs) = ([0.0; PACKET], [0.0; PACKET]);
+        _mm256_storeu_ps(us.as_mut_ptr(), u);
+        _mm256_storeu_ps(vs.as_mut_ptr(), v);
+        (lane, t_best, us[lane], vs[lane])
+    })
 }
 
 /// Möller–Trumbore ray/triangle test on eight triangles at once (Möller & Trumbore 1997, in the
@@ -856,10 +855,14 @@ mod tests {
 
     /// A random direction, or (one time in four) an axis-aligned one with signed zeros.
     fn direction(rng: &mut Pcg32) -> Vec3 {
-        if rng.next_u32() % 4 == 0 {
+        if rng.next_u32().is_multiple_of(4) {
             let axis = rng.next_u32() as usize % 3;
             let mut d = [-0.0, 0.0, -0.0];
-            d[axis] = if rng.next_u32() % 2 == 0 { 1.0 } else { -1.0 };
+            d[axis] = if rng.next_u32().is_multiple_of(2) {
+                1.0
+            } else {
+                -1.0
+            };
             Vec3::from_array(d)
         } else {
             point(rng, 1.0).normalize_or(Vec3::X)
@@ -870,12 +873,12 @@ mod tests {
     fn node(rng: &mut Pcg32) -> Node {
         let mut n = Node::empty();
         for lane in 0..WIDTH {
-            if rng.next_u32() % 8 == 0 {
+            if rng.next_u32().is_multiple_of(8) {
                 continue;
             }
             let (a, b) = (point(rng, 2.0), point(rng, 2.0));
             let (lo, mut hi) = (a.min(b), a.max(b));
-            if rng.next_u32() % 8 == 0 {
+            if rng.next_u32().is_multiple_of(8) {
                 hi.y = lo.y;
             }
             for axis in 0..3 {
@@ -993,7 +996,7 @@ mod tests {
             let ids: Vec<u32> = (0..count as u32).collect();
             let p = Packet::new(&ids, &tris);
             let o = point(&mut rng, 3.0);
-            let d = if rng.next_u32() % 2 == 0 {
+            let d = if rng.next_u32().is_multiple_of(2) {
                 let [a, b, c] = tris[rng.next_u32() as usize % count];
                 let (u, v) = (rng.next_f32(), rng.next_f32());
                 (a + (b - a) * u + (c - a) * v * (1.0 - u) - o).normalize_or(Vec3::Z)
