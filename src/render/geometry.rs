@@ -179,7 +179,7 @@ pub struct Accel {
 
 /// The BVH build parameters used by the renderer (`medium_build`: PLOC with reinsertion; measured
 /// against the others in notes/render.md). Only the BVH2 settings matter (leaf size and the
-/// CWBVH/BVH2 collapse settings are not used: the wide BVH makes leaves of up to 4 triangles).
+/// CWBVH/BVH2 collapse settings are not used: the wide BVH makes leaves of up to 8 triangles).
 pub const BUILD_PARAMS: BvhBuildParams = BvhBuildParams::medium_build();
 
 impl Accel {
