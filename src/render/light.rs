@@ -274,29 +274,101 @@ fn sample_sphere(
     radius: f32,
     radiance: Vec3,
     ux: f32,
-    (sin_phi, cos_phi): (f32, f32),
+    azimuth: (f32, f32),
 ) -> Option<LightSample> {
-    let to = center - p;
-    let d2 = to.length_squared();
-    let r2 = radius * radius;
-    if d2 <= r2 {
-        return None;
-    }
-    let cos_max = (1.0 - r2 / d2).max(0.0).sqrt();
-    let d = d2.sqrt();
-    let frame = Frame::from_normal(to / d);
-    let cos_t = 1.0 - ux * (1.0 - cos_max);
-    let sin2_t = (1.0 - cos_t * cos_t).max(0.0);
-    let sin_t = sin2_t.sqrt();
-    let wi = frame.to_world(Vec3::new(sin_t * cos_phi, sin_t * sin_phi, cos_t));
-    let dist = d * cos_t - (r2 - d2 * sin2_t).max(0.0).sqrt();
-    Some(LightSample {
-        wi,
-        dist,
+    let c = ConeSample::new(center - p, radius * radius, ux, azimuth);
+    c.valid.then_some(LightSample {
+        wi: Vec3::from_array(c.wi),
+        dist: c.dist,
         li: radiance,
-        pdf: 1.0 / (2.0 * PI * (1.0 - cos_max)),
+        pdf: c.pdf,
         is_delta: false,
     })
+}
+
+/// One cone sample of [`sample_sphere`] in plain `f32`s, computed whether or not it is valid, so
+/// that a loop of them over many sphere centres ([`SphereSamples::sample`]) vectorises; the
+/// scalar sampler calls the same function, so both give the same bits.
+#[derive(Clone, Copy, Debug)]
+struct ConeSample {
+    wi: [f32; 3],
+    dist: f32,
+    pdf: f32,
+    /// False when the point lies inside the sphere (then the other fields are meaningless).
+    valid: bool,
+}
+
+impl ConeSample {
+    /// The sample for the centre at `to` (centre − point), squared radius `r2` and numbers
+    /// `ux`, `(sin φ, cos φ)` (pbrt-v4 §6.2.4, see [`sample_sphere`]); the frame about the
+    /// centre's direction is Duff et al. 2017 ([`Frame::from_normal`]), written out.
+    #[inline(always)]
+    fn new(to: Vec3, r2: f32, ux: f32, (sin_phi, cos_phi): (f32, f32)) -> Self {
+        let d2 = to.length_squared();
+        let cos_max = (1.0 - r2 / d2).max(0.0).sqrt();
+        let d = d2.sqrt();
+        let frame = Frame::from_normal(to / d);
+        let cos_t = 1.0 - ux * (1.0 - cos_max);
+        let sin2_t = (1.0 - cos_t * cos_t).max(0.0);
+        let sin_t = sin2_t.sqrt();
+        let wi = frame.to_world(Vec3::new(sin_t * cos_phi, sin_t * sin_phi, cos_t));
+        ConeSample {
+            wi: wi.to_array(),
+            dist: d * cos_t - (r2 - d2 * sin2_t).max(0.0).sqrt(),
+            pdf: 1.0 / (2.0 * PI * (1.0 - cos_max)),
+            valid: d2 > r2,
+        }
+    }
+}
+
+/// Cone samples of one sphere light from one point at many places of the sphere (the frames of
+/// a light sweep) with the same numbers, as columns: the per-frame loop has no dependency from
+/// one frame to the next, so it runs in SIMD lanes instead of one latency-bound chain of square
+/// roots and divisions per frame. Values bit-identical to [`Light::sample_at`] (tested).
+#[derive(Clone, Debug, Default)]
+pub struct SphereSamples {
+    /// Unit directions towards the light (world), by component.
+    pub wi: [Vec<f32>; 3],
+    pub dist: Vec<f32>,
+    /// Solid-angle density; 0 where the point lies inside that frame's sphere (no sample).
+    pub pdf: Vec<f32>,
+}
+
+impl SphereSamples {
+    /// Samples the sphere of radius `radius` centred at `centers[k]` (by component) from `p`,
+    /// for every k, with numbers `u`.
+    pub fn sample(&mut self, p: Vec3, centers: &[Vec<f32>; 3], radius: f32, u: &LightU) {
+        let n = centers[0].len();
+        for c in self.wi.iter_mut().chain([&mut self.dist, &mut self.pdf]) {
+            c.resize(n, 0.0);
+        }
+        let [cx, cy, cz] = centers;
+        let (cx, cy, cz) = (&cx[..n], &cy[..n], &cz[..n]);
+        let [wx, wy, wz] = &mut self.wi;
+        let (wx, wy, wz) = (&mut wx[..n], &mut wy[..n], &mut wz[..n]);
+        let (dist, pdf) = (&mut self.dist[..n], &mut self.pdf[..n]);
+        let r2 = radius * radius;
+        for k in 0..n {
+            let to = Vec3::new(cx[k], cy[k], cz[k]) - p;
+            let c = ConeSample::new(to, r2, u.u.x, u.azimuth);
+            [wx[k], wy[k], wz[k]] = c.wi;
+            dist[k] = c.dist;
+            pdf[k] = if c.valid { c.pdf } else { 0.0 };
+        }
+    }
+
+    /// Frame `k`'s sample as [`Light::sample_at`] returns it, for a sphere of radiance
+    /// `radiance`.
+    #[inline]
+    pub fn get(&self, k: usize, radiance: Vec3) -> Option<LightSample> {
+        (self.pdf[k] != 0.0).then(|| LightSample {
+            wi: Vec3::new(self.wi[0][k], self.wi[1][k], self.wi[2][k]),
+            dist: self.dist[k],
+            li: radiance,
+            pdf: self.pdf[k],
+            is_delta: false,
+        })
+    }
 }
 
 fn delta_point(p: Vec3, position: Vec3, intensity: Vec3) -> Option<LightSample> {
@@ -537,6 +609,56 @@ mod tests {
                 assert!((pdf - s.pdf).abs() < 1e-3 * pdf, "{pdf} {}", s.pdf);
             }
         }
+    }
+
+    #[test]
+    fn sphere_samples_for_many_centres_equal_sample_at() {
+        // The column sampler (a light sweep's frames in SIMD lanes) must give `sample_at`'s bits
+        // for every centre, including centres so near that the point is inside the sphere (no
+        // sample) and directions along ±z (the frame's branch).
+        let mut rng = Pcg32::new(41, 2);
+        let mut cones = SphereSamples::default();
+        let (mut inside, mut outside) = (0, 0);
+        for n in [1, 3, 8, 37, 48] {
+            for _ in 0..50 {
+                let p = 100.0 * (2.0 * rng.next_vec2().extend(rng.next_f32()) - 1.0);
+                let radius = 1.0 + 60.0 * rng.next_f32();
+                let centers: Vec<Vec3> = (0..n)
+                    .map(|k| match k % 5 {
+                        0 => p + Vec3::Z * (200.0 * rng.next_f32() - 100.0),
+                        _ => 150.0 * (2.0 * rng.next_vec2().extend(rng.next_f32()) - 1.0),
+                    })
+                    .collect();
+                let cols = [0, 1, 2].map(|i| centers.iter().map(|c| c[i]).collect());
+                let u = LightU::new(rng.next_vec2());
+                cones.sample(p, &cols, radius, &u);
+                for (k, &center) in centers.iter().enumerate() {
+                    let light = Light::Sphere {
+                        center,
+                        radius,
+                        radiance: Vec3::splat(2.0),
+                    };
+                    let want = light.sample_at(p, &u);
+                    let got = cones.get(k, Vec3::splat(2.0));
+                    match (want, got) {
+                        (None, None) => inside += 1,
+                        (Some(a), Some(b)) => {
+                            outside += 1;
+                            assert_eq!(
+                                a.wi.to_array().map(f32::to_bits),
+                                b.wi.to_array().map(f32::to_bits)
+                            );
+                            assert_eq!(a.dist.to_bits(), b.dist.to_bits());
+                            assert_eq!(a.pdf.to_bits(), b.pdf.to_bits());
+                            assert_eq!(a.li, b.li);
+                            assert!(!b.is_delta);
+                        }
+                        (a, b) => panic!("{a:?} {b:?}"),
+                    }
+                }
+            }
+        }
+        assert!(inside > 50 && outside > 3000, "{inside} {outside}");
     }
 
     #[test]

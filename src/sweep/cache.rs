@@ -17,7 +17,7 @@ use crate::math::{power_heuristic, Pcg32};
 use crate::render::integrator::{
     self, light_rng, primary_sample, BsdfAtWo, PrimarySample, RayCount, ShadowTest,
 };
-use crate::render::light::LightU;
+use crate::render::light::{LightU, SphereSamples};
 use crate::render::{
     Aov, Image, Integrator, Light, PixelSum, Ray, RenderError, RenderSettings, RunOptions, Scene,
     TILE,
@@ -383,6 +383,8 @@ struct FrameScratch {
     us: Vec<LightU>,
     /// Each light's next-event term; those of the lights that do not move hold for every frame.
     terms: Vec<Vec3>,
+    /// A moving sphere light's samples in every frame.
+    cones: SphereSamples,
 }
 
 /// [`integrator::direct_radiance`] of one primary sample for every frame's lights, into `out`;
@@ -405,7 +407,12 @@ fn direct_for_frames(
 ) {
     let (lights, moving, shadow) = (&sweep.frames, sweep.moving, &sweep.shadow);
     let mut rays = RayCount::default();
-    let FrameScratch { shaded, us, terms } = scratch;
+    let FrameScratch {
+        shaded,
+        us,
+        terms,
+        cones,
+    } = scratch;
     shaded.clear();
     shaded.resize(out.len(), false);
     sweep.nearest_per_frame(&ps.ray, ps.t_hit, |k, hit| {
@@ -443,18 +450,18 @@ fn direct_for_frames(
                 integrator::light_term(shadow, sp, &bsdf, light.sample_at(sp.p, &u), &mut rays)
             });
         }
+        if let Some(sphere) = &sweep.sphere {
+            cones.sample(sp.p, &sphere.centers, sphere.radius, &us[moving]);
+        }
         for (k, frame_lights) in lights.iter().enumerate() {
             if !shaded[k] {
                 continue;
             }
-            let m = &frame_lights[moving];
-            let term_m = integrator::light_term(
-                shadow,
-                sp,
-                &bsdf,
-                m.sample_at(sp.p, &us[moving]),
-                &mut rays,
-            );
+            let ls = match &sweep.sphere {
+                Some(sphere) => cones.get(k, sphere.radiance),
+                None => frame_lights[moving].sample_at(sp.p, &us[moving]),
+            };
+            let term_m = integrator::light_term(shadow, sp, &bsdf, ls, &mut rays);
             let mut l = Vec3::ZERO;
             for (j, t) in terms.iter().enumerate() {
                 l += if j == moving { term_m } else { *t };
@@ -506,6 +513,45 @@ struct SweepLights<'a> {
     /// of a ray–sphere test; `None` when rays cannot meet the light at all (a delta light).
     swept: Option<(Vec3A, Vec3A)>,
     shadow: ShadowTest<'a>,
+    /// The moving light's centre in every frame (by component), radius and radiance, when it
+    /// is a sphere: sampled for all frames at once ([`SphereSamples`]).
+    sphere: Option<MovingSphere>,
+}
+
+/// A sphere light's places over the frames of a sweep.
+struct MovingSphere {
+    centers: [Vec<f32>; 3],
+    radius: f32,
+    radiance: Vec3,
+}
+
+impl MovingSphere {
+    /// The moving light of `frames` (each frame's lights) if it is a sphere in every frame.
+    fn new(frames: &[Vec<Light>], moving: usize) -> Option<Self> {
+        let mut m = MovingSphere {
+            centers: Default::default(),
+            radius: 0.0,
+            radiance: Vec3::ZERO,
+        };
+        for fl in frames {
+            let Light::Sphere {
+                center,
+                radius,
+                radiance,
+            } = fl[moving]
+            else {
+                return None;
+            };
+            if !m.centers[0].is_empty() && (radius, radiance) != (m.radius, m.radiance) {
+                return None;
+            }
+            for (c, v) in m.centers.iter_mut().zip(center.to_array()) {
+                c.push(v);
+            }
+            (m.radius, m.radiance) = (radius, radiance);
+        }
+        Some(m)
+    }
 }
 
 impl<'a> SweepLights<'a> {
@@ -543,6 +589,7 @@ impl<'a> SweepLights<'a> {
             .map(|(_, l)| l.clone())
             .collect();
         SweepLights {
+            sphere: MovingSphere::new(&frames, moving),
             frames,
             moving,
             fixed,
