@@ -11,7 +11,7 @@
 
 use super::film::Aov;
 use super::geometry::{Accel, Hit, Ray};
-use super::light::{Light, LightSample};
+use super::light::{Light, LightSample, LightSamples};
 use super::Scene;
 use crate::bsdf::{Bsdf, WoodAtWo};
 use crate::material::{MaterialHit, SurfaceBsdf};
@@ -287,6 +287,29 @@ impl<'a> ShadowTest<'a> {
         }
         self.accel.unoccluded(ray, t_max)
     }
+
+    /// For the shadow segment from `sp` towards each sample of `ls` (as [`light_term`] builds
+    /// it), whether the boxes alone show it unoccluded (`culled[k]`; all false without boxes).
+    /// One loop over the samples per box, so the slab tests run in SIMD lanes.
+    pub fn culled_many(&self, sp: &ShadingPoint, ls: &LightSamples, culled: &mut Vec<bool>) {
+        let n = ls.len();
+        culled.clear();
+        culled.resize(n, self.boxes.is_some());
+        let Some(boxes) = &self.boxes else {
+            return;
+        };
+        let [wx, wy, wz] = &ls.wi;
+        let (wx, wy, wz, dist) = (&wx[..n], &wy[..n], &wz[..n], &ls.dist[..n]);
+        for (lo, hi) in boxes {
+            let (lo, hi) = (lo.to_array(), hi.to_array());
+            for k in 0..n {
+                let d = Vec3::new(wx[k], wy[k], wz[k]);
+                let o = offset_origin(sp, d);
+                let inv = (Vec3::ONE / d).to_array();
+                culled[k] &= slab_misses(o.to_array(), inv, shadow_t_max(dist[k]), lo, hi);
+            }
+        }
+    }
 }
 
 /// Slab test (Kay & Kajiya 1986) of the segment `o + t·d`, t in [0, t_max], against a box, with
@@ -294,13 +317,28 @@ impl<'a> ShadowTest<'a> {
 /// origin exactly on a slab plane of an axis the ray runs parallel to) answers "may hit".
 #[inline]
 pub fn segment_misses_box(o: Vec3A, inv: Vec3A, t_max: f32, lo: Vec3A, hi: Vec3A) -> bool {
-    let (ta, tb) = ((lo - o) * inv, (hi - o) * inv);
-    if ta.is_nan_mask().any() || tb.is_nan_mask().any() {
-        return false;
+    slab_misses(
+        o.to_array(),
+        inv.to_array(),
+        t_max,
+        lo.to_array(),
+        hi.to_array(),
+    )
+}
+
+/// [`segment_misses_box`] on plain arrays, written with comparisons and selects only so that a
+/// loop of it over many segments vectorises.
+#[inline(always)]
+fn slab_misses(o: [f32; 3], inv: [f32; 3], t_max: f32, lo: [f32; 3], hi: [f32; 3]) -> bool {
+    let (mut t0, mut t1, mut nan) = (0.0f32, t_max, false);
+    for a in 0..3 {
+        let (ta, tb) = ((lo[a] - o[a]) * inv[a], (hi[a] - o[a]) * inv[a]);
+        nan |= ta.is_nan() | tb.is_nan();
+        let (near, far) = if ta < tb { (ta, tb) } else { (tb, ta) };
+        t0 = if near > t0 { near } else { t0 };
+        t1 = if far < t1 { far } else { t1 };
     }
-    let t0 = ta.min(tb).max_element().max(0.0);
-    let t1 = ta.max(tb).min_element().min(t_max);
-    t0 > t1
+    !nan & (t0 > t1)
 }
 
 /// Next-event estimation: one sample of every light, weighted against BSDF sampling by the power
@@ -352,20 +390,106 @@ pub fn light_term(
         d: ls.wi,
     };
     rays.0 += 1;
-    let t_max = if ls.dist.is_finite() {
-        ls.dist * (1.0 - 1e-4)
-    } else {
-        f32::INFINITY
-    };
-    if !shadow.unoccluded(&ray, t_max) {
+    if !shadow.unoccluded(&ray, shadow_t_max(ls.dist)) {
         return Vec3::ZERO;
     }
-    let w = if ls.is_delta {
+    weighted_term(f, ls.li, wi.z, ls.pdf, bsdf_pdf, ls.is_delta)
+}
+
+/// How far a shadow ray towards a light sample at distance `dist` looks: just short of the
+/// light (so the light's own surface never counts), or without end for lights at infinity.
+#[inline(always)]
+fn shadow_t_max(dist: f32) -> f32 {
+    if dist.is_finite() {
+        dist * (1.0 - 1e-4)
+    } else {
+        f32::INFINITY
+    }
+}
+
+/// f · Li · |cos θi| · w / pdf of an unoccluded light sample, w the power heuristic (Veach 1997
+/// eq. 9.13) of the light's density against the BSDF's (1 for delta lights).
+#[inline(always)]
+fn weighted_term(f: Vec3, li: Vec3, wi_z: f32, pdf: f32, bsdf_pdf: f32, is_delta: bool) -> Vec3 {
+    let w = if is_delta {
         1.0
     } else {
-        power_heuristic(ls.pdf, bsdf_pdf)
+        power_heuristic(pdf, bsdf_pdf)
     };
-    f * ls.li * (wi.z.abs() * w / ls.pdf)
+    f * li * (wi_z.abs() * w / pdf)
+}
+
+/// Scratch columns of [`light_terms`], reused from call to call.
+#[derive(Clone, Debug, Default)]
+pub struct TermScratch {
+    /// The samples' directions in the local shading frame.
+    wi: Vec<Vec3>,
+    f: Vec<Vec3>,
+    bsdf_pdf: Vec<f32>,
+    /// Whether each shadow segment surely misses every object (no BVH query needed).
+    culled: Vec<bool>,
+}
+
+/// [`light_term`] of every sample of `ls` (one light at many places: a light sweep's frames)
+/// where `active[k]`, into `out[k]` (others left as they are), stage by stage over all samples —
+/// local directions, BSDF values and densities, culled shadow segments, MIS weights — so each
+/// stage is a loop without dependencies from one sample to the next. The same functions as
+/// [`light_term`] on the same values, so the same bits (tested by the sweep's equality test).
+#[allow(clippy::too_many_arguments)]
+pub fn light_terms(
+    shadow: &ShadowTest,
+    sp: &ShadingPoint,
+    bsdf: &BsdfAtWo,
+    ls: &LightSamples,
+    active: &[bool],
+    scratch: &mut TermScratch,
+    out: &mut [Vec3],
+    rays: &mut RayCount,
+) {
+    let n = ls.len();
+    let TermScratch {
+        wi,
+        f,
+        bsdf_pdf,
+        culled,
+    } = scratch;
+    let [wx, wy, wz] = &ls.wi;
+    let (wx, wy, wz) = (&wx[..n], &wy[..n], &wz[..n]);
+    wi.clear();
+    wi.extend((0..n).map(|k| sp.frame.to_local(Vec3::new(wx[k], wy[k], wz[k]))));
+    f.clear();
+    f.resize(n, Vec3::ZERO);
+    bsdf_pdf.clear();
+    bsdf_pdf.resize(n, 0.0);
+    for k in 0..n {
+        if active[k] && ls.pdf[k] > 0.0 && ls.li[k] != Vec3::ZERO {
+            (f[k], bsdf_pdf[k]) = bsdf.eval_pdf(wi[k], !ls.is_delta);
+        }
+    }
+    shadow.culled_many(sp, ls, culled);
+    for k in 0..n {
+        if !active[k] {
+            continue;
+        }
+        out[k] = Vec3::ZERO;
+        if f[k] == Vec3::ZERO {
+            continue;
+        }
+        let d = Vec3::new(wx[k], wy[k], wz[k]);
+        rays.0 += 1;
+        if !culled[k]
+            && !shadow.accel.unoccluded(
+                &Ray {
+                    o: offset_origin(sp, d),
+                    d,
+                },
+                shadow_t_max(ls.dist[k]),
+            )
+        {
+            continue;
+        }
+        out[k] = weighted_term(f[k], ls.li[k], wi[k].z, ls.pdf[k], bsdf_pdf[k], ls.is_delta);
+    }
 }
 
 /// The light-dependent part of direct lighting at a shading point: next-event estimation over all

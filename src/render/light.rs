@@ -287,7 +287,7 @@ fn sample_sphere(
 }
 
 /// One cone sample of [`sample_sphere`] in plain `f32`s, computed whether or not it is valid, so
-/// that a loop of them over many sphere centres ([`SphereSamples::sample`]) vectorises; the
+/// that a loop of them over many sphere centres ([`LightSamples::sample_sphere`]) vectorises; the
 /// scalar sampler calls the same function, so both give the same bits.
 #[derive(Clone, Copy, Debug)]
 struct ConeSample {
@@ -321,27 +321,54 @@ impl ConeSample {
     }
 }
 
-/// Cone samples of one sphere light from one point at many places of the sphere (the frames of
-/// a light sweep) with the same numbers, as columns: the per-frame loop has no dependency from
-/// one frame to the next, so it runs in SIMD lanes instead of one latency-bound chain of square
-/// roots and divisions per frame. Values bit-identical to [`Light::sample_at`] (tested).
+/// Samples of one light from one point at many places of the light (the frames of a light
+/// sweep) with the same numbers, as columns (structure of arrays), for the batch next-event
+/// terms of [`crate::render::integrator::light_terms`]. A sphere light is sampled by one loop over
+/// the frames' centres ([`LightSamples::sample_sphere`]): no frame depends on another, so the
+/// loop runs in SIMD lanes instead of one latency-bound chain of square roots and divisions per
+/// frame. Values bit-identical to [`Light::sample_at`] (tested).
 #[derive(Clone, Debug, Default)]
-pub struct SphereSamples {
+pub struct LightSamples {
     /// Unit directions towards the light (world), by component.
     pub wi: [Vec<f32>; 3],
     pub dist: Vec<f32>,
-    /// Solid-angle density; 0 where the point lies inside that frame's sphere (no sample).
+    /// Solid-angle density (1 for delta lights); 0 where there is no sample.
     pub pdf: Vec<f32>,
+    pub li: Vec<Vec3>,
+    /// Whether the light is a delta light (the same in every place).
+    pub is_delta: bool,
 }
 
-impl SphereSamples {
-    /// Samples the sphere of radius `radius` centred at `centers[k]` (by component) from `p`,
-    /// for every k, with numbers `u`.
-    pub fn sample(&mut self, p: Vec3, centers: &[Vec<f32>; 3], radius: f32, u: &LightU) {
-        let n = centers[0].len();
+impl LightSamples {
+    pub fn len(&self) -> usize {
+        self.pdf.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.pdf.is_empty()
+    }
+
+    fn resize(&mut self, n: usize) {
         for c in self.wi.iter_mut().chain([&mut self.dist, &mut self.pdf]) {
             c.resize(n, 0.0);
         }
+        self.li.resize(n, Vec3::ZERO);
+    }
+
+    /// Samples the sphere of radius `radius` and radiance `radiance` centred at `centers[k]` (by
+    /// component) from `p`, for every k, with numbers `u`.
+    pub fn sample_sphere(
+        &mut self,
+        p: Vec3,
+        centers: &[Vec<f32>; 3],
+        radius: f32,
+        radiance: Vec3,
+        u: &LightU,
+    ) {
+        let n = centers[0].len();
+        self.resize(n);
+        self.is_delta = false;
+        self.li.fill(radiance);
         let [cx, cy, cz] = centers;
         let (cx, cy, cz) = (&cx[..n], &cy[..n], &cz[..n]);
         let [wx, wy, wz] = &mut self.wi;
@@ -357,16 +384,41 @@ impl SphereSamples {
         }
     }
 
-    /// Frame `k`'s sample as [`Light::sample_at`] returns it, for a sphere of radiance
-    /// `radiance`.
+    /// Samples of `light` at `lights[k]`, one place per frame (any kind of light), from `p`.
+    pub fn sample_each<'a>(
+        &mut self,
+        p: Vec3,
+        lights: impl ExactSizeIterator<Item = &'a Light>,
+        u: &LightU,
+    ) {
+        self.resize(lights.len());
+        self.is_delta = false;
+        for (k, light) in lights.enumerate() {
+            self.is_delta = light.is_delta();
+            let s = light.sample_at(p, u);
+            let s = s.unwrap_or(LightSample {
+                wi: Vec3::ZERO,
+                dist: 0.0,
+                li: Vec3::ZERO,
+                pdf: 0.0,
+                is_delta: self.is_delta,
+            });
+            for (c, v) in self.wi.iter_mut().zip(s.wi.to_array()) {
+                c[k] = v;
+            }
+            (self.dist[k], self.pdf[k], self.li[k]) = (s.dist, s.pdf, s.li);
+        }
+    }
+
+    /// Place `k`'s sample as [`Light::sample_at`] returns it (`None` where it returns `None`).
     #[inline]
-    pub fn get(&self, k: usize, radiance: Vec3) -> Option<LightSample> {
+    pub fn get(&self, k: usize) -> Option<LightSample> {
         (self.pdf[k] != 0.0).then(|| LightSample {
             wi: Vec3::new(self.wi[0][k], self.wi[1][k], self.wi[2][k]),
             dist: self.dist[k],
-            li: radiance,
+            li: self.li[k],
             pdf: self.pdf[k],
-            is_delta: false,
+            is_delta: self.is_delta,
         })
     }
 }
@@ -617,7 +669,7 @@ mod tests {
         // for every centre, including centres so near that the point is inside the sphere (no
         // sample) and directions along ±z (the frame's branch).
         let mut rng = Pcg32::new(41, 2);
-        let mut cones = SphereSamples::default();
+        let mut cones = LightSamples::default();
         let (mut inside, mut outside) = (0, 0);
         for n in [1, 3, 8, 37, 48] {
             for _ in 0..50 {
@@ -631,7 +683,7 @@ mod tests {
                     .collect();
                 let cols = [0, 1, 2].map(|i| centers.iter().map(|c| c[i]).collect());
                 let u = LightU::new(rng.next_vec2());
-                cones.sample(p, &cols, radius, &u);
+                cones.sample_sphere(p, &cols, radius, Vec3::splat(2.0), &u);
                 for (k, &center) in centers.iter().enumerate() {
                     let light = Light::Sphere {
                         center,
@@ -639,7 +691,7 @@ mod tests {
                         radiance: Vec3::splat(2.0),
                     };
                     let want = light.sample_at(p, &u);
-                    let got = cones.get(k, Vec3::splat(2.0));
+                    let got = cones.get(k);
                     match (want, got) {
                         (None, None) => inside += 1,
                         (Some(a), Some(b)) => {

@@ -15,9 +15,9 @@ use super::path::{ArcPlane, LightArc, PathError};
 use crate::bsdf::Bsdf;
 use crate::math::{power_heuristic, Pcg32};
 use crate::render::integrator::{
-    self, light_rng, primary_sample, BsdfAtWo, PrimarySample, RayCount, ShadowTest,
+    self, light_rng, primary_sample, BsdfAtWo, PrimarySample, RayCount, ShadowTest, TermScratch,
 };
-use crate::render::light::{LightU, SphereSamples};
+use crate::render::light::{LightSamples, LightU};
 use crate::render::{
     Aov, Image, Integrator, Light, PixelSum, Ray, RenderError, RenderSettings, RunOptions, Scene,
     TILE,
@@ -383,8 +383,10 @@ struct FrameScratch {
     us: Vec<LightU>,
     /// Each light's next-event term; those of the lights that do not move hold for every frame.
     terms: Vec<Vec3>,
-    /// A moving sphere light's samples in every frame.
-    cones: SphereSamples,
+    /// The moving light's samples, next-event terms and their scratch columns, every frame.
+    samples: LightSamples,
+    moving_terms: Vec<Vec3>,
+    term_scratch: TermScratch,
 }
 
 /// [`integrator::direct_radiance`] of one primary sample for every frame's lights, into `out`;
@@ -411,7 +413,9 @@ fn direct_for_frames(
         shaded,
         us,
         terms,
-        cones,
+        samples,
+        moving_terms,
+        term_scratch,
     } = scratch;
     shaded.clear();
     shaded.resize(out.len(), false);
@@ -450,21 +454,28 @@ fn direct_for_frames(
                 integrator::light_term(shadow, sp, &bsdf, light.sample_at(sp.p, &u), &mut rays)
             });
         }
-        if let Some(sphere) = &sweep.sphere {
-            cones.sample(sp.p, &sphere.centers, sphere.radius, &us[moving]);
+        // The moving light's term in every frame at once (`light_terms`), then each frame's sum
+        // in the lights' order.
+        let u = &us[moving];
+        match &sweep.sphere {
+            Some(s) => samples.sample_sphere(sp.p, &s.centers, s.radius, s.radiance, u),
+            None => samples.sample_each(sp.p, lights.iter().map(|fl| &fl[moving]), u),
         }
-        for (k, frame_lights) in lights.iter().enumerate() {
-            if !shaded[k] {
-                continue;
-            }
-            let ls = match &sweep.sphere {
-                Some(sphere) => cones.get(k, sphere.radiance),
-                None => frame_lights[moving].sample_at(sp.p, &us[moving]),
-            };
-            let term_m = integrator::light_term(shadow, sp, &bsdf, ls, &mut rays);
+        moving_terms.resize(out.len(), Vec3::ZERO);
+        integrator::light_terms(
+            shadow,
+            sp,
+            &bsdf,
+            samples,
+            shaded,
+            term_scratch,
+            moving_terms,
+            &mut rays,
+        );
+        for k in (0..out.len()).filter(|&k| shaded[k]) {
             let mut l = Vec3::ZERO;
             for (j, t) in terms.iter().enumerate() {
-                l += if j == moving { term_m } else { *t };
+                l += if j == moving { moving_terms[k] } else { *t };
             }
             out[k] = l;
         }
@@ -514,7 +525,7 @@ struct SweepLights<'a> {
     swept: Option<(Vec3A, Vec3A)>,
     shadow: ShadowTest<'a>,
     /// The moving light's centre in every frame (by component), radius and radiance, when it
-    /// is a sphere: sampled for all frames at once ([`SphereSamples`]).
+    /// is a sphere: sampled for all frames at once ([`LightSamples::sample_sphere`]).
     sphere: Option<MovingSphere>,
 }
 
