@@ -218,6 +218,19 @@ impl<'a> BsdfAtWo<'a> {
             }
         }
     }
+
+    /// [`BsdfAtWo::eval_pdf`] of every `wi[k]` into `f[k]`, `pdf[k]` (the wood BSDF a batch at
+    /// a time, [`WoodAtWo::eval_pdf_many`]; others one by one).
+    pub fn eval_pdf_many(&self, wi: &[Vec3], with_pdf: bool, f: &mut [Vec3], pdf: &mut [f32]) {
+        match self {
+            BsdfAtWo::Wood(w) => w.eval_pdf_many(wi, with_pdf, f, pdf),
+            _ => {
+                for ((wi, f), pdf) in wi.iter().zip(f.iter_mut()).zip(pdf.iter_mut()) {
+                    (*f, *pdf) = self.eval_pdf(*wi, with_pdf);
+                }
+            }
+        }
+    }
 }
 
 /// Shadow queries, optionally culled: with the world boxes of a scene's few objects, a shadow
@@ -457,13 +470,12 @@ pub fn light_terms(
     let (wx, wy, wz) = (&wx[..n], &wy[..n], &wz[..n]);
     wi.clear();
     wi.extend((0..n).map(|k| sp.frame.to_local(Vec3::new(wx[k], wy[k], wz[k]))));
-    f.clear();
     f.resize(n, Vec3::ZERO);
-    bsdf_pdf.clear();
     bsdf_pdf.resize(n, 0.0);
+    bsdf.eval_pdf_many(wi, !ls.is_delta, &mut f[..n], &mut bsdf_pdf[..n]);
     for k in 0..n {
-        if active[k] && ls.pdf[k] > 0.0 && ls.li[k] != Vec3::ZERO {
-            (f[k], bsdf_pdf[k]) = bsdf.eval_pdf(wi[k], !ls.is_delta);
+        if !(active[k] && ls.pdf[k] > 0.0 && ls.li[k] != Vec3::ZERO) {
+            f[k] = Vec3::ZERO;
         }
     }
     shadow.culled_many(sp, ls, culled);
