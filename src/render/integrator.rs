@@ -303,26 +303,58 @@ impl<'a> ShadowTest<'a> {
 
     /// For the shadow segment from `sp` towards each sample of `ls` (as [`light_term`] builds
     /// it), whether the boxes alone show it unoccluded (`culled[k]`; all false without boxes).
-    /// One loop over the samples per box, so the slab tests run in SIMD lanes.
-    pub fn culled_many(&self, sp: &ShadingPoint, ls: &LightSamples, culled: &mut Vec<bool>) {
+    /// The segments are set up in one loop and tested in one loop per box, so the slab tests
+    /// run in SIMD lanes.
+    pub fn culled_many(
+        &self,
+        sp: &ShadingPoint,
+        ls: &LightSamples,
+        seg: &mut Segments,
+        culled: &mut Vec<bool>,
+    ) {
         let n = ls.len();
         culled.clear();
         culled.resize(n, self.boxes.is_some());
         let Some(boxes) = &self.boxes else {
             return;
         };
+        for c in seg.o.iter_mut().chain(&mut seg.inv).chain([&mut seg.t_max]) {
+            c.resize(n, 0.0);
+        }
         let [wx, wy, wz] = &ls.wi;
         let (wx, wy, wz, dist) = (&wx[..n], &wy[..n], &wz[..n], &ls.dist[..n]);
+        let ([ox, oy, oz], [ix, iy, iz]) = (&mut seg.o, &mut seg.inv);
+        let (ox, oy, oz) = (&mut ox[..n], &mut oy[..n], &mut oz[..n]);
+        let (ix, iy, iz, t_max) = (
+            &mut ix[..n],
+            &mut iy[..n],
+            &mut iz[..n],
+            &mut seg.t_max[..n],
+        );
+        for k in 0..n {
+            let d = Vec3::new(wx[k], wy[k], wz[k]);
+            [ox[k], oy[k], oz[k]] = offset_origin(sp, d).to_array();
+            [ix[k], iy[k], iz[k]] = (Vec3::ONE / d).to_array();
+            t_max[k] = shadow_t_max(dist[k]);
+        }
+        let culled = &mut culled[..n];
         for (lo, hi) in boxes {
             let (lo, hi) = (lo.to_array(), hi.to_array());
             for k in 0..n {
-                let d = Vec3::new(wx[k], wy[k], wz[k]);
-                let o = offset_origin(sp, d);
-                let inv = (Vec3::ONE / d).to_array();
-                culled[k] &= slab_misses(o.to_array(), inv, shadow_t_max(dist[k]), lo, hi);
+                let (o, inv) = ([ox[k], oy[k], oz[k]], [ix[k], iy[k], iz[k]]);
+                culled[k] &= slab_misses(o, inv, t_max[k], lo, hi);
             }
         }
     }
+}
+
+/// Shadow segments by component (origin, 1/direction, length), scratch of
+/// [`ShadowTest::culled_many`].
+#[derive(Clone, Debug, Default)]
+pub struct Segments {
+    o: [Vec<f32>; 3],
+    inv: [Vec<f32>; 3],
+    t_max: Vec<f32>,
 }
 
 /// Slab test (Kay & Kajiya 1986) of the segment `o + t·d`, t in [0, t_max], against a box, with
@@ -441,6 +473,7 @@ pub struct TermScratch {
     bsdf_pdf: Vec<f32>,
     /// Whether each shadow segment surely misses every object (no BVH query needed).
     culled: Vec<bool>,
+    segments: Segments,
 }
 
 /// [`light_term`] of every sample of `ls` (one light at many places: a light sweep's frames)
@@ -465,6 +498,7 @@ pub fn light_terms(
         f,
         bsdf_pdf,
         culled,
+        segments,
     } = scratch;
     let [wx, wy, wz] = &ls.wi;
     let (wx, wy, wz) = (&wx[..n], &wy[..n], &wz[..n]);
@@ -478,7 +512,7 @@ pub fn light_terms(
             f[k] = Vec3::ZERO;
         }
     }
-    shadow.culled_many(sp, ls, culled);
+    shadow.culled_many(sp, ls, segments, culled);
     for k in 0..n {
         if !active[k] {
             continue;

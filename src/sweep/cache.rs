@@ -326,7 +326,10 @@ fn sweep_tile(
     let (tw, th) = (TILE.min(w - origin.x), TILE.min(h - origin.y));
     let n = (tw * th) as usize;
     let lights = &sweep.frames;
-    let mut sums = vec![vec![PixelSum::default(); n]; lights.len()];
+    let frames = lights.len();
+    // Pixel-major (pixel i, frame k at i·frames + k): a pixel's samples update one contiguous
+    // run of sums instead of one cache line in each of `frames` arrays.
+    let mut sums = vec![PixelSum::default(); n * frames];
     let mut aov_sums = vec![PixelSum::default(); n];
     let mut radiance = vec![Vec3::ZERO; lights.len()];
     let mut scratch = FrameScratch::default();
@@ -356,17 +359,17 @@ fn sweep_tile(
                     }
                 }
             }
-            for (frame_sums, l) in sums.iter_mut().zip(&radiance) {
-                frame_sums[i].add_radiance(*l);
+            for (sum, l) in sums[i * frames..(i + 1) * frames].iter_mut().zip(&radiance) {
+                sum.add_radiance(*l);
             }
             aov_sums[i].add(Vec3::ZERO, &ps.aov);
         }
     }
     let aov = Image::from_sums(tw, th, &aov_sums).aov;
-    let frames = sums
-        .iter()
-        .map(|frame_sums| {
-            let mut img = Image::from_sums(tw, th, frame_sums);
+    let frames = (0..frames)
+        .map(|k| {
+            let frame_sums: Vec<PixelSum> = sums.iter().skip(k).step_by(frames).copied().collect();
+            let mut img = Image::from_sums(tw, th, &frame_sums);
             img.aov = Vec::new();
             img
         })
