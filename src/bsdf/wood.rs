@@ -390,7 +390,7 @@ impl WoodAtWo<'_> {
         };
         let (f_fib, p_fib) = lobe(&b.fiber, &self.fiber, p.ray_mask < 1.0, probs.fiber > 0.0);
         let (f_ray, p_ray) = lobe(&b.ray, &self.ray, p.ray_mask > 0.0, probs.ray > 0.0);
-        let f = self.value(wi, f_fib, f_ray);
+        let f = self.value(wi, self.transmission(wi.z), f_fib, f_ray);
         if !with_pdf {
             return (f, 0.0);
         }
@@ -428,9 +428,13 @@ impl WoodAtWo<'_> {
             };
             let (f_fib, p_fib) = lobe(&b.fiber, &self.fiber, p.ray_mask < 1.0, probs.fiber > 0.0);
             let (f_ray, p_ray) = lobe(&b.ray, &self.ray, p.ray_mask > 0.0, probs.ray > 0.0);
+            let mut t = [0.0; BATCH];
+            for k in 0..n {
+                t[k] = self.transmission(wi[k].z);
+            }
             for k in 0..n {
                 let above = self.wo.z > 0.0 && wi[k].z > 0.0;
-                f[k] = self.value(wi[k], f_fib[k], f_ray[k]);
+                f[k] = self.value(wi[k], t[k], f_fib[k], f_ray[k]);
                 pdf[k] = if with_pdf {
                     self.density(wi[k], wi_in[k], p_fib[k], p_ray[k])
                 } else {
@@ -443,13 +447,19 @@ impl WoodAtWo<'_> {
         }
     }
 
-    /// f from the fibre and ray lobes' values at ωi: the steps of `Bsdf::eval` and
-    /// `substrate`, in their order (notes/bsdf.md eq. 1.4).
+    /// T(θo) T(θi) / η², the finish's share of f (notes/bsdf.md eq. 1.4) for cos θi = `wi_z`.
     #[inline(always)]
-    fn value(&self, wi: Vec3, f_fib: f32, f_ray: f32) -> Vec3 {
+    fn transmission(&self, wi_z: f32) -> f32 {
+        let b = self.bsdf;
+        self.t_o * b.transmittance(wi_z) * b.inv_eta2
+    }
+
+    /// f from the finish's [`WoodAtWo::transmission`] `t` and the fibre and ray lobes' values at
+    /// ωi: the steps of `Bsdf::eval` and `substrate`, in their order (notes/bsdf.md eq. 1.4).
+    #[inline(always)]
+    fn value(&self, wi: Vec3, t: f32, f_fib: f32, f_ray: f32) -> Vec3 {
         let b = self.bsdf;
         let p = &b.params;
-        let t = self.t_o * b.transmittance(wi.z) * b.inv_eta2;
         let mut fib = 0.0;
         if p.ray_mask < 1.0 {
             fib += (1.0 - p.ray_mask) * f_fib;

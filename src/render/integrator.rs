@@ -456,12 +456,18 @@ fn shadow_t_max(dist: f32) -> f32 {
 /// eq. 9.13) of the light's density against the BSDF's (1 for delta lights).
 #[inline(always)]
 fn weighted_term(f: Vec3, li: Vec3, wi_z: f32, pdf: f32, bsdf_pdf: f32, is_delta: bool) -> Vec3 {
+    f * li * mis_scale(wi_z, pdf, bsdf_pdf, is_delta)
+}
+
+/// |cos θi| · w / pdf, the factor of f · Li in [`weighted_term`].
+#[inline(always)]
+fn mis_scale(wi_z: f32, pdf: f32, bsdf_pdf: f32, is_delta: bool) -> f32 {
     let w = if is_delta {
         1.0
     } else {
         power_heuristic(pdf, bsdf_pdf)
     };
-    f * li * (wi_z.abs() * w / pdf)
+    wi_z.abs() * w / pdf
 }
 
 /// Scratch columns of [`light_terms`], reused from call to call.
@@ -474,6 +480,8 @@ pub struct TermScratch {
     /// Whether each shadow segment surely misses every object (no BVH query needed).
     culled: Vec<bool>,
     segments: Segments,
+    /// [`mis_scale`] of each sample.
+    scale: Vec<f32>,
 }
 
 /// [`light_term`] of every sample of `ls` (one light at many places: a light sweep's frames)
@@ -499,6 +507,7 @@ pub fn light_terms(
         bsdf_pdf,
         culled,
         segments,
+        scale,
     } = scratch;
     let [wx, wy, wz] = &ls.wi;
     let (wx, wy, wz) = (&wx[..n], &wy[..n], &wz[..n]);
@@ -513,6 +522,10 @@ pub fn light_terms(
         }
     }
     shadow.culled_many(sp, ls, segments, culled);
+    scale.resize(n, 0.0);
+    for k in 0..n {
+        scale[k] = mis_scale(wi[k].z, ls.pdf[k], bsdf_pdf[k], ls.is_delta);
+    }
     for k in 0..n {
         if !active[k] {
             continue;
@@ -534,7 +547,7 @@ pub fn light_terms(
         {
             continue;
         }
-        out[k] = weighted_term(f[k], ls.li[k], wi[k].z, ls.pdf[k], bsdf_pdf[k], ls.is_delta);
+        out[k] = f[k] * ls.li[k] * scale[k];
     }
 }
 
