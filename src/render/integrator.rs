@@ -205,17 +205,7 @@ impl<'a> BsdfAtWo<'a> {
     pub fn eval_pdf(&self, wi: Vec3, with_pdf: bool) -> (Vec3, f32) {
         match self {
             BsdfAtWo::Wood(w) => w.eval_pdf(wi, with_pdf),
-            BsdfAtWo::Other(b, wo) => {
-                let f = b.eval(*wo, wi);
-                (
-                    f,
-                    if with_pdf && f != Vec3::ZERO {
-                        b.pdf(*wo, wi)
-                    } else {
-                        0.0
-                    },
-                )
-            }
+            BsdfAtWo::Other(b, wo) => eval_then_pdf(*b, *wo, wi, with_pdf),
         }
     }
 
@@ -224,12 +214,40 @@ impl<'a> BsdfAtWo<'a> {
     pub fn eval_pdf_many(&self, wi: &[Vec3], with_pdf: bool, f: &mut [Vec3], pdf: &mut [f32]) {
         match self {
             BsdfAtWo::Wood(w) => w.eval_pdf_many(wi, with_pdf, f, pdf),
-            _ => {
-                for ((wi, f), pdf) in wi.iter().zip(f.iter_mut()).zip(pdf.iter_mut()) {
-                    (*f, *pdf) = self.eval_pdf(*wi, with_pdf);
-                }
+            // The material's kind chosen once, not per direction.
+            BsdfAtWo::Other(SurfaceBsdf::Lambertian(b), wo) => {
+                eval_then_pdf_each(b, *wo, wi, with_pdf, f, pdf)
             }
+            BsdfAtWo::Other(b, wo) => eval_then_pdf_each(*b, *wo, wi, with_pdf, f, pdf),
         }
+    }
+}
+
+/// `(eval(wo, wi), pdf(wo, wi))`, the density only when `with_pdf` and f ≠ 0 (else 0).
+#[inline(always)]
+fn eval_then_pdf(b: &impl Bsdf, wo: Vec3, wi: Vec3, with_pdf: bool) -> (Vec3, f32) {
+    let f = b.eval(wo, wi);
+    (
+        f,
+        if with_pdf && f != Vec3::ZERO {
+            b.pdf(wo, wi)
+        } else {
+            0.0
+        },
+    )
+}
+
+/// [`eval_then_pdf`] of every `wi[k]` into `f[k]`, `pdf[k]`.
+fn eval_then_pdf_each(
+    b: &impl Bsdf,
+    wo: Vec3,
+    wi: &[Vec3],
+    with_pdf: bool,
+    f: &mut [Vec3],
+    pdf: &mut [f32],
+) {
+    for ((wi, f), pdf) in wi.iter().zip(f.iter_mut()).zip(pdf.iter_mut()) {
+        (*f, *pdf) = eval_then_pdf(b, wo, *wi, with_pdf);
     }
 }
 

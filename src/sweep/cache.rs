@@ -397,8 +397,10 @@ struct FrameScratch {
 ///
 /// The lighting stream `rng` draws two numbers per light for next-event estimation whatever the
 /// lights' positions, so the numbers — and hence the next-event terms of the lights that do not
-/// move — are the same in every frame and are computed once; per frame only the moving light is
-/// sampled, with the BSDF prepared for this `wo` once ([`BsdfAtWo`]). The BSDF-sampled direction
+/// move — are the same in every frame and are computed once; only the moving light's term differs
+/// per frame, and it is computed for all frames at once, frames in SIMD lanes
+/// ([`LightSamples`], [`integrator::light_terms`]), with the BSDF prepared for this `wo` once
+/// ([`BsdfAtWo`]). The BSDF-sampled direction
 /// that follows, and the scene hit along it, are also the same in every frame: traced once, and
 /// per frame only the light it may meet is tested. Sums run in the renderer's order
 /// (`sample_lights`, `shade_direct`), so each frame equals the naive render.
