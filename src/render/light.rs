@@ -301,7 +301,7 @@ struct ConeSample {
 impl ConeSample {
     /// The sample for the centre at `to` (centre − point), squared radius `r2` and numbers
     /// `ux`, `(sin φ, cos φ)` (pbrt-v4 §6.2.4, see [`sample_sphere`]); the frame about the
-    /// centre's direction is Duff et al. 2017 ([`Frame::from_normal`]), written out.
+    /// centre's direction is Duff et al. 2017 ([`Frame::from_normal`], branch-free).
     #[inline(always)]
     fn new(to: Vec3, r2: f32, ux: f32, (sin_phi, cos_phi): (f32, f32)) -> Self {
         let d2 = to.length_squared();
@@ -384,7 +384,8 @@ impl LightSamples {
         }
     }
 
-    /// Samples of `light` at `lights[k]`, one place per frame (any kind of light), from `p`.
+    /// Samples from `p` of `lights` — one light's place in each frame, any kind of light — one
+    /// at a time ([`Light::sample_at`]); a failed sample is stored with density 0.
     pub fn sample_each<'a>(
         &mut self,
         p: Vec3,
