@@ -282,3 +282,54 @@ fn culled_shadow_test_answers_as_the_bvh() {
     }
     assert!(blocked > 1000 && free > 1000, "{blocked} {free}");
 }
+
+#[test]
+fn batch_culled_shadow_segments_are_unoccluded() {
+    // `culled_many` (a sweep's shadow segments box-tested all frames at once) may only cull
+    // segments the BVH finds unoccluded: from the camera's first hits towards sphere lights at
+    // random places, above and below the board's top, both culled and kept segments occurring.
+    use xylem::math::Pcg32;
+    use xylem::render::integrator::{Segments, ShadowTest};
+    use xylem::render::light::{LightSamples, LightU};
+    use xylem::render::{primary_sample, Ray};
+    let loaded = from_str(WOOD_SCENE, "sweep_cache_wood.toml", Path::new("."), "test").unwrap();
+    let scene = &loaded.scene;
+    let (culled_test, bvh) = (
+        ShadowTest::culled(&scene.accel),
+        ShadowTest::bvh(&scene.accel),
+    );
+    let mut rng = Pcg32::new(23, 1);
+    let (mut samples, mut seg, mut culled) = (LightSamples::default(), Segments::default(), vec![]);
+    let (mut n_culled, mut n_kept) = (0, 0);
+    for y in 0..scene.camera.height {
+        for x in 0..scene.camera.width {
+            let Some(sp) = primary_sample(scene, glam::UVec2::new(x, y), 0, 3).point else {
+                continue;
+            };
+            let centers: [Vec<f32>; 3] = [
+                (0..24).map(|_| 400.0 * rng.next_f32() - 200.0).collect(),
+                (0..24).map(|_| 400.0 * rng.next_f32() - 200.0).collect(),
+                (0..24).map(|_| 300.0 * rng.next_f32() - 20.0).collect(),
+            ];
+            let u = LightU::new(rng.next_vec2());
+            samples.sample_sphere(sp.p, &centers, 5.0, glam::Vec3::ONE, &u);
+            culled_test.culled_many(&sp, &samples, &mut seg, &mut culled);
+            for k in 0..samples.len() {
+                let Some(ls) = samples.get(k) else { continue };
+                let side = if sp.ng.dot(ls.wi) >= 0.0 { 1.0 } else { -1.0 };
+                let ray = Ray {
+                    o: sp.p + sp.ng * (side * sp.eps),
+                    d: ls.wi,
+                };
+                let t_max = ls.dist * (1.0 - 1e-4);
+                if culled[k] {
+                    assert!(bvh.unoccluded(&ray, t_max), "{ray:?} {t_max}");
+                    n_culled += 1;
+                } else {
+                    n_kept += 1;
+                }
+            }
+        }
+    }
+    assert!(n_culled > 2000 && n_kept > 300, "{n_culled} {n_kept}");
+}

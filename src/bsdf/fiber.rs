@@ -44,8 +44,73 @@ pub struct FiberAxis {
 /// Normalised Gaussian g(β, x) = exp(−x²/2β²) / (β√(2π)) (Marschner et al. 2005, §4.2).
 #[inline]
 pub fn gaussian(beta: f32, x: f32) -> f32 {
+    gaussian_scale(beta, gaussian_exponent(beta, x).exp())
+}
+
+/// Directions per call of [`FiberAxis::eval_pdf_many_at`] (its columns live on the stack).
+pub const BATCH: usize = 16;
+
+/// −x²/2β², the exponent of [`gaussian`].
+#[inline(always)]
+fn gaussian_exponent(beta: f32, x: f32) -> f32 {
+    -0.5 * (x / beta) * (x / beta)
+}
+
+/// [`gaussian`] from e = exp(−x²/2β²): e / (β√(2π)).
+#[inline(always)]
+fn gaussian_scale(beta: f32, e: f32) -> f32 {
     const INV_SQRT_2PI: f32 = 0.398_942_3;
-    INV_SQRT_2PI / beta * (-0.5 * (x / beta) * (x / beta)).exp()
+    INV_SQRT_2PI / beta * e
+}
+
+/// The cosine the lobe's normalisation needs: cos ψi (energy-bounded) or cos((ψr − ψi)/2)
+/// (published, Marschner et al. 2005 eq. 3).
+#[inline(always)]
+fn lobe_cos(norm: FiberNormalization, psi_i: f32, at: &FiberAtWo) -> f32 {
+    match norm {
+        FiberNormalization::EnergyBounded => psi_i.cos(),
+        FiberNormalization::Published => (0.5 * (at.psi_r - psi_i)).cos(),
+    }
+}
+
+/// The lobe from g = g(β, ψi + ψr) and c = [`lobe_cos`]: g / (2π max(cos ψi, cos ψr))
+/// (notes/bsdf.md §2) or g / cos²(ψd/2) (Marschner et al. 2005 eq. 3).
+#[inline(always)]
+fn lobe_value(norm: FiberNormalization, g: f32, c: f32, at: &FiberAtWo) -> f32 {
+    match norm {
+        FiberNormalization::EnergyBounded => g / (2.0 * PI * c.max(at.cos_psi_r).max(MIN_COS_PSI)),
+        FiberNormalization::Published => g / (c * c).max(MIN_COS_PSI * MIN_COS_PSI),
+    }
+}
+
+/// Δ = acos t on (−1, 1), π at or below −1, 0 at or above 1 (see
+/// [`FiberAxis::half_width_argument`]).
+#[inline(always)]
+fn arc_from_argument(t: f32) -> f32 {
+    if t <= -1.0 {
+        PI
+    } else if t >= 1.0 {
+        0.0
+    } else {
+        t.acos()
+    }
+}
+
+/// Whether [`pdf_value`] looks at Δ (else it is 0 whatever Δ is).
+#[inline(always)]
+fn arc_needed(wi_z: f32, z_min: f32, cos_psi: f32) -> bool {
+    wi_z > z_min && cos_psi >= MIN_COS_PSI
+}
+
+/// The density of [`FiberAxis::pdf`] from g, the interior z of ωi, cos ψi and the arc's Δ:
+/// g / (2 max(Δ, MIN_ARC) cos ψi), 0 where ωi cannot leave the finish, lies on the axis or off
+/// every arc.
+#[inline(always)]
+fn pdf_value(g: f32, wi_z: f32, z_min: f32, cos_psi: f32, delta: f32) -> f32 {
+    if !arc_needed(wi_z, z_min, cos_psi) || delta <= 0.0 {
+        return 0.0;
+    }
+    g / (2.0 * delta.max(MIN_ARC) * cos_psi)
 }
 
 /// Inverse error function, single-precision polynomial of Giles 2010 ("Approximating the erfinv
@@ -135,6 +200,7 @@ impl FiberAxis {
 
     /// `(eval(wo, wi, beta, norm), pdf(wo, wi, beta, z_min))` for the `wo` of `at`, sharing
     /// ψi and the Gaussian g(β, ψi + ψr) between the two; the same values as the two calls.
+    /// Built from the stages of [`FiberAxis::eval_pdf_many_at`], so the two agree bit for bit.
     pub fn eval_pdf_at(
         &self,
         at: &FiberAtWo,
@@ -143,32 +209,82 @@ impl FiberAxis {
         norm: FiberNormalization,
         z_min: f32,
     ) -> (f32, f32) {
-        let psi_i = self.psi(wi);
-        let g = gaussian(beta, psi_i + at.psi_r);
-        let f = match norm {
-            FiberNormalization::EnergyBounded => {
-                let c = psi_i.cos().max(at.cos_psi_r).max(MIN_COS_PSI);
-                g / (2.0 * PI * c)
-            }
-            FiberNormalization::Published => {
-                let c = (0.5 * (at.psi_r - psi_i)).cos();
-                g / (c * c).max(MIN_COS_PSI * MIN_COS_PSI)
-            }
-        };
-        if !(wi.z > z_min) {
+        let sin_psi = wi.dot(self.frame.n);
+        let psi_i = safe_asin(sin_psi);
+        let g = gaussian_scale(beta, gaussian_exponent(beta, psi_i + at.psi_r).exp());
+        let f = lobe_value(norm, g, lobe_cos(norm, psi_i, at), at);
+        // As in `pdf`: sin ψi clamped, ψi = asin of it (= `psi(wi)`), so g is the same; the arc
+        // (an acos) only where `pdf_value` needs it.
+        let (cos_psi, t) = self.arc_argument(sin_psi, z_min);
+        if !arc_needed(wi.z, z_min, cos_psi) {
             return (f, 0.0);
         }
-        // As in `pdf`: sin ψi clamped, ψi = asin of it (= `psi(wi)`), so g is the same.
-        let sin_psi = wi.dot(self.frame.n).clamp(-1.0, 1.0);
+        (f, pdf_value(g, wi.z, z_min, cos_psi, arc_from_argument(t)))
+    }
+
+    /// [`FiberAxis::eval_pdf_at`] of `wi[k]` into `f[k]` and, when `with_pdf`, `pdf[k]` (else
+    /// left as they are), for `k < wi.len() ≤ BATCH`. Stage by stage over all directions:
+    /// the arithmetic stages are loops LLVM vectorises, the libm calls (asin, exp, cos, acos)
+    /// loops of independent calls, instead of one dependent chain per direction.
+    #[allow(clippy::too_many_arguments)]
+    pub fn eval_pdf_many_at(
+        &self,
+        at: &FiberAtWo,
+        wi: &[Vec3],
+        beta: f32,
+        norm: FiberNormalization,
+        z_min: f32,
+        with_pdf: bool,
+        f: &mut [f32],
+        pdf: &mut [f32],
+    ) {
+        let n = wi.len();
+        assert!(n <= BATCH && f.len() >= n && pdf.len() >= n);
+        let (mut sin_psi, mut psi, mut g, mut c) =
+            ([0.0; BATCH], [0.0; BATCH], [0.0; BATCH], [0.0; BATCH]);
+        for k in 0..n {
+            sin_psi[k] = wi[k].dot(self.frame.n);
+        }
+        for k in 0..n {
+            psi[k] = safe_asin(sin_psi[k]);
+        }
+        for k in 0..n {
+            g[k] = gaussian_exponent(beta, psi[k] + at.psi_r);
+        }
+        for x in &mut g[..n] {
+            *x = x.exp();
+        }
+        for k in 0..n {
+            g[k] = gaussian_scale(beta, g[k]);
+            c[k] = lobe_cos(norm, psi[k], at);
+        }
+        for k in 0..n {
+            f[k] = lobe_value(norm, g[k], c[k], at);
+        }
+        if !with_pdf {
+            return;
+        }
+        let (cos_psi, t) = (&mut psi, &mut c);
+        for k in 0..n {
+            (cos_psi[k], t[k]) = self.arc_argument(sin_psi[k], z_min);
+        }
+        for k in 0..n {
+            if arc_needed(wi[k].z, z_min, cos_psi[k]) {
+                t[k] = arc_from_argument(t[k]);
+            }
+        }
+        for k in 0..n {
+            pdf[k] = pdf_value(g[k], wi[k].z, z_min, cos_psi[k], t[k]);
+        }
+    }
+
+    /// cos ψ of a direction with ω·u = `sin_psi` (clamped), and the argument of the arc cosine
+    /// of [`FiberAxis::half_width`] for it ([`arc_from_argument`] gives Δ).
+    #[inline(always)]
+    fn arc_argument(&self, sin_psi: f32, z_min: f32) -> (f32, f32) {
+        let sin_psi = sin_psi.clamp(-1.0, 1.0);
         let cos_psi = safe_sqrt(1.0 - sin_psi * sin_psi);
-        if cos_psi < MIN_COS_PSI {
-            return (f, 0.0);
-        }
-        let delta = self.half_width(sin_psi, cos_psi, z_min);
-        if delta <= 0.0 {
-            return (f, 0.0);
-        }
-        (f, g / (2.0 * delta.max(MIN_ARC) * cos_psi))
+        (cos_psi, self.half_width_argument(sin_psi, cos_psi, z_min))
     }
 
     /// Half-width Δ of the azimuth arc of the cone at longitudinal angle ψ whose directions have
@@ -183,21 +299,22 @@ impl FiberAxis {
     /// Δ of [`FiberAxis::arc`] alone.
     #[inline]
     fn half_width(&self, sin_psi: f32, cos_psi: f32, z_min: f32) -> f32 {
+        arc_from_argument(self.half_width_argument(sin_psi, cos_psi, z_min))
+    }
+
+    /// t with Δ = acos t clamped to [0, π] ([`arc_from_argument`]): z(φ) > z_min ⇔
+    /// cos(φ − φ0) > t = (z_min − sinψ u_z) / (cosψ h). A cone whose z does not vary with φ
+    /// (cosψ h < 1e-7) is wholly above (t = −1, Δ = π) or below (t = 1, Δ = 0).
+    #[inline(always)]
+    fn half_width_argument(&self, sin_psi: f32, cos_psi: f32, z_min: f32) -> f32 {
         let (u, v, w) = (self.frame.n, self.frame.s, self.frame.t);
         let h = (v.z * v.z + w.z * w.z).sqrt();
         let a = sin_psi * u.z;
         let b = cos_psi * h;
         if b < 1e-7 {
-            return if a > z_min { PI } else { 0.0 };
+            return if a > z_min { -1.0 } else { 1.0 };
         }
-        let t = (z_min - a) / b;
-        if t <= -1.0 {
-            PI
-        } else if t >= 1.0 {
-            0.0
-        } else {
-            t.acos()
-        }
+        (z_min - a) / b
     }
 
     /// Samples an interior direction: ψi from the Gaussian about −ψr (inverse CDF), φ uniform on

@@ -4,7 +4,7 @@
 //! reciprocity, the closed-form internal reflections of the diffuse part and the sampling
 //! densities are derived in notes/bsdf.md.
 
-use super::fiber::{FiberAtWo, FiberAxis, FiberNormalization};
+use super::fiber::{FiberAtWo, FiberAxis, FiberNormalization, BATCH};
 use super::fresnel::{fresnel_dielectric, fresnel_diffuse_reflectance, refract_in, refract_out};
 use super::ggx::Ggx;
 use super::{Bsdf, BsdfError, BsdfSample, WoodBsdfParams};
@@ -375,24 +375,91 @@ impl WoodBsdf {
 impl WoodAtWo<'_> {
     /// `(eval(wo, wi), pdf(wo, wi))`; the density only when `with_pdf` (else 0).
     pub fn eval_pdf(&self, wi: Vec3, with_pdf: bool) -> (Vec3, f32) {
-        let (b, wo, probs) = (self.bsdf, self.wo, &self.probs);
-        if !(wo.z > 0.0 && wi.z > 0.0) {
+        let (b, probs) = (self.bsdf, &self.probs);
+        if !(self.wo.z > 0.0 && wi.z > 0.0) {
             return (Vec3::ZERO, 0.0);
         }
         let p = &b.params;
-        let (eta, beta) = (p.eta, p.highlight_width);
-        let wi_in = refract_in(wi, eta);
+        let wi_in = refract_in(wi, p.eta);
         let lobe = |axis: &FiberAxis, at: &FiberAtWo, in_f: bool, in_pdf: bool| {
             if in_f || (with_pdf && in_pdf) {
-                axis.eval_pdf_at(at, wi_in, beta, b.norm, b.z_crit)
+                axis.eval_pdf_at(at, wi_in, p.highlight_width, b.norm, b.z_crit)
             } else {
                 (0.0, 0.0)
             }
         };
         let (f_fib, p_fib) = lobe(&b.fiber, &self.fiber, p.ray_mask < 1.0, probs.fiber > 0.0);
         let (f_ray, p_ray) = lobe(&b.ray, &self.ray, p.ray_mask > 0.0, probs.ray > 0.0);
-        // eval: the steps of `Bsdf::eval` and `substrate`, in their order.
-        let t = self.t_o * b.transmittance(wi.z) * b.inv_eta2;
+        let f = self.value(wi, self.transmission(wi.z), f_fib, f_ray);
+        if !with_pdf {
+            return (f, 0.0);
+        }
+        (f, self.density(wi, wi_in, p_fib, p_ray))
+    }
+
+    /// [`WoodAtWo::eval_pdf`] of every `wi[k]` into `f[k]`, `pdf[k]` (`f`, `pdf` as long as
+    /// `wi`): the same stages, each run over [`BATCH`] directions at a time ([`FiberAxis::
+    /// eval_pdf_many_at`] for the fibre lobes), so that the same values come out (tested) with
+    /// the arithmetic in SIMD lanes.
+    pub fn eval_pdf_many(&self, wi: &[Vec3], with_pdf: bool, f: &mut [Vec3], pdf: &mut [f32]) {
+        assert!(f.len() == wi.len() && pdf.len() == wi.len());
+        let (b, probs) = (self.bsdf, &self.probs);
+        let p = &b.params;
+        for ((wi, f), pdf) in wi
+            .chunks(BATCH)
+            .zip(f.chunks_mut(BATCH))
+            .zip(pdf.chunks_mut(BATCH))
+        {
+            let n = wi.len();
+            let mut wi_in = [Vec3::ZERO; BATCH];
+            for k in 0..n {
+                wi_in[k] = refract_in(wi[k], p.eta);
+            }
+            let wi_in = &wi_in[..n];
+            let lobe = |axis: &FiberAxis, at: &FiberAtWo, in_f: bool, in_pdf: bool| {
+                let (mut f, mut pdf) = ([0.0; BATCH], [0.0; BATCH]);
+                if in_f || (with_pdf && in_pdf) {
+                    let (beta, norm) = (p.highlight_width, b.norm);
+                    axis.eval_pdf_many_at(
+                        at, wi_in, beta, norm, b.z_crit, with_pdf, &mut f, &mut pdf,
+                    );
+                }
+                (f, pdf)
+            };
+            let (f_fib, p_fib) = lobe(&b.fiber, &self.fiber, p.ray_mask < 1.0, probs.fiber > 0.0);
+            let (f_ray, p_ray) = lobe(&b.ray, &self.ray, p.ray_mask > 0.0, probs.ray > 0.0);
+            let mut t = [0.0; BATCH];
+            for k in 0..n {
+                t[k] = self.transmission(wi[k].z);
+            }
+            for k in 0..n {
+                let above = self.wo.z > 0.0 && wi[k].z > 0.0;
+                f[k] = self.value(wi[k], t[k], f_fib[k], f_ray[k]);
+                pdf[k] = if with_pdf {
+                    self.density(wi[k], wi_in[k], p_fib[k], p_ray[k])
+                } else {
+                    0.0
+                };
+                if !above {
+                    (f[k], pdf[k]) = (Vec3::ZERO, 0.0);
+                }
+            }
+        }
+    }
+
+    /// T(θo) T(θi) / η², the finish's share of f (notes/bsdf.md eq. 1.4) for cos θi = `wi_z`.
+    #[inline(always)]
+    fn transmission(&self, wi_z: f32) -> f32 {
+        let b = self.bsdf;
+        self.t_o * b.transmittance(wi_z) * b.inv_eta2
+    }
+
+    /// f from the finish's [`WoodAtWo::transmission`] `t` and the fibre and ray lobes' values at
+    /// ωi: the steps of `Bsdf::eval` and `substrate`, in their order (notes/bsdf.md eq. 1.4).
+    #[inline(always)]
+    fn value(&self, wi: Vec3, t: f32, f_fib: f32, f_ray: f32) -> Vec3 {
+        let b = self.bsdf;
+        let p = &b.params;
         let mut fib = 0.0;
         if p.ray_mask < 1.0 {
             fib += (1.0 - p.ray_mask) * f_fib;
@@ -402,17 +469,19 @@ impl WoodAtWo<'_> {
         }
         let mut f = (b.diffuse_eff * INV_PI + p.fiber_color * fib) * t;
         if let Some(ggx) = &b.ggx {
-            f += Vec3::splat(b.rough_reflection(ggx, wo, wi));
+            f += Vec3::splat(b.rough_reflection(ggx, self.wo, wi));
         }
-        let f = if f.is_finite() {
+        if f.is_finite() {
             f.max(Vec3::ZERO)
         } else {
             Vec3::ZERO
-        };
-        if !with_pdf {
-            return (f, 0.0);
         }
-        // pdf: the steps of `pdf_with`.
+    }
+
+    /// The density from the lobes' interior densities: the steps of `pdf_with`.
+    #[inline(always)]
+    fn density(&self, wi: Vec3, wi_in: Vec3, p_fib: f32, p_ray: f32) -> f32 {
+        let (b, probs) = (self.bsdf, &self.probs);
         let mut pdf = probs.diffuse * wi.z * INV_PI;
         if probs.fiber > 0.0 || probs.ray > 0.0 {
             let jac = wi.z * b.inv_eta2 / wi_in.z.max(1e-7);
@@ -427,11 +496,15 @@ impl WoodAtWo<'_> {
         }
         if let Some(ggx) = &b.ggx {
             if probs.specular > 0.0 {
-                let h = (wo + wi).normalize_or_zero();
-                pdf += probs.specular * ggx.reflection_pdf(wo, h);
+                let h = (self.wo + wi).normalize_or_zero();
+                pdf += probs.specular * ggx.reflection_pdf(self.wo, h);
             }
         }
-        (f, if pdf.is_finite() { pdf } else { 0.0 })
+        if pdf.is_finite() {
+            pdf
+        } else {
+            0.0
+        }
     }
 }
 
@@ -547,6 +620,19 @@ mod tests {
         ]
     }
 
+    /// Every configuration with ray masks 0, 0.4 and 1, in both normalisations.
+    fn variants() -> Vec<WoodBsdf> {
+        let norms = [
+            FiberNormalization::EnergyBounded,
+            FiberNormalization::Published,
+        ];
+        configs()
+            .into_iter()
+            .flat_map(|base| [0.0, 0.4, 1.0].map(|ray_mask| WoodBsdfParams { ray_mask, ..base }))
+            .flat_map(|p| norms.map(|n| WoodBsdf::new(p).unwrap().with_normalization(n)))
+            .collect()
+    }
+
     /// ∫ f cos dω over the upper hemisphere by the midpoint rule in (cos θ, φ).
     fn quadrature_albedo(b: &WoodBsdf, wo: Vec3, n: usize) -> Vec3 {
         let mut s = Vec3::ZERO;
@@ -570,33 +656,64 @@ mod tests {
         // directions over the whole sphere (below-horizon ones must give 0 too).
         let mut rng = Pcg32::new(29, 3);
         let mut nonzero = 0;
-        for base in configs() {
-            for ray_mask in [0.0, 0.4, 1.0] {
-                for norm in [
-                    FiberNormalization::EnergyBounded,
-                    FiberNormalization::Published,
-                ] {
-                    let b = WoodBsdf::new(WoodBsdfParams { ray_mask, ..base })
-                        .unwrap()
-                        .with_normalization(norm);
-                    for _ in 0..40 {
-                        let wo = crate::math::uniform_sphere(rng.next_vec2());
-                        let at = b.at_wo(wo);
-                        for _ in 0..40 {
-                            let wi = crate::math::uniform_sphere(rng.next_vec2());
-                            let (f, pdf) = at.eval_pdf(wi, true);
-                            assert_eq!(f, b.eval(wo, wi), "{wo} {wi}");
-                            assert_eq!(pdf.to_bits(), b.pdf(wo, wi).to_bits(), "{wo} {wi}");
-                            assert_eq!(at.eval_pdf(wi, false), (f, 0.0));
-                            nonzero += (pdf > 0.0) as u32;
-                        }
-                    }
+        for b in variants() {
+            for _ in 0..40 {
+                let wo = crate::math::uniform_sphere(rng.next_vec2());
+                let at = b.at_wo(wo);
+                for _ in 0..40 {
+                    let wi = crate::math::uniform_sphere(rng.next_vec2());
+                    let (f, pdf) = at.eval_pdf(wi, true);
+                    assert_eq!(f, b.eval(wo, wi), "{wo} {wi}");
+                    assert_eq!(pdf.to_bits(), b.pdf(wo, wi).to_bits(), "{wo} {wi}");
+                    assert_eq!(at.eval_pdf(wi, false), (f, 0.0));
+                    nonzero += (pdf > 0.0) as u32;
                 }
             }
         }
         // About a quarter of the 38 400 pairs lie above the horizon on both sides: the test saw
         // real values, not only the zeros below it.
         assert!(nonzero > 7_000, "{nonzero}");
+    }
+
+    #[test]
+    fn batch_eval_pdf_equals_one_at_a_time() {
+        // `eval_pdf_many` (a light sweep's frames in SIMD lanes) must give `eval_pdf`'s bits for
+        // every direction: all configurations, both normalisations, ray masks 0, 0.4, 1, with and
+        // without the density, batches of 1..=40 directions (partial and several chunks),
+        // directions over the whole sphere, within 0.1° of the horizon and exactly ±z; a grazing wo.
+        let mut rng = Pcg32::new(53, 9);
+        let (mut nonzero, mut below) = (0, 0);
+        for b in variants() {
+            for n in [1, 7, 16, 17, 40] {
+                let wo = match n % 3 {
+                    0 => dir(89.95, 360.0 * rng.next_f32()),
+                    _ => crate::math::uniform_sphere(rng.next_vec2()),
+                };
+                let at = b.at_wo(wo);
+                let wi: Vec<Vec3> = (0..n)
+                    .map(|k| match k % 4 {
+                        0 => dir(90.0 - 0.1 * rng.next_f32(), 360.0 * rng.next_f32()),
+                        1 if k % 8 == 1 => Vec3::Z,
+                        1 => -Vec3::Z,
+                        _ => crate::math::uniform_sphere(rng.next_vec2()),
+                    })
+                    .collect();
+                for with_pdf in [true, false] {
+                    let (mut f, mut pdf) = (vec![Vec3::NAN; n], vec![f32::NAN; n]);
+                    at.eval_pdf_many(&wi, with_pdf, &mut f, &mut pdf);
+                    for k in 0..n {
+                        let (f1, p1) = at.eval_pdf(wi[k], with_pdf);
+                        let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                        assert_eq!(bits(f[k]), bits(f1), "{wo} {}", wi[k]);
+                        assert_eq!(pdf[k].to_bits(), p1.to_bits(), "{wo} {}", wi[k]);
+                        assert!(f[k].is_finite() && pdf[k].is_finite());
+                        nonzero += (pdf[k] > 0.0) as u32;
+                        below += (wi[k].z <= 0.0) as u32;
+                    }
+                }
+            }
+        }
+        assert!(nonzero > 300 && below > 300, "{nonzero} {below}");
     }
 
     #[test]

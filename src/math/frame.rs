@@ -13,6 +13,7 @@ pub struct Frame {
 impl Frame {
     /// A frame around unit normal `n`, branch-free and continuous except on one half-line
     /// (Duff et al. 2017, "Building an Orthonormal Basis, Revisited", JCGT 6(1), Listing 3).
+    #[inline]
     pub fn from_normal(n: Vec3) -> Self {
         let sign = 1.0_f32.copysign(n.z);
         let a = -1.0 / (sign + n.z);

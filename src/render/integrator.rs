@@ -11,7 +11,7 @@
 
 use super::film::Aov;
 use super::geometry::{Accel, Hit, Ray};
-use super::light::{Light, LightSample};
+use super::light::{Light, LightSample, LightSamples};
 use super::Scene;
 use crate::bsdf::{Bsdf, WoodAtWo};
 use crate::material::{MaterialHit, SurfaceBsdf};
@@ -205,18 +205,49 @@ impl<'a> BsdfAtWo<'a> {
     pub fn eval_pdf(&self, wi: Vec3, with_pdf: bool) -> (Vec3, f32) {
         match self {
             BsdfAtWo::Wood(w) => w.eval_pdf(wi, with_pdf),
-            BsdfAtWo::Other(b, wo) => {
-                let f = b.eval(*wo, wi);
-                (
-                    f,
-                    if with_pdf && f != Vec3::ZERO {
-                        b.pdf(*wo, wi)
-                    } else {
-                        0.0
-                    },
-                )
-            }
+            BsdfAtWo::Other(b, wo) => eval_then_pdf(*b, *wo, wi, with_pdf),
         }
+    }
+
+    /// [`BsdfAtWo::eval_pdf`] of every `wi[k]` into `f[k]`, `pdf[k]` (the wood BSDF a batch at
+    /// a time, [`WoodAtWo::eval_pdf_many`]; others one by one).
+    pub fn eval_pdf_many(&self, wi: &[Vec3], with_pdf: bool, f: &mut [Vec3], pdf: &mut [f32]) {
+        match self {
+            BsdfAtWo::Wood(w) => w.eval_pdf_many(wi, with_pdf, f, pdf),
+            // The material's kind chosen once, not per direction.
+            BsdfAtWo::Other(SurfaceBsdf::Lambertian(b), wo) => {
+                eval_then_pdf_each(b, *wo, wi, with_pdf, f, pdf)
+            }
+            BsdfAtWo::Other(b, wo) => eval_then_pdf_each(*b, *wo, wi, with_pdf, f, pdf),
+        }
+    }
+}
+
+/// `(eval(wo, wi), pdf(wo, wi))`, the density only when `with_pdf` and f ≠ 0 (else 0).
+#[inline(always)]
+fn eval_then_pdf(b: &impl Bsdf, wo: Vec3, wi: Vec3, with_pdf: bool) -> (Vec3, f32) {
+    let f = b.eval(wo, wi);
+    (
+        f,
+        if with_pdf && f != Vec3::ZERO {
+            b.pdf(wo, wi)
+        } else {
+            0.0
+        },
+    )
+}
+
+/// [`eval_then_pdf`] of every `wi[k]` into `f[k]`, `pdf[k]`.
+fn eval_then_pdf_each(
+    b: &impl Bsdf,
+    wo: Vec3,
+    wi: &[Vec3],
+    with_pdf: bool,
+    f: &mut [Vec3],
+    pdf: &mut [f32],
+) {
+    for ((wi, f), pdf) in wi.iter().zip(f.iter_mut()).zip(pdf.iter_mut()) {
+        (*f, *pdf) = eval_then_pdf(b, wo, *wi, with_pdf);
     }
 }
 
@@ -287,6 +318,61 @@ impl<'a> ShadowTest<'a> {
         }
         self.accel.unoccluded(ray, t_max)
     }
+
+    /// For the shadow segment from `sp` towards each sample of `ls` (as [`light_term`] builds
+    /// it), whether the boxes alone show it unoccluded (`culled[k]`; all false without boxes).
+    /// The segments are set up in one loop and tested in one loop per box, so the slab tests
+    /// run in SIMD lanes.
+    pub fn culled_many(
+        &self,
+        sp: &ShadingPoint,
+        ls: &LightSamples,
+        seg: &mut Segments,
+        culled: &mut Vec<bool>,
+    ) {
+        let n = ls.len();
+        culled.clear();
+        culled.resize(n, self.boxes.is_some());
+        let Some(boxes) = &self.boxes else {
+            return;
+        };
+        for c in seg.o.iter_mut().chain(&mut seg.inv).chain([&mut seg.t_max]) {
+            c.resize(n, 0.0);
+        }
+        let [wx, wy, wz] = &ls.wi;
+        let (wx, wy, wz, dist) = (&wx[..n], &wy[..n], &wz[..n], &ls.dist[..n]);
+        let ([ox, oy, oz], [ix, iy, iz]) = (&mut seg.o, &mut seg.inv);
+        let (ox, oy, oz) = (&mut ox[..n], &mut oy[..n], &mut oz[..n]);
+        let (ix, iy, iz, t_max) = (
+            &mut ix[..n],
+            &mut iy[..n],
+            &mut iz[..n],
+            &mut seg.t_max[..n],
+        );
+        for k in 0..n {
+            let d = Vec3::new(wx[k], wy[k], wz[k]);
+            [ox[k], oy[k], oz[k]] = offset_origin(sp, d).to_array();
+            [ix[k], iy[k], iz[k]] = (Vec3::ONE / d).to_array();
+            t_max[k] = shadow_t_max(dist[k]);
+        }
+        let culled = &mut culled[..n];
+        for (lo, hi) in boxes {
+            let (lo, hi) = (lo.to_array(), hi.to_array());
+            for k in 0..n {
+                let (o, inv) = ([ox[k], oy[k], oz[k]], [ix[k], iy[k], iz[k]]);
+                culled[k] &= slab_misses(o, inv, t_max[k], lo, hi);
+            }
+        }
+    }
+}
+
+/// Shadow segments by component (origin, 1/direction, length), scratch of
+/// [`ShadowTest::culled_many`].
+#[derive(Clone, Debug, Default)]
+pub struct Segments {
+    o: [Vec<f32>; 3],
+    inv: [Vec<f32>; 3],
+    t_max: Vec<f32>,
 }
 
 /// Slab test (Kay & Kajiya 1986) of the segment `o + t·d`, t in [0, t_max], against a box, with
@@ -294,13 +380,28 @@ impl<'a> ShadowTest<'a> {
 /// origin exactly on a slab plane of an axis the ray runs parallel to) answers "may hit".
 #[inline]
 pub fn segment_misses_box(o: Vec3A, inv: Vec3A, t_max: f32, lo: Vec3A, hi: Vec3A) -> bool {
-    let (ta, tb) = ((lo - o) * inv, (hi - o) * inv);
-    if ta.is_nan_mask().any() || tb.is_nan_mask().any() {
-        return false;
+    slab_misses(
+        o.to_array(),
+        inv.to_array(),
+        t_max,
+        lo.to_array(),
+        hi.to_array(),
+    )
+}
+
+/// [`segment_misses_box`] on plain arrays, written with comparisons and selects only so that a
+/// loop of it over many segments vectorises.
+#[inline(always)]
+fn slab_misses(o: [f32; 3], inv: [f32; 3], t_max: f32, lo: [f32; 3], hi: [f32; 3]) -> bool {
+    let (mut t0, mut t1, mut nan) = (0.0f32, t_max, false);
+    for a in 0..3 {
+        let (ta, tb) = ((lo[a] - o[a]) * inv[a], (hi[a] - o[a]) * inv[a]);
+        nan |= ta.is_nan() | tb.is_nan();
+        let (near, far) = if ta < tb { (ta, tb) } else { (tb, ta) };
+        t0 = if near > t0 { near } else { t0 };
+        t1 = if far < t1 { far } else { t1 };
     }
-    let t0 = ta.min(tb).max_element().max(0.0);
-    let t1 = ta.max(tb).min_element().min(t_max);
-    t0 > t1
+    !nan & (t0 > t1)
 }
 
 /// Next-event estimation: one sample of every light, weighted against BSDF sampling by the power
@@ -352,20 +453,120 @@ pub fn light_term(
         d: ls.wi,
     };
     rays.0 += 1;
-    let t_max = if ls.dist.is_finite() {
-        ls.dist * (1.0 - 1e-4)
-    } else {
-        f32::INFINITY
-    };
-    if !shadow.unoccluded(&ray, t_max) {
+    if !shadow.unoccluded(&ray, shadow_t_max(ls.dist)) {
         return Vec3::ZERO;
     }
-    let w = if ls.is_delta {
+    weighted_term(f, ls.li, wi.z, ls.pdf, bsdf_pdf, ls.is_delta)
+}
+
+/// How far a shadow ray towards a light sample at distance `dist` looks: just short of the
+/// light (so the light's own surface never counts), or without end for lights at infinity.
+#[inline(always)]
+fn shadow_t_max(dist: f32) -> f32 {
+    if dist.is_finite() {
+        dist * (1.0 - 1e-4)
+    } else {
+        f32::INFINITY
+    }
+}
+
+/// f · Li · |cos θi| · w / pdf of an unoccluded light sample, w the power heuristic (Veach 1997
+/// eq. 9.13) of the light's density against the BSDF's (1 for delta lights).
+#[inline(always)]
+fn weighted_term(f: Vec3, li: Vec3, wi_z: f32, pdf: f32, bsdf_pdf: f32, is_delta: bool) -> Vec3 {
+    f * li * mis_scale(wi_z, pdf, bsdf_pdf, is_delta)
+}
+
+/// |cos θi| · w / pdf, the factor of f · Li in [`weighted_term`].
+#[inline(always)]
+fn mis_scale(wi_z: f32, pdf: f32, bsdf_pdf: f32, is_delta: bool) -> f32 {
+    let w = if is_delta {
         1.0
     } else {
-        power_heuristic(ls.pdf, bsdf_pdf)
+        power_heuristic(pdf, bsdf_pdf)
     };
-    f * ls.li * (wi.z.abs() * w / ls.pdf)
+    wi_z.abs() * w / pdf
+}
+
+/// Scratch columns of [`light_terms`], reused from call to call.
+#[derive(Clone, Debug, Default)]
+pub struct TermScratch {
+    /// The samples' directions in the local shading frame.
+    wi: Vec<Vec3>,
+    f: Vec<Vec3>,
+    bsdf_pdf: Vec<f32>,
+    /// Whether each shadow segment surely misses every object (no BVH query needed).
+    culled: Vec<bool>,
+    segments: Segments,
+    /// [`mis_scale`] of each sample.
+    scale: Vec<f32>,
+}
+
+/// [`light_term`] of every sample of `ls` (one light at many places: a light sweep's frames)
+/// where `active[k]`, into `out[k]` (others left as they are), stage by stage over all samples —
+/// local directions, BSDF values and densities, culled shadow segments, MIS weights — so each
+/// stage is a loop without dependencies from one sample to the next. The same functions as
+/// [`light_term`] on the same values, so the same bits (tested by the sweep's equality test).
+#[allow(clippy::too_many_arguments)]
+pub fn light_terms(
+    shadow: &ShadowTest,
+    sp: &ShadingPoint,
+    bsdf: &BsdfAtWo,
+    ls: &LightSamples,
+    active: &[bool],
+    scratch: &mut TermScratch,
+    out: &mut [Vec3],
+    rays: &mut RayCount,
+) {
+    let n = ls.len();
+    let TermScratch {
+        wi,
+        f,
+        bsdf_pdf,
+        culled,
+        segments,
+        scale,
+    } = scratch;
+    let [wx, wy, wz] = &ls.wi;
+    let (wx, wy, wz) = (&wx[..n], &wy[..n], &wz[..n]);
+    wi.clear();
+    wi.extend((0..n).map(|k| sp.frame.to_local(Vec3::new(wx[k], wy[k], wz[k]))));
+    f.resize(n, Vec3::ZERO);
+    bsdf_pdf.resize(n, 0.0);
+    bsdf.eval_pdf_many(wi, !ls.is_delta, &mut f[..n], &mut bsdf_pdf[..n]);
+    for k in 0..n {
+        if !(active[k] && ls.pdf[k] > 0.0 && ls.li[k] != Vec3::ZERO) {
+            f[k] = Vec3::ZERO;
+        }
+    }
+    shadow.culled_many(sp, ls, segments, culled);
+    scale.resize(n, 0.0);
+    for k in 0..n {
+        scale[k] = mis_scale(wi[k].z, ls.pdf[k], bsdf_pdf[k], ls.is_delta);
+    }
+    for k in 0..n {
+        if !active[k] {
+            continue;
+        }
+        out[k] = Vec3::ZERO;
+        if f[k] == Vec3::ZERO {
+            continue;
+        }
+        let d = Vec3::new(wx[k], wy[k], wz[k]);
+        rays.0 += 1;
+        if !culled[k]
+            && !shadow.accel.unoccluded(
+                &Ray {
+                    o: offset_origin(sp, d),
+                    d,
+                },
+                shadow_t_max(ls.dist[k]),
+            )
+        {
+            continue;
+        }
+        out[k] = f[k] * ls.li[k] * scale[k];
+    }
 }
 
 /// The light-dependent part of direct lighting at a shading point: next-event estimation over all

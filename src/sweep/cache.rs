@@ -15,9 +15,9 @@ use super::path::{ArcPlane, LightArc, PathError};
 use crate::bsdf::Bsdf;
 use crate::math::{power_heuristic, Pcg32};
 use crate::render::integrator::{
-    self, light_rng, primary_sample, BsdfAtWo, PrimarySample, RayCount, ShadowTest,
+    self, light_rng, primary_sample, BsdfAtWo, PrimarySample, RayCount, ShadowTest, TermScratch,
 };
-use crate::render::light::LightU;
+use crate::render::light::{LightSamples, LightU};
 use crate::render::{
     Aov, Image, Integrator, Light, PixelSum, Ray, RenderError, RenderSettings, RunOptions, Scene,
     TILE,
@@ -326,7 +326,10 @@ fn sweep_tile(
     let (tw, th) = (TILE.min(w - origin.x), TILE.min(h - origin.y));
     let n = (tw * th) as usize;
     let lights = &sweep.frames;
-    let mut sums = vec![vec![PixelSum::default(); n]; lights.len()];
+    let frames = lights.len();
+    // Pixel-major (pixel i, frame k at i·frames + k): a pixel's samples update one contiguous
+    // run of sums instead of one cache line in each of `frames` arrays.
+    let mut sums = vec![PixelSum::default(); n * frames];
     let mut aov_sums = vec![PixelSum::default(); n];
     let mut radiance = vec![Vec3::ZERO; lights.len()];
     let mut scratch = FrameScratch::default();
@@ -356,17 +359,17 @@ fn sweep_tile(
                     }
                 }
             }
-            for (frame_sums, l) in sums.iter_mut().zip(&radiance) {
-                frame_sums[i].add_radiance(*l);
+            for (sum, l) in sums[i * frames..(i + 1) * frames].iter_mut().zip(&radiance) {
+                sum.add_radiance(*l);
             }
             aov_sums[i].add(Vec3::ZERO, &ps.aov);
         }
     }
     let aov = Image::from_sums(tw, th, &aov_sums).aov;
-    let frames = sums
-        .iter()
-        .map(|frame_sums| {
-            let mut img = Image::from_sums(tw, th, frame_sums);
+    let frames = (0..frames)
+        .map(|k| {
+            let frame_sums: Vec<PixelSum> = sums.iter().skip(k).step_by(frames).copied().collect();
+            let mut img = Image::from_sums(tw, th, &frame_sums);
             img.aov = Vec::new();
             img
         })
@@ -383,6 +386,10 @@ struct FrameScratch {
     us: Vec<LightU>,
     /// Each light's next-event term; those of the lights that do not move hold for every frame.
     terms: Vec<Vec3>,
+    /// The moving light's samples, next-event terms and their scratch columns, every frame.
+    samples: LightSamples,
+    moving_terms: Vec<Vec3>,
+    term_scratch: TermScratch,
 }
 
 /// [`integrator::direct_radiance`] of one primary sample for every frame's lights, into `out`;
@@ -390,8 +397,10 @@ struct FrameScratch {
 ///
 /// The lighting stream `rng` draws two numbers per light for next-event estimation whatever the
 /// lights' positions, so the numbers — and hence the next-event terms of the lights that do not
-/// move — are the same in every frame and are computed once; per frame only the moving light is
-/// sampled, with the BSDF prepared for this `wo` once ([`BsdfAtWo`]). The BSDF-sampled direction
+/// move — are the same in every frame and are computed once; only the moving light's term differs
+/// per frame, and it is computed for all frames at once, frames in SIMD lanes
+/// ([`LightSamples`], [`integrator::light_terms`]), with the BSDF prepared for this `wo` once
+/// ([`BsdfAtWo`]). The BSDF-sampled direction
 /// that follows, and the scene hit along it, are also the same in every frame: traced once, and
 /// per frame only the light it may meet is tested. Sums run in the renderer's order
 /// (`sample_lights`, `shade_direct`), so each frame equals the naive render.
@@ -405,7 +414,14 @@ fn direct_for_frames(
 ) {
     let (lights, moving, shadow) = (&sweep.frames, sweep.moving, &sweep.shadow);
     let mut rays = RayCount::default();
-    let FrameScratch { shaded, us, terms } = scratch;
+    let FrameScratch {
+        shaded,
+        us,
+        terms,
+        samples,
+        moving_terms,
+        term_scratch,
+    } = scratch;
     shaded.clear();
     shaded.resize(out.len(), false);
     sweep.nearest_per_frame(&ps.ray, ps.t_hit, |k, hit| {
@@ -443,21 +459,28 @@ fn direct_for_frames(
                 integrator::light_term(shadow, sp, &bsdf, light.sample_at(sp.p, &u), &mut rays)
             });
         }
-        for (k, frame_lights) in lights.iter().enumerate() {
-            if !shaded[k] {
-                continue;
-            }
-            let m = &frame_lights[moving];
-            let term_m = integrator::light_term(
-                shadow,
-                sp,
-                &bsdf,
-                m.sample_at(sp.p, &us[moving]),
-                &mut rays,
-            );
+        // The moving light's term in every frame at once (`light_terms`), then each frame's sum
+        // in the lights' order.
+        let u = &us[moving];
+        match &sweep.sphere {
+            Some(s) => samples.sample_sphere(sp.p, &s.centers, s.radius, s.radiance, u),
+            None => samples.sample_each(sp.p, lights.iter().map(|fl| &fl[moving]), u),
+        }
+        moving_terms.resize(out.len(), Vec3::ZERO);
+        integrator::light_terms(
+            shadow,
+            sp,
+            &bsdf,
+            samples,
+            shaded,
+            term_scratch,
+            moving_terms,
+            &mut rays,
+        );
+        for k in (0..out.len()).filter(|&k| shaded[k]) {
             let mut l = Vec3::ZERO;
             for (j, t) in terms.iter().enumerate() {
-                l += if j == moving { term_m } else { *t };
+                l += if j == moving { moving_terms[k] } else { *t };
             }
             out[k] = l;
         }
@@ -506,6 +529,45 @@ struct SweepLights<'a> {
     /// of a ray–sphere test; `None` when rays cannot meet the light at all (a delta light).
     swept: Option<(Vec3A, Vec3A)>,
     shadow: ShadowTest<'a>,
+    /// The moving light's centre in every frame (by component), radius and radiance, when it
+    /// is a sphere: sampled for all frames at once ([`LightSamples::sample_sphere`]).
+    sphere: Option<MovingSphere>,
+}
+
+/// A sphere light's places over the frames of a sweep.
+struct MovingSphere {
+    centers: [Vec<f32>; 3],
+    radius: f32,
+    radiance: Vec3,
+}
+
+impl MovingSphere {
+    /// The moving light of `frames` (each frame's lights) if it is a sphere in every frame.
+    fn new(frames: &[Vec<Light>], moving: usize) -> Option<Self> {
+        let mut m = MovingSphere {
+            centers: Default::default(),
+            radius: 0.0,
+            radiance: Vec3::ZERO,
+        };
+        for fl in frames {
+            let Light::Sphere {
+                center,
+                radius,
+                radiance,
+            } = fl[moving]
+            else {
+                return None;
+            };
+            if !m.centers[0].is_empty() && (radius, radiance) != (m.radius, m.radiance) {
+                return None;
+            }
+            for (c, v) in m.centers.iter_mut().zip(center.to_array()) {
+                c.push(v);
+            }
+            (m.radius, m.radiance) = (radius, radiance);
+        }
+        Some(m)
+    }
 }
 
 impl<'a> SweepLights<'a> {
@@ -543,6 +605,7 @@ impl<'a> SweepLights<'a> {
             .map(|(_, l)| l.clone())
             .collect();
         SweepLights {
+            sphere: MovingSphere::new(&frames, moving),
             frames,
             moving,
             fixed,
