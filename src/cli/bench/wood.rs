@@ -21,6 +21,9 @@ pub struct Args {
     /// instruction counts: `valgrind --tool=callgrind xylem bench wood --passes 1 ...`).
     #[arg(long)]
     passes: Option<usize>,
+    /// With `--passes`: only this level of `needs` (colour, fibres or all; default: the three).
+    #[arg(long)]
+    needs: Option<String>,
 }
 
 /// CPU time of the calling thread in seconds (Linux: /proc/thread-self/stat, clock ticks of
@@ -101,11 +104,20 @@ fn fixed_passes(args: &Args, points: &[Vec3], passes: usize) -> anyhow::Result<E
     let names = selected(&args.only);
     for name in names {
         let volume = WoodVolume::new(wood::preset(name)?, 1)?;
-        for (label, needs) in [
-            ("colour", Needs::COLOR),
-            ("colour + fibres", Needs::COLOR_FIBERS),
-            ("everything", Needs::ALL),
-        ] {
+        let levels = [
+            ("colour", "colour", Needs::COLOR),
+            ("fibres", "colour + fibres", Needs::COLOR_FIBERS),
+            ("all", "everything", Needs::ALL),
+        ];
+        if let Some(bad) = args
+            .needs
+            .as_deref()
+            .filter(|n| !levels.iter().any(|l| l.0 == *n))
+        {
+            anyhow::bail!("--needs {bad}: expected colour, fibres or all");
+        }
+        let wanted = |key: &str| args.needs.as_deref().is_none_or(|n| n == key);
+        for (_, label, needs) in levels.into_iter().filter(|l| wanted(l.0)) {
             let mut sink = 0.0f32;
             for _ in 0..passes {
                 for &p in points {
