@@ -8,7 +8,8 @@
 //! Derivations that are ours (impulses per cell, the search window, the Campbell-theorem moments
 //! the tests check) are in notes/noise.md.
 
-use super::hash::{cell3, cell3_offset, floor_i32, mix32, seed_offsets};
+use super::hash::{cell3, cell3_offset, floor_i32, mix32, pcg3d, seed_offsets};
+use super::lanes::Simd;
 use crate::math::Frame;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
@@ -338,6 +339,15 @@ impl PoissonTable {
         }
     }
 
+    /// The count for hash `h` if below [`TABLE`], else [`TABLE`] (integer compares only).
+    #[inline(always)]
+    fn table_count(&self, h: u32) -> u32 {
+        // Signed compares (every value is below 2⁶³), which SIMD units have.
+        let h = h as i64;
+        let t = self.thresholds.map(|t| t as i64);
+        (h >= t[0]) as u32 + (h >= t[1]) as u32 + (h >= t[2]) as u32 + (h >= t[3]) as u32
+    }
+
     /// The count for hash `h`: integer compares, the f64 walk only past the table (rare).
     #[inline(always)]
     fn count(&self, h: u32) -> u32 {
@@ -374,12 +384,25 @@ static INV_K: [f64; MAX_DRAW as usize + 1] = {
 /// impulse instead of a second `pcg3d`.
 #[inline(always)]
 fn impulse(h: [u32; 3], k: u32) -> (Vec3, f32) {
-    let mut z = (((h[1] as u64) << 32) | h[2] as u64)
-        .wrapping_add((k as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15));
+    impulse_numbers(impulse_stream(h[1], h[2], k))
+}
+
+/// The SplitMix64 state of impulse `k` of a cell with hash words `h1`, `h2` (see [`impulse`]).
+#[inline(always)]
+fn impulse_stream(h1: u32, h2: u32, k: u32) -> u64 {
+    (((h1 as u64) << 32) | h2 as u64)
+        .wrapping_add((k as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15))
+}
+
+/// The SplitMix64 finaliser of `z` cut into the impulse's position in its cell and its weight
+/// (see [`impulse`]).
+#[inline(always)]
+fn impulse_numbers(mut z: u64) -> (Vec3, f32) {
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
     z ^= z >> 31;
-    let field = |shift: u32| ((z >> shift) & 0xffff) as f32 * (1.0 / 65_536.0);
+    // 16-bit fields: exact as i32, so the same value as converting the u64.
+    let field = |shift: u32| ((z >> shift) & 0xffff) as i32 as f32 * (1.0 / 65_536.0);
     (
         Vec3::new(field(48), field(32), field(16)),
         2.0 * field(0) - 1.0,
@@ -428,8 +451,88 @@ impl KernelMap {
     }
 }
 
+/// Everything a Cartesian query needs besides the band: the kernel map after the fit, the
+/// point's cell `base` and its place `f` in it, the window `lo..=hi` (cell offsets per axis), the
+/// per-axis gap scale of the axis-aligned cell test (0 for oriented kernels) and the counts.
+struct CartesianQuery {
+    map: KernelMap,
+    reach: Vec3,
+    base: [i32; 3],
+    f: Vec3,
+    lo: [i32; 3],
+    hi: [i32; 3],
+    gap_scale: Vec3,
+    counts: PoissonTable,
+}
+
+impl CartesianQuery {
+    /// Cell height in fitted kernel semi-axes along z (for upright kernels, whose local z is z).
+    #[inline(always)]
+    fn gap_scale_z_upright(&self) -> f32 {
+        1.0 / (self.reach.z.max(f32::MIN_POSITIVE))
+    }
+}
+
+/// Whether a kernel frame only turns about z (n = ẑ, s and t horizontal), as the distortion's
+/// cylindrical frame does: then the kernel's local z is the world z.
+#[inline(always)]
+fn is_upright(frame: &Frame) -> bool {
+    frame.n == Vec3::Z && frame.s.z == 0.0 && frame.t.z == 0.0
+}
+
+/// Slack on [`layer_shrink`], far above f32 rounding, so no cell holding a contributing impulse
+/// is ever dropped.
+const LAYER_SLACK: f32 = 1e-4;
+
+/// For an upright kernel (z semi-axis e_z, window reach ρ_z = e_z / cell height in cells), the
+/// fraction of its x and y extent left in the layer of cells at z offset `oz` from a point at
+/// `fz` in its cell: the layer lies g = gap / ρ_z semi-axes away along z, where the ellipsoid's
+/// slice is the ellipse scaled by √(1 − g²), so its bounding box (eq. 9) scales by that too.
+/// Returned with slack, capped at 1.
+#[inline(always)]
+fn layer_shrink(oz: i32, fz: f32, cells_per_semi_axis: f32) -> f32 {
+    let gap = ((oz as f32 + 0.5 - fz).abs() - 0.5).max(0.0) * cells_per_semi_axis;
+    ((1.0 - gap * gap).max(0.0).sqrt() + LAYER_SLACK).min(1.0)
+}
+
+/// The instruction set the Cartesian block search is built for: AVX-512 (F, DQ for the 64-bit
+/// multiply, VL), else AVX2, else none (one cell at a time); std caches the detection.
+#[cfg(target_arch = "x86_64")]
+#[inline]
+fn cell_simd() -> Simd {
+    if is_x86_feature_detected!("avx512f")
+        && is_x86_feature_detected!("avx512dq")
+        && is_x86_feature_detected!("avx512vl")
+    {
+        Simd::Avx512
+    } else if is_x86_feature_detected!("avx2") {
+        Simd::Avx2
+    } else {
+        Simd::Sse2
+    }
+}
+
+/// Lanes of the block search: the 27 cells of the 3 × 3 × 3 block plus 5 padding lanes.
+const BLOCK: usize = 32;
+
+/// Cell offsets (x, y, z) of each block lane, z outermost and x innermost like the scalar loop;
+/// the padding lanes sit at z = 2, outside every window.
+const BLOCK_OFFSETS: [[i32; BLOCK]; 3] = {
+    let mut o = [[0; BLOCK]; 3];
+    let mut i = 0;
+    while i < BLOCK {
+        o[0][i] = (i % 3) as i32 - 1;
+        o[1][i] = ((i / 3) % 3) as i32 - 1;
+        o[2][i] = (i / 9) as i32 - 1;
+        i += 1;
+    }
+    o
+};
+
 impl Band {
-    fn cartesian<const GRAD: bool>(&self, p: Vec3, frame: Option<&Frame>) -> (f32, Vec3) {
+    /// The query setup shared by both Cartesian paths: the fit, the kernel map and the window.
+    #[inline(always)]
+    fn cartesian_query(&self, p: Vec3, frame: Option<&Frame>) -> CartesianQuery {
         // Kernel extent per axis before the fit (eq. 9), then the fit (eq. 11) against the cell.
         let (ext, axes) = match frame {
             None => (self.env, None),
@@ -466,16 +569,49 @@ impl Band {
         // Axis-aligned kernels: cells whose box lies outside the kernel's ellipsoid about p (semi-
         // axes s_b·Sₑ) cannot hold a contributing centre and are skipped before hashing (each
         // axis' gap to the cell bounds that axis' term of q from below). Oriented kernels: no
-        // test — separating-axis tests against the kernel's box culled ≈ 6 % of the cells of the
-        // presets and cost more than they saved (notes/wood.md §12).
-        let scale = (self.cell / (sb * self.env)) * (frame.is_none() as u32 as f32);
+        // such test (scale 0) — separating-axis tests against the kernel's box culled ≈ 6 % of
+        // the cells of the presets and cost more than they saved (notes/wood.md §12).
+        let gap_scale = (self.cell / (sb * self.env)) * (frame.is_none() as u32 as f32);
+        CartesianQuery {
+            map,
+            reach,
+            base,
+            f,
+            lo,
+            hi,
+            gap_scale,
+            counts,
+        }
+    }
+
+    /// Cartesian cells: on CPUs with AVX2 or AVX-512 the 3 × 3 × 3 block of cells is searched in
+    /// SIMD lanes ([`Band::cartesian_block`]), else (and for windows wider than the block, which
+    /// only rounding can make) one cell at a time. Both give the same value, bit for bit.
+    fn cartesian<const GRAD: bool>(&self, p: Vec3, frame: Option<&Frame>) -> (f32, Vec3) {
+        let q = self.cartesian_query(p, frame);
+        #[cfg(target_arch = "x86_64")]
+        if q.lo.iter().all(|&l| l >= -1) && q.hi.iter().all(|&h| h <= 1) {
+            let upright = frame.is_some_and(is_upright);
+            match cell_simd() {
+                // SAFETY: each arm runs only where `cell_simd` detected its instruction set.
+                Simd::Avx512 => return unsafe { self.cartesian_avx512::<GRAD>(&q, upright) },
+                Simd::Avx2 => return unsafe { self.cartesian_avx2::<GRAD>(&q, upright) },
+                _ => {}
+            }
+        }
+        self.cartesian_cells::<GRAD>(&q)
+    }
+
+    /// One cell at a time over the window (the reference the block search must equal).
+    fn cartesian_cells<const GRAD: bool>(&self, q: &CartesianQuery) -> (f32, Vec3) {
+        let (f, base) = (q.f, q.base);
         let mut acc = (0.0, Vec3::ZERO);
-        for oz in lo[2]..hi[2] + 1 {
-            for oy in lo[1]..hi[1] + 1 {
-                for ox in lo[0]..hi[0] + 1 {
+        for oz in q.lo[2]..q.hi[2] + 1 {
+            for oy in q.lo[1]..q.hi[1] + 1 {
+                for ox in q.lo[0]..q.hi[0] + 1 {
                     let o = Vec3::new(ox as f32, oy as f32, oz as f32);
                     // Distance from f to the cell [o, o + 1] per axis, in kernel semi-axes.
-                    let gap = ((o + 0.5 - f).abs() - 0.5).max(Vec3::ZERO) * scale;
+                    let gap = ((o + 0.5 - f).abs() - 0.5).max(Vec3::ZERO) * q.gap_scale;
                     if gap.length_squared() >= 1.0 {
                         continue;
                     }
@@ -485,13 +621,138 @@ impl Band {
                         base[2].wrapping_add(oz),
                         &self.offsets,
                     );
-                    for k in 0..counts.count(h[0]) {
+                    for k in 0..q.counts.count(h[0]) {
                         let (u, w) = impulse(h, k);
                         let d = (f - o - u) * self.cell;
                         let w = if self.signed { w } else { 1.0 };
-                        map.add::<GRAD>(self.kernel, d, w, &mut acc);
+                        q.map.add::<GRAD>(self.kernel, d, w, &mut acc);
                     }
                 }
+            }
+        }
+        acc
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn cartesian_avx2<const GRAD: bool>(
+        &self,
+        q: &CartesianQuery,
+        upright: bool,
+    ) -> (f32, Vec3) {
+        self.cartesian_block::<GRAD>(q, upright)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512dq,avx512vl")]
+    unsafe fn cartesian_avx512<const GRAD: bool>(
+        &self,
+        q: &CartesianQuery,
+        upright: bool,
+    ) -> (f32, Vec3) {
+        self.cartesian_block::<GRAD>(q, upright)
+    }
+
+    /// The window searched in lanes, one lane per cell of the 3 × 3 × 3 block (in the order of
+    /// [`Band::cartesian_cells`]): every lane hashes its cell and draws its count; then, impulse k
+    /// of every cell at once, each lane tests whether the impulse reaches p (q < 1, the same
+    /// operations as the scalar test). Only those impulses — ≈ the density, out of ≈ 20 tested
+    /// for the distortion — are then summed one by one, in the scalar order, by the scalar code:
+    /// the value is [`Band::cartesian_cells`]' bit for bit. Loops over whole lane arrays with no
+    /// early exit, so the compiler vectorises them for the enclosing `target_feature`.
+    #[inline(always)]
+    fn cartesian_block<const GRAD: bool>(&self, q: &CartesianQuery, upright: bool) -> (f32, Vec3) {
+        let (f, base, seed) = (q.f, q.base, &self.offsets);
+        let per_semi_axis_z = q.gap_scale_z_upright();
+        // Three plain loops over the lanes (each vectorises on its own): which cells the window
+        // keeps, their hashes, their counts.
+        let mut inside = [false; BLOCK];
+        for (i, inside) in inside.iter_mut().enumerate() {
+            let o = Vec3::new(
+                BLOCK_OFFSETS[0][i] as f32,
+                BLOCK_OFFSETS[1][i] as f32,
+                BLOCK_OFFSETS[2][i] as f32,
+            );
+            // Upright kernels: the layer's x and y window (1 keeps the whole window exactly).
+            let shrink = if upright {
+                layer_shrink(BLOCK_OFFSETS[2][i], f.z, per_semi_axis_z)
+            } else {
+                1.0
+            };
+            let (lo, hi) = (f - shrink * q.reach, f + shrink * q.reach);
+            // o ≥ ⌊lo⌋ ⇔ lo < o + 1 and o ≤ ⌊hi⌋ ⇔ o ≤ hi for integer o: the window of
+            // `cartesian_query` without the float-to-int conversions.
+            let gap = ((o + 0.5 - f).abs() - 0.5).max(Vec3::ZERO) * q.gap_scale;
+            *inside = (lo.x < o.x + 1.0)
+                & (o.x <= hi.x)
+                & (lo.y < o.y + 1.0)
+                & (o.y <= hi.y)
+                & (f.z - q.reach.z < o.z + 1.0)
+                & (o.z <= f.z + q.reach.z)
+                & (gap.length_squared() < 1.0);
+        }
+        let mut h = [[0u32; BLOCK]; 3];
+        for i in 0..BLOCK {
+            let hash = pcg3d([
+                (base[0].wrapping_add(BLOCK_OFFSETS[0][i]) as u32).wrapping_add(seed[0]),
+                (base[1].wrapping_add(BLOCK_OFFSETS[1][i]) as u32).wrapping_add(seed[1]),
+                (base[2].wrapping_add(BLOCK_OFFSETS[2][i]) as u32).wrapping_add(seed[2]),
+            ]);
+            (h[0][i], h[1][i], h[2][i]) = (hash[0], hash[1], hash[2]);
+        }
+        let mut count = [0u32; BLOCK];
+        let mut walk = [false; BLOCK];
+        for i in 0..BLOCK {
+            let c = q.counts.table_count(h[0][i]);
+            count[i] = if inside[i] { c } else { 0 };
+            walk[i] = inside[i] & (c >= TABLE as u32);
+        }
+        if walk.iter().any(|&w| w) {
+            for i in 0..BLOCK {
+                if walk[i] {
+                    count[i] = q.counts.count(h[0][i]);
+                }
+            }
+        }
+        let rounds = count.iter().copied().max().unwrap_or(0);
+        if rounds > u32::BITS {
+            return self.cartesian_cells::<GRAD>(q);
+        }
+        // Bit k of lane i: impulse k of cell i reaches p.
+        let mut hits = [0u32; BLOCK];
+        let axes = q.map.axes;
+        for k in 0..rounds {
+            for i in 0..BLOCK {
+                let (u, _) = impulse_numbers(impulse_stream(h[1][i], h[2][i], k));
+                let o = Vec3::new(
+                    BLOCK_OFFSETS[0][i] as f32,
+                    BLOCK_OFFSETS[1][i] as f32,
+                    BLOCK_OFFSETS[2][i] as f32,
+                );
+                let d = (f - o - u) * self.cell;
+                let local = match &axes {
+                    None => d,
+                    Some(fr) => fr.to_local(d),
+                };
+                let reaches = (local * q.map.inv).length_squared() < 1.0;
+                hits[i] |= ((reaches & (k < count[i])) as u32) << k;
+            }
+        }
+        let mut acc = (0.0, Vec3::ZERO);
+        for i in 0..BLOCK {
+            let mut bits = hits[i];
+            while bits != 0 {
+                let k = bits.trailing_zeros();
+                bits &= bits - 1;
+                let o = Vec3::new(
+                    BLOCK_OFFSETS[0][i] as f32,
+                    BLOCK_OFFSETS[1][i] as f32,
+                    BLOCK_OFFSETS[2][i] as f32,
+                );
+                let (u, w) = impulse([h[0][i], h[1][i], h[2][i]], k);
+                let d = (f - o - u) * self.cell;
+                let w = if self.signed { w } else { 1.0 };
+                q.map.add::<GRAD>(self.kernel, d, w, &mut acc);
             }
         }
         acc
@@ -870,6 +1131,75 @@ mod tests {
             );
         }
         assert!(nonzero > 60, "the comparison must see kernels");
+    }
+
+    /// The SIMD block search gives the one-cell-at-a-time value and gradient bit for bit, for
+    /// axis-aligned, upright (turned about z, the layer shrink) and tilted kernels, sparse and
+    /// dense cells (counts past the threshold table, many rounds), and both signs of coordinates.
+    #[test]
+    fn block_search_matches_the_cell_loop() {
+        let mut rng = Pcg32::new(5, 0);
+        let mut compared = 0;
+        for i in 0..3000u32 {
+            let env = Vec3::new(
+                0.2 + rng.next_f32(),
+                0.2 + 2.0 * rng.next_f32(),
+                0.2 + 4.0 * rng.next_f32(),
+            );
+            let per_cell = [0.05f32, 1.2, 6.0][i as usize % 3];
+            let cell = env * (0.6 + 0.8 * rng.next_f32());
+            let mut b = band(env, cell, i);
+            b.intensity = per_cell / (cell.x * cell.y * cell.z);
+            b.signed = i % 2 == 0;
+            if i % 4 == 1 {
+                b.kernel = Kernel::Bump { sharpness: 1.0 };
+            }
+            let p = (Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - 1.0) * 200.0;
+            let angle = 2.0 * PI * rng.next_f32();
+            let (c, s) = (angle.cos(), angle.sin());
+            let upright = Frame {
+                s: Vec3::new(c, s, 0.0),
+                t: Vec3::new(-s, c, 0.0),
+                n: Vec3::Z,
+            };
+            let tilted = Frame::from_normal(uniform_sphere(rng.next_vec2()));
+            for frame in [None, Some(&upright), Some(&tilted)] {
+                let q = b.cartesian_query(p, frame);
+                let reference = b.cartesian_cells::<true>(&q);
+                let value = b.cartesian_cells::<false>(&q).0;
+                let fast = b.cartesian::<true>(p, frame);
+                let fast_value = b.cartesian::<false>(p, frame).0;
+                assert_eq!(
+                    fast.0.to_bits(),
+                    reference.0.to_bits(),
+                    "value at {p} ({i})"
+                );
+                assert_eq!(fast_value.to_bits(), value.to_bits(), "value at {p} ({i})");
+                for k in 0..3 {
+                    assert_eq!(
+                        fast.1[k].to_bits(),
+                        reference.1[k].to_bits(),
+                        "∇ at {p} ({i})"
+                    );
+                }
+                // Every instruction set this CPU has, not only the widest.
+                #[cfg(target_arch = "x86_64")]
+                if is_x86_feature_detected!("avx2")
+                    && q.lo.iter().all(|&l| l >= -1)
+                    && q.hi.iter().all(|&h| h <= 1)
+                {
+                    let up = frame.is_some_and(is_upright);
+                    // SAFETY: AVX2 was detected just above.
+                    let avx2 = unsafe { b.cartesian_avx2::<true>(&q, up) };
+                    assert_eq!(avx2.0.to_bits(), reference.0.to_bits(), "AVX2 at {p} ({i})");
+                }
+                compared += (reference.0 != 0.0) as u32;
+            }
+        }
+        assert!(
+            compared > 3000,
+            "the comparison must see kernels ({compared})"
+        );
     }
 
     /// The integer thresholds reproduce the f64 walk exactly: at random hashes, at every threshold
