@@ -225,37 +225,29 @@ impl SparseConvolution {
     }
 
     fn sum<const GRAD: bool>(&self, p: Vec3, frame: Option<&Frame>, seed: u32) -> (f32, Vec3) {
-        let mut value = 0.0;
-        let mut gradient = Vec3::ZERO;
+        let bands = (0..self.bands.max(1)).map(|index| self.band(index, seed));
+        sum_bands::<GRAD, _>(bands, self.cells, p, frame)
+    }
+
+    /// Band `index` for `seed`: magnitude α β^(γ i) and the band with every length scaled by βⁱ
+    /// (eq. 8). βⁱ is built by repeated multiplication, band 0 skips the libm call (1^γ = 1).
+    fn band(&self, index: u32, seed: u32) -> (f32, Band) {
         let mut scale = 1.0f32;
-        for band in 0..self.bands.max(1) {
-            // β^(γ i); band 0 skips the libm call (1^γ = 1 exactly).
-            let amp = self.magnitude
-                * if band == 0 {
-                    1.0
-                } else {
-                    scale.powf(self.dropoff)
-                };
-            let bseed = mix32(seed ^ mix32(band.wrapping_add(0x5bd1_e995)));
-            let band = Band {
-                kernel: self.kernel,
-                env: self.envelope * scale,
-                cell: self.cell * scale,
-                intensity: self.intensity() / (scale * scale * scale),
-                signed: self.weights == Weights::Signed,
-                offsets: seed_offsets(bseed),
-            };
-            let (v, g) = match self.cells {
-                Cells::Cartesian => band.cartesian::<GRAD>(p, frame),
-                Cells::Cylindrical => band.cylindrical::<GRAD>(p, frame),
-            };
-            value += amp * v;
-            if GRAD {
-                gradient += amp * g;
-            }
+        for _ in 0..index {
             scale *= self.size_factor;
         }
-        (value, gradient)
+        let amp = self.magnitude
+            * if index == 0 {
+                1.0
+            } else {
+                scale.powf(self.dropoff)
+            };
+        let bseed = mix32(seed ^ mix32(index.wrapping_add(0x5bd1_e995)));
+        let (env, cell) = (self.envelope * scale, self.cell * scale);
+        let intensity = self.intensity() / (scale * scale * scale);
+        let signed = self.weights == Weights::Signed;
+        let band = Band::new(self.kernel, env, cell, intensity, signed, bseed);
+        (amp, band)
     }
 
     /// Number of impulses the base band holds in Cartesian cell `(ix, iy, iz)` for `seed`
@@ -264,6 +256,78 @@ impl SparseConvolution {
         let bseed = mix32(seed ^ mix32(0x5bd1_e995));
         let h = cell3(cell[0], cell[1], cell[2], bseed);
         poisson(h[0], self.impulses_per_cell())
+    }
+}
+
+/// Σ amplitude × band (eq. 7–8) over `bands`, in order.
+#[inline(always)]
+fn sum_bands<const GRAD: bool, B: std::borrow::Borrow<(f32, Band)>>(
+    bands: impl Iterator<Item = B>,
+    cells: Cells,
+    p: Vec3,
+    frame: Option<&Frame>,
+) -> (f32, Vec3) {
+    let mut value = 0.0;
+    let mut gradient = Vec3::ZERO;
+    for b in bands {
+        let (amp, band) = b.borrow();
+        let (v, g) = match cells {
+            Cells::Cartesian => band.cartesian::<GRAD>(p, frame),
+            Cells::Cylindrical => band.cylindrical::<GRAD>(p, frame),
+        };
+        value += amp * v;
+        if GRAD {
+            gradient += amp * g;
+        }
+    }
+    (value, gradient)
+}
+
+/// A [`SparseConvolution`] bound to a seed, with what does not depend on the query point — each
+/// band's magnitude, scaled lengths, lattice offsets and Poisson thresholds — computed once.
+/// Evaluates exactly as the `SparseConvolution` methods with that seed, for callers that query
+/// one noise many times (the wood features).
+#[derive(Clone, Debug)]
+pub struct SeededSparse {
+    noise: SparseConvolution,
+    bands: Vec<(f32, Band)>,
+}
+
+impl SeededSparse {
+    pub fn new(noise: SparseConvolution, seed: u32) -> Self {
+        let bands = (0..noise.bands.max(1))
+            .map(|index| noise.band(index, seed))
+            .collect();
+        SeededSparse { noise, bands }
+    }
+
+    /// The parameters.
+    pub fn noise(&self) -> &SparseConvolution {
+        &self.noise
+    }
+
+    /// [`SparseConvolution::eval`].
+    #[inline]
+    pub fn eval(&self, p: Vec3) -> f32 {
+        self.sum::<false>(p, None, self.bands.len()).0
+    }
+
+    /// [`SparseConvolution::eval_oriented`] with the first `bands` bands (all: the same value).
+    #[inline]
+    pub fn eval_oriented_bands(&self, p: Vec3, frame: &Frame, bands: usize) -> f32 {
+        self.sum::<false>(p, Some(frame), bands).0
+    }
+
+    /// [`SparseConvolution::eval_oriented_grad`] with the first `bands` bands.
+    #[inline]
+    pub fn eval_oriented_grad_bands(&self, p: Vec3, frame: &Frame, bands: usize) -> (f32, Vec3) {
+        self.sum::<true>(p, Some(frame), bands)
+    }
+
+    #[inline]
+    fn sum<const GRAD: bool>(&self, p: Vec3, frame: Option<&Frame>, bands: usize) -> (f32, Vec3) {
+        let bands = self.bands[..bands.min(self.bands.len())].iter();
+        sum_bands::<GRAD, _>(bands, self.noise.cells, p, frame)
     }
 }
 
@@ -309,7 +373,7 @@ const TABLE: usize = 4;
 /// steps past k while u > CDF(k), u = (h + ½)/2³²; both sides are exact in f64 (a power-of-two
 /// scale), so u > CDF(k) ⇔ h ≥ T_k with T_k = ⌊2³² CDF(k) − ½⌋ + 1, and the count is the number
 /// of thresholds h reaches: the same count, bit for bit (test `poisson_table_matches_the_walk`).
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Debug)]
 struct PoissonTable {
     /// T_k for k < [`TABLE`], as u64 (2³² and beyond: never reached).
     thresholds: [u64; TABLE],
@@ -410,6 +474,7 @@ fn impulse_numbers(mut z: u64) -> (Vec3, f32) {
 }
 
 /// One band, all lengths already scaled.
+#[derive(Clone, Debug)]
 struct Band {
     kernel: Kernel,
     env: Vec3,
@@ -418,6 +483,8 @@ struct Band {
     signed: bool,
     /// The band's seed, as the lattice translations of [`seed_offsets`].
     offsets: [u32; 3],
+    /// Counts of a Cartesian cell (mean `intensity` × cell volume).
+    cell_counts: PoissonTable,
 }
 
 /// The kernel's inverse map M = s_b⁻¹ Sₑ⁻¹ Rᵀ of eq. 12, kept as axes and inverse lengths.
@@ -530,6 +597,19 @@ const BLOCK_OFFSETS: [[i32; BLOCK]; 3] = {
 };
 
 impl Band {
+    /// A band with lengths already scaled; `seed` is the band's own.
+    fn new(kernel: Kernel, env: Vec3, cell: Vec3, intensity: f32, signed: bool, seed: u32) -> Band {
+        Band {
+            kernel,
+            env,
+            cell,
+            intensity,
+            signed,
+            offsets: seed_offsets(seed),
+            cell_counts: PoissonTable::new((intensity * cell.x * cell.y * cell.z) as f64),
+        }
+    }
+
     /// The query setup shared by both Cartesian paths: the fit, the kernel map and the window.
     #[inline(always)]
     fn cartesian_query(&self, p: Vec3, frame: Option<&Frame>) -> CartesianQuery {
@@ -564,8 +644,7 @@ impl Band {
             floor_i32(f.y + reach.y),
             floor_i32(f.z + reach.z),
         ];
-        let counts =
-            PoissonTable::new((self.intensity * self.cell.x * self.cell.y * self.cell.z) as f64);
+        let counts = self.cell_counts;
         // Axis-aligned kernels: cells whose box lies outside the kernel's ellipsoid about p (semi-
         // axes s_b·Sₑ) cannot hold a contributing centre and are skipped before hashing (each
         // axis' gap to the cell bounds that axis' term of q from below). Oriented kernels: no
@@ -1070,14 +1149,8 @@ mod tests {
     }
 
     fn band(env: Vec3, cell: Vec3, seed: u32) -> Band {
-        Band {
-            kernel: Kernel::Wyvill,
-            env,
-            cell,
-            intensity: 3.0 / (4.0 / 3.0 * PI * env.x * env.y * env.z),
-            signed: true,
-            offsets: seed_offsets(seed),
-        }
+        let intensity = 3.0 / (4.0 / 3.0 * PI * env.x * env.y * env.z);
+        Band::new(Kernel::Wyvill, env, cell, intensity, true, seed)
     }
 
     /// The bounding-box fit (eq. 9–12) keeps every contributing kernel inside the searched cells:
@@ -1148,12 +1221,13 @@ mod tests {
             );
             let per_cell = [0.05f32, 1.2, 6.0][i as usize % 3];
             let cell = env * (0.6 + 0.8 * rng.next_f32());
-            let mut b = band(env, cell, i);
-            b.intensity = per_cell / (cell.x * cell.y * cell.z);
-            b.signed = i % 2 == 0;
-            if i % 4 == 1 {
-                b.kernel = Kernel::Bump { sharpness: 1.0 };
-            }
+            let kernel = if i % 4 == 1 {
+                Kernel::Bump { sharpness: 1.0 }
+            } else {
+                Kernel::Wyvill
+            };
+            let intensity = per_cell / (cell.x * cell.y * cell.z);
+            let b = Band::new(kernel, env, cell, intensity, i % 2 == 0, i);
             let p = (Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - 1.0) * 200.0;
             let angle = 2.0 * PI * rng.next_f32();
             let (c, s) = (angle.cos(), angle.sin());
