@@ -365,11 +365,12 @@ fn poisson_with(h: u32, m: f64, exp_neg_m: f64) -> u32 {
     k
 }
 
-/// Entries of [`PoissonTable`]: counts below this come from integer compares alone.
-const TABLE: usize = 4;
+/// Entries of [`PoissonTable`]: counts below this come from integer compares alone (a Poisson
+/// count of mean 1.2, the distortion's, reaches 8 with probability 10⁻⁵).
+const TABLE: usize = 8;
 
 /// The inverse-CDF walk of [`poisson_with`] turned into integer thresholds on the raw hash, built
-/// once per query (per ring for cylindrical cells) instead of walking in f64 per cell. The walk
+/// once per band (per ring for cylindrical cells) instead of walking in f64 per cell. The walk
 /// steps past k while u > CDF(k), u = (h + ½)/2³²; both sides are exact in f64 (a power-of-two
 /// scale), so u > CDF(k) ⇔ h ≥ T_k with T_k = ⌊2³² CDF(k) − ½⌋ + 1, and the count is the number
 /// of thresholds h reaches: the same count, bit for bit (test `poisson_table_matches_the_walk`).
@@ -377,6 +378,10 @@ const TABLE: usize = 4;
 struct PoissonTable {
     /// T_k for k < [`TABLE`], as u64 (2³² and beyond: never reached).
     thresholds: [u64; TABLE],
+    /// The same test in u32 for SIMD lanes: h ≥ T_k ⇔ h > T_k − 1 (saturated at u32::MAX, never
+    /// true, for T_k > 2³²); T_k = 0 (always reached) is counted in `always` and stored as MAX.
+    below: [u32; TABLE],
+    always: u32,
     m: f64,
     exp_neg_m: f64,
 }
@@ -396,20 +401,23 @@ impl PoissonTable {
             // (x < 2³³, so the i64 conversion, one instruction, is exact after truncation.)
             *t = if x < 0.0 { 0 } else { (x as i64 + 1) as u64 };
         }
+        let below = thresholds.map(|t| match t {
+            0 => u32::MAX,
+            t => (t - 1).min(u32::MAX as u64) as u32,
+        });
         PoissonTable {
             thresholds,
+            below,
+            always: thresholds.iter().filter(|&&t| t == 0).count() as u32,
             m,
             exp_neg_m,
         }
     }
 
-    /// The count for hash `h` if below [`TABLE`], else [`TABLE`] (integer compares only).
+    /// The count for hash `h` if below [`TABLE`], else [`TABLE`]: u32 compares only, for lanes.
     #[inline(always)]
     fn table_count(&self, h: u32) -> u32 {
-        // Signed compares (every value is below 2⁶³), which SIMD units have.
-        let h = h as i64;
-        let t = self.thresholds.map(|t| t as i64);
-        (h >= t[0]) as u32 + (h >= t[1]) as u32 + (h >= t[2]) as u32 + (h >= t[3]) as u32
+        self.always + self.below.iter().map(|&b| (h > b) as u32).sum::<u32>()
     }
 
     /// The count for hash `h`: integer compares, the f64 walk only past the table (rare).
@@ -421,8 +429,9 @@ impl PoissonTable {
         if h < t[0] {
             return 0;
         }
+        // Three more compares cover counts below 4 (≈ 97 % of non-empty cells at mean 1.2).
         let c = 1 + (h >= t[1]) as u32 + (h >= t[2]) as u32 + (h >= t[3]) as u32;
-        if c < TABLE as u32 {
+        if c < 4 {
             c
         } else {
             poisson_with(h as u32, self.m, self.exp_neg_m)
@@ -577,6 +586,18 @@ fn cell_simd() -> Simd {
     } else {
         Simd::Sse2
     }
+}
+
+/// The indices of the set bits of `mask`, ascending.
+#[inline(always)]
+fn lanes(mut mask: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (mask != 0).then(|| {
+            let i = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            i
+        })
+    })
 }
 
 /// Lanes of the block search: the 27 cells of the 3 × 3 × 3 block plus 5 padding lanes.
@@ -780,20 +801,16 @@ impl Band {
             (h[0][i], h[1][i], h[2][i]) = (hash[0], hash[1], hash[2]);
         }
         let mut count = [0u32; BLOCK];
-        let mut walk = [false; BLOCK];
+        let mut walk = 0u32;
         for i in 0..BLOCK {
             let c = q.counts.table_count(h[0][i]);
             count[i] = if inside[i] { c } else { 0 };
-            walk[i] = inside[i] & (c >= TABLE as u32);
+            walk |= ((count[i] >= TABLE as u32) as u32) << i;
         }
-        if walk.iter().any(|&w| w) {
-            for i in 0..BLOCK {
-                if walk[i] {
-                    count[i] = q.counts.count(h[0][i]);
-                }
-            }
+        for i in lanes(walk) {
+            count[i] = q.counts.count(h[0][i]);
         }
-        let rounds = count.iter().copied().max().unwrap_or(0);
+        let rounds = count.iter().fold(0, |m, &c| m.max(c));
         if rounds > u32::BITS {
             return self.cartesian_cells::<GRAD>(q);
         }
@@ -817,12 +834,14 @@ impl Band {
                 hits[i] |= ((reaches & (k < count[i])) as u32) << k;
             }
         }
+        let mut hit_cells = 0u32;
+        for (i, &bits) in hits.iter().enumerate() {
+            hit_cells |= ((bits != 0) as u32) << i;
+        }
         let mut acc = (0.0, Vec3::ZERO);
-        for i in 0..BLOCK {
-            let mut bits = hits[i];
-            while bits != 0 {
-                let k = bits.trailing_zeros();
-                bits &= bits - 1;
+        for i in lanes(hit_cells) {
+            for k in lanes(hits[i]) {
+                let k = k as u32;
                 let o = Vec3::new(
                     BLOCK_OFFSETS[0][i] as f32,
                     BLOCK_OFFSETS[1][i] as f32,
@@ -1283,21 +1302,21 @@ mod tests {
         for m in [1e-4f64, 0.0716, 0.256, 1.19, 3.0, 11.0, 64.0] {
             let table = PoissonTable::new(m);
             let walk = |h: u32| poisson_with(h, m, (-m).exp());
-            for i in 0..20_000u32 {
-                let h = mix32(i ^ 0x1234_5678);
+            // The lane count equals the walk below the table's end and says so past it.
+            let check = |h: u32| {
                 assert_eq!(table.count(h), walk(h), "m {m} h {h}");
-            }
+                let lanes = table.table_count(h);
+                assert_eq!(lanes, walk(h).min(TABLE as u32), "lanes: m {m} h {h}");
+            };
+            (0..20_000u32).for_each(|i| check(mix32(i ^ 0x1234_5678)));
             for &t in &table.thresholds {
                 for h in [t.saturating_sub(1), t, t + 1] {
                     if h <= u32::MAX as u64 {
-                        let h = h as u32;
-                        assert_eq!(table.count(h), walk(h), "m {m} h {h} at a threshold");
+                        check(h as u32);
                     }
                 }
             }
-            for h in [0, 1, u32::MAX - 1, u32::MAX] {
-                assert_eq!(table.count(h), walk(h), "m {m} h {h}");
-            }
+            [0, 1, u32::MAX - 1, u32::MAX].into_iter().for_each(check);
         }
     }
 

@@ -14,7 +14,7 @@ pub struct Args {
     /// Only these presets (default: all).
     #[arg(long)]
     only: Vec<String>,
-    /// Also time each preset with one feature switched off at a time (full model).
+    /// Also time each preset with one feature switched off at a time (colour and full model).
     #[arg(long)]
     breakdown: bool,
     /// Run exactly this many passes per level of `needs` instead of timing (a fixed workload for
@@ -137,7 +137,8 @@ fn fixed_passes(args: &Args, points: &[Vec3], passes: usize) -> anyhow::Result<E
     Ok(ExitCode::SUCCESS)
 }
 
-/// Full-model speed with each feature switched off in turn: the saving is that feature's cost.
+/// Colour-only and full-model speed with each feature switched off in turn: the saving is that
+/// feature's cost.
 fn breakdown(params: &wood::WoodParams, points: &[Vec3]) -> anyhow::Result<()> {
     let variants: [(&str, fn(&mut wood::WoodParams)); 7] = [
         ("no growth noise", |p| p.growth = None),
@@ -162,8 +163,9 @@ fn breakdown(params: &wood::WoodParams, points: &[Vec3]) -> anyhow::Result<()> {
         let mut p = params.clone();
         edit(&mut p);
         let v = WoodVolume::new(p, 1)?;
+        let c = texels_per_second(&v, points, Needs::COLOR);
         let all = texels_per_second(&v, points, Needs::ALL);
-        println!("|   {label} | | | {:.2} | |", all / 1e6);
+        println!("|   {label} | {:.2} | | {:.2} | |", c / 1e6, all / 1e6);
     }
     Ok(())
 }
