@@ -535,13 +535,28 @@ struct CartesianQuery {
     reach: Vec3,
     base: [i32; 3],
     f: Vec3,
-    lo: [i32; 3],
-    hi: [i32; 3],
     gap_scale: Vec3,
-    counts: PoissonTable,
 }
 
 impl CartesianQuery {
+    /// The window: offsets ⌊f − reach⌋ ..= ⌊f + reach⌋ per axis (≤ 3 cells, 4 if rounding).
+    #[inline(always)]
+    fn window(&self) -> ([i32; 3], [i32; 3]) {
+        let (lo, hi) = (self.f - self.reach, self.f + self.reach);
+        (
+            [floor_i32(lo.x), floor_i32(lo.y), floor_i32(lo.z)],
+            [floor_i32(hi.x), floor_i32(hi.y), floor_i32(hi.z)],
+        )
+    }
+
+    /// Whether the window lies in the 3 × 3 × 3 block (⌊f − reach⌋ ≥ −1 and ⌊f + reach⌋ ≤ 1 per
+    /// axis, tested on the same rounded sums without converting them).
+    #[inline(always)]
+    fn in_block(&self) -> bool {
+        let (lo, hi) = (self.f - self.reach, self.f + self.reach);
+        lo.cmpge(Vec3::splat(-1.0)).all() && hi.cmplt(Vec3::splat(2.0)).all()
+    }
+
     /// Cell height in fitted kernel semi-axes along z (for upright kernels, whose local z is z).
     #[inline(always)]
     fn gap_scale_z_upright(&self) -> f32 {
@@ -655,32 +670,21 @@ impl Band {
             pc.y - base[1] as f32,
             pc.z - base[2] as f32,
         );
-        let lo = [
-            floor_i32(f.x - reach.x),
-            floor_i32(f.y - reach.y),
-            floor_i32(f.z - reach.z),
-        ];
-        let hi = [
-            floor_i32(f.x + reach.x),
-            floor_i32(f.y + reach.y),
-            floor_i32(f.z + reach.z),
-        ];
-        let counts = self.cell_counts;
         // Axis-aligned kernels: cells whose box lies outside the kernel's ellipsoid about p (semi-
         // axes s_b·Sₑ) cannot hold a contributing centre and are skipped before hashing (each
         // axis' gap to the cell bounds that axis' term of q from below). Oriented kernels: no
         // such test (scale 0) — separating-axis tests against the kernel's box culled ≈ 6 % of
         // the cells of the presets and cost more than they saved (notes/wood.md §12).
-        let gap_scale = (self.cell / (sb * self.env)) * (frame.is_none() as u32 as f32);
+        let gap_scale = match frame {
+            None => self.cell / (sb * self.env),
+            Some(_) => Vec3::ZERO,
+        };
         CartesianQuery {
             map,
             reach,
             base,
             f,
-            lo,
-            hi,
             gap_scale,
-            counts,
         }
     }
 
@@ -690,7 +694,7 @@ impl Band {
     fn cartesian<const GRAD: bool>(&self, p: Vec3, frame: Option<&Frame>) -> (f32, Vec3) {
         let q = self.cartesian_query(p, frame);
         #[cfg(target_arch = "x86_64")]
-        if q.lo.iter().all(|&l| l >= -1) && q.hi.iter().all(|&h| h <= 1) {
+        if q.in_block() {
             let upright = frame.is_some_and(is_upright);
             match cell_simd() {
                 // SAFETY: each arm runs only where `cell_simd` detected its instruction set.
@@ -705,10 +709,11 @@ impl Band {
     /// One cell at a time over the window (the reference the block search must equal).
     fn cartesian_cells<const GRAD: bool>(&self, q: &CartesianQuery) -> (f32, Vec3) {
         let (f, base) = (q.f, q.base);
+        let (lo, hi) = q.window();
         let mut acc = (0.0, Vec3::ZERO);
-        for oz in q.lo[2]..q.hi[2] + 1 {
-            for oy in q.lo[1]..q.hi[1] + 1 {
-                for ox in q.lo[0]..q.hi[0] + 1 {
+        for oz in lo[2]..hi[2] + 1 {
+            for oy in lo[1]..hi[1] + 1 {
+                for ox in lo[0]..hi[0] + 1 {
                     let o = Vec3::new(ox as f32, oy as f32, oz as f32);
                     // Distance from f to the cell [o, o + 1] per axis, in kernel semi-axes.
                     let gap = ((o + 0.5 - f).abs() - 0.5).max(Vec3::ZERO) * q.gap_scale;
@@ -721,7 +726,7 @@ impl Band {
                         base[2].wrapping_add(oz),
                         &self.offsets,
                     );
-                    for k in 0..q.counts.count(h[0]) {
+                    for k in 0..self.cell_counts.count(h[0]) {
                         let (u, w) = impulse(h, k);
                         let d = (f - o - u) * self.cell;
                         let w = if self.signed { w } else { 1.0 };
@@ -803,12 +808,12 @@ impl Band {
         let mut count = [0u32; BLOCK];
         let mut walk = 0u32;
         for i in 0..BLOCK {
-            let c = q.counts.table_count(h[0][i]);
+            let c = self.cell_counts.table_count(h[0][i]);
             count[i] = if inside[i] { c } else { 0 };
             walk |= ((count[i] >= TABLE as u32) as u32) << i;
         }
         for i in lanes(walk) {
-            count[i] = q.counts.count(h[0][i]);
+            count[i] = self.cell_counts.count(h[0][i]);
         }
         let rounds = count.iter().fold(0, |m, &c| m.max(c));
         if rounds > u32::BITS {
@@ -1277,10 +1282,7 @@ mod tests {
                 }
                 // Every instruction set this CPU has, not only the widest.
                 #[cfg(target_arch = "x86_64")]
-                if is_x86_feature_detected!("avx2")
-                    && q.lo.iter().all(|&l| l >= -1)
-                    && q.hi.iter().all(|&h| h <= 1)
-                {
+                if is_x86_feature_detected!("avx2") && q.in_block() {
                     let up = frame.is_some_and(is_upright);
                     // SAFETY: AVX2 was detected just above.
                     let avx2 = unsafe { b.cartesian_avx2::<true>(&q, up) };
