@@ -45,30 +45,36 @@ impl SmoothTriangleWave {
         self.s_down
     }
 
-    /// (w(x), w'(x)).
+    /// (w(x), w'(x)). Every segment's value is computed and the one `x` falls in is selected, so
+    /// the evaluation has no data-dependent branch (random points would mispredict them).
     #[inline]
     pub fn eval(&self, x: f32) -> (f32, f32) {
-        let [rise, top, fall, _bottom] = self.lengths;
+        let [rise, top, fall, bottom] = self.lengths;
         let [w1, w2, w3] = self.knots;
         let (a, b) = (self.s_up, -self.s_down);
-        let mut u = x.rem_euclid(self.period);
-        if u < rise {
-            return (a * u, a);
+        let u_rise = x.rem_euclid(self.period);
+        let u_top = u_rise - rise;
+        let u_fall = u_top - top;
+        let u_bottom = u_fall - fall;
+        // Over the top w' goes linearly from a to b, over the bottom back from b to a.
+        let (top_slope, bottom_slope) = ((b - a) / top, (a - b) / bottom);
+        let on_rise = (a * u_rise, a);
+        let on_top = (
+            w1 + a * u_top + 0.5 * top_slope * u_top * u_top,
+            a + top_slope * u_top,
+        );
+        let on_fall = (w2 + b * u_fall, b);
+        let on_bottom = (
+            w3 + b * u_bottom + 0.5 * bottom_slope * u_bottom * u_bottom,
+            b + bottom_slope * u_bottom,
+        );
+        let later = if u_fall < fall { on_fall } else { on_bottom };
+        let later = if u_top < top { on_top } else { later };
+        if u_rise < rise {
+            on_rise
+        } else {
+            later
         }
-        u -= rise;
-        if u < top {
-            // w' goes linearly from a to b over the top.
-            let slope = (b - a) / top;
-            return (w1 + a * u + 0.5 * slope * u * u, a + slope * u);
-        }
-        u -= top;
-        if u < fall {
-            return (w2 + b * u, b);
-        }
-        u -= fall;
-        let bottom = self.lengths[3];
-        let slope = (a - b) / bottom;
-        (w3 + b * u + 0.5 * slope * u * u, b + slope * u)
     }
 }
 
@@ -106,27 +112,65 @@ impl SmoothRectangleWave {
         }
     }
 
-    /// The wave at time `t` (period 1).
+    /// The wave at time `t` (period 1), every segment computed and the right one selected (no
+    /// data-dependent branch).
     #[inline]
     pub fn eval(&self, t: f32) -> f32 {
-        let u = t - t.floor();
+        let u = t - floor_exact(t);
         let [e0, e1, e2] = self.ends;
-        let s = if u < e0 {
-            0.0
-        } else if u < e1 {
-            smootherstep((u - e0) / self.rise)
-        } else if u < e2 {
-            1.0
-        } else {
-            1.0 - smootherstep(((u - e2) / self.fall).min(1.0))
-        };
+        let rising = smootherstep((u - e0) / self.rise);
+        let falling = 1.0 - smootherstep(((u - e2) / self.fall).min(1.0));
+        let s = if u < e2 { 1.0 } else { falling };
+        let s = if u < e1 { rising } else { s };
+        let s = if u < e0 { 0.0 } else { s };
         self.min + (self.max - self.min) * s
+    }
+}
+
+/// `t.floor()` without the libm call (baseline x86-64 has no rounding instruction): through i32
+/// below 2²³, where floats have a fraction; the sign of a zero kept.
+#[inline]
+fn floor_exact(t: f32) -> f32 {
+    if t.abs() < 8_388_608.0 {
+        let i = t as i32 as f32;
+        if i > t {
+            i - 1.0
+        } else {
+            i.copysign(t)
+        }
+    } else {
+        t
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn floor_exact_is_floor() {
+        let mut x = 1.0e-3f32;
+        while x < 3.0e7 {
+            for t in [x, -x, x + 0.5, -x - 0.5, x.round(), -x.round()] {
+                assert_eq!(floor_exact(t).to_bits(), t.floor().to_bits(), "{t}");
+            }
+            x *= 1.013;
+        }
+        for t in [
+            0.0f32,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            f32::MAX,
+            f32::MIN,
+            f32::INFINITY,
+        ] {
+            assert_eq!(floor_exact(t).to_bits(), t.floor().to_bits(), "{t}");
+        }
+        assert!(floor_exact(f32::NAN).is_nan());
+    }
 
     #[test]
     fn triangle_wave_is_periodic_c1_with_the_requested_amplitude() {
