@@ -52,7 +52,7 @@ impl SmoothTriangleWave {
         let [rise, top, fall, bottom] = self.lengths;
         let [w1, w2, w3] = self.knots;
         let (a, b) = (self.s_up, -self.s_down);
-        let u_rise = x.rem_euclid(self.period);
+        let u_rise = rem_euclid_exact(x, self.period);
         let u_top = u_rise - rise;
         let u_fall = u_top - top;
         let u_bottom = u_fall - fall;
@@ -127,6 +127,33 @@ impl SmoothRectangleWave {
     }
 }
 
+/// `x.rem_euclid(p)` for p > 0 without the libm `fmod` loop: the remainder x − n p is an f32
+/// (fmod is exact), n p is exact in f64 (24 × 24 bits) and so is their difference; n = ⌊x / p⌋
+/// from an f64 division, corrected by one where it rounded across an integer. Falls back to `%`
+/// where the quotient is not small. Same bits as `rem_euclid` (tested).
+#[inline]
+fn rem_euclid_exact(x: f32, p: f32) -> f32 {
+    let (xd, pd) = (x as f64, p as f64);
+    let n = (xd / pd).floor();
+    if !(n.abs() < 4_194_304.0) || !(p > 0.0) {
+        return x.rem_euclid(p);
+    }
+    let r = xd - n * pd;
+    let r = if r < 0.0 {
+        r + pd
+    } else if r >= pd {
+        r - pd
+    } else {
+        r
+    };
+    // A zero remainder keeps the sign of x, as fmod's does.
+    if r == 0.0 {
+        0.0f32.copysign(x)
+    } else {
+        r as f32
+    }
+}
+
 /// `t.floor()` without the libm call (baseline x86-64 has no rounding instruction): through i32
 /// below 2²³, where floats have a fraction; the sign of a zero kept.
 #[inline]
@@ -146,6 +173,24 @@ fn floor_exact(t: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn rem_euclid_exact_is_rem_euclid() {
+        let mut rng = crate::math::Pcg32::new(3, 0);
+        for i in 0..400_000 {
+            let p = [8.0f32, 6.0, 0.37, 12.5, 1.0][i % 5] * (1.0 + rng.next_f32());
+            let scale = [1.0f32, 10.0, 1e3, 1e5][(i / 5) % 4];
+            let x = (rng.next_f32() * 2.0 - 1.0) * scale;
+            for x in [x, (x / p).round() * p, x.next_up(), x.next_down()] {
+                let (fast, slow) = (rem_euclid_exact(x, p), x.rem_euclid(p));
+                assert_eq!(
+                    fast.to_bits(),
+                    slow.to_bits(),
+                    "{x} mod {p}: {fast} vs {slow}"
+                );
+            }
+        }
+    }
 
     #[test]
     fn floor_exact_is_floor() {
