@@ -366,7 +366,7 @@ fn poisson_with(h: u32, m: f64, exp_neg_m: f64) -> u32 {
 }
 
 /// Entries of [`PoissonTable`]: counts below this come from integer compares alone (a Poisson
-/// count of mean 1.2, the distortion's, reaches 8 with probability 10⁻⁵).
+/// count of mean 1.19, the distortion's, reaches 8 with probability 3.5·10⁻⁵).
 const TABLE: usize = 8;
 
 /// The inverse-CDF walk of [`poisson_with`] turned into integer thresholds on the raw hash, built
