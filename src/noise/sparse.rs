@@ -9,7 +9,6 @@
 //! the tests check) are in notes/noise.md.
 
 use super::hash::{cell3, cell3_offset, floor_i32, mix32, pcg3d, seed_offsets};
-use super::lanes::Simd;
 use crate::math::Frame;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
@@ -586,21 +585,16 @@ fn layer_shrink(oz: i32, fz: f32, cells_per_semi_axis: f32) -> f32 {
     ((1.0 - gap * gap).max(0.0).sqrt() + LAYER_SLACK).min(1.0)
 }
 
-/// The instruction set the Cartesian block search is built for: AVX-512 (F, DQ for the 64-bit
-/// multiply, VL), else AVX2, else none (one cell at a time); std caches the detection.
+/// Whether the CPU runs the Cartesian block search: AVX-512 F, DQ (the 64-bit multiply of the
+/// impulse stream) and VL; std caches the detection. With AVX2 alone the block search (64-bit
+/// multiplies emulated) measured slower than one cell at a time (notes/wood.md §12), so it is
+/// not built for it.
 #[cfg(target_arch = "x86_64")]
 #[inline]
-fn cell_simd() -> Simd {
-    if is_x86_feature_detected!("avx512f")
+fn block_search() -> bool {
+    is_x86_feature_detected!("avx512f")
         && is_x86_feature_detected!("avx512dq")
         && is_x86_feature_detected!("avx512vl")
-    {
-        Simd::Avx512
-    } else if is_x86_feature_detected!("avx2") {
-        Simd::Avx2
-    } else {
-        Simd::Sse2
-    }
 }
 
 /// The indices of the set bits of `mask`, ascending.
@@ -688,20 +682,16 @@ impl Band {
         }
     }
 
-    /// Cartesian cells: on CPUs with AVX2 or AVX-512 the 3 × 3 × 3 block of cells is searched in
+    /// Cartesian cells: on CPUs with AVX-512 the 3 × 3 × 3 block of cells is searched in
     /// SIMD lanes ([`Band::cartesian_block`]), else (and for windows wider than the block, which
     /// only rounding can make) one cell at a time. Both give the same value, bit for bit.
     fn cartesian<const GRAD: bool>(&self, p: Vec3, frame: Option<&Frame>) -> (f32, Vec3) {
         let q = self.cartesian_query(p, frame);
         #[cfg(target_arch = "x86_64")]
-        if q.in_block() {
+        if q.in_block() && block_search() {
             let upright = frame.is_some_and(is_upright);
-            match cell_simd() {
-                // SAFETY: each arm runs only where `cell_simd` detected its instruction set.
-                Simd::Avx512 => return unsafe { self.cartesian_avx512::<GRAD>(&q, upright) },
-                Simd::Avx2 => return unsafe { self.cartesian_avx2::<GRAD>(&q, upright) },
-                _ => {}
-            }
+            // SAFETY: `block_search` detected the instruction sets.
+            return unsafe { self.cartesian_avx512::<GRAD>(&q, upright) };
         }
         self.cartesian_cells::<GRAD>(&q)
     }
@@ -736,16 +726,6 @@ impl Band {
             }
         }
         acc
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn cartesian_avx2<const GRAD: bool>(
-        &self,
-        q: &CartesianQuery,
-        upright: bool,
-    ) -> (f32, Vec3) {
-        self.cartesian_block::<GRAD>(q, upright)
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -1279,14 +1259,6 @@ mod tests {
                         reference.1[k].to_bits(),
                         "∇ at {p} ({i})"
                     );
-                }
-                // Every instruction set this CPU has, not only the widest.
-                #[cfg(target_arch = "x86_64")]
-                if is_x86_feature_detected!("avx2") && q.in_block() {
-                    let up = frame.is_some_and(is_upright);
-                    // SAFETY: AVX2 was detected just above.
-                    let avx2 = unsafe { b.cartesian_avx2::<true>(&q, up) };
-                    assert_eq!(avx2.0.to_bits(), reference.0.to_bits(), "AVX2 at {p} ({i})");
                 }
                 compared += (reference.0 != 0.0) as u32;
             }
