@@ -95,8 +95,8 @@ pub use gradient::{
 };
 pub use lanes::Simd;
 pub use sparse::{
-    band_cells, Cells, Kernel, NoiseError, SparseConvolution, SparseConvolution1, Weights,
-    MAX_IMPULSES_PER_CELL,
+    band_cells, Cells, Kernel, NoiseError, SeededSparse, SparseConvolution, SparseConvolution1,
+    Weights, MAX_IMPULSES_PER_CELL,
 };
 pub use value::{value1, value1_grad, value3, value3_grad};
 pub use warp::{Warp, WarpSample};

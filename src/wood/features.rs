@@ -4,7 +4,7 @@
 
 use super::params::{NoiseParams, PoreParams, RayParams};
 use crate::math::Frame;
-use crate::noise::{gradient1_grad, Cells, Kernel, SparseConvolution, Weights};
+use crate::noise::{gradient1_grad, Cells, Kernel, SeededSparse, SparseConvolution, Weights};
 use glam::Vec3;
 
 /// Cell size in units of the kernel's (fitted) semi-axes: cells as large as the kernel's diameter
@@ -25,8 +25,7 @@ pub fn sub_seed(seed: u64, salt: u32) -> u32 {
 /// about ẑ, so the eq. 11 shrink never applies.
 #[derive(Clone, Debug)]
 pub struct DistortionNoise {
-    noise: SparseConvolution,
-    seed: u32,
+    noise: SeededSparse,
 }
 
 impl DistortionNoise {
@@ -34,19 +33,21 @@ impl DistortionNoise {
         let env = Vec3::from(p.size);
         let xy = env.x.max(env.y);
         DistortionNoise {
-            noise: SparseConvolution {
-                kernel: Kernel::Wyvill,
-                density: p.density,
-                envelope: env,
-                cell: CELL_SCALE * Vec3::new(xy, xy, env.z),
-                magnitude: p.magnitude,
-                weights: Weights::Signed,
-                cells: Cells::Cartesian,
-                bands: p.bands,
-                size_factor: p.size_factor,
-                dropoff: p.dropoff,
-            },
-            seed,
+            noise: SeededSparse::new(
+                SparseConvolution {
+                    kernel: Kernel::Wyvill,
+                    density: p.density,
+                    envelope: env,
+                    cell: CELL_SCALE * Vec3::new(xy, xy, env.z),
+                    magnitude: p.magnitude,
+                    weights: Weights::Signed,
+                    cells: Cells::Cartesian,
+                    bands: p.bands,
+                    size_factor: p.size_factor,
+                    dropoff: p.dropoff,
+                },
+                seed,
+            ),
         }
     }
 
@@ -54,22 +55,19 @@ impl DistortionNoise {
     /// the gradient is zero (enough for the lookup point f(p)).
     #[inline]
     pub fn eval<const GRAD: bool>(&self, p: Vec3, cyl: &Frame) -> (f32, Vec3) {
-        if GRAD {
-            self.noise.eval_oriented_grad(p, cyl, self.seed)
-        } else {
-            (self.noise.eval_oriented(p, cyl, self.seed), Vec3::ZERO)
-        }
+        self.eval_bands::<GRAD>(p, cyl, self.noise.noise().bands)
     }
 
     /// How many bands (from the largest) have kernels at least `footprint` mm across: band i has
     /// semi-axes βⁱ Sₑ (Liu 2016 eq. 8), so its narrowest diameter is 2 βⁱ min(Sₑ).
     #[inline]
     pub fn bands_above(&self, footprint: f32) -> u32 {
-        let mut d = 2.0 * self.noise.envelope.min_element();
+        let noise = self.noise.noise();
+        let mut d = 2.0 * noise.envelope.min_element();
         let mut n = 0;
-        while n < self.noise.bands && d >= footprint {
+        while n < noise.bands && d >= footprint {
             n += 1;
-            d *= self.noise.size_factor;
+            d *= noise.size_factor;
         }
         n
     }
@@ -78,20 +76,14 @@ impl DistortionNoise {
     /// mean is zero, signed weights); all bands give exactly `eval`.
     #[inline]
     pub fn eval_bands<const GRAD: bool>(&self, p: Vec3, cyl: &Frame, bands: u32) -> (f32, Vec3) {
-        if bands >= self.noise.bands {
-            return self.eval::<GRAD>(p, cyl);
-        }
         if bands == 0 {
             return (0.0, Vec3::ZERO);
         }
-        let noise = SparseConvolution {
-            bands,
-            ..self.noise
-        };
         if GRAD {
-            noise.eval_oriented_grad(p, cyl, self.seed)
+            self.noise.eval_oriented_grad_bands(p, cyl, bands as usize)
         } else {
-            (noise.eval_oriented(p, cyl, self.seed), Vec3::ZERO)
+            let v = self.noise.eval_oriented_bands(p, cyl, bands as usize);
+            (v, Vec3::ZERO)
         }
     }
 }
@@ -124,7 +116,7 @@ pub fn footprint_weight(size: f32, footprint: f32) -> f32 {
 /// using one minus the growth ring volume", interpolated towards uniform size).
 #[derive(Clone, Debug)]
 pub struct Pores {
-    noise: SparseConvolution,
+    noise: SeededSparse,
     sharpness: f32,
     ring_porosity: f32,
     /// Bump depth at full mask, mm (depth fraction × radius, §6.1.7).
@@ -133,7 +125,6 @@ pub struct Pores {
     pub diameter: f32,
     /// Mean mask at full pore size, min(1, density · bump_kernel_mean(s)).
     mean_full: f32,
-    seed: u32,
 }
 
 impl Pores {
@@ -143,26 +134,28 @@ impl Pores {
         let env = Vec3::new(p.radius, p.radius, 0.5 * p.length);
         let xy = (env.x * env.x + (env.z * max_tilt.sin()).powi(2)).sqrt() * 1.001;
         Pores {
-            noise: SparseConvolution {
-                kernel: Kernel::Bump {
-                    sharpness: p.sharpness,
+            noise: SeededSparse::new(
+                SparseConvolution {
+                    kernel: Kernel::Bump {
+                        sharpness: p.sharpness,
+                    },
+                    density: p.density,
+                    envelope: env,
+                    cell: CELL_SCALE * Vec3::new(xy, xy, env.z * 1.001),
+                    magnitude: 1.0,
+                    weights: Weights::Unit,
+                    cells: Cells::Cartesian,
+                    bands: 1,
+                    size_factor: 0.5,
+                    dropoff: 1.0,
                 },
-                density: p.density,
-                envelope: env,
-                cell: CELL_SCALE * Vec3::new(xy, xy, env.z * 1.001),
-                magnitude: 1.0,
-                weights: Weights::Unit,
-                cells: Cells::Cartesian,
-                bands: 1,
-                size_factor: 0.5,
-                dropoff: 1.0,
-            },
+                seed,
+            ),
             sharpness: p.sharpness.max(1e-3),
             ring_porosity: p.ring_porosity,
             depth: p.depth * p.radius,
             diameter: 2.0 * p.radius,
             mean_full: (p.density * bump_kernel_mean(p.sharpness)).min(1.0),
-            seed,
         }
     }
 
@@ -188,9 +181,9 @@ impl Pores {
             return (0.0, Vec3::ZERO);
         }
         let (v, grad) = if GRAD {
-            self.noise.eval_oriented_grad(q, fiber, self.seed)
+            self.noise.eval_oriented_grad_bands(q, fiber, 1)
         } else {
-            (self.noise.eval_oriented(q, fiber, self.seed), Vec3::ZERO)
+            (self.noise.eval_oriented_bands(q, fiber, 1), Vec3::ZERO)
         };
         resize_bump(v, grad, size, self.sharpness)
     }
@@ -228,46 +221,47 @@ pub fn resize_bump(v: f32, grad: Vec3, size: f32, s: f32) -> (f32, Vec3) {
 /// tall in z and long in r, aligned with (r̂, θ̂, ẑ).
 #[derive(Clone, Debug)]
 pub struct Rays {
-    noise: SparseConvolution,
+    noise: SeededSparse,
     strength: f32,
     /// Ray width (its narrowest extent), mm.
     pub width: f32,
     /// Mean of [`Rays::mask`]: strength · min(1, density · bump_kernel_mean(s)).
     pub mean_mask: f32,
-    seed: u32,
 }
 
 impl Rays {
     pub fn new(p: &RayParams, seed: u32) -> Self {
         let env = Vec3::new(0.5 * p.length, 0.5 * p.width, 0.5 * p.height);
         Rays {
-            noise: SparseConvolution {
-                kernel: Kernel::Bump {
-                    sharpness: p.sharpness,
+            noise: SeededSparse::new(
+                SparseConvolution {
+                    kernel: Kernel::Bump {
+                        sharpness: p.sharpness,
+                    },
+                    density: p.density,
+                    envelope: env,
+                    // Arc cells wider than the ray: the search window along θ is set by the longest
+                    // semi-axis anyway (notes/noise.md), so thin cells would only add cells.
+                    cell: Vec3::new(env.x, RAY_ARC_CELLS * env.y, env.z),
+                    magnitude: 1.0,
+                    weights: Weights::Unit,
+                    cells: Cells::Cylindrical,
+                    bands: 1,
+                    size_factor: 0.5,
+                    dropoff: 1.0,
                 },
-                density: p.density,
-                envelope: env,
-                // Arc cells wider than the ray: the search window along θ is set by the longest
-                // semi-axis anyway (notes/noise.md), so thin cells would only add cells.
-                cell: Vec3::new(env.x, RAY_ARC_CELLS * env.y, env.z),
-                magnitude: 1.0,
-                weights: Weights::Unit,
-                cells: Cells::Cylindrical,
-                bands: 1,
-                size_factor: 0.5,
-                dropoff: 1.0,
-            },
+                seed,
+            ),
             strength: p.strength,
             width: p.width,
             mean_mask: p.strength * (p.density * bump_kernel_mean(p.sharpness)).min(1.0),
-            seed,
         }
     }
 
     /// Ray mask in [0, strength] at `q`.
     #[inline]
     pub fn mask(&self, q: Vec3) -> f32 {
-        self.noise.eval(q, self.seed).min(1.0) * self.strength
+        self.noise.eval(q).min(1.0) * self.strength
     }
 }
 

@@ -45,30 +45,36 @@ impl SmoothTriangleWave {
         self.s_down
     }
 
-    /// (w(x), w'(x)).
+    /// (w(x), w'(x)). Every segment's value is computed and the one `x` falls in is selected, so
+    /// the evaluation has no data-dependent branch (random points would mispredict them).
     #[inline]
     pub fn eval(&self, x: f32) -> (f32, f32) {
-        let [rise, top, fall, _bottom] = self.lengths;
+        let [rise, top, fall, bottom] = self.lengths;
         let [w1, w2, w3] = self.knots;
         let (a, b) = (self.s_up, -self.s_down);
-        let mut u = x.rem_euclid(self.period);
-        if u < rise {
-            return (a * u, a);
+        let u_rise = rem_euclid_exact(x, self.period);
+        let u_top = u_rise - rise;
+        let u_fall = u_top - top;
+        let u_bottom = u_fall - fall;
+        // Over the top w' goes linearly from a to b, over the bottom back from b to a.
+        let (top_slope, bottom_slope) = ((b - a) / top, (a - b) / bottom);
+        let on_rise = (a * u_rise, a);
+        let on_top = (
+            w1 + a * u_top + 0.5 * top_slope * u_top * u_top,
+            a + top_slope * u_top,
+        );
+        let on_fall = (w2 + b * u_fall, b);
+        let on_bottom = (
+            w3 + b * u_bottom + 0.5 * bottom_slope * u_bottom * u_bottom,
+            b + bottom_slope * u_bottom,
+        );
+        let later = if u_fall < fall { on_fall } else { on_bottom };
+        let later = if u_top < top { on_top } else { later };
+        if u_rise < rise {
+            on_rise
+        } else {
+            later
         }
-        u -= rise;
-        if u < top {
-            // w' goes linearly from a to b over the top.
-            let slope = (b - a) / top;
-            return (w1 + a * u + 0.5 * slope * u * u, a + slope * u);
-        }
-        u -= top;
-        if u < fall {
-            return (w2 + b * u, b);
-        }
-        u -= fall;
-        let bottom = self.lengths[3];
-        let slope = (a - b) / bottom;
-        (w3 + b * u + 0.5 * slope * u * u, b + slope * u)
     }
 }
 
@@ -106,27 +112,110 @@ impl SmoothRectangleWave {
         }
     }
 
-    /// The wave at time `t` (period 1).
+    /// The wave at time `t` (period 1), every segment computed and the right one selected (no
+    /// data-dependent branch).
     #[inline]
     pub fn eval(&self, t: f32) -> f32 {
-        let u = t - t.floor();
+        let u = t - floor_exact(t);
         let [e0, e1, e2] = self.ends;
-        let s = if u < e0 {
-            0.0
-        } else if u < e1 {
-            smootherstep((u - e0) / self.rise)
-        } else if u < e2 {
-            1.0
-        } else {
-            1.0 - smootherstep(((u - e2) / self.fall).min(1.0))
-        };
+        let rising = smootherstep((u - e0) / self.rise);
+        let falling = 1.0 - smootherstep(((u - e2) / self.fall).min(1.0));
+        let s = if u < e2 { 1.0 } else { falling };
+        let s = if u < e1 { rising } else { s };
+        let s = if u < e0 { 0.0 } else { s };
         self.min + (self.max - self.min) * s
+    }
+}
+
+/// `x.rem_euclid(p)` for p > 0 without the libm `fmod` loop: the remainder x − n p is an f32
+/// (fmod is exact), n p is exact in f64 (24 × 24 bits) and so is their difference; n = ⌊x / p⌋
+/// from an f64 division, corrected by one where it rounded across an integer. Falls back to `%`
+/// where the quotient is not small. Same bits as `rem_euclid` (tested).
+#[inline]
+fn rem_euclid_exact(x: f32, p: f32) -> f32 {
+    let (xd, pd) = (x as f64, p as f64);
+    let n = (xd / pd).floor();
+    if !(n.abs() < 4_194_304.0) || !(p > 0.0) {
+        return x.rem_euclid(p);
+    }
+    let r = xd - n * pd;
+    let r = if r < 0.0 {
+        r + pd
+    } else if r >= pd {
+        r - pd
+    } else {
+        r
+    };
+    // A zero remainder keeps the sign of x, as fmod's does.
+    if r == 0.0 {
+        0.0f32.copysign(x)
+    } else {
+        r as f32
+    }
+}
+
+/// `t.floor()` without the libm call (baseline x86-64 has no rounding instruction): through i32
+/// below 2²³, where floats have a fraction; the sign of a zero kept.
+#[inline]
+fn floor_exact(t: f32) -> f32 {
+    if t.abs() < 8_388_608.0 {
+        let i = t as i32 as f32;
+        if i > t {
+            i - 1.0
+        } else {
+            i.copysign(t)
+        }
+    } else {
+        t
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn rem_euclid_exact_is_rem_euclid() {
+        let mut rng = crate::math::Pcg32::new(3, 0);
+        for i in 0..400_000 {
+            let p = [8.0f32, 6.0, 0.37, 12.5, 1.0][i % 5] * (1.0 + rng.next_f32());
+            let scale = [1.0f32, 10.0, 1e3, 1e5][(i / 5) % 4];
+            let x = (rng.next_f32() * 2.0 - 1.0) * scale;
+            for x in [x, (x / p).round() * p, x.next_up(), x.next_down()] {
+                let (fast, slow) = (rem_euclid_exact(x, p), x.rem_euclid(p));
+                assert_eq!(
+                    fast.to_bits(),
+                    slow.to_bits(),
+                    "{x} mod {p}: {fast} vs {slow}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn floor_exact_is_floor() {
+        let mut x = 1.0e-3f32;
+        while x < 3.0e7 {
+            for t in [x, -x, x + 0.5, -x - 0.5, x.round(), -x.round()] {
+                assert_eq!(floor_exact(t).to_bits(), t.floor().to_bits(), "{t}");
+            }
+            x *= 1.013;
+        }
+        for t in [
+            0.0f32,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            f32::MAX,
+            f32::MIN,
+            f32::INFINITY,
+        ] {
+            assert_eq!(floor_exact(t).to_bits(), t.floor().to_bits(), "{t}");
+        }
+        assert!(floor_exact(f32::NAN).is_nan());
+    }
 
     #[test]
     fn triangle_wave_is_periodic_c1_with_the_requested_amplitude() {

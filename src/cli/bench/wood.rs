@@ -14,13 +14,16 @@ pub struct Args {
     /// Only these presets (default: all).
     #[arg(long)]
     only: Vec<String>,
-    /// Also time each preset with one feature switched off at a time (full model).
+    /// Also time each preset with one feature switched off at a time (colour and full model).
     #[arg(long)]
     breakdown: bool,
     /// Run exactly this many passes per level of `needs` instead of timing (a fixed workload for
     /// instruction counts: `valgrind --tool=callgrind xylem bench wood --passes 1 ...`).
     #[arg(long)]
     passes: Option<usize>,
+    /// With `--passes`: only this level of `needs` (colour, fibres or all; default: the three).
+    #[arg(long)]
+    needs: Option<String>,
 }
 
 /// CPU time of the calling thread in seconds (Linux: /proc/thread-self/stat, clock ticks of
@@ -101,28 +104,41 @@ fn fixed_passes(args: &Args, points: &[Vec3], passes: usize) -> anyhow::Result<E
     let names = selected(&args.only);
     for name in names {
         let volume = WoodVolume::new(wood::preset(name)?, 1)?;
-        for (label, needs) in [
-            ("colour", Needs::COLOR),
-            ("colour + fibres", Needs::COLOR_FIBERS),
-            ("everything", Needs::ALL),
-        ] {
+        let levels = [
+            ("colour", "colour", Needs::COLOR),
+            ("fibres", "colour + fibres", Needs::COLOR_FIBERS),
+            ("all", "everything", Needs::ALL),
+        ];
+        if let Some(bad) = args
+            .needs
+            .as_deref()
+            .filter(|n| !levels.iter().any(|l| l.0 == *n))
+        {
+            anyhow::bail!("--needs {bad}: expected colour, fibres or all");
+        }
+        let wanted = |key: &str| args.needs.as_deref().is_none_or(|n| n == key);
+        for (_, label, needs) in levels.into_iter().filter(|l| wanted(l.0)) {
             let mut sink = 0.0f32;
+            let mut bits = Fingerprint::default();
             for _ in 0..passes {
                 for &p in points {
                     let t = volume.eval(p, needs);
                     sink += t.diffuse.x + t.fiber_dir.z + t.bump;
+                    bits.add_texel(&t);
                 }
             }
             println!(
-                "{name} {label}: {} texels, checksum {sink:.6e}",
-                passes * points.len()
+                "{name} {label}: {} texels, checksum {sink:.6e}, bits {:016x}",
+                passes * points.len(),
+                bits.0
             );
         }
     }
     Ok(ExitCode::SUCCESS)
 }
 
-/// Full-model speed with each feature switched off in turn: the saving is that feature's cost.
+/// Colour-only and full-model speed with each feature switched off in turn: the saving is that
+/// feature's cost.
 fn breakdown(params: &wood::WoodParams, points: &[Vec3]) -> anyhow::Result<()> {
     let variants: [(&str, fn(&mut wood::WoodParams)); 7] = [
         ("no growth noise", |p| p.growth = None),
@@ -147,8 +163,48 @@ fn breakdown(params: &wood::WoodParams, points: &[Vec3]) -> anyhow::Result<()> {
         let mut p = params.clone();
         edit(&mut p);
         let v = WoodVolume::new(p, 1)?;
+        let c = texels_per_second(&v, points, Needs::COLOR);
         let all = texels_per_second(&v, points, Needs::ALL);
-        println!("|   {label} | | | {:.2} | |", all / 1e6);
+        println!("|   {label} | {:.2} | | {:.2} | |", c / 1e6, all / 1e6);
     }
     Ok(())
+}
+
+/// FNV-1a over the bits of every field of every texel: equal only if the outputs are bit for bit
+/// equal (the check that a speed change left the model alone).
+#[derive(Debug)]
+struct Fingerprint(u64);
+
+impl Default for Fingerprint {
+    fn default() -> Self {
+        Fingerprint(0xcbf2_9ce4_8422_2325)
+    }
+}
+
+impl Fingerprint {
+    fn add(&mut self, x: f32) {
+        for byte in x.to_bits().to_le_bytes() {
+            self.0 = (self.0 ^ byte as u64).wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+
+    fn add_texel(&mut self, t: &wood::WoodTexel) {
+        for v in [
+            t.diffuse,
+            t.fiber_color,
+            t.fiber_dir,
+            t.ray_dir,
+            t.bump_grad,
+        ] {
+            v.to_array().into_iter().for_each(|x| self.add(x));
+        }
+        let scalars = [
+            t.ray_mask,
+            t.pore_mask,
+            t.bump,
+            t.highlight_width,
+            t.growth_time,
+        ];
+        scalars.into_iter().for_each(|x| self.add(x));
+    }
 }
