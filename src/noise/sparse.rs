@@ -225,7 +225,7 @@ impl SparseConvolution {
 
     fn sum<const GRAD: bool>(&self, p: Vec3, frame: Option<&Frame>, seed: u32) -> (f32, Vec3) {
         let bands = (0..self.bands.max(1)).map(|index| self.band(index, seed));
-        sum_bands::<GRAD, _>(bands, self.cells, p, frame)
+        sum_bands::<GRAD, _>(bands, self.cells, p, frame, 1.0)
     }
 
     /// Band `index` for `seed`: magnitude α β^(γ i) and the band with every length scaled by βⁱ
@@ -265,14 +265,15 @@ fn sum_bands<const GRAD: bool, B: std::borrow::Borrow<(f32, Band)>>(
     cells: Cells,
     p: Vec3,
     frame: Option<&Frame>,
+    kernel_scale: f32,
 ) -> (f32, Vec3) {
     let mut value = 0.0;
     let mut gradient = Vec3::ZERO;
     for b in bands {
         let (amp, band) = b.borrow();
         let (v, g) = match cells {
-            Cells::Cartesian => band.cartesian::<GRAD>(p, frame),
-            Cells::Cylindrical => band.cylindrical::<GRAD>(p, frame),
+            Cells::Cartesian => band.cartesian::<GRAD>(p, frame, kernel_scale),
+            Cells::Cylindrical => band.cylindrical::<GRAD>(p, frame, kernel_scale),
         };
         value += amp * v;
         if GRAD {
@@ -323,10 +324,26 @@ impl SeededSparse {
         self.sum::<true>(p, Some(frame), bands)
     }
 
+    /// [`SeededSparse::eval_oriented_grad_bands`] over all bands with every kernel shrunk about
+    /// its own centre by `kernel_scale` ∈ (0, 1] (the same impulses, smaller kernels: K(M(p − k)
+    /// / kernel_scale)), for features whose size varies with the point, such as ring-porous pores
+    /// (Liu et al. 2016 §6.1.6). A scale of 1 gives exactly the unscaled noise.
+    #[inline]
+    pub fn eval_oriented_scaled<const GRAD: bool>(
+        &self,
+        p: Vec3,
+        frame: &Frame,
+        kernel_scale: f32,
+    ) -> (f32, Vec3) {
+        let bands = self.bands.iter();
+        let scale = kernel_scale.clamp(f32::MIN_POSITIVE, 1.0);
+        sum_bands::<GRAD, _>(bands, self.noise.cells, p, Some(frame), scale)
+    }
+
     #[inline]
     fn sum<const GRAD: bool>(&self, p: Vec3, frame: Option<&Frame>, bands: usize) -> (f32, Vec3) {
         let bands = self.bands[..bands.min(self.bands.len())].iter();
-        sum_bands::<GRAD, _>(bands, self.noise.cells, p, frame)
+        sum_bands::<GRAD, _>(bands, self.noise.cells, p, frame, 1.0)
     }
 }
 
@@ -642,11 +659,12 @@ impl Band {
 
     /// The query setup shared by both Cartesian paths: the fit, the kernel map and the window.
     #[inline(always)]
-    fn cartesian_query(&self, p: Vec3, frame: Option<&Frame>) -> CartesianQuery {
+    fn cartesian_query(&self, p: Vec3, frame: Option<&Frame>, kernel_scale: f32) -> CartesianQuery {
         // Kernel extent per axis before the fit (eq. 9), then the fit (eq. 11) against the cell.
+        let env = self.env * kernel_scale;
         let (ext, axes) = match frame {
-            None => (self.env, None),
-            Some(f) => (bbox_half_extent(self.env, f), Some(*f)),
+            None => (env, None),
+            Some(f) => (bbox_half_extent(env, f), Some(*f)),
         };
         let sb = (self.cell.x / ext.x)
             .min(self.cell.y / ext.y)
@@ -654,7 +672,7 @@ impl Band {
             .min(1.0);
         let map = KernelMap {
             axes,
-            inv: 1.0 / (sb * self.env),
+            inv: 1.0 / (sb * env),
         };
         let reach = sb * ext / self.cell; // ≤ 1 cell per axis
         let pc = p / self.cell;
@@ -670,7 +688,7 @@ impl Band {
         // such test (scale 0) — separating-axis tests against the kernel's box culled ≈ 6 % of
         // the cells of the presets and cost more than they saved (notes/wood.md §12).
         let gap_scale = match frame {
-            None => self.cell / (sb * self.env),
+            None => self.cell / (sb * env),
             Some(_) => Vec3::ZERO,
         };
         CartesianQuery {
@@ -685,8 +703,13 @@ impl Band {
     /// Cartesian cells: on CPUs with AVX-512 the 3 × 3 × 3 block of cells is searched in
     /// SIMD lanes ([`Band::cartesian_block`]), else (and for windows wider than the block, which
     /// only rounding can make) one cell at a time. Both give the same value, bit for bit.
-    fn cartesian<const GRAD: bool>(&self, p: Vec3, frame: Option<&Frame>) -> (f32, Vec3) {
-        let q = self.cartesian_query(p, frame);
+    fn cartesian<const GRAD: bool>(
+        &self,
+        p: Vec3,
+        frame: Option<&Frame>,
+        kernel_scale: f32,
+    ) -> (f32, Vec3) {
+        let q = self.cartesian_query(p, frame, kernel_scale);
         #[cfg(target_arch = "x86_64")]
         if q.in_block() && block_search() {
             let upright = frame.is_some_and(is_upright);
@@ -841,7 +864,13 @@ impl Band {
         acc
     }
 
-    fn cylindrical<const GRAD: bool>(&self, p: Vec3, frame: Option<&Frame>) -> (f32, Vec3) {
+    fn cylindrical<const GRAD: bool>(
+        &self,
+        p: Vec3,
+        frame: Option<&Frame>,
+        kernel_scale: f32,
+    ) -> (f32, Vec3) {
+        let env = self.env * kernel_scale;
         let r = (p.x * p.x + p.y * p.y).sqrt();
         let radial = if r > 0.0 {
             Vec3::new(p.x / r, p.y / r, 0.0)
@@ -860,19 +889,19 @@ impl Band {
             t: cyl.to_local(kf.t),
             n: cyl.to_local(kf.n),
         };
-        let ext = bbox_half_extent(self.env, &rel);
+        let ext = bbox_half_extent(env, &rel);
         let sb = (self.cell.x / ext.x)
             .min(self.cell.y / ext.y)
             .min(self.cell.z / ext.z)
             .min(1.0);
         let map = KernelMap {
             axes: Some(kf),
-            inv: 1.0 / (sb * self.env),
+            inv: 1.0 / (sb * env),
         };
         // Search window (notes/noise.md): a kernel reaching p has its centre within ρ = s_b·max(Sₑ)
         // of p, so in bands overlapping [r − ρ, r + ρ], at angles within asin(ρ / r) of θ(p), and
         // within s_b·ext_z of p along z.
-        let rho = sb * self.env.max_element();
+        let rho = sb * env.max_element();
         let reach_z = sb * ext.z / self.cell.z;
         let theta = p.y.atan2(p.x).rem_euclid(2.0 * PI);
         // A kernel at k reaching p has |(p − k)·θ̂| = r_k |sin Δθ| ≤ s_b·ext_y and
@@ -1167,7 +1196,7 @@ mod tests {
             let b = band(Vec3::new(0.2, 0.2, 1.6), Vec3::new(0.4, 0.4, 1.2), i);
             let p = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 20.0 - 10.0;
             let f = Frame::from_normal(uniform_sphere(rng.next_vec2()));
-            let fast = b.cartesian::<false>(p, Some(&f)).0;
+            let fast = b.cartesian::<false>(p, Some(&f), 1.0).0;
             let slow = b.brute(p, &f, false, 3);
             assert!(
                 (fast - slow).abs() <= 1e-5 * (1.0 + slow.abs()),
@@ -1183,7 +1212,7 @@ mod tests {
         for i in 0..300 {
             let b = band(Vec3::new(0.35, 0.2, 1.0), Vec3::new(0.4, 0.4, 1.2), i);
             let p = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 20.0 - 10.0;
-            let fast = b.cartesian::<false>(p, None).0;
+            let fast = b.cartesian::<false>(p, None, 1.0).0;
             let slow = b.brute(p, &identity, false, 3);
             assert!(
                 (fast - slow).abs() <= 1e-5 * (1.0 + slow.abs()),
@@ -1199,7 +1228,7 @@ mod tests {
             // Mostly along the pith (as wood features are), some far off it.
             let n = Vec3::Z + 0.7 * uniform_sphere(rng.next_vec2());
             let f = Frame::from_normal(n.normalize());
-            let fast = b.cylindrical::<false>(p, Some(&f)).0;
+            let fast = b.cylindrical::<false>(p, Some(&f), 1.0).0;
             let slow = b.brute(p, &f, true, 3);
             nonzero += (slow != 0.0) as i32;
             assert!(
@@ -1242,11 +1271,11 @@ mod tests {
             };
             let tilted = Frame::from_normal(uniform_sphere(rng.next_vec2()));
             for frame in [None, Some(&upright), Some(&tilted)] {
-                let q = b.cartesian_query(p, frame);
+                let q = b.cartesian_query(p, frame, 1.0);
                 let reference = b.cartesian_cells::<true>(&q);
                 let value = b.cartesian_cells::<false>(&q).0;
-                let fast = b.cartesian::<true>(p, frame);
-                let fast_value = b.cartesian::<false>(p, frame).0;
+                let fast = b.cartesian::<true>(p, frame, 1.0);
+                let fast_value = b.cartesian::<false>(p, frame, 1.0).0;
                 assert_eq!(
                     fast.0.to_bits(),
                     reference.0.to_bits(),

@@ -117,7 +117,6 @@ pub fn footprint_weight(size: f32, footprint: f32) -> f32 {
 #[derive(Clone, Debug)]
 pub struct Pores {
     noise: SeededSparse,
-    sharpness: f32,
     ring_porosity: f32,
     /// Bump depth at full mask, mm (depth fraction × radius, §6.1.7).
     pub depth: f32,
@@ -151,7 +150,6 @@ impl Pores {
                 },
                 seed,
             ),
-            sharpness: p.sharpness.max(1e-3),
             ring_porosity: p.ring_porosity,
             depth: p.depth * p.radius,
             diameter: 2.0 * p.radius,
@@ -159,9 +157,10 @@ impl Pores {
         }
     }
 
-    /// The mean of [`Pores::mask`] at growth-ring value `g`: every pore scaled by
-    /// size = 1 − porosity · g in all three axes keeps its count, so the covered fraction scales
-    /// by size³ (exact where pores do not overlap, like `resize_bump`).
+    /// The mean of [`Pores::mask`] at growth-ring value `g`: every pore shrunk by
+    /// size = 1 − porosity · g in all three axes about its own centre keeps its count, so by
+    /// Campbell's theorem the mean of the (unclamped) kernel sum scales by size³ (notes/noise.md);
+    /// the clamp at 1 only matters where pores overlap.
     #[inline]
     pub fn mean_mask(&self, g: f32) -> f32 {
         let size = 1.0 - self.ring_porosity * g;
@@ -173,48 +172,27 @@ impl Pores {
     }
 
     /// Pore mask in [0, 1] and its gradient at `q` for growth-ring value `g`, kernels along `fiber`
-    /// (s, t across the fibre, n along it).
+    /// (s, t across the fibre, n along it). Ring porosity (Liu et al. 2016 §6.1.6) shrinks every
+    /// pore kernel about its centre by size = 1 − porosity · g: the same vessels, narrower in the
+    /// latewood, vanishing where size reaches 0. Overlapping kernels saturate at a full mask.
+    /// The gradient holds the frame and the size fixed (eq. 14).
     #[inline]
     pub fn mask<const GRAD: bool>(&self, q: Vec3, fiber: &Frame, g: f32) -> (f32, Vec3) {
         let size = 1.0 - self.ring_porosity * g;
         if size <= 1e-3 {
             return (0.0, Vec3::ZERO);
         }
-        let (v, grad) = if GRAD {
-            self.noise.eval_oriented_grad_bands(q, fiber, 1)
+        let (v, grad) = self
+            .noise
+            .eval_oriented_scaled::<GRAD>(q, fiber, size.min(1.0));
+        if v <= 1e-12 {
+            (0.0, Vec3::ZERO)
+        } else if v >= 1.0 {
+            (1.0, Vec3::ZERO)
         } else {
-            (self.noise.eval_oriented_bands(q, fiber, 1), Vec3::ZERO)
-        };
-        resize_bump(v, grad, size, self.sharpness)
+            (v, grad)
+        }
     }
-}
-
-/// Re-size a bump-kernel value: for one kernel v = K(q) = exp(−s q/(1−q)) at q = r² (Liu 2016
-/// eq. 6), the same kernel scaled by `size` has value K(q / size²). Inverting K,
-/// q = L / (s + L) with L = −ln v. Exact where pores do not overlap (low density); overlapping
-/// kernels are clamped to a full mask first. Returns the new value and the chain-ruled gradient.
-#[inline]
-pub fn resize_bump(v: f32, grad: Vec3, size: f32, s: f32) -> (f32, Vec3) {
-    if v <= 1e-12 {
-        return (0.0, Vec3::ZERO);
-    }
-    if v >= 1.0 {
-        return (1.0, Vec3::ZERO);
-    }
-    if size >= 0.999 {
-        return (v, grad);
-    }
-    let l = -v.ln();
-    let q = l / (s + l);
-    let q2 = q / (size * size);
-    if q2 >= 1.0 {
-        return (0.0, Vec3::ZERO);
-    }
-    let a = 1.0 - q2;
-    let v2 = (-s * q2 / a).exp();
-    // dv2/dv = v2 · s² / (a² size² (s + L)² v)
-    let d = v2 * s * s / (a * a * size * size * (s + l) * (s + l) * v);
-    (v2, grad * d)
 }
 
 /// Rays: bump-kernel noise with unit weights on cylindrical cells (§4.2), kernels thin in θ,
@@ -286,24 +264,74 @@ impl Noise1 {
 mod tests {
     use super::*;
 
+    /// Red oak's pores (ring porosity 1, overlapping bump kernels) at random points.
+    fn ring_porous() -> (Pores, Vec<Vec3>) {
+        let params = crate::wood::preset("red_oak").unwrap();
+        let mut pores = params.pores.clone().expect("red oak has pores");
+        pores.ring_porosity = 1.0;
+        let mut r = crate::math::Pcg32::new(5, 0);
+        let pts = (0..200_000)
+            .map(|_| {
+                Vec3::new(r.next_f32(), r.next_f32(), r.next_f32()) * Vec3::new(6.0, 6.0, 20.0)
+            })
+            .collect();
+        (Pores::new(&pores, 0.0, 9), pts)
+    }
+
+    const UPRIGHT: Frame = Frame {
+        s: Vec3::X,
+        t: Vec3::Y,
+        n: Vec3::Z,
+    };
+
+    /// Shrunk pores cover size³ of what full pores cover (Campbell's theorem on the kernels
+    /// shrunk about their centres; at size 0.25 overlaps are rare, so the clamp hardly acts),
+    /// and only where a full-size pore was.
     #[test]
-    fn resize_bump_matches_a_scaled_kernel() {
-        let s = 1.3;
-        let k = |q: f32| {
-            if q < 1.0 {
-                (-s * q / (1.0 - q)).exp()
-            } else {
-                0.0
-            }
-        };
-        for r in [0.0, 0.2, 0.5, 0.7, 0.9] {
-            for size in [0.3, 0.6, 0.95] {
-                let (v, _) = resize_bump(k(r * r), Vec3::ZERO, size, s);
-                let expect = k((r / size) * (r / size));
+    fn ring_porous_pores_shrink_about_their_centres() {
+        let (pores, pts) = ring_porous();
+        let size = 0.25;
+        let g = 1.0 - size;
+        let (mut full, mut shrunk) = (0.0f64, 0.0f64);
+        for &p in &pts {
+            let m1 = pores.mask::<false>(p, &UPRIGHT, 0.0).0;
+            let ms = pores.mask::<false>(p, &UPRIGHT, g).0;
+            assert!(
+                ms <= 0.0 || m1 > 0.0,
+                "a pore appeared at {p} when shrinking"
+            );
+            full += m1 as f64;
+            shrunk += ms as f64;
+        }
+        let n = pts.len() as f64;
+        let expect = pores.mean_mask(g) as f64;
+        let got = shrunk / n;
+        assert!(full / n > 0.05, "full-size pores cover {}", full / n);
+        assert!(
+            (got - expect).abs() < 0.15 * expect,
+            "mean mask at size {size}: {got}, expected {expect}"
+        );
+    }
+
+    /// The mask changes continuously as the pores shrink to nothing (no region that stays full
+    /// and then vanishes at once).
+    #[test]
+    fn ring_porous_mask_is_continuous_in_size() {
+        let (pores, pts) = ring_porous();
+        for &p in pts
+            .iter()
+            .filter(|&&p| pores.mask::<false>(p, &UPRIGHT, 0.0).0 > 0.5)
+            .take(300)
+        {
+            let mut last = pores.mask::<false>(p, &UPRIGHT, 0.0).0;
+            for k in 1..=2000 {
+                let g = k as f32 * 5e-4;
+                let m = pores.mask::<false>(p, &UPRIGHT, g).0;
                 assert!(
-                    (v - expect).abs() < 1e-4,
-                    "r {r} size {size}: {v} vs {expect}"
+                    (m - last).abs() < 0.2,
+                    "at {p}: mask {last} → {m} at g = {g}"
                 );
+                last = m;
             }
         }
     }
