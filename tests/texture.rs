@@ -114,7 +114,7 @@ fn ring_wood_depends_on_radius_only_without_wobble_and_tilt() {
     let mut r = Pcg32::new(2, 0);
     for _ in 0..1000 {
         let radius = 60.0 * r.next_f32();
-        let (a, z) = (6.283 * r.next_f32(), 100.0 * r.next_f32());
+        let (a, z) = (std::f32::consts::TAU * r.next_f32(), 100.0 * r.next_f32());
         let p = Vec3::new(radius * a.cos(), radius * a.sin(), z);
         let c = t.eval(p);
         assert!((c - t.eval(Vec3::new(radius, 0.0, 0.0))).length() < 1e-4);
