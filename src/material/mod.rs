@@ -298,23 +298,21 @@ impl WoodMaterial {
     /// placement space is the object's, or the world's for `world_space` placements.
     pub fn shade(&self, hit: &MaterialHit) -> Shading {
         let place = &hit.placement;
-        // Placement space → world: directions by `to_world_dir`, gradients by `to_world_grad`;
-        // `unit` is world mm per placement unit (|det|^⅓ of the instance map).
-        let (p, n, to_world_dir, to_world_grad, unit) = if place.world_space {
-            (hit.p_world, hit.ng, Mat3::IDENTITY, Mat3::IDENTITY, 1.0)
+        // Placement space → world: directions by `to_world_dir`, gradients by `to_world_grad`.
+        let (p, n, to_world_dir, to_world_grad) = if place.world_space {
+            (hit.p_world, hit.ng, Mat3::IDENTITY, Mat3::IDENTITY)
         } else {
-            let unit = hit.object_to_world.determinant().abs().cbrt().max(1e-12);
             (
                 hit.p_object,
                 hit.n_object,
                 hit.object_to_world,
                 hit.normal_to_world,
-                unit,
             )
         };
         let (p_tree, j) = place.to_tree(p, n);
         let texel = if self.switches.footprint_filter && hit.footprint > 0.0 {
-            // World mm → placement units → tree mm.
+            // World mm → placement units (|det|^⅓ of the placement → world map) → tree mm.
+            let unit = to_world_dir.determinant().abs().cbrt().max(1e-12);
             let footprint = hit.footprint / unit * place.scale;
             self.volume.eval_filtered(p_tree, self.needs(), footprint)
         } else {
