@@ -41,17 +41,18 @@ fn uniform(r: &mut Pcg32, lo: f32, hi: f32) -> f32 {
     lo + (hi - lo) * r.next_f32()
 }
 
+/// A uniform point of the square [−half, half]² in the plane z = 0.
+fn plane_point(r: &mut Pcg32, half: f32) -> Vec3 {
+    Vec3::new(uniform(r, -half, half), uniform(r, -half, half), 0.0)
+}
+
 /// Mean |fibre · axis| of the shaded fibre AOV over random points of the plane z = 0.
 fn mean_alignment(m: &WoodMaterial, placement: Placement, axis: Vec3) -> f32 {
     let mut r = Pcg32::new(11, 0);
     let n = 400;
     let mut sum = 0.0;
     for _ in 0..n {
-        let p = Vec3::new(
-            uniform(&mut r, -900.0, 900.0),
-            uniform(&mut r, -900.0, 900.0),
-            0.0,
-        );
+        let p = plane_point(&mut r, 900.0);
         let s = m.shade(&hit(p, Vec3::Z, Mat3::IDENTITY, placement));
         assert!(s.aov.fiber.is_finite() && (s.aov.fiber.length() - 1.0).abs() < 1e-3);
         sum += s.aov.fiber.dot(axis).abs();
@@ -109,11 +110,7 @@ fn parquet_strips_alternate_direction() {
     let mut r = Pcg32::new(2, 0);
     let (mut along_x, mut along_y) = (0, 0);
     for _ in 0..400 {
-        let p = Vec3::new(
-            uniform(&mut r, -900.0, 900.0),
-            uniform(&mut r, -900.0, 900.0),
-            0.0,
-        );
+        let p = plane_point(&mut r, 900.0);
         let f = m.shade(&hit(p, Vec3::Z, Mat3::IDENTITY, parquet)).aov.fiber;
         assert!(f.z.abs() < 0.5, "fibre leaves the floor: {f}");
         if f.x.abs() > 0.9 {
@@ -143,11 +140,7 @@ fn veneer_faces_show_fibres_in_their_plane() {
     for n in [Vec3::X, Vec3::NEG_Y, Vec3::Z] {
         let mut sum = 0.0;
         for _ in 0..100 {
-            let t = Vec3::new(
-                uniform(&mut r, -50.0, 50.0),
-                uniform(&mut r, -50.0, 50.0),
-                0.0,
-            );
+            let t = plane_point(&mut r, 50.0);
             let p = Mat3::from_cols(
                 n.any_orthonormal_vector(),
                 n.cross(n.any_orthonormal_vector()),
@@ -239,11 +232,7 @@ fn bump_tilts_the_normal_against_the_height_gradient() {
     let mut r = Pcg32::new(8, 0);
     let (mut checked, mut cos_sum) = (0, 0.0);
     for _ in 0..4000 {
-        let p = Vec3::new(
-            uniform(&mut r, -40.0, 40.0),
-            uniform(&mut r, -40.0, 40.0),
-            0.0,
-        );
+        let p = plane_point(&mut r, 40.0);
         let h = hit(p, Vec3::Z, to_world, placement);
         let n = m.shade(&h).frame.n;
         assert!(n.is_finite() && (n.length() - 1.0).abs() < 1e-4);

@@ -312,30 +312,20 @@ impl SeededSparse {
         self.sum::<false>(p, None, self.bands.len()).0
     }
 
-    /// [`SparseConvolution::eval_oriented`] with the first `bands` bands (all: the same value).
+    /// [`SparseConvolution::eval_oriented`] (with its gradient when `GRAD`) over the first
+    /// `bands` bands (all: the same value), every kernel shrunk about its own centre by
+    /// `kernel_scale` ∈ (0, 1]: the same impulses, smaller kernels K(M(p − k) / kernel_scale), for
+    /// features whose size varies with the point such as ring-porous pores (Liu et al. 2016
+    /// §6.1.6). A scale of 1 gives exactly the unscaled noise.
     #[inline]
-    pub fn eval_oriented_bands(&self, p: Vec3, frame: &Frame, bands: usize) -> f32 {
-        self.sum::<false>(p, Some(frame), bands).0
-    }
-
-    /// [`SparseConvolution::eval_oriented_grad`] with the first `bands` bands.
-    #[inline]
-    pub fn eval_oriented_grad_bands(&self, p: Vec3, frame: &Frame, bands: usize) -> (f32, Vec3) {
-        self.sum::<true>(p, Some(frame), bands)
-    }
-
-    /// [`SeededSparse::eval_oriented_grad_bands`] over all bands with every kernel shrunk about
-    /// its own centre by `kernel_scale` ∈ (0, 1] (the same impulses, smaller kernels: K(M(p − k)
-    /// / kernel_scale)), for features whose size varies with the point, such as ring-porous pores
-    /// (Liu et al. 2016 §6.1.6). A scale of 1 gives exactly the unscaled noise.
-    #[inline]
-    pub fn eval_oriented_scaled<const GRAD: bool>(
+    pub fn eval_oriented_with<const GRAD: bool>(
         &self,
         p: Vec3,
         frame: &Frame,
+        bands: usize,
         kernel_scale: f32,
     ) -> (f32, Vec3) {
-        let bands = self.bands.iter();
+        let bands = self.bands[..bands.min(self.bands.len())].iter();
         let scale = kernel_scale.clamp(f32::MIN_POSITIVE, 1.0);
         sum_bands::<GRAD, _>(bands, self.noise.cells, p, Some(frame), scale)
     }

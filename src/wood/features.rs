@@ -79,12 +79,8 @@ impl DistortionNoise {
         if bands == 0 {
             return (0.0, Vec3::ZERO);
         }
-        if GRAD {
-            self.noise.eval_oriented_grad_bands(p, cyl, bands as usize)
-        } else {
-            let v = self.noise.eval_oriented_bands(p, cyl, bands as usize);
-            (v, Vec3::ZERO)
-        }
+        self.noise
+            .eval_oriented_with::<GRAD>(p, cyl, bands as usize, 1.0)
     }
 }
 
@@ -141,12 +137,9 @@ impl Pores {
                     density: p.density,
                     envelope: env,
                     cell: CELL_SCALE * Vec3::new(xy, xy, env.z * 1.001),
-                    magnitude: 1.0,
-                    weights: Weights::Unit,
                     cells: Cells::Cartesian,
-                    bands: 1,
-                    size_factor: 0.5,
-                    dropoff: 1.0,
+                    // One band of unit weights (`Default`): a mask, not a signed noise.
+                    ..SparseConvolution::default()
                 },
                 seed,
             ),
@@ -184,7 +177,7 @@ impl Pores {
         }
         let (v, grad) = self
             .noise
-            .eval_oriented_scaled::<GRAD>(q, fiber, size.min(1.0));
+            .eval_oriented_with::<GRAD>(q, fiber, 1, size.min(1.0));
         if v <= 1e-12 {
             (0.0, Vec3::ZERO)
         } else if v >= 1.0 {
@@ -221,12 +214,9 @@ impl Rays {
                     // Arc cells wider than the ray: the search window along θ is set by the longest
                     // semi-axis anyway (notes/noise.md), so thin cells would only add cells.
                     cell: Vec3::new(env.x, RAY_ARC_CELLS * env.y, env.z),
-                    magnitude: 1.0,
-                    weights: Weights::Unit,
                     cells: Cells::Cylindrical,
-                    bands: 1,
-                    size_factor: 0.5,
-                    dropoff: 1.0,
+                    // One band of unit weights (`Default`): a mask, not a signed noise.
+                    ..SparseConvolution::default()
                 },
                 seed,
             ),
