@@ -33,13 +33,25 @@ impl Cylindrical {
 /// r̂ × θ̂ = ẑ). On the pith (r < [`PITH_EPSILON`]) the frame is (x̂, ŷ, ẑ), so it is never NaN.
 #[inline]
 pub fn cylinder_frame(p: Vec3) -> Frame {
-    let r2 = p.x * p.x + p.y * p.y;
-    let (c, s) = if r2 > PITH_EPSILON * PITH_EPSILON {
-        let inv = 1.0 / r2.sqrt();
-        (p.x * inv, p.y * inv)
+    let (c, s) = cylinder_cos_sin(p.x, p.y);
+    cylinder_frame_from(c, s)
+}
+
+/// (cos θ, sin θ) of the point (x, y, ·): r̂'s components, (1, 0) on the pith.
+#[inline(always)]
+pub fn cylinder_cos_sin(x: f32, y: f32) -> (f32, f32) {
+    let r2 = x * x + y * y;
+    let inv = 1.0 / r2.sqrt();
+    if r2 > PITH_EPSILON * PITH_EPSILON {
+        (x * inv, y * inv)
     } else {
         (1.0, 0.0)
-    };
+    }
+}
+
+/// The frame (r̂, θ̂, ẑ) from r̂ = (c, s, 0).
+#[inline(always)]
+pub fn cylinder_frame_from(c: f32, s: f32) -> Frame {
     Frame {
         s: Vec3::new(c, s, 0.0),
         t: Vec3::new(-s, c, 0.0),

@@ -5,10 +5,16 @@ use crate::math::Frame;
 
 /// Rotate the frame (r̂, θ̂, ẑ) about r̂ by `angle` (radians): the longitudinal axis tilts towards θ̂
 /// (a helix of pitch angle `angle`), the radial axis stays. Orthonormality is preserved exactly up
-/// to rounding.
+/// to rounding. (sin, cos) from the branch-free polynomial, so batch evaluation vectorises.
 #[inline]
 pub fn rotate_about_radial(frame: &Frame, angle: f32) -> Frame {
-    let (s, c) = angle.sin_cos();
+    let (s, c) = crate::math::elementary::sin_cos(angle);
+    rotate_by(frame, s, c)
+}
+
+/// [`rotate_about_radial`] by the angle whose sine and cosine are `s` and `c`.
+#[inline(always)]
+pub fn rotate_by(frame: &Frame, s: f32, c: f32) -> Frame {
     Frame {
         s: frame.s,
         t: frame.t * c - frame.n * s,

@@ -6,6 +6,8 @@ mod cylindrical;
 mod distortion;
 mod interlock;
 
-pub use cylindrical::{cylinder_frame, Cylindrical, PITH_EPSILON};
+pub use cylindrical::{
+    cylinder_cos_sin, cylinder_frame, cylinder_frame_from, Cylindrical, PITH_EPSILON,
+};
 pub use distortion::{exact_jacobian, Displacement, Distortion, JacobianModel, Magnitude};
-pub use interlock::rotate_about_radial;
+pub use interlock::{rotate_about_radial, rotate_by};

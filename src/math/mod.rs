@@ -1,6 +1,8 @@
 //! Small pure math shared by every module: orthonormal frames, safe inverse
-//! trigonometry, sampling warps and a seedable random number generator.
+//! trigonometry, sampling warps, a seedable random number generator, and `exp` / `sin_cos` that
+//! vectorise (`elementary`).
 
+pub mod elementary;
 mod frame;
 mod rng;
 mod sampling;

@@ -49,10 +49,32 @@ impl SmoothTriangleWave {
     /// the evaluation has no data-dependent branch (random points would mispredict them).
     #[inline]
     pub fn eval(&self, x: f32) -> (f32, f32) {
+        self.eval_with::<true>(x)
+    }
+
+    /// Whether [`SmoothTriangleWave::eval_unchecked`] holds at `x`: |x| below 2²¹ periods.
+    #[inline]
+    pub fn in_fast_range(&self, x: f32) -> bool {
+        x.abs() < 2_097_152.0 * self.period
+    }
+
+    /// [`SmoothTriangleWave::eval`] where [`SmoothTriangleWave::in_fast_range`] holds (same bits),
+    /// without the remainder's fallback call: a loop over many points vectorises.
+    #[inline]
+    pub fn eval_unchecked(&self, x: f32) -> (f32, f32) {
+        self.eval_with::<false>(x)
+    }
+
+    #[inline(always)]
+    fn eval_with<const CHECKED: bool>(&self, x: f32) -> (f32, f32) {
         let [rise, top, fall, bottom] = self.lengths;
         let [w1, w2, w3] = self.knots;
         let (a, b) = (self.s_up, -self.s_down);
-        let u_rise = rem_euclid_exact(x, self.period);
+        let u_rise = if CHECKED {
+            rem_euclid_exact(x, self.period)
+        } else {
+            rem_euclid_small(x, self.period).0
+        };
         let u_top = u_rise - rise;
         let u_fall = u_top - top;
         let u_bottom = u_fall - fall;
@@ -133,11 +155,18 @@ impl SmoothRectangleWave {
 /// where the quotient is not small. Same bits as `rem_euclid` (tested).
 #[inline]
 fn rem_euclid_exact(x: f32, p: f32) -> f32 {
-    let (xd, pd) = (x as f64, p as f64);
-    let n = (xd / pd).floor();
-    if !(n.abs() < 4_194_304.0) || !(p > 0.0) {
-        return x.rem_euclid(p);
+    match rem_euclid_small(x, p) {
+        (r, true) => r,
+        _ => x.rem_euclid(p),
     }
+}
+
+/// The fast case of [`rem_euclid_exact`] and whether it applies (|⌊x / p⌋| < 2²², p > 0).
+#[inline(always)]
+fn rem_euclid_small(x: f32, p: f32) -> (f32, bool) {
+    let (xd, pd) = (x as f64, p as f64);
+    let n = floor_f64(xd / pd);
+    let ok = n.abs() < 4_194_304.0 && p > 0.0;
     let r = xd - n * pd;
     let r = if r < 0.0 {
         r + pd
@@ -147,10 +176,25 @@ fn rem_euclid_exact(x: f32, p: f32) -> f32 {
         r
     };
     // A zero remainder keeps the sign of x, as fmod's does.
-    if r == 0.0 {
+    let r = if r == 0.0 {
         0.0f32.copysign(x)
     } else {
         r as f32
+    };
+    (r, ok)
+}
+
+/// ⌊x⌋ through i64 (no libm call on baseline x86-64; exact for |x| < 2⁶³, and beyond |x| ≥ 2⁵²
+/// every f64 is an integer): the same value as `f64::floor` for every finite x that
+/// [`rem_euclid_small`] accepts.
+#[inline(always)]
+fn floor_f64(x: f64) -> f64 {
+    let t = x as i64 as f64;
+    let t = if t > x { t - 1.0 } else { t };
+    if x.abs() < 4_503_599_627_370_496.0 {
+        t
+    } else {
+        x
     }
 }
 

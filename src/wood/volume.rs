@@ -9,8 +9,8 @@ use super::knots::{KnotSample, Knots};
 use super::params::WoodParams;
 use super::{Needs, WoodTexel};
 use crate::field::{
-    cylinder_frame, exact_jacobian, rotate_about_radial, Cylindrical, Displacement, Distortion,
-    JacobianModel,
+    cylinder_cos_sin, cylinder_frame, cylinder_frame_from, exact_jacobian, rotate_about_radial,
+    rotate_by, Cylindrical, Displacement, Distortion, JacobianModel,
 };
 use crate::math::Frame;
 use glam::Vec3;
@@ -35,6 +35,9 @@ pub struct WoodVolume {
     knots: Option<Knots>,
     jacobian: JacobianModel,
 }
+
+/// Points per block of [`WoodVolume::eval_many`] (16 f32 lanes: one AVX-512 register).
+const BATCH: usize = 16;
 
 /// Salts of the independent noise fields, so each feature has its own seed.
 mod salt {
@@ -163,10 +166,20 @@ impl WoodVolume {
     /// (notes/wood.md).
     #[inline]
     pub fn time(&self, r: f32) -> (f32, f32) {
+        self.time_with::<true>(r)
+    }
+
+    /// [`WoodVolume::time`]; without `CHECKED` only where [`WoodVolume::batch_time_ok`] holds.
+    #[inline(always)]
+    fn time_with<const CHECKED: bool>(&self, r: f32) -> (f32, f32) {
         let u = r * self.inv_ring_width;
         let (mut t, mut dt) = (u, self.inv_ring_width);
         if let Some(w) = &self.growth {
-            let (wv, wd) = w.eval(u);
+            let (wv, wd) = if CHECKED {
+                w.eval(u)
+            } else {
+                w.eval_unchecked(u)
+            };
             t += wv;
             dt *= 1.0 + wd;
         }
@@ -251,7 +264,7 @@ impl WoodVolume {
 
     /// The fibre frame at the distorted point q: the cylindrical frame rotated by the interlock
     /// angle (s = r̂, t = θ̂', n = longitudinal fibre).
-    #[inline]
+    #[inline(always)]
     fn fiber_frame(&self, q: Vec3, r: f32) -> Frame {
         let frame = cylinder_frame(q);
         match &self.interlock {
@@ -343,6 +356,181 @@ impl WoodVolume {
             texel.highlight_width = self.highlight.eval(c.time);
         }
         texel
+    }
+
+    /// [`WoodVolume::eval`] at every point of `points` into `out` (same length): the same texels,
+    /// bit for bit. Colour alone (`Needs::COLOR`, no knots: what slices, previews and bakes of
+    /// colour ask for) runs in blocks of [`BATCH`] points, stage by stage: the noise lookups
+    /// (distortion, pores, rays) point by point, everything between them (frames, growth time,
+    /// rings, interlock, Beer's law) in SIMD lanes. Anything else, and a last partial block, goes
+    /// point by point.
+    pub fn eval_many(&self, points: &[Vec3], needs: Needs, out: &mut [WoodTexel]) {
+        assert_eq!(points.len(), out.len(), "eval_many: one texel per point");
+        let mut done = 0;
+        if needs == Needs::COLOR && self.knots.is_none() {
+            let simd = crate::noise::Simd::best();
+            for (p, o) in points.chunks_exact(BATCH).zip(out.chunks_exact_mut(BATCH)) {
+                let p: &[Vec3; BATCH] = p.try_into().expect("a whole block");
+                let o: &mut [WoodTexel; BATCH] = o.try_into().expect("a whole block");
+                if !self.color_block_on(simd, p, o) {
+                    for (o, &p) in o.iter_mut().zip(p) {
+                        *o = self.eval(p, needs);
+                    }
+                }
+                done += BATCH;
+            }
+        }
+        for (o, &p) in out[done..].iter_mut().zip(&points[done..]) {
+            *o = self.eval(p, needs);
+        }
+    }
+
+    /// [`WoodVolume::color_block`] compiled for the widest instruction set the CPU has.
+    #[inline]
+    fn color_block_on(
+        &self,
+        simd: crate::noise::Simd,
+        p: &[Vec3; BATCH],
+        out: &mut [WoodTexel; BATCH],
+    ) -> bool {
+        use crate::noise::Simd;
+        #[cfg(target_arch = "x86_64")]
+        match simd {
+            // SAFETY: `Simd::best` detected the instruction set.
+            Simd::Avx512 => return unsafe { self.color_block_avx512(p, out) },
+            Simd::Avx2 => return unsafe { self.color_block_avx2(p, out) },
+            _ => {}
+        }
+        let _ = simd;
+        self.color_block(p, out)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
+    unsafe fn color_block_avx512(&self, p: &[Vec3; BATCH], out: &mut [WoodTexel; BATCH]) -> bool {
+        self.color_block(p, out)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn color_block_avx2(&self, p: &[Vec3; BATCH], out: &mut [WoodTexel; BATCH]) -> bool {
+        self.color_block(p, out)
+    }
+
+    /// One block of colour-only texels (see [`WoodVolume::eval_many`]): the operations of
+    /// [`WoodVolume::eval_filtered`] with footprint 0, in its order, so the same bits. The lane
+    /// stages hold one array per coordinate and loop with no call and no data-dependent branch,
+    /// which the compiler vectorises. `false` (nothing written) where a point lies beyond the
+    /// growth wave's fast range: the caller then evaluates the block point by point.
+    #[inline(always)]
+    fn color_block(&self, p: &[Vec3; BATCH], out: &mut [WoodTexel; BATCH]) -> bool {
+        type Lanes = [f32; BATCH];
+        let (mut qx, mut qy, mut qz): (Lanes, Lanes, Lanes) =
+            ([0.0; BATCH], [0.0; BATCH], [0.0; BATCH]);
+        for i in 0..BATCH {
+            (qx[i], qy[i], qz[i]) = (p[i].x, p[i].y, p[i].z);
+        }
+        // f(p) (`Distortion::add`'s point update q += m a, in its order r̂, θ̂, ẑ): the magnitudes
+        // point by point, frames and sums in lanes.
+        if self.distortion.iter().any(Option::is_some) {
+            let (mut c, mut s) = ([0.0; BATCH], [0.0; BATCH]);
+            for i in 0..BATCH {
+                (c[i], s[i]) = cylinder_cos_sin(p[i].x, p[i].y);
+            }
+            for (axis, noise) in self.distortion.iter().enumerate() {
+                let Some(noise) = noise else { continue };
+                let mut m = [0.0f32; BATCH];
+                for i in 0..BATCH {
+                    let frame = cylinder_frame_from(c[i], s[i]);
+                    m[i] = noise.eval::<false>(p[i], &frame).0;
+                }
+                for i in 0..BATCH {
+                    // a = r̂ = (c, s, 0), θ̂ = (−s, c, 0) or ẑ = (0, 0, 1).
+                    let (ax, ay, az) = match axis {
+                        0 => (c[i], s[i], 0.0),
+                        1 => (-s[i], c[i], 0.0),
+                        _ => (0.0, 0.0, 1.0),
+                    };
+                    qx[i] += m[i] * ax;
+                    qy[i] += m[i] * ay;
+                    qz[i] += m[i] * az;
+                }
+            }
+        }
+        // Growth time and rings in lanes.
+        let mut r: Lanes = [0.0; BATCH];
+        for i in 0..BATCH {
+            r[i] = (qx[i] * qx[i] + qy[i] * qy[i]).sqrt();
+        }
+        if let Some(w) = &self.growth {
+            let mut ok = true;
+            for &r in &r {
+                ok &= w.in_fast_range(r * self.inv_ring_width);
+            }
+            if !ok {
+                return false;
+            }
+        }
+        let (mut time, mut g): (Lanes, Lanes) = ([0.0; BATCH], [0.0; BATCH]);
+        for i in 0..BATCH {
+            time[i] = self.time_with::<false>(r[i]).0;
+        }
+        for i in 0..BATCH {
+            g[i] = self.rings.eval(time[i]);
+        }
+        // Pores: the fibre frame in lanes, the noise point by point.
+        let mut pore: Lanes = [0.0; BATCH];
+        if let Some(pores) = &self.pores {
+            let (mut c, mut s) = ([0.0; BATCH], [0.0; BATCH]);
+            for i in 0..BATCH {
+                (c[i], s[i]) = cylinder_cos_sin(qx[i], qy[i]);
+            }
+            let (mut sin, mut cos) = ([0.0; BATCH], [1.0; BATCH]);
+            if let Some(n) = &self.interlock {
+                for i in 0..BATCH {
+                    (sin[i], cos[i]) = crate::math::elementary::sin_cos(n.eval(r[i]).0);
+                }
+            }
+            for i in 0..BATCH {
+                let frame = cylinder_frame_from(c[i], s[i]);
+                let frame = if self.interlock.is_some() {
+                    rotate_by(&frame, sin[i], cos[i])
+                } else {
+                    frame
+                };
+                let q = Vec3::new(qx[i], qy[i], qz[i]);
+                pore[i] = pores.mask::<false>(q, &frame, g[i]).0;
+            }
+        }
+        let mut ray: Lanes = [0.0; BATCH];
+        if let Some(rays) = self.rays.as_ref().filter(|_| self.color_uses_rays()) {
+            for i in 0..BATCH {
+                ray[i] = rays.mask(Vec3::new(qx[i], qy[i], qz[i]));
+            }
+        }
+        // Beer's law in lanes, a channel at a time.
+        let mut diffuse = [[0.0f32; BATCH]; 3];
+        let mut fiber = [[0.0f32; BATCH]; 3];
+        for ch in 0..3 {
+            let (base, ring, late) = self.color.channel(ch);
+            for i in 0..BATCH {
+                let a = self
+                    .color
+                    .channel_absorbance(base, ring, late, g[i], pore[i], ray[i]);
+                (diffuse[ch][i], fiber[ch][i]) = self.color.channel_colors(a);
+            }
+        }
+        for i in 0..BATCH {
+            out[i] = WoodTexel {
+                diffuse: Vec3::new(diffuse[0][i], diffuse[1][i], diffuse[2][i]),
+                fiber_color: Vec3::new(fiber[0][i], fiber[1][i], fiber[2][i]),
+                pore_mask: pore[i],
+                ray_mask: ray[i],
+                growth_time: time[i],
+                ..WoodTexel::default()
+            };
+        }
+        true
     }
 
     /// Whether rays change the colour (a non-zero ray path length).

@@ -21,6 +21,9 @@ pub struct Args {
     /// instruction counts: `valgrind --tool=callgrind xylem bench wood --passes 1 ...`).
     #[arg(long)]
     passes: Option<usize>,
+    /// With `--passes`: evaluate point by point (`eval`) instead of in batches (`eval_many`).
+    #[arg(long)]
+    per_point: bool,
     /// With `--passes`: only this level of `needs` (colour, fibres or all; default: the three).
     #[arg(long)]
     needs: Option<String>,
@@ -37,14 +40,22 @@ fn thread_cpu_seconds() -> Option<f64> {
 }
 
 /// Texels per CPU second of `volume` over `points` (one thread; wall clock where thread CPU time
-/// is unavailable). Repeats the pass until at least a second of CPU time has been spent.
-pub fn texels_per_second(volume: &WoodVolume, points: &[Vec3], needs: Needs) -> f64 {
+/// is unavailable), evaluated by `eval_many` when `batch`, else point by point with `eval`.
+/// Repeats the pass until at least a second of CPU time has been spent.
+pub fn texels_per_second(volume: &WoodVolume, points: &[Vec3], needs: Needs, batch: bool) -> f64 {
     let (wall, cpu0) = (Instant::now(), thread_cpu_seconds());
     let mut sink = 0.0f32;
     let mut done = 0usize;
+    let mut out = vec![wood::WoodTexel::default(); points.len()];
     loop {
-        for &p in points {
-            let t = volume.eval(p, needs);
+        if batch {
+            volume.eval_many(points, needs, &mut out);
+        } else {
+            for (o, &p) in out.iter_mut().zip(points) {
+                *o = volume.eval(p, needs);
+            }
+        }
+        for t in &out {
             sink += t.diffuse.x + t.fiber_dir.z + t.bump;
         }
         done += points.len();
@@ -66,19 +77,23 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     let names = selected(&args.only);
     println!(
-        "| preset | colour (M texels/s) | colour + fibres | everything | colour / everything |"
+        "| preset | colour (M texels/s) | colour, per point | colour + fibres | everything | \
+         colour / everything |"
     );
-    println!("| --- | ---: | ---: | ---: | ---: |");
+    println!("| --- | ---: | ---: | ---: | ---: | ---: |");
     for name in names {
         let volume = WoodVolume::new(wood::preset(name)?, 1)?;
-        // Warm-up, then measure each level of `needs`.
-        texels_per_second(&volume, &points[..points.len() / 10], Needs::COLOR);
-        let c = texels_per_second(&volume, &points, Needs::COLOR);
-        let cf = texels_per_second(&volume, &points, Needs::COLOR_FIBERS);
-        let all = texels_per_second(&volume, &points, Needs::ALL);
+        // Warm-up, then measure each level of `needs`: colour in batches (`eval_many`, as
+        // slices and bakes evaluate it) and point by point (`eval`, as a renderer's hit does).
+        texels_per_second(&volume, &points[..points.len() / 10], Needs::COLOR, true);
+        let c = texels_per_second(&volume, &points, Needs::COLOR, true);
+        let c1 = texels_per_second(&volume, &points, Needs::COLOR, false);
+        let cf = texels_per_second(&volume, &points, Needs::COLOR_FIBERS, false);
+        let all = texels_per_second(&volume, &points, Needs::ALL, false);
         println!(
-            "| {name} | {:.2} | {:.2} | {:.2} | {:.1}× |",
+            "| {name} | {:.2} | {:.2} | {:.2} | {:.2} | {:.1}× |",
             c / 1e6,
+            c1 / 1e6,
             cf / 1e6,
             all / 1e6,
             c / all
@@ -120,11 +135,18 @@ fn fixed_passes(args: &Args, points: &[Vec3], passes: usize) -> anyhow::Result<E
         for (_, label, needs) in levels.into_iter().filter(|l| wanted(l.0)) {
             let mut sink = 0.0f32;
             let mut bits = Fingerprint::default();
+            let mut out = vec![wood::WoodTexel::default(); points.len()];
             for _ in 0..passes {
-                for &p in points {
-                    let t = volume.eval(p, needs);
+                if args.per_point {
+                    for (o, &p) in out.iter_mut().zip(points) {
+                        *o = volume.eval(p, needs);
+                    }
+                } else {
+                    volume.eval_many(points, needs, &mut out);
+                }
+                for t in &out {
                     sink += t.diffuse.x + t.fiber_dir.z + t.bump;
-                    bits.add_texel(&t);
+                    bits.add_texel(t);
                 }
             }
             println!(
@@ -163,9 +185,9 @@ fn breakdown(params: &wood::WoodParams, points: &[Vec3]) -> anyhow::Result<()> {
         let mut p = params.clone();
         edit(&mut p);
         let v = WoodVolume::new(p, 1)?;
-        let c = texels_per_second(&v, points, Needs::COLOR);
-        let all = texels_per_second(&v, points, Needs::ALL);
-        println!("|   {label} | {:.2} | | {:.2} | |", c / 1e6, all / 1e6);
+        let c = texels_per_second(&v, points, Needs::COLOR, true);
+        let all = texels_per_second(&v, points, Needs::ALL, false);
+        println!("|   {label} | {:.2} | | | {:.2} | |", c / 1e6, all / 1e6);
     }
     Ok(())
 }
