@@ -330,6 +330,45 @@ impl SeededSparse {
         sum_bands::<GRAD, _>(bands, self.noise.cells, p, Some(frame), scale)
     }
 
+    /// [`SeededSparse::eval_oriented_with`]'s value at `N` points, each with its frame and kernel
+    /// scale: every band's query set-up (eq. 9–12) in SIMD lanes, the cell search point by
+    /// point. The same values, bit for bit (tests).
+    #[inline(always)]
+    pub fn eval_oriented_many<const N: usize>(
+        &self,
+        p: &[Vec3; N],
+        frames: &[Frame; N],
+        bands: usize,
+        kernel_scale: &[f32; N],
+    ) -> [f32; N] {
+        let scale = kernel_scale.map(|k| k.clamp(f32::MIN_POSITIVE, 1.0));
+        let mut value = [0.0f32; N];
+        for (amp, band) in &self.bands[..bands.min(self.bands.len())] {
+            let queries = match self.noise.cells {
+                Cells::Cartesian => band.cartesian_queries(p, frames, &scale),
+                Cells::Cylindrical => None,
+            };
+            for i in 0..N {
+                let v = match &queries {
+                    Some(q) => band.cartesian_search::<false>(&q[i]).0,
+                    None => {
+                        match self.noise.cells {
+                            Cells::Cartesian => {
+                                band.cartesian::<false>(p[i], Some(&frames[i]), scale[i])
+                            }
+                            Cells::Cylindrical => {
+                                band.cylindrical::<false>(p[i], Some(&frames[i]), scale[i])
+                            }
+                        }
+                        .0
+                    }
+                };
+                value[i] += amp * v;
+            }
+        }
+        value
+    }
+
     #[inline]
     fn sum<const GRAD: bool>(&self, p: Vec3, frame: Option<&Frame>, bands: usize) -> (f32, Vec3) {
         let bands = self.bands[..bands.min(self.bands.len())].iter();
@@ -503,6 +542,7 @@ struct Band {
 }
 
 /// The kernel's inverse map M = s_b⁻¹ Sₑ⁻¹ Rᵀ of eq. 12, kept as axes and inverse lengths.
+#[derive(Clone, Copy)]
 struct KernelMap {
     axes: Option<Frame>,
     inv: Vec3,
@@ -536,6 +576,7 @@ impl KernelMap {
 /// Everything a Cartesian query needs besides the band: the kernel map after the fit, the
 /// point's cell `base` and its place `f` in it, the window `lo..=hi` (cell offsets per axis), the
 /// per-axis gap scale of the axis-aligned cell test (0 for oriented kernels) and the counts.
+#[derive(Clone, Copy)]
 struct CartesianQuery {
     map: KernelMap,
     reach: Vec3,
@@ -700,13 +741,105 @@ impl Band {
         kernel_scale: f32,
     ) -> (f32, Vec3) {
         let q = self.cartesian_query(p, frame, kernel_scale);
+        self.cartesian_search::<GRAD>(&q)
+    }
+
+    /// The cell search of a prepared query (see [`Band::cartesian`]).
+    #[inline(always)]
+    fn cartesian_search<const GRAD: bool>(&self, q: &CartesianQuery) -> (f32, Vec3) {
         #[cfg(target_arch = "x86_64")]
         if q.in_block() && block_search() {
-            let upright = frame.is_some_and(is_upright);
+            let upright = q.map.axes.as_ref().is_some_and(is_upright);
             // SAFETY: `block_search` detected the instruction sets.
-            return unsafe { self.cartesian_avx512::<GRAD>(&q, upright) };
+            return unsafe { self.cartesian_avx512::<GRAD>(q, upright) };
         }
-        self.cartesian_cells::<GRAD>(&q)
+        self.cartesian_cells::<GRAD>(q)
+    }
+
+    /// [`Band::cartesian_query`] for `N` points with their frames and kernel scales, in lanes: one
+    /// array per coordinate, the same operations in the same order, so the same queries. `None`
+    /// where a point's cell index is not below 2³⁰ in magnitude (or not finite): there the lanes'
+    /// floor could differ from [`floor_i32`]'s saturation, and the caller asks point by point.
+    #[inline(always)]
+    fn cartesian_queries<const N: usize>(
+        &self,
+        p: &[Vec3; N],
+        frames: &[Frame; N],
+        scale: &[f32; N],
+    ) -> Option<[CartesianQuery; N]> {
+        type Lanes<const N: usize> = [f32; N];
+        let (cell, env0) = (self.cell, self.env);
+        let zero = [0.0f32; N];
+        let (mut ex, mut ey, mut ez): (Lanes<N>, Lanes<N>, Lanes<N>) = (zero, zero, zero);
+        let (mut ix, mut iy, mut iz) = (zero, zero, zero);
+        let (mut rx, mut ry, mut rz) = (zero, zero, zero);
+        for i in 0..N {
+            let (f, k) = (&frames[i], scale[i]);
+            let (e_x, e_y, e_z) = (env0.x * k, env0.y * k, env0.z * k);
+            // Eq. 9 (`bbox_half_extent`): the rows of R·Sₑ, a = s e_x, b = t e_y, c = n e_z.
+            let (a, b, c) = (f.s * e_x, f.t * e_y, f.n * e_z);
+            ex[i] = (a.x * a.x + b.x * b.x + c.x * c.x).sqrt();
+            ey[i] = (a.y * a.y + b.y * b.y + c.y * c.y).sqrt();
+            ez[i] = (a.z * a.z + b.z * b.z + c.z * c.z).sqrt();
+            // Eq. 11: the fit.
+            let sb = (cell.x / ex[i])
+                .min(cell.y / ey[i])
+                .min(cell.z / ez[i])
+                .min(1.0);
+            (ix[i], iy[i], iz[i]) = (1.0 / (sb * e_x), 1.0 / (sb * e_y), 1.0 / (sb * e_z));
+            (rx[i], ry[i], rz[i]) = (
+                sb * ex[i] / cell.x,
+                sb * ey[i] / cell.y,
+                sb * ez[i] / cell.z,
+            );
+        }
+        let (mut px, mut py, mut pz) = (zero, zero, zero);
+        let mut in_range = true;
+        for i in 0..N {
+            (px[i], py[i], pz[i]) = (p[i].x / cell.x, p[i].y / cell.y, p[i].z / cell.z);
+            in_range &= px[i].abs() < 1.0e9 && py[i].abs() < 1.0e9 && pz[i].abs() < 1.0e9;
+        }
+        if !in_range {
+            return None;
+        }
+        let (mut fx, mut fy, mut fz) = (zero, zero, zero);
+        let mut base = [[0i32; 3]; N];
+        for i in 0..N {
+            // SAFETY: |⌊x⌋| < 10⁹ < 2³¹ and finite (checked above): each conversion is exact.
+            let b: [i32; 3] = unsafe {
+                [
+                    px[i].floor().to_int_unchecked(),
+                    py[i].floor().to_int_unchecked(),
+                    pz[i].floor().to_int_unchecked(),
+                ]
+            };
+            (fx[i], fy[i], fz[i]) = (
+                px[i] - b[0] as f32,
+                py[i] - b[1] as f32,
+                pz[i] - b[2] as f32,
+            );
+            base[i] = b;
+        }
+        let mut queries = [CartesianQuery {
+            map: KernelMap {
+                axes: None,
+                inv: Vec3::ZERO,
+            },
+            reach: Vec3::ZERO,
+            base: [0; 3],
+            f: Vec3::ZERO,
+            gap_scale: Vec3::ZERO,
+        }; N];
+        for (i, q) in queries.iter_mut().enumerate() {
+            q.map = KernelMap {
+                axes: Some(frames[i]),
+                inv: Vec3::new(ix[i], iy[i], iz[i]),
+            };
+            q.reach = Vec3::new(rx[i], ry[i], rz[i]);
+            q.base = base[i];
+            q.f = Vec3::new(fx[i], fy[i], fz[i]);
+        }
+        Some(queries)
     }
 
     /// One cell at a time over the window (the reference the block search must equal).

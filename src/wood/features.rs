@@ -58,6 +58,18 @@ impl DistortionNoise {
         self.eval_bands::<GRAD>(p, cyl, self.noise.noise().bands)
     }
 
+    /// [`DistortionNoise::eval`]'s value at `N` points with their cylindrical frames (the query
+    /// set-up in lanes, [`SeededSparse::eval_oriented_many`]).
+    #[inline(always)]
+    pub fn eval_many<const N: usize>(&self, p: &[Vec3; N], cyl: &[Frame; N]) -> [f32; N] {
+        match self.noise.noise().bands {
+            0 => [0.0; N],
+            bands => self
+                .noise
+                .eval_oriented_many(p, cyl, bands as usize, &[1.0; N]),
+        }
+    }
+
     /// How many bands (from the largest) have kernels at least `footprint` mm across: band i has
     /// semi-axes βⁱ Sₑ (Liu 2016 eq. 8), so its narrowest diameter is 2 βⁱ min(Sₑ).
     #[inline]
@@ -185,6 +197,34 @@ impl Pores {
         } else {
             (v, grad)
         }
+    }
+}
+
+impl Pores {
+    /// [`Pores::mask`]'s value at `N` points with their fibre frames and ring values (the query
+    /// set-up in lanes, [`SeededSparse::eval_oriented_many`]); the same values.
+    #[inline(always)]
+    pub fn mask_many<const N: usize>(
+        &self,
+        q: &[Vec3; N],
+        fiber: &[Frame; N],
+        g: &[f32; N],
+    ) -> [f32; N] {
+        let size = g.map(|g| 1.0 - self.ring_porosity * g);
+        // Vanished pores are searched at full size (cheap to run, then discarded).
+        let scale = size.map(|s| if s <= 1e-3 { 1.0 } else { s.min(1.0) });
+        let v = self.noise.eval_oriented_many(q, fiber, 1, &scale);
+        let mut mask = [0.0; N];
+        for i in 0..N {
+            mask[i] = if size[i] <= 1e-3 || v[i] <= 1e-12 {
+                0.0
+            } else if v[i] >= 1.0 {
+                1.0
+            } else {
+                v[i]
+            };
+        }
+        mask
     }
 }
 

@@ -439,11 +439,11 @@ impl WoodVolume {
             }
             for (axis, noise) in self.distortion.iter().enumerate() {
                 let Some(noise) = noise else { continue };
-                let mut m = [0.0f32; BATCH];
+                let mut frames = [cylinder_frame_from(1.0, 0.0); BATCH];
                 for i in 0..BATCH {
-                    let frame = cylinder_frame_from(c[i], s[i]);
-                    m[i] = noise.eval::<false>(p[i], &frame).0;
+                    frames[i] = cylinder_frame_from(c[i], s[i]);
                 }
+                let m = noise.eval_many(p, &frames);
                 for i in 0..BATCH {
                     // a = r̂ = (c, s, 0), θ̂ = (−s, c, 0) or ẑ = (0, 0, 1).
                     let (ax, ay, az) = match axis {
@@ -491,16 +491,18 @@ impl WoodVolume {
                     (sin[i], cos[i]) = crate::math::elementary::sin_cos(n.eval(r[i]).0);
                 }
             }
+            let mut frames = [cylinder_frame_from(1.0, 0.0); BATCH];
+            let mut q = [Vec3::ZERO; BATCH];
             for i in 0..BATCH {
                 let frame = cylinder_frame_from(c[i], s[i]);
-                let frame = if self.interlock.is_some() {
+                frames[i] = if self.interlock.is_some() {
                     rotate_by(&frame, sin[i], cos[i])
                 } else {
                     frame
                 };
-                let q = Vec3::new(qx[i], qy[i], qz[i]);
-                pore[i] = pores.mask::<false>(q, &frame, g[i]).0;
+                q[i] = Vec3::new(qx[i], qy[i], qz[i]);
             }
+            pore = pores.mask_many(&q, &frames, &g);
         }
         let mut ray: Lanes = [0.0; BATCH];
         if let Some(rays) = self.rays.as_ref().filter(|_| self.color_uses_rays()) {
