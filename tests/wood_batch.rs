@@ -3,6 +3,7 @@
 //! at the pith and far out where the growth wave leaves its fast range.
 
 use glam::Vec3;
+use xylem::noise::Simd;
 use xylem::wood::{self, Needs, WoodTexel, WoodVolume};
 
 fn bits(t: &WoodTexel) -> Vec<u32> {
@@ -48,15 +49,22 @@ fn eval_many_is_eval_bit_for_bit() {
     for name in wood::PRESET_NAMES {
         let volume = WoodVolume::new(wood::preset(name).unwrap(), 7).unwrap();
         for needs in [Needs::COLOR, Needs::COLOR_FIBERS, Needs::ALL] {
-            let mut many = vec![WoodTexel::default(); pts.len()];
-            volume.eval_many(&pts, needs, &mut many);
-            for (i, (&p, t)) in pts.iter().zip(&many).enumerate() {
-                let one = volume.eval(p, needs);
-                assert_eq!(
-                    bits(t),
-                    bits(&one),
-                    "{name} {needs:?}: point {i} {p}: {t:?} vs {one:?}"
-                );
+            let one: Vec<WoodTexel> = pts.iter().map(|&p| volume.eval(p, needs)).collect();
+            // Every instruction set this CPU has (the lane stages are compiled for each).
+            for simd in [Simd::Scalar, Simd::Sse2, Simd::Avx2, Simd::Avx512] {
+                if simd > Simd::best() {
+                    continue;
+                }
+                let mut many = vec![WoodTexel::default(); pts.len()];
+                volume.eval_many_on(simd, &pts, needs, &mut many);
+                for (i, (t, one)) in many.iter().zip(&one).enumerate() {
+                    assert_eq!(
+                        bits(t),
+                        bits(one),
+                        "{name} {needs:?} {simd:?}: point {i} {}: {t:?} vs {one:?}",
+                        pts[i]
+                    );
+                }
             }
         }
     }

@@ -132,7 +132,13 @@ fn cuts(
             } else {
                 Needs::COLOR
             };
-            let px = slice.render(&|p| preview_color(&volume.eval(p, needs), view, shade));
+            let px = slice.render_rows(&|p, o| {
+                let mut texels = vec![crate::wood::WoodTexel::default(); p.len()];
+                volume.eval_many(p, needs, &mut texels);
+                for (o, t) in o.iter_mut().zip(&texels) {
+                    *o = preview_color(t, view, shade);
+                }
+            });
             let path = out.join(format!("{name}_{tag}.png"));
             write_png_linear(&path, res, res, &px, 0.0)
                 .with_context(|| format!("writing {}", path.display()))?;

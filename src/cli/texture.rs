@@ -147,14 +147,29 @@ struct WoodSlice {
     shade: bool,
 }
 
-impl SolidTexture for WoodSlice {
-    fn eval(&self, p: glam::Vec3) -> glam::Vec3 {
-        let needs = if self.shade {
+impl WoodSlice {
+    /// Colour alone, or with the fibres when the preview shades their highlight.
+    fn needs(&self) -> crate::wood::Needs {
+        if self.shade {
             crate::wood::Needs::COLOR_FIBERS
         } else {
             crate::wood::Needs::COLOR
-        };
-        crate::wood::preview_color(&self.volume.eval(p, needs), self.view, self.shade)
+        }
+    }
+}
+
+impl SolidTexture for WoodSlice {
+    fn eval(&self, p: glam::Vec3) -> glam::Vec3 {
+        crate::wood::preview_color(&self.volume.eval(p, self.needs()), self.view, self.shade)
+    }
+
+    /// A row at once through [`crate::wood::WoodVolume::eval_many`] (the same texels).
+    fn eval_many(&self, points: &[glam::Vec3], out: &mut [glam::Vec3]) {
+        let mut texels = vec![crate::wood::WoodTexel::default(); points.len()];
+        self.volume.eval_many(points, self.needs(), &mut texels);
+        for (o, t) in out.iter_mut().zip(&texels) {
+            *o = crate::wood::preview_color(t, self.view, self.shade);
+        }
     }
 }
 

@@ -365,10 +365,23 @@ impl WoodVolume {
     /// rings, interlock, Beer's law) in SIMD lanes. Anything else, and a last partial block, goes
     /// point by point.
     pub fn eval_many(&self, points: &[Vec3], needs: Needs, out: &mut [WoodTexel]) {
+        self.eval_many_on(crate::noise::Simd::best(), points, needs, out);
+    }
+
+    /// [`WoodVolume::eval_many`] with the lane stages compiled for `simd` (which the CPU must
+    /// have; tests run every level).
+    #[doc(hidden)]
+    pub fn eval_many_on(
+        &self,
+        simd: crate::noise::Simd,
+        points: &[Vec3],
+        needs: Needs,
+        out: &mut [WoodTexel],
+    ) {
         assert_eq!(points.len(), out.len(), "eval_many: one texel per point");
+        assert!(simd <= crate::noise::Simd::best(), "{simd:?} not available");
         let mut done = 0;
         if needs == Needs::COLOR && self.knots.is_none() {
-            let simd = crate::noise::Simd::best();
             for (p, o) in points.chunks_exact(BATCH).zip(out.chunks_exact_mut(BATCH)) {
                 let p: &[Vec3; BATCH] = p.try_into().expect("a whole block");
                 let o: &mut [WoodTexel; BATCH] = o.try_into().expect("a whole block");
