@@ -184,15 +184,17 @@ fn rem_euclid_small(x: f32, p: f32) -> (f32, bool) {
     (r, ok)
 }
 
-/// ⌊x⌋ through i64 (no libm call on baseline x86-64; exact for |x| < 2⁶³, and beyond |x| ≥ 2⁵²
-/// every f64 is an integer): the same value as `f64::floor` for every finite x that
-/// [`rem_euclid_small`] accepts.
+/// ⌊x⌋ up to the sign of a zero, by rounding to an integer with ±2⁵² (exact for |x| < 2⁵², and
+/// beyond every f64 is an integer): plain arithmetic, no libm call on baseline x86-64, and it
+/// vectorises. A zero quotient's sign does not change [`rem_euclid_small`]'s result.
 #[inline(always)]
 fn floor_f64(x: f64) -> f64 {
-    let t = x as i64 as f64;
-    let t = if t > x { t - 1.0 } else { t };
-    if x.abs() < 4_503_599_627_370_496.0 {
-        t
+    const TWO_52: f64 = 4_503_599_627_370_496.0;
+    let m = TWO_52.copysign(x);
+    let r = (x + m) - m;
+    let r = if r > x { r - 1.0 } else { r };
+    if x.abs() < TWO_52 {
+        r
     } else {
         x
     }
@@ -202,13 +204,14 @@ fn floor_f64(x: f64) -> f64 {
 /// below 2²³, where floats have a fraction; the sign of a zero kept.
 #[inline]
 fn floor_exact(t: f32) -> f32 {
-    if t.abs() < 8_388_608.0 {
-        let i = t as i32 as f32;
-        if i > t {
-            i - 1.0
-        } else {
-            i.copysign(t)
-        }
+    let small = t.abs() < 8_388_608.0;
+    // The truncation unchecked on an argument replaced by 0 where it is large or NaN (a plain
+    // `as` saturates, which compiles to scalar code even in a loop the compiler vectorises).
+    // SAFETY: the argument is finite and below 2²³ in magnitude.
+    let i = unsafe { (if small { t } else { 0.0 }).to_int_unchecked::<i32>() } as f32;
+    let f = if i > t { i - 1.0 } else { i.copysign(t) };
+    if small {
+        f
     } else {
         t
     }
@@ -234,6 +237,21 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn floor_f64_is_floor_up_to_the_sign_of_zero() {
+        let mut rng = crate::math::Pcg32::new(8, 0);
+        for i in 0..200_000 {
+            let x = (rng.next_f32() as f64 * 2.0 - 1.0) * 10f64.powi(i % 18);
+            for x in [x, x.round(), x + 0.5, x.round() - 0.5] {
+                assert_eq!(floor_f64(x), x.floor(), "{x}");
+            }
+        }
+        for x in [4.5e15, -4.5e15, 1e300, -1e300, f64::INFINITY, 0.0, -0.0] {
+            assert_eq!(floor_f64(x), x.floor(), "{x}");
+        }
+        assert!(floor_f64(f64::NAN).is_nan());
     }
 
     #[test]
