@@ -1,10 +1,11 @@
 //! `cargo bench --bench wood`: wood texels per second (one thread) for every species preset, with
-//! `needs` = colour only and = everything. Results: target/criterion/wood/<preset>/<needs>/.
+//! `needs` = colour only (in batches, `eval_many`, and point by point, `eval`) and = everything.
+//! Results: target/criterion/wood/<preset>/<id>/.
 //! Figures and machine: notes/wood.md (also `xylem bench wood`, which prints the table).
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 use std::time::Duration;
-use xylem::wood::{preset, sample_points, Needs, WoodVolume, PRESET_NAMES};
+use xylem::wood::{preset, sample_points, Needs, WoodTexel, WoodVolume, PRESET_NAMES};
 
 const POINTS: usize = 2048;
 
@@ -17,6 +18,13 @@ fn bench(c: &mut Criterion) {
         group.warm_up_time(Duration::from_millis(500));
         group.measurement_time(Duration::from_secs(2));
         group.sample_size(20);
+        let mut out = vec![WoodTexel::default(); POINTS];
+        group.bench_function("colour_batch", |b| {
+            b.iter(|| {
+                volume.eval_many(black_box(&points), Needs::COLOR, &mut out);
+                out.iter().map(|t| t.diffuse.x).sum::<f32>()
+            })
+        });
         for (id, needs) in [("colour", Needs::COLOR), ("all", Needs::ALL)] {
             group.bench_function(id, |b| {
                 b.iter(|| {
