@@ -198,9 +198,7 @@ impl Pores {
             (v, grad)
         }
     }
-}
 
-impl Pores {
     /// [`Pores::mask`]'s value at `N` points with their fibre frames and ring values (the query
     /// set-up in lanes, [`SeededSparse::eval_oriented_many`]); the same values.
     #[inline(always)]
