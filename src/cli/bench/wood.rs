@@ -98,11 +98,26 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             all / 1e6,
             c / all
         );
+        if name == "african_mahogany" {
+            goal_line(all, c, c1);
+        }
         if args.breakdown {
             breakdown(volume.params(), &points)?;
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Issue 4's speed goals for the mahogany preset: the full model at ≥ 1 M texels/s per core, colour
+/// alone at ≥ 3× that (3 M); colour is timed in batches and point by point.
+fn goal_line(all: f64, colour_batch: f64, colour_point: f64) {
+    let verdict = |ok: bool| if ok { "met" } else { "not met" };
+    println!(
+        "|   goals: everything ≥ 1 M/s {}; colour ≥ 3 M/s {} in batches, {} point by point | | | | | |",
+        verdict(all >= 1e6),
+        verdict(colour_batch >= 3e6),
+        verdict(colour_point >= 3e6),
+    );
 }
 
 /// The presets named by `--only`, or all.
