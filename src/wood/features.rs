@@ -119,6 +119,27 @@ pub fn footprint_weight(size: f32, footprint: f32) -> f32 {
     (2.0 - footprint / size).clamp(0.0, 1.0)
 }
 
+/// A mask of discrete features: one band of bump kernels (sharpness `sharpness`, semi-axes `env`)
+/// with unit weights (`SparseConvolution::default()`'s tail), `density` overlapping a point on
+/// average, in `cells` of size `cell`.
+fn bump_mask_noise(
+    sharpness: f32,
+    density: f32,
+    env: Vec3,
+    (cell, cells): (Vec3, Cells),
+    seed: u32,
+) -> SeededSparse {
+    let noise = SparseConvolution {
+        kernel: Kernel::Bump { sharpness },
+        density,
+        envelope: env,
+        cell,
+        cells,
+        ..SparseConvolution::default()
+    };
+    SeededSparse::new(noise, seed)
+}
+
 /// Pores (vessels): bump-kernel noise with unit weights, kernels elongated along the fibre frame.
 /// Ring porosity scales each pore's size by s = 1 − porosity · g (§6.1.6: "modulate the pore sizes
 /// using one minus the growth ring volume", interpolated towards uniform size).
@@ -141,18 +162,14 @@ impl Pores {
         let env = Vec3::new(p.radius, p.radius, 0.5 * p.length);
         let xy = (env.x * env.x + (env.z * max_tilt.sin()).powi(2)).sqrt() * 1.001;
         Pores {
-            noise: SeededSparse::new(
-                SparseConvolution {
-                    kernel: Kernel::Bump {
-                        sharpness: p.sharpness,
-                    },
-                    density: p.density,
-                    envelope: env,
-                    cell: CELL_SCALE * Vec3::new(xy, xy, env.z * 1.001),
-                    cells: Cells::Cartesian,
-                    // One band of unit weights (`Default`): a mask, not a signed noise.
-                    ..SparseConvolution::default()
-                },
+            noise: bump_mask_noise(
+                p.sharpness,
+                p.density,
+                env,
+                (
+                    CELL_SCALE * Vec3::new(xy, xy, env.z * 1.001),
+                    Cells::Cartesian,
+                ),
                 seed,
             ),
             ring_porosity: p.ring_porosity,
@@ -242,20 +259,16 @@ impl Rays {
     pub fn new(p: &RayParams, seed: u32) -> Self {
         let env = Vec3::new(0.5 * p.length, 0.5 * p.width, 0.5 * p.height);
         Rays {
-            noise: SeededSparse::new(
-                SparseConvolution {
-                    kernel: Kernel::Bump {
-                        sharpness: p.sharpness,
-                    },
-                    density: p.density,
-                    envelope: env,
-                    // Arc cells wider than the ray: the search window along θ is set by the longest
-                    // semi-axis anyway (notes/noise.md), so thin cells would only add cells.
-                    cell: Vec3::new(env.x, RAY_ARC_CELLS * env.y, env.z),
-                    cells: Cells::Cylindrical,
-                    // One band of unit weights (`Default`): a mask, not a signed noise.
-                    ..SparseConvolution::default()
-                },
+            // Arc cells wider than the ray: the search window along θ is set by the longest
+            // semi-axis anyway (notes/noise.md), so thin cells would only add cells.
+            noise: bump_mask_noise(
+                p.sharpness,
+                p.density,
+                env,
+                (
+                    Vec3::new(env.x, RAY_ARC_CELLS * env.y, env.z),
+                    Cells::Cylindrical,
+                ),
                 seed,
             ),
             strength: p.strength,
