@@ -495,35 +495,38 @@ static INV_K: [f64; MAX_DRAW as usize + 1] = {
     t
 };
 
-/// Random numbers of impulse `k` of a cell: the SplitMix64 output (Steele, Lea & Flood 2014,
-/// "Fast splittable pseudorandom number generators", OOPSLA; finaliser Stafford's "Mix13") of the
-/// cell's 64 hash bits advanced k + 1 golden-ratio steps — four 16-bit fields: the position in
-/// the cell (resolution 2⁻¹⁶ of a cell) and a weight uniform in [−1, 1). Two multiplies per
-/// impulse instead of a second `pcg3d`.
+/// Random numbers of impulse `k` of a cell: two 32-bit words, the cell's hash words `h1` and `h2`
+/// advanced k + 1 Weyl steps (odd constants: the golden ratio's and MurmurHash3's), each through
+/// the lowbias32 finaliser ([`mix32`]; the second chained on the first) and cut into four 16-bit
+/// fields: the position in the cell (resolution 2⁻¹⁶ of a cell) and a weight uniform in [−1, 1).
+/// Only 32-bit multiplies, so AVX2 lanes run it as well as AVX-512 ones (a 64-bit SplitMix stream
+/// before, whose products AVX2 lacks: notes/noise.md).
 #[inline(always)]
 fn impulse(h: [u32; 3], k: u32) -> (Vec3, f32) {
     impulse_numbers(impulse_stream(h[1], h[2], k))
 }
 
-/// The SplitMix64 state of impulse `k` of a cell with hash words `h1`, `h2` (see [`impulse`]).
+/// The two words of impulse `k` of a cell with hash words `h1`, `h2` (see [`impulse`]).
 #[inline(always)]
-fn impulse_stream(h1: u32, h2: u32, k: u32) -> u64 {
-    (((h1 as u64) << 32) | h2 as u64)
-        .wrapping_add((k as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15))
+fn impulse_stream(h1: u32, h2: u32, k: u32) -> (u32, u32) {
+    let k1 = k.wrapping_add(1);
+    (
+        h1.wrapping_add(k1.wrapping_mul(0x9e37_79b9)),
+        h2.wrapping_add(k1.wrapping_mul(0x85eb_ca6b)),
+    )
 }
 
-/// The SplitMix64 finaliser of `z` cut into the impulse's position in its cell and its weight
-/// (see [`impulse`]).
+/// The words of [`impulse_stream`] mixed and cut into the impulse's position in its cell and its
+/// weight (see [`impulse`]).
 #[inline(always)]
-fn impulse_numbers(mut z: u64) -> (Vec3, f32) {
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^= z >> 31;
-    // 16-bit fields: exact as i32, so the same value as converting the u64.
-    let field = |shift: u32| ((z >> shift) & 0xffff) as i32 as f32 * (1.0 / 65_536.0);
+fn impulse_numbers((a, b): (u32, u32)) -> (Vec3, f32) {
+    let a = mix32(a);
+    let b = mix32(b ^ a);
+    // 16-bit fields: exact as i32 and as f32.
+    let field = |v: u32, shift: u32| ((v >> shift) & 0xffff) as i32 as f32 * (1.0 / 65_536.0);
     (
-        Vec3::new(field(48), field(32), field(16)),
-        2.0 * field(0) - 1.0,
+        Vec3::new(field(a, 16), field(a, 0), field(b, 16)),
+        2.0 * field(b, 0) - 1.0,
     )
 }
 
@@ -633,16 +636,30 @@ fn layer_shrink(oz: i32, fz: f32, cells_per_semi_axis: f32) -> f32 {
     ((1.0 - gap * gap).max(0.0).sqrt() + LAYER_SLACK).min(1.0)
 }
 
-/// Whether the CPU runs the Cartesian block search: AVX-512 F, DQ (the 64-bit multiply of the
-/// impulse stream) and VL; std caches the detection. With AVX2 alone the block search (64-bit
-/// multiplies emulated) measured slower than one cell at a time (notes/wood.md §12), so it is
-/// not built for it.
+/// The instruction set the Cartesian block search runs on, if any: AVX-512 (F, DQ, VL: 32 lanes
+/// in two registers) or AVX2 (four); std caches the detection. Without AVX2 the cells are
+/// searched one at a time.
+#[cfg(target_arch = "x86_64")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum BlockSearch {
+    Avx512,
+    Avx2,
+    None,
+}
+
 #[cfg(target_arch = "x86_64")]
 #[inline]
-fn block_search() -> bool {
-    is_x86_feature_detected!("avx512f")
+fn block_search() -> BlockSearch {
+    if is_x86_feature_detected!("avx512f")
         && is_x86_feature_detected!("avx512dq")
         && is_x86_feature_detected!("avx512vl")
+    {
+        BlockSearch::Avx512
+    } else if is_x86_feature_detected!("avx2") {
+        BlockSearch::Avx2
+    } else {
+        BlockSearch::None
+    }
 }
 
 /// The indices of the set bits of `mask`, ascending.
@@ -731,9 +748,9 @@ impl Band {
         }
     }
 
-    /// Cartesian cells: on CPUs with AVX-512 the 3 × 3 × 3 block of cells is searched in
+    /// Cartesian cells: on CPUs with AVX-512 or AVX2 the 3 × 3 × 3 block of cells is searched in
     /// SIMD lanes ([`Band::cartesian_block`]), else (and for windows wider than the block, which
-    /// only rounding can make) one cell at a time. Both give the same value, bit for bit.
+    /// only rounding can make) one cell at a time. All give the same value, bit for bit.
     fn cartesian<const GRAD: bool>(
         &self,
         p: Vec3,
@@ -748,10 +765,14 @@ impl Band {
     #[inline(always)]
     fn cartesian_search<const GRAD: bool>(&self, q: &CartesianQuery) -> (f32, Vec3) {
         #[cfg(target_arch = "x86_64")]
-        if q.in_block() && block_search() {
+        if q.in_block() {
             let upright = q.map.axes.as_ref().is_some_and(is_upright);
-            // SAFETY: `block_search` detected the instruction sets.
-            return unsafe { self.cartesian_avx512::<GRAD>(q, upright) };
+            match block_search() {
+                // SAFETY: `block_search` detected the instruction sets.
+                BlockSearch::Avx512 => return unsafe { self.cartesian_avx512::<GRAD>(q, upright) },
+                BlockSearch::Avx2 => return unsafe { self.cartesian_avx2::<GRAD>(q, upright) },
+                BlockSearch::None => {}
+            }
         }
         self.cartesian_cells::<GRAD>(q)
     }
@@ -872,6 +893,16 @@ impl Band {
             }
         }
         acc
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn cartesian_avx2<const GRAD: bool>(
+        &self,
+        q: &CartesianQuery,
+        upright: bool,
+    ) -> (f32, Vec3) {
+        self.cartesian_block::<GRAD>(q, upright)
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -1362,7 +1393,8 @@ mod tests {
         assert!(nonzero > 60, "the comparison must see kernels");
     }
 
-    /// The SIMD block search gives the one-cell-at-a-time value and gradient bit for bit, for
+    /// The SIMD block search (AVX-512 and AVX2) gives the one-cell-at-a-time value and gradient
+    /// bit for bit, for
     /// axis-aligned, upright (turned about z, the layer shrink) and tilted kernels, sparse and
     /// dense cells (counts past the threshold table, many rounds), and both signs of coordinates.
     #[test]
@@ -1397,20 +1429,37 @@ mod tests {
                 let q = b.cartesian_query(p, frame, 1.0);
                 let reference = b.cartesian_cells::<true>(&q);
                 let value = b.cartesian_cells::<false>(&q).0;
-                let fast = b.cartesian::<true>(p, frame, 1.0);
-                let fast_value = b.cartesian::<false>(p, frame, 1.0).0;
-                assert_eq!(
-                    fast.0.to_bits(),
-                    reference.0.to_bits(),
-                    "value at {p} ({i})"
-                );
-                assert_eq!(fast_value.to_bits(), value.to_bits(), "value at {p} ({i})");
-                for k in 0..3 {
+                // The dispatched search (the widest the CPU has) and, where the CPU has AVX2,
+                // the AVX2 block search itself.
+                let mut searches = vec![(
+                    b.cartesian::<true>(p, frame, 1.0),
+                    b.cartesian::<false>(p, frame, 1.0).0,
+                )];
+                #[cfg(target_arch = "x86_64")]
+                if q.in_block() && is_x86_feature_detected!("avx2") {
+                    let upright = frame.is_some_and(is_upright);
+                    // SAFETY: AVX2 detected.
+                    searches.push(unsafe {
+                        (
+                            b.cartesian_avx2::<true>(&q, upright),
+                            b.cartesian_avx2::<false>(&q, upright).0,
+                        )
+                    });
+                }
+                for (fast, fast_value) in searches {
                     assert_eq!(
-                        fast.1[k].to_bits(),
-                        reference.1[k].to_bits(),
-                        "∇ at {p} ({i})"
+                        fast.0.to_bits(),
+                        reference.0.to_bits(),
+                        "value at {p} ({i})"
                     );
+                    assert_eq!(fast_value.to_bits(), value.to_bits(), "value at {p} ({i})");
+                    for k in 0..3 {
+                        assert_eq!(
+                            fast.1[k].to_bits(),
+                            reference.1[k].to_bits(),
+                            "∇ at {p} ({i})"
+                        );
+                    }
                 }
                 compared += (reference.0 != 0.0) as u32;
             }
