@@ -98,17 +98,65 @@ pub fn signed_f32(h: u32) -> f32 {
     (h >> 8) as f32 * (2.0 / 16_777_216.0) - 1.0
 }
 
+/// `x as i32` (truncation, saturating, NaN → 0) from an unchecked conversion and selects: the
+/// same values, but a loop over many x vectorises (a plain `as` compiles to scalar code there).
+#[inline(always)]
+pub fn saturating_i32(x: f32) -> i32 {
+    const LIMIT: f32 = 2_147_483_648.0; // 2³¹
+    let inside = x.abs() < LIMIT;
+    // SAFETY: the argument is finite and below 2³¹ in magnitude.
+    let t = unsafe { (if inside { x } else { 0.0 }).to_int_unchecked::<i32>() };
+    if inside {
+        t
+    } else if x >= LIMIT {
+        i32::MAX
+    } else if x <= -LIMIT {
+        i32::MIN
+    } else {
+        0
+    }
+}
+
 /// `⌊x⌋` as an integer without a libm call (`f32::floor` is not an instruction on baseline
-/// x86-64). Exact for |x| < 2^31.
+/// x86-64). Exact for |x| < 2^31; vectorises (through [`saturating_i32`]).
 #[inline(always)]
 pub fn floor_i32(x: f32) -> i32 {
-    let i = x as i32;
+    let i = saturating_i32(x);
     i - ((x < i as f32) as i32)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn saturating_i32_is_as() {
+        let mut r = crate::math::Pcg32::new(11, 0);
+        let mut check = |x: f32| assert_eq!(saturating_i32(x), x as i32, "{x}");
+        for x in [
+            0.0f32,
+            -0.0,
+            0.5,
+            -0.5,
+            -1.0,
+            2_147_483_520.0,
+            -2_147_483_648.0,
+            2_147_483_648.0,
+            -2_147_483_904.0,
+            f32::MAX,
+            f32::MIN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+        ] {
+            check(x);
+        }
+        for _ in 0..100_000 {
+            let x = (r.next_f32() * 2.0 - 1.0) * 10f32.powf(r.next_f32() * 12.0);
+            check(x);
+            check(x.round());
+        }
+    }
 
     #[test]
     fn floor_matches_std() {

@@ -344,26 +344,21 @@ impl SeededSparse {
         let scale = kernel_scale.map(|k| k.clamp(f32::MIN_POSITIVE, 1.0));
         let mut value = [0.0f32; N];
         for (amp, band) in &self.bands[..bands.min(self.bands.len())] {
-            let queries = match self.noise.cells {
-                Cells::Cartesian => band.cartesian_queries(p, frames, &scale),
-                Cells::Cylindrical => None,
-            };
-            for i in 0..N {
-                let v = match &queries {
-                    Some(q) => band.cartesian_search::<false>(&q[i]).0,
-                    None => {
-                        match self.noise.cells {
-                            Cells::Cartesian => {
-                                band.cartesian::<false>(p[i], Some(&frames[i]), scale[i])
-                            }
-                            Cells::Cylindrical => {
-                                band.cylindrical::<false>(p[i], Some(&frames[i]), scale[i])
-                            }
-                        }
-                        .0
+            match self.noise.cells {
+                Cells::Cartesian => {
+                    let queries = band.cartesian_queries(p, frames, &scale);
+                    for (value, q) in value.iter_mut().zip(&queries) {
+                        *value += amp * band.cartesian_search::<false>(q).0;
                     }
-                };
-                value[i] += amp * v;
+                }
+                Cells::Cylindrical => {
+                    for i in 0..N {
+                        let v = band
+                            .cylindrical::<false>(p[i], Some(&frames[i]), scale[i])
+                            .0;
+                        value[i] += amp * v;
+                    }
+                }
             }
         }
         value
@@ -777,70 +772,15 @@ impl Band {
         self.cartesian_cells::<GRAD>(q)
     }
 
-    /// [`Band::cartesian_query`] for `N` points with their frames and kernel scales, in lanes: one
-    /// array per coordinate, the same operations in the same order, so the same queries. `None`
-    /// where a point's cell index is not below 2³⁰ in magnitude (or not finite): there the lanes'
-    /// floor could differ from [`floor_i32`]'s saturation, and the caller asks point by point.
+    /// [`Band::cartesian_query`] for `N` points with their frames and kernel scales: one loop with
+    /// no call and no data-dependent branch, which the compiler runs in SIMD lanes.
     #[inline(always)]
     fn cartesian_queries<const N: usize>(
         &self,
         p: &[Vec3; N],
         frames: &[Frame; N],
         scale: &[f32; N],
-    ) -> Option<[CartesianQuery; N]> {
-        type Lanes<const N: usize> = [f32; N];
-        let (cell, env0) = (self.cell, self.env);
-        let zero = [0.0f32; N];
-        let (mut ex, mut ey, mut ez): (Lanes<N>, Lanes<N>, Lanes<N>) = (zero, zero, zero);
-        let (mut ix, mut iy, mut iz) = (zero, zero, zero);
-        let (mut rx, mut ry, mut rz) = (zero, zero, zero);
-        for i in 0..N {
-            let (f, k) = (&frames[i], scale[i]);
-            let (e_x, e_y, e_z) = (env0.x * k, env0.y * k, env0.z * k);
-            // Eq. 9 (`bbox_half_extent`): the rows of R·Sₑ, a = s e_x, b = t e_y, c = n e_z.
-            let (a, b, c) = (f.s * e_x, f.t * e_y, f.n * e_z);
-            ex[i] = (a.x * a.x + b.x * b.x + c.x * c.x).sqrt();
-            ey[i] = (a.y * a.y + b.y * b.y + c.y * c.y).sqrt();
-            ez[i] = (a.z * a.z + b.z * b.z + c.z * c.z).sqrt();
-            // Eq. 11: the fit.
-            let sb = (cell.x / ex[i])
-                .min(cell.y / ey[i])
-                .min(cell.z / ez[i])
-                .min(1.0);
-            (ix[i], iy[i], iz[i]) = (1.0 / (sb * e_x), 1.0 / (sb * e_y), 1.0 / (sb * e_z));
-            (rx[i], ry[i], rz[i]) = (
-                sb * ex[i] / cell.x,
-                sb * ey[i] / cell.y,
-                sb * ez[i] / cell.z,
-            );
-        }
-        let (mut px, mut py, mut pz) = (zero, zero, zero);
-        let mut in_range = true;
-        for i in 0..N {
-            (px[i], py[i], pz[i]) = (p[i].x / cell.x, p[i].y / cell.y, p[i].z / cell.z);
-            in_range &= px[i].abs() < 1.0e9 && py[i].abs() < 1.0e9 && pz[i].abs() < 1.0e9;
-        }
-        if !in_range {
-            return None;
-        }
-        let (mut fx, mut fy, mut fz) = (zero, zero, zero);
-        let mut base = [[0i32; 3]; N];
-        for i in 0..N {
-            // SAFETY: |⌊x⌋| < 10⁹ < 2³¹ and finite (checked above): each conversion is exact.
-            let b: [i32; 3] = unsafe {
-                [
-                    px[i].floor().to_int_unchecked(),
-                    py[i].floor().to_int_unchecked(),
-                    pz[i].floor().to_int_unchecked(),
-                ]
-            };
-            (fx[i], fy[i], fz[i]) = (
-                px[i] - b[0] as f32,
-                py[i] - b[1] as f32,
-                pz[i] - b[2] as f32,
-            );
-            base[i] = b;
-        }
+    ) -> [CartesianQuery; N] {
         let mut queries = [CartesianQuery {
             map: KernelMap {
                 axes: None,
@@ -852,15 +792,9 @@ impl Band {
             gap_scale: Vec3::ZERO,
         }; N];
         for (i, q) in queries.iter_mut().enumerate() {
-            q.map = KernelMap {
-                axes: Some(frames[i]),
-                inv: Vec3::new(ix[i], iy[i], iz[i]),
-            };
-            q.reach = Vec3::new(rx[i], ry[i], rz[i]);
-            q.base = base[i];
-            q.f = Vec3::new(fx[i], fy[i], fz[i]);
+            *q = self.cartesian_query(p[i], Some(&frames[i]), scale[i]);
         }
-        Some(queries)
+        queries
     }
 
     /// One cell at a time over the window (the reference the block search must equal).
