@@ -34,56 +34,39 @@ impl BeerColor {
     /// (latewood units, e.g. knot wood).
     #[inline(always)]
     pub fn absorbance(&self, g: f32, pore: f32, ray: f32, extra: f32) -> Vec3 {
-        self.base
-            + self.ring * g
-            + self.late * (self.pore_path * pore + self.ray_path * ray + extra)
+        let channel = |ch| self.channel_absorbance(ch, g, pore, ray, extra);
+        Vec3::new(channel(0), channel(1), channel(2))
     }
 
     /// (diffuse, fibre) colours of an absorbance; the fibre colour uses a scaled absorbance so it is
     /// less saturated than the diffuse (App. A.3). Clamped to [0, 1] (a negative path may lighten).
     #[inline(always)]
     pub fn colors(&self, absorbance: Vec3) -> (Vec3, Vec3) {
-        let a = absorbance.max(Vec3::ZERO);
-        (exp3(-a), exp3(-a * self.fiber_saturation))
+        let (r, g, b) = (
+            self.channel_colors(absorbance.x),
+            self.channel_colors(absorbance.y),
+            self.channel_colors(absorbance.z),
+        );
+        (Vec3::new(r.0, g.0, b.0), Vec3::new(r.1, g.1, b.1))
     }
-}
 
-impl BeerColor {
-    /// Channel `ch` (0 red, 1 green, 2 blue) of the earlywood, ring and latewood absorbances, for
-    /// [`BeerColor::channel_absorbance`].
+    /// Channel `ch` (0 red, 1 green, 2 blue) of [`BeerColor::absorbance`]: one scalar expression,
+    /// so a loop over many texels runs it in SIMD lanes.
     #[inline(always)]
-    pub fn channel(&self, ch: usize) -> (f32, f32, f32) {
-        (self.base[ch], self.ring[ch], self.late[ch])
+    pub fn channel_absorbance(&self, ch: usize, g: f32, pore: f32, ray: f32, extra: f32) -> f32 {
+        self.base[ch]
+            + self.ring[ch] * g
+            + self.late[ch] * (self.pore_path * pore + self.ray_path * ray + extra)
     }
 
-    /// One channel of [`BeerColor::absorbance`] with no extra path (the same operations).
-    #[inline(always)]
-    pub fn channel_absorbance(
-        &self,
-        base: f32,
-        ring: f32,
-        late: f32,
-        g: f32,
-        pore: f32,
-        ray: f32,
-    ) -> f32 {
-        base + ring * g + late * (self.pore_path * pore + self.ray_path * ray + 0.0)
-    }
-
-    /// One channel of [`BeerColor::colors`] (the same operations).
+    /// One channel of [`BeerColor::colors`]: (diffuse, fibre), by the branch-free `exp` that
+    /// vectorises.
     #[inline(always)]
     pub fn channel_colors(&self, absorbance: f32) -> (f32, f32) {
         use crate::math::elementary::exp;
         let a = absorbance.max(0.0);
         (exp(-a), exp(-a * self.fiber_saturation))
     }
-}
-
-/// eˣ per channel, by the branch-free polynomial that vectorises in batch evaluation.
-#[inline(always)]
-fn exp3(v: Vec3) -> Vec3 {
-    use crate::math::elementary::exp;
-    Vec3::new(exp(v.x), exp(v.y), exp(v.z))
 }
 
 #[cfg(test)]

@@ -169,7 +169,8 @@ impl WoodVolume {
         self.time_with::<true>(r)
     }
 
-    /// [`WoodVolume::time`]; without `CHECKED` only where [`WoodVolume::batch_time_ok`] holds.
+    /// [`WoodVolume::time`]; without `CHECKED` only where the growth wave's
+    /// [`SmoothTriangleWave::in_fast_range`] holds.
     #[inline(always)]
     fn time_with<const CHECKED: bool>(&self, r: f32) -> (f32, f32) {
         let u = r * self.inv_ring_width;
@@ -398,7 +399,7 @@ impl WoodVolume {
         }
     }
 
-    /// [`WoodVolume::color_block`] compiled for the widest instruction set the CPU has.
+    /// [`WoodVolume::color_block`] compiled for `simd`.
     #[inline]
     fn color_block_on(
         &self,
@@ -527,11 +528,10 @@ impl WoodVolume {
         let mut diffuse = [[0.0f32; BATCH]; 3];
         let mut fiber = [[0.0f32; BATCH]; 3];
         for ch in 0..3 {
-            let (base, ring, late) = self.color.channel(ch);
             for i in 0..BATCH {
                 let a = self
                     .color
-                    .channel_absorbance(base, ring, late, g[i], pore[i], ray[i]);
+                    .channel_absorbance(ch, g[i], pore[i], ray[i], 0.0);
                 (diffuse[ch][i], fiber[ch][i]) = self.color.channel_colors(a);
             }
         }
