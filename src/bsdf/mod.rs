@@ -2,6 +2,8 @@
 //! the surface): the finished-wood BSDF of Marschner et al. 2005 and the simple BSDFs scenes need.
 
 mod fiber;
+pub mod fiber_albedo;
+mod fiber_albedo_table;
 mod fresnel;
 mod ggx;
 mod lambertian;

@@ -5,6 +5,7 @@
 //! densities are derived in notes/bsdf.md.
 
 use super::fiber::{FiberAtWo, FiberAxis, FiberNormalization, BATCH};
+use super::fiber_albedo::{dip_of, max_lobe_albedo};
 use super::fresnel::{fresnel_dielectric, fresnel_diffuse_reflectance, refract_in, refract_out};
 use super::ggx::Ggx;
 use super::{Bsdf, BsdfError, BsdfSample, WoodBsdfParams};
@@ -25,7 +26,7 @@ pub struct WoodBsdf {
     ray: FiberAxis,
     /// ρ'/(1 − ρ' F̄_int): the diffuse albedo including the closed-form series of internal
     /// reflections under the finish (notes/bsdf.md §1.3), with ρ' = s ρ scaled just enough that
-    /// ρ' ≤ 1 − k_f in every channel (notes/bsdf.md §2.3).
+    /// ρ' ≤ 1 − k_f Ā in every channel ([`bounded_diffuse`], notes/bsdf.md §2.3).
     diffuse_eff: Vec3,
     /// 1 − F̄_int = (1 − F̄_ext)/η²: fraction of Lambertian light from the substrate that leaves.
     escape: f32,
@@ -104,11 +105,22 @@ fn check_range(
     }
 }
 
-/// The diffuse albedo scaled uniformly, s = min(1, min_c (1 − k_f,c)/ρ_c), so that diffuse plus
-/// fibre albedo stays ≤ 1 per channel (notes/bsdf.md §2.3). A uniform scale keeps the wood's hue;
-/// clamping each channel to 1 − k_f would shift it (a bright fibre colour turned maple teal).
-fn bounded_diffuse(rho: Vec3, kf: Vec3) -> Vec3 {
-    let room = Vec3::ONE - kf;
+/// The diffuse albedo scaled uniformly, s = min(1, min_c (1 − k_f,c Ā)/ρ_c), so that the diffuse
+/// plus the most the fibre lobes can reflect at any view, k_f Ā, stays ≤ 1 per channel
+/// (notes/bsdf.md §2.3). Ā = (1 − m) A_max(β, δ_fibre) + m A_max(β, δ_ray) is the ray-mask blend
+/// of the lobes' largest directional albedos ([`max_lobe_albedo`]), not 1: bounding by k_f
+/// alone made pale woods render at a fifth of their colour. A uniform scale keeps the wood's hue.
+fn bounded_diffuse(p: &WoodBsdfParams) -> Vec3 {
+    let m = p.ray_mask;
+    let beta = p.highlight_width;
+    let mut lobe_albedo = 0.0;
+    if m < 1.0 {
+        lobe_albedo += (1.0 - m) * max_lobe_albedo(beta, dip_of(p.fiber_dir.z));
+    }
+    if m > 0.0 {
+        lobe_albedo += m * max_lobe_albedo(beta, dip_of(p.ray_dir.z));
+    }
+    let (rho, room) = (p.diffuse, Vec3::ONE - p.fiber_color * lobe_albedo);
     let mut s = 1.0f32;
     for c in 0..3 {
         if rho[c] > room[c] {
@@ -161,7 +173,7 @@ impl WoodBsdf {
         let f_ext = fresnel_diffuse_reflectance(eta);
         let escape = (1.0 - f_ext) / (eta * eta);
         let f_int = 1.0 - escape;
-        let rho = bounded_diffuse(params.diffuse, params.fiber_color);
+        let rho = bounded_diffuse(&params);
         let diffuse_eff = rho / (Vec3::ONE - rho * f_int);
         Ok(WoodBsdf {
             finish: FinishModel::ClosedForm,
@@ -190,7 +202,7 @@ impl WoodBsdf {
         if finish == self.finish {
             return self;
         }
-        let rho = bounded_diffuse(self.params.diffuse, self.params.fiber_color);
+        let rho = bounded_diffuse(&self.params);
         self.diffuse_eff = match finish {
             // ρ'' = ρ'/(1 − ρ' F̄_int), F̄_int = 1 − escape (notes/bsdf.md eq. 1.3).
             FinishModel::ClosedForm => rho / (Vec3::ONE - rho * (1.0 - self.escape)),
@@ -902,17 +914,50 @@ mod tests {
 #[cfg(test)]
 mod bounded_diffuse_tests {
     use super::bounded_diffuse;
+    use crate::bsdf::fiber_albedo::TABLE_MARGIN;
+    use crate::bsdf::WoodBsdfParams;
     use glam::Vec3;
+    use std::f32::consts::FRAC_1_PI;
 
+    fn params(diffuse: Vec3, fiber_color: Vec3) -> WoodBsdfParams {
+        WoodBsdfParams {
+            diffuse,
+            fiber_color,
+            fiber_dir: Vec3::X,
+            ray_dir: Vec3::Z,
+            ray_mask: 0.0,
+            highlight_width: 1e-3,
+            eta: 1.5,
+            roughness: 0.0,
+        }
+    }
+
+    /// In-plane fibres with a sharp highlight reflect at most 1/π (notes/bsdf.md §2.1, C = 2 cos ψ),
+    /// so a pale maple keeps (1 − k_f/π)/ρ of its colour, not (1 − k_f)/ρ, in the same hue.
     #[test]
-    fn keeps_hue_and_bounds_each_channel() {
-        let rho = Vec3::new(0.8, 0.6, 0.35);
-        let kf = Vec3::new(0.6, 0.5, 0.4);
-        let b = bounded_diffuse(rho, kf);
-        assert!((b + kf).max_element() <= 1.0 + 1e-6);
-        // Same hue: every channel scaled by the same factor (0.4 / 0.8 = 0.5 from red).
-        assert!((b / rho - Vec3::splat(0.5)).abs().max_element() < 1e-6);
+    fn leaves_room_for_what_the_lobe_reflects() {
+        let (rho, kf) = (Vec3::new(0.9, 0.8, 0.6), Vec3::new(0.9, 0.85, 0.75));
+        let b = bounded_diffuse(&params(rho, kf));
+        let lobe = FRAC_1_PI * (1.0 + TABLE_MARGIN);
+        let s = (1.0 - kf.x * lobe) / rho.x;
+        assert!((b / rho - Vec3::splat(s)).abs().max_element() < 1e-4, "{b}");
+        assert!((b + kf * lobe).max_element() <= 1.0 + 1e-4);
         // Colours that already fit are unchanged.
-        assert_eq!(bounded_diffuse(Vec3::splat(0.3), kf), Vec3::splat(0.3));
+        let dark = Vec3::new(0.3, 0.2, 0.1);
+        assert_eq!(bounded_diffuse(&params(dark, kf)), dark);
+    }
+
+    /// Ray fibres along the normal reflect every sharp highlight into the surface (the cone about
+    /// ψi = −ψr lies below it), so a full ray mask leaves the diffuse as it is.
+    #[test]
+    fn blends_the_ray_lobe_by_the_mask() {
+        let (rho, kf) = (Vec3::splat(0.95), Vec3::ONE);
+        let mut p = params(rho, kf);
+        p.ray_mask = 1.0;
+        assert!((bounded_diffuse(&p) - rho).abs().max_element() < 2e-3);
+        p.ray_mask = 0.5;
+        let half = bounded_diffuse(&p).x;
+        let want = (1.0 - 0.5 * FRAC_1_PI * (1.0 + TABLE_MARGIN)) / 0.95;
+        assert!((half / 0.95 - want.min(1.0)).abs() < 2e-3, "{half}");
     }
 }

@@ -5,6 +5,7 @@
 //! - [`sweep`]: highlight tracking, renderer against the BSDF, figure signatures of light sweeps;
 //! - [`report`]: validation/REPORT.md, one replaceable section per suite.
 
+pub mod appearance;
 pub mod bsdf;
 pub mod report;
 pub mod sweep;
