@@ -11,9 +11,9 @@
 //! as c^s with the preset's fibre saturation s (exact for the Beer's-law colours of
 //! `wood::BeerColor`, whose fibre colour is exp(−s a) = c^s).
 
-use super::{wood_shading, MaterialHit, Shading, ShadingSwitches};
-use crate::bsdf::WoodBsdfParams;
-use crate::math::{safe_sqrt, Frame};
+use super::face::{bilinear_taps, face_shading, FaceRect, FaceTexel};
+use super::{MaterialHit, Shading, ShadingSwitches};
+use crate::math::safe_sqrt;
 use glam::{Vec2, Vec3};
 use std::sync::Arc;
 
@@ -46,46 +46,6 @@ pub enum BakedFibers {
     Direction,
 }
 
-/// A rectangle of a plane: texel (0, 0)'s corner, unit `right` (+u) and `down` (+v) axes and the
-/// size along them. Lengths in the units of the space it lives in.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct FaceRect {
-    pub corner: Vec3,
-    pub right: Vec3,
-    pub down: Vec3,
-    pub size: Vec2,
-}
-
-impl FaceRect {
-    /// The face normal right × up (up = −down).
-    pub fn normal(&self) -> Vec3 {
-        self.right.cross(-self.down)
-    }
-
-    /// The point at texture coordinates `uv` ∈ [0, 1]².
-    pub fn point(&self, uv: Vec2) -> Vec3 {
-        self.corner + self.right * (uv.x * self.size.x) + self.down * (uv.y * self.size.y)
-    }
-
-    /// Texture coordinates of the projection of `p` onto the face.
-    pub fn uv(&self, p: Vec3) -> Vec2 {
-        let d = p - self.corner;
-        Vec2::new(
-            d.dot(self.right) / self.size.x,
-            d.dot(self.down) / self.size.y,
-        )
-    }
-
-    /// Texture size for `res` texels along `right` (at least 1 × 1), square texels.
-    pub fn texture_size(&self, res: u32) -> (u32, u32) {
-        let res = res.max(1);
-        (
-            res,
-            ((res as f32 * self.size.y / self.size.x).round() as u32).max(1),
-        )
-    }
-}
-
 /// Everything one bilinear lookup of the maps returns.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BakedTexel {
@@ -104,18 +64,7 @@ impl BakedMaps {
     /// Bilinear lookup at texture coordinates `uv` (texel centres at (i + ½)/W), clamped to the
     /// edge texels outside [0, 1]².
     pub fn lookup(&self, uv: Vec2) -> BakedTexel {
-        let (w, h) = (self.width as usize, self.height as usize);
-        let x = (uv.x * w as f32 - 0.5).clamp(0.0, (w - 1) as f32);
-        let y = (uv.y * h as f32 - 0.5).clamp(0.0, (h - 1) as f32);
-        let (x0, y0) = (x as usize, y as usize);
-        let (x1, y1) = ((x0 + 1).min(w - 1), (y0 + 1).min(h - 1));
-        let (fx, fy) = (x - x0 as f32, y - y0 as f32);
-        let weights = [
-            (y0 * w + x0, (1.0 - fx) * (1.0 - fy)),
-            (y0 * w + x1, fx * (1.0 - fy)),
-            (y1 * w + x0, (1.0 - fx) * fy),
-            (y1 * w + x1, fx * fy),
-        ];
+        let weights = bilinear_taps(uv, self.width, self.height);
         let mut t = BakedTexel {
             base_color: Vec3::ZERO,
             anisotropy: Vec3::ZERO,
@@ -180,43 +129,40 @@ impl BakedWoodMaterial {
     pub fn shade(&self, hit: &MaterialHit) -> Shading {
         let t = self.maps.lookup(self.face.uv(hit.p_object));
         let f = &self.face;
-        let up = -f.down;
-        let to_world = |tangent: Vec3| {
-            let obj = f.right * tangent.x + up * tangent.y + f.normal() * tangent.z;
-            (hit.object_to_world * obj).normalize_or_zero()
-        };
         let mut n = hit.ns;
         if self.bump != 0.0 && t.normal.z > 1e-3 {
             // The normal map stores n ∝ (−∂h/∂x, −∂h/∂y, 1): the height gradient in the face is
             // (−n_x/n_z, −n_y/n_z); it tilts the normal as the volume's bump does (Blinn 1978).
             let (hx, hy) = (-t.normal.x / t.normal.z, -t.normal.y / t.normal.z);
-            let g = hit.normal_to_world * (f.right * hx + up * hy) * self.bump;
+            let g = hit.normal_to_world * (f.right * hx - f.down * hy) * self.bump;
             let tilted = (n - (g - n * g.dot(n))).normalize_or_zero();
             if tilted != Vec3::ZERO && tilted.is_finite() {
                 n = tilted;
             }
         }
-        let fiber_world = to_world(match self.fibers {
+        let fiber = match self.fibers {
             BakedFibers::Anisotropy => fiber_from_anisotropy(t.anisotropy),
             BakedFibers::Direction => t.fiber,
-        });
-        let frame = Frame::from_normal_tangent(n, fiber_world);
-        let ray_world = frame.t;
+        };
         let diffuse = t.base_color.clamp(Vec3::ZERO, Vec3::ONE);
-        let fiber_color = diffuse
-            .powf(self.fiber_saturation)
-            .clamp(Vec3::ZERO, Vec3::ONE);
-        let local = WoodBsdfParams {
+        let texel = FaceTexel {
             diffuse,
-            fiber_color,
-            fiber_dir: frame.to_local(fiber_world),
-            ray_dir: frame.to_local(ray_world),
+            fiber_color: diffuse
+                .powf(self.fiber_saturation)
+                .clamp(Vec3::ZERO, Vec3::ONE),
+            fiber,
             ray_mask: t.ray_mask.clamp(0.0, 1.0),
             highlight_width: t.highlight_width.clamp(1e-3, 0.5 * std::f32::consts::PI),
-            eta: self.eta,
-            roughness: self.roughness,
         };
-        wood_shading(local, frame, fiber_world, 0.0, self.switches.finish)
+        face_shading(
+            hit,
+            f,
+            n,
+            texel,
+            self.eta,
+            self.roughness,
+            self.switches.finish,
+        )
     }
 }
 
@@ -255,19 +201,5 @@ mod tests {
         // Strength ½: the in-face part has length ½ and the fibre dips into the face.
         let g = fiber_from_anisotropy(Vec3::new(0.5, 1.0, 0.5));
         assert!((g.length() - 1.0).abs() < 1e-6 && (g.y - 0.5).abs() < 1e-6 && g.z < 0.0);
-    }
-
-    #[test]
-    fn face_maps_points_to_uv_and_back() {
-        let f = FaceRect {
-            corner: Vec3::new(-10.0, 5.0, 2.0),
-            right: Vec3::X,
-            down: -Vec3::Y,
-            size: Vec2::new(20.0, 10.0),
-        };
-        assert_eq!(f.normal(), Vec3::Z);
-        let uv = Vec2::new(0.3, 0.8);
-        assert!((f.uv(f.point(uv)) - uv).length() < 1e-6);
-        assert_eq!(f.texture_size(64), (64, 32));
     }
 }

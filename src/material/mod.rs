@@ -6,10 +6,15 @@
 //! in the tree, so the same log can be cut along different planes.
 
 mod baked;
+mod face;
+mod measured;
 mod placement;
 
-pub use baked::{
-    fiber_from_anisotropy, BakedFibers, BakedMaps, BakedTexel, BakedWoodMaterial, FaceRect,
+pub use baked::{fiber_from_anisotropy, BakedFibers, BakedMaps, BakedTexel, BakedWoodMaterial};
+pub use face::{bilinear_taps, FaceRect};
+pub use measured::{
+    energy_bounded_fiber_color, BoardFace, ColorSpace, MeasuredBoard, MeasuredError, MeasuredFiles,
+    MeasuredMaterial,
 };
 pub use placement::{Cutting, Placement};
 
@@ -136,6 +141,9 @@ pub enum Material {
     /// Wood from baked texture maps on one flat face (the procedural volume's image-texture
     /// counterpart, for `xylem tradeoff`).
     BakedWood(Box<BakedWoodMaterial>),
+    /// A board measured by Marschner et al. 2005: per-texel BSDF parameters from image maps on
+    /// one flat face.
+    Measured(Box<MeasuredMaterial>),
     Mirror {
         reflectance: Vec3,
     },
@@ -205,6 +213,7 @@ impl Material {
             }
             Material::Wood(w) => w.shade(hit),
             Material::BakedWood(b) => b.shade(hit),
+            Material::Measured(m) => m.shade(hit),
             Material::Mirror { reflectance } => Shading {
                 bsdf: SurfaceBsdf::Mirror(Mirror {
                     reflectance: *reflectance,
