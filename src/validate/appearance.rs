@@ -5,10 +5,11 @@
 //!   environment: its radiance must rise with the preset's diffuse albedo (pale earlywood
 //!   renders pale), i.e. the BSDF's energy split keeps the albedo's order (notes/bsdf.md §2.3).
 
-use crate::material::Placement;
+use crate::material::{MeasuredBoard, Placement};
 use crate::math::luminance;
 use crate::render::{render, RunOptions};
 use crate::scene;
+use crate::sweep::cache::{render_sweep, SweepPath};
 use crate::wood::{Needs, WoodVolume};
 use glam::Vec3;
 use std::path::Path;
@@ -99,43 +100,26 @@ pub fn white_light_ring_order(preset: &str, spp: u32) -> Result<WhiteLightOrder,
     })
 }
 
-/// Pearson's correlation coefficient of (x, y) pairs; 0 when either has no variance.
+/// Pearson's correlation of (x, y) pairs ([`super::sweep::pearson`] on the two columns).
 pub fn pearson(pairs: &[(f64, f64)]) -> f64 {
-    let n = pairs.len().max(1) as f64;
-    let (mx, my) = pairs
-        .iter()
-        .fold((0.0, 0.0), |(a, b), p| (a + p.0 / n, b + p.1 / n));
-    let (mut sxy, mut sxx, mut syy) = (0.0, 0.0, 0.0);
-    for &(x, y) in pairs {
-        sxy += (x - mx) * (y - my);
-        sxx += (x - mx) * (x - mx);
-        syy += (y - my) * (y - my);
-    }
-    if sxx > 0.0 && syy > 0.0 {
-        sxy / (sxx * syy).sqrt()
-    } else {
-        0.0
-    }
+    let (x, y): (Vec<f64>, Vec<f64>) = pairs.iter().copied().unzip();
+    super::sweep::pearson(&x, &y)
 }
 
-/// Per-texel BSDF parameters of a flat board face, in the encoding of the measured boards of
-/// Marschner et al. 2005: row-major, top row first; `fiber_axis` in the board frame (x along
-/// the columns, y along the rows, z the face normal), a line (u ≡ −u).
-#[derive(Clone, Debug, Default)]
+/// A flat board face in the encoding of the measured boards of Marschner et al. 2005
+/// ([`MeasuredBoard`]: row-major, top row first, fibre axis in the board frame x along the
+/// columns, y towards the top row, z out of the face), and which way its grain runs.
+#[derive(Clone, Debug)]
 pub struct BoardMaps {
-    pub width: usize,
-    pub height: usize,
-    pub diffuse: Vec<Vec3>,
-    pub fiber_color: Vec<Vec3>,
-    pub fiber_axis: Vec<Vec3>,
+    pub board: MeasuredBoard,
     /// Which image axis the grain runs along: true for columns (x), false for rows (y).
     pub grain_along_x: bool,
 }
 
 impl BoardMaps {
-    /// A preset's board face: `width` × `height` texels of `pitch` mm on the top face of a board
-    /// placed in the tree as `placement` places object space, with the grain along object x
-    /// (image columns). The face is the object's z = `face_z` plane.
+    /// A preset's board face: `width` × `height` texels of `pitch` mm centred on the object's
+    /// origin in its z = `face_z` plane, the board placed in the tree by `placement` (object x
+    /// along the image columns, object y towards the top row), grain along object x.
     pub fn from_preset(
         volume: &WoodVolume,
         placement: &Placement,
@@ -144,13 +128,13 @@ impl BoardMaps {
         face_z: f32,
     ) -> BoardMaps {
         let n = width * height;
-        let mut maps = BoardMaps {
-            width,
-            height,
+        let mut board = MeasuredBoard {
+            width: width as u32,
+            height: height as u32,
             diffuse: Vec::with_capacity(n),
             fiber_color: Vec::with_capacity(n),
             fiber_axis: Vec::with_capacity(n),
-            grain_along_x: true,
+            highlight_width: None,
         };
         let needs = Needs {
             color: true,
@@ -159,7 +143,6 @@ impl BoardMaps {
         };
         for row in 0..height {
             for col in 0..width {
-                // Image rows run down (−y), columns along +x, centred on the object's origin.
                 let p = Vec3::new(
                     (col as f32 + 0.5 - 0.5 * width as f32) * pitch,
                     (0.5 * height as f32 - row as f32 - 0.5) * pitch,
@@ -167,21 +150,23 @@ impl BoardMaps {
                 );
                 let (q, j) = placement.to_tree(p, Vec3::Z);
                 let t = volume.eval(q, needs);
-                let f = j.transpose() * t.fiber_dir;
-                maps.diffuse.push(t.diffuse);
-                maps.fiber_color.push(t.fiber_color);
-                // Object (x, y, z) → board frame (x right, y down the rows, z out of the face).
-                maps.fiber_axis
-                    .push(Vec3::new(f.x, -f.y, f.z).normalize_or_zero());
+                board.diffuse.push(t.diffuse);
+                board.fiber_color.push(t.fiber_color);
+                board
+                    .fiber_axis
+                    .push((j.transpose() * t.fiber_dir).normalize_or_zero());
             }
         }
-        maps
+        BoardMaps {
+            board,
+            grain_along_x: true,
+        }
     }
 
     /// The fibre axis turned to point along the grain (+x or +y), so dips and in-plane angles
     /// have a sign: (along, across, normal) components.
     fn oriented_axis(&self, i: usize) -> (f32, f32, f32) {
-        let u = self.fiber_axis[i];
+        let u = self.board.fiber_axis[i];
         let (along, across) = if self.grain_along_x {
             (u.x, u.y)
         } else {
@@ -206,19 +191,21 @@ impl BoardMaps {
 
     /// Texels along the grain and across it.
     fn grain_dims(&self) -> (usize, usize) {
+        let (w, h) = (self.board.width as usize, self.board.height as usize);
         if self.grain_along_x {
-            (self.width, self.height)
+            (w, h)
         } else {
-            (self.height, self.width)
+            (h, w)
         }
     }
 
     /// Texel index of position `a` along the grain and `c` across it.
     fn index(&self, a: usize, c: usize) -> usize {
+        let w = self.board.width as usize;
         if self.grain_along_x {
-            c * self.width + a
+            c * w + a
         } else {
-            a * self.width + c
+            a * w + c
         }
     }
 
@@ -321,13 +308,13 @@ pub fn board_statistics(maps: &BoardMaps, across: std::ops::Range<usize>) -> Vec
         }
         m
     };
-    let (d, f) = (mean(&maps.diffuse), mean(&maps.fiber_color));
+    let (d, f) = (mean(&maps.board.diffuse), mean(&maps.board.fiber_color));
     let dc = chromaticity(d);
     let fc = chromaticity(f);
     let rc = chromaticity([0, 1, 2].map(|c| f[c] / d[c].max(1e-12)));
     let lum: Vec<f64> = idx
         .iter()
-        .map(|&i| luminance(maps.diffuse[i]) as f64)
+        .map(|&i| luminance(maps.board.diffuse[i]) as f64)
         .collect();
     let dips: Vec<f64> = idx.iter().map(|&i| maps.dip_deg(i)).collect();
     let inplane: Vec<f64> = idx.iter().map(|&i| maps.in_plane_deg(i)).collect();
@@ -406,4 +393,293 @@ pub fn compare_boards(preset: &BoardMaps, measured: &BoardMaps) -> Vec<Compariso
             }
         })
         .collect()
+}
+
+/// A board to compare: a preset (with its tree placement) or a measured board's maps.
+#[derive(Clone, Debug)]
+pub enum Subject {
+    Preset { name: String, seed: u64 },
+    Measured { dir: String, grain_along_x: bool },
+}
+
+/// Square board side (mm) of the comparisons: the measured boards at the 0.25 mm pitch
+/// notes/measured.md assumes (390 px = 97.5 mm).
+pub const BOARD_MM: f32 = 97.5;
+
+/// The tree placement of preset boards: quartersawn, 120 mm from the pith, grain along x (as
+/// scenes/sweep_board.toml cuts its board).
+pub const PRESET_TREE: &str =
+    "{ origin = [0.0, 120.0, 0.0], axis = [1.0, 0.0, 0.0], rotation_deg = 0.0 }";
+
+impl Subject {
+    fn grain_along_x(&self) -> bool {
+        match self {
+            Subject::Preset { .. } => true,
+            Subject::Measured { grain_along_x, .. } => *grain_along_x,
+        }
+    }
+
+    /// The scene material table and the board object's extra fields.
+    fn material_toml(&self) -> (String, String) {
+        match self {
+            Subject::Preset { name, seed } => (
+                format!("type = \"wood\"\npreset = \"{name}\"\nseed = {seed}\neta = 1.5\nroughness = 0.0\nbump = 0.0\n"),
+                format!("tree = {PRESET_TREE}\n"),
+            ),
+            Subject::Measured { dir, .. } => (
+                format!(
+                    "type = \"measured\"\ndiffuse = \"{dir}/diffuse.png\"\nfiber_color = \"{dir}/fiber_color.png\"\nfiber_axis = \"{dir}/fiber_axis.png\"\nsize_mm = [{BOARD_MM}, {BOARD_MM}]\nface = \"+z\"\neta = 1.5\nroughness = 0.0\n"
+                ),
+                String::new(),
+            ),
+        }
+    }
+
+    /// The board's maps: the measured ones as read, a preset's sampled at the same texel count.
+    pub fn maps(&self, base: &Path) -> Result<BoardMaps, String> {
+        match self {
+            Subject::Measured { dir, grain_along_x } => {
+                let board = MeasuredBoard::load(&base.join(dir)).map_err(|e| e.to_string())?;
+                Ok(BoardMaps {
+                    board,
+                    grain_along_x: *grain_along_x,
+                })
+            }
+            Subject::Preset { name, seed } => {
+                let params = crate::wood::preset(name).map_err(|e| e.to_string())?;
+                let volume = WoodVolume::new(params, *seed).map_err(|e| e.to_string())?;
+                let placement = Placement {
+                    origin: Vec3::new(0.0, 120.0, 0.0),
+                    axis: Vec3::X,
+                    ..Placement::default()
+                };
+                let n = 390;
+                Ok(BoardMaps::from_preset(
+                    &volume,
+                    &placement,
+                    (n, n),
+                    BOARD_MM / n as f32,
+                    9.0,
+                ))
+            }
+        }
+    }
+
+    /// A top-down orthographic sweep of the board: a distant light moving along the grain over
+    /// `arc` degrees from the zenith in `frames` steps, `res`² pixels over the board.
+    pub fn sweep_scene(&self, frames: usize, arc: f32, res: u32, spp: u32) -> String {
+        let (material, tree) = self.material_toml();
+        let axis = if self.grain_along_x() {
+            "[0.0, 1.0, 0.0]"
+        } else {
+            "[1.0, 0.0, 0.0]"
+        };
+        format!(
+            r#"
+[render]
+width = {res}
+height = {res}
+spp = {spp}
+seed = 5
+filter = "box"
+filter_radius = 0.5
+[camera]
+projection = "orthographic"
+eye = [0.0, 0.0, 500.0]
+target = [0.0, 0.0, 18.0]
+up = [0.0, 1.0, 0.0]
+width = {BOARD_MM}
+[[lights]]
+type = "distant"
+name = "sun"
+direction = [0.0, 0.0, 1.0]
+irradiance = 1.0
+[materials.board]
+{material}
+[[objects]]
+name = "board"
+shape = "box"
+size = [{BOARD_MM}, {BOARD_MM}, 18.0]
+translate = [0.0, 0.0, 9.0]
+material = "board"
+{tree}
+[sweep]
+frames = {frames}
+arc_deg = [{lo}, {arc}]
+light = "sun"
+radius = 1000.0
+axis = {axis}
+"#,
+            lo = -arc,
+        )
+    }
+
+    /// Renders [`Subject::sweep_scene`]: per-pixel luminance of every frame.
+    pub fn sweep(&self, base: &Path, frames: usize, res: u32, spp: u32) -> Result<SweepLuminance, String> {
+        let text = self.sweep_scene(frames, 60.0, res, spp);
+        let loaded =
+            scene::from_str(&text, "<appearance sweep>", base, "appearance").map_err(|e| e.to_string())?;
+        let (path, moving) =
+            SweepPath::from_scene(&loaded, None, None).map_err(|e| e.to_string())?;
+        let r = render_sweep(
+            &loaded.scene,
+            &loaded.settings,
+            &path,
+            moving,
+            0..path.arc.frames,
+            &RunOptions::default(),
+        )
+        .map_err(|e| e.to_string())?;
+        Ok(SweepLuminance {
+            width: r.width,
+            height: r.height,
+            angles: r.frames.iter().map(|f| f.light_deg).collect(),
+            frames: r.frames.iter().map(|f| f.beauty.clone()).collect(),
+        })
+    }
+}
+
+/// The frames of a top-down sweep (linear RGB, row-major) and their light angles.
+#[derive(Clone, Debug)]
+pub struct SweepLuminance {
+    pub width: u32,
+    pub height: u32,
+    pub angles: Vec<f32>,
+    pub frames: Vec<Vec<Vec3>>,
+}
+
+impl SweepLuminance {
+    /// Per-pixel chatoyance: max / min luminance over the sweep (Marschner et al. 2005's
+    /// "highlight that moves": 1 for a Lambertian board under a light at constant distance...
+    /// divided by the cosine's range, so it is reported next to a Lambertian reference).
+    pub fn chatoyance(&self) -> Vec<f64> {
+        let n = (self.width * self.height) as usize;
+        (0..n)
+            .map(|i| {
+                let (lo, hi) = self.frames.iter().fold((f64::MAX, 0.0f64), |(lo, hi), f| {
+                    let y = luminance(f[i]) as f64;
+                    (lo.min(y), hi.max(y))
+                });
+                if lo > 0.0 {
+                    hi / lo
+                } else {
+                    f64::NAN
+                }
+            })
+            .collect()
+    }
+}
+
+/// A calibrated preset and the measured board it is checked against.
+#[derive(Clone, Debug)]
+pub struct Pair {
+    pub preset: &'static str,
+    pub measured_dir: &'static str,
+    pub grain_along_x: bool,
+}
+
+/// The calibrated presets of issue 11 and their measured boards (data/marschner2005/README.md:
+/// maple fibres run along x, padauk along y).
+pub const PAIRS: [Pair; 2] = [
+    Pair {
+        preset: "curly_maple",
+        measured_dir: "data/marschner2005/maple",
+        grain_along_x: true,
+    },
+    Pair {
+        preset: "padauk",
+        measured_dir: "data/marschner2005/padauk",
+        grain_along_x: false,
+    },
+];
+
+/// Sweep sampling of the chatoyance comparison: frames over ±60°, pixels across the board, spp.
+#[derive(Clone, Copy, Debug)]
+pub struct SweepSettings {
+    pub frames: usize,
+    pub res: u32,
+    pub spp: u32,
+}
+
+impl SweepSettings {
+    pub const FULL: SweepSettings = SweepSettings {
+        frames: 25,
+        res: 130,
+        spp: 4,
+    };
+}
+
+/// Chatoyance statistics of a rendered sweep: the whole board's median and p90/p10 of the
+/// per-pixel max/min, and the medians of [`STRIPS`] strips across the grain.
+fn chatoyance_statistics(s: &SweepLuminance, grain_along_x: bool) -> ([f64; 2], Vec<[f64; 2]>) {
+    let c = s.chatoyance();
+    let (w, h) = (s.width as usize, s.height as usize);
+    let stats = |v: &[f64]| [quantile(v, 0.5), quantile(v, 0.9) / quantile(v, 0.1)];
+    let across = if grain_along_x { h } else { w };
+    let strips = (0..STRIPS)
+        .map(|k| {
+            let r = k * across / STRIPS..(k + 1) * across / STRIPS;
+            let v: Vec<f64> = (0..w * h)
+                .filter(|i| r.contains(&if grain_along_x { i / w } else { i % w }))
+                .map(|i| c[i])
+                .collect();
+            stats(&v)
+        })
+        .collect();
+    (stats(&c), strips)
+}
+
+/// The comparison of one pair: board statistics, chatoyance, and the rendered sweeps.
+pub struct PairReport {
+    pub pair: Pair,
+    pub rows: Vec<Comparison>,
+    pub preset_maps: BoardMaps,
+    pub measured_maps: BoardMaps,
+    pub preset_sweep: SweepLuminance,
+    pub measured_sweep: SweepLuminance,
+}
+
+impl PairReport {
+    pub fn passes(&self) -> bool {
+        self.rows.iter().all(Comparison::passes)
+    }
+}
+
+/// Compares `pair.preset` (seed 7) with its measured board: maps and a rendered sweep each.
+pub fn compare_pair(pair: &Pair, base: &Path, sweep: SweepSettings) -> Result<PairReport, String> {
+    let preset = Subject::Preset {
+        name: pair.preset.to_string(),
+        seed: 7,
+    };
+    let measured = Subject::Measured {
+        dir: pair.measured_dir.to_string(),
+        grain_along_x: pair.grain_along_x,
+    };
+    let (pm, mm) = (preset.maps(base)?, measured.maps(base)?);
+    let mut rows = compare_boards(&pm, &mm);
+    // Only figured boards have a dip profile worth comparing along the grain.
+    if pair.preset != "curly_maple" {
+        rows.retain(|r| !r.name.starts_with("dip profile"));
+    }
+    let render = |s: &Subject| s.sweep(base, sweep.frames, sweep.res, sweep.spp);
+    let (ps, ms) = (render(&preset)?, render(&measured)?);
+    let (pc, _) = chatoyance_statistics(&ps, true);
+    let (mc, strips) = chatoyance_statistics(&ms, pair.grain_along_x);
+    for (k, name) in ["chatoyance median (max/min)", "chatoyance p90/p10"].iter().enumerate() {
+        let v: Vec<f64> = strips.iter().map(|s| s[k]).collect();
+        rows.push(Comparison {
+            name: name.to_string(),
+            preset: pc[k],
+            measured: mc[k],
+            band: (quantile(&v, 0.1), quantile(&v, 0.9)),
+        });
+    }
+    Ok(PairReport {
+        pair: pair.clone(),
+        rows,
+        preset_maps: pm,
+        measured_maps: mm,
+        preset_sweep: ps,
+        measured_sweep: ms,
+    })
 }
