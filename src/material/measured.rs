@@ -64,20 +64,22 @@ impl MeasuredFiles {
 /// Why a measured board could not be read; `field()` is the map it concerns.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MeasuredError {
-    #[error("`{field}`: cannot read {path}: {cause} (an 8-bit RGB, RGBA or grey PNG is allowed)")]
+    #[error(
+        "{field} map {path}: cannot read it: {cause} (allowed: an 8-bit RGB, RGBA or grey PNG)"
+    )]
     Read {
         field: &'static str,
         path: String,
         cause: String,
     },
-    #[error("`{field}`: {path} is {got}, but the diffuse map is {want}: every map must have the same size")]
+    #[error("{field} map {path} is {got}, but the diffuse map is {want} (allowed: every map the same size)")]
     Size {
         field: &'static str,
         path: String,
         got: String,
         want: String,
     },
-    #[error("`{field}`: {path}: texel (column {x}, row {y}) {what} (allowed {allowed})")]
+    #[error("{field} map {path}: texel (column {x}, row {y}) {what} (allowed {allowed})")]
     Value {
         field: &'static str,
         path: String,
@@ -237,6 +239,15 @@ impl MeasuredBoard {
         energy_bounded_fiber_color(scale * self.fiber_color[i])
     }
 }
+
+/// The default `fiber_color_scale`, 1/(2π): the stored value is then the energy-bounded lobe's
+/// k_f itself, so the 8-bit range [0, 1] fills the BSDF's k_f range [0, 1] and no texel of either
+/// board is clamped (the ported shader's ×10 would clamp nearly all; notes/measured.md).
+pub const DEFAULT_FIBER_COLOR_SCALE: f32 = 0.5 * std::f32::consts::FRAC_1_PI;
+
+/// The default β where a board has no β map: the ported GLSL shader's 0.1745 rad
+/// (mckennapsean/wood-shader, openGL4/wood.frag).
+pub const DEFAULT_HIGHLIGHT_WIDTH_DEG: f32 = 10.0;
 
 /// The k_f of xylem's energy-bounded fibre lobe that matches a k_f fitted to the published lobe
 /// of Marschner et al. 2005 (eq. 3, f = k_f g/cos²(ψd/2)): near the specular cone the

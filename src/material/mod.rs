@@ -14,7 +14,7 @@ pub use baked::{fiber_from_anisotropy, BakedFibers, BakedMaps, BakedTexel, Baked
 pub use face::{bilinear_taps, FaceRect};
 pub use measured::{
     energy_bounded_fiber_color, BoardFace, ColorSpace, MeasuredBoard, MeasuredError, MeasuredFiles,
-    MeasuredMaterial,
+    MeasuredMaterial, DEFAULT_FIBER_COLOR_SCALE, DEFAULT_HIGHLIGHT_WIDTH_DEG,
 };
 pub use placement::{Cutting, Placement};
 

@@ -220,6 +220,29 @@ pub enum MaterialTable {
         #[serde(default)]
         bump: f32,
     },
+    /// A board measured by Marschner et al. 2005: per-texel BSDF parameters from image maps (in
+    /// the encoding of data/marschner2005/) on one face of the object. Paths relative to the scene.
+    Measured {
+        diffuse: String,
+        fiber_color: String,
+        fiber_axis: String,
+        /// Optional β map (β = 90° · v/255); else `highlight_width_deg` everywhere.
+        highlight_width: Option<String>,
+        highlight_width_deg: Option<f32>,
+        /// The published lobe's k_f per stored unit (notes/measured.md).
+        #[serde(default = "default_fiber_color_scale")]
+        fiber_color_scale: f32,
+        #[serde(default)]
+        color_space: crate::material::ColorSpace,
+        /// [width, height] of the image on the face (object-space mm).
+        size_mm: [f32; 2],
+        #[serde(default)]
+        face: crate::material::BoardFace,
+        #[serde(default = "default_eta")]
+        eta: f32,
+        #[serde(default)]
+        roughness: f32,
+    },
     /// A classic solid texture as a Lambertian albedo.
     Texture {
         /// Texture name (see `xylem texture --help`): marble, slab_marble, ring_wood, log_wood,
@@ -246,6 +269,9 @@ fn default_ray_dir() -> [f32; 3] {
 }
 fn default_highlight() -> f32 {
     8.0
+}
+fn default_fiber_color_scale() -> f32 {
+    crate::material::DEFAULT_FIBER_COLOR_SCALE
 }
 fn default_eta() -> f32 {
     1.5

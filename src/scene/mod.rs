@@ -11,7 +11,10 @@ pub mod teapot;
 pub use format::{SceneFile, SweepRegion, SweepTable};
 
 use crate::bsdf::{WoodBsdf, WoodBsdfParams};
-use crate::material::{Cutting, Material, Placement, TextureMaterial, WoodMaterial};
+use crate::material::{
+    Cutting, Material, MeasuredBoard, MeasuredFiles, MeasuredMaterial, Placement, TextureMaterial,
+    WoodMaterial,
+};
 use crate::render::{
     self, Accel, Camera, EnvMap, Environment, Filter, Instance, Integrator, Light, Projection,
     RenderSettings, Transform, TriMesh,
@@ -421,7 +424,7 @@ impl Builder<'_> {
     }
 
     fn materials(
-        &self,
+        &mut self,
         tables: &BTreeMap<String, MaterialTable>,
     ) -> Result<(Vec<Material>, HashMap<String, u32>), SceneError> {
         let mut out = Vec::new();
@@ -493,6 +496,7 @@ impl Builder<'_> {
                         switches: Default::default(),
                     }))
                 }
+                MaterialTable::Measured { .. } => self.measured(t, name)?,
                 MaterialTable::Texture { texture, params } => {
                     let t = crate::texture::by_name(texture, params)
                         .map_err(|e| self.invalid(f("texture"), e.to_string()))?;
@@ -513,6 +517,71 @@ impl Builder<'_> {
             out.push(m);
         }
         Ok((out, index))
+    }
+
+    /// A `measured` material: reads and checks the maps (errors name the field and the range) and
+    /// warns when fibre colours had to be clamped into the BSDF's range (notes/measured.md).
+    fn measured(&mut self, t: &MaterialTable, name: &str) -> Result<Material, SceneError> {
+        let MaterialTable::Measured {
+            diffuse,
+            fiber_color,
+            fiber_axis,
+            highlight_width,
+            highlight_width_deg,
+            fiber_color_scale,
+            color_space,
+            size_mm,
+            face,
+            eta,
+            roughness,
+        } = t
+        else {
+            unreachable!("called for measured materials only")
+        };
+        let f = |s: &str| format!("materials.{name}.{s}");
+        if highlight_width.is_some() && highlight_width_deg.is_some() {
+            return Err(self.invalid(
+                f("highlight_width_deg"),
+                "give either a β map `highlight_width` or a constant `highlight_width_deg`, not both",
+            ));
+        }
+        let beta = self.range(
+            &f("highlight_width_deg"),
+            highlight_width_deg.unwrap_or(crate::material::DEFAULT_HIGHLIGHT_WIDTH_DEG),
+            0.06,
+            90.0,
+        )?;
+        let scale = self.range(&f("fiber_color_scale"), *fiber_color_scale, 0.0, 1000.0)?;
+        let size = Vec2::new(
+            self.range(&f("size_mm"), size_mm[0], 1e-3, 1e6)?,
+            self.range(&f("size_mm"), size_mm[1], 1e-3, 1e6)?,
+        );
+        let files = MeasuredFiles {
+            diffuse: self.base.join(diffuse),
+            fiber_color: self.base.join(fiber_color),
+            fiber_axis: self.base.join(fiber_axis),
+            highlight_width: highlight_width.as_ref().map(|p| self.base.join(p)),
+        };
+        let board = MeasuredBoard::from_files(&files, *color_space)
+            .map_err(|e| self.invalid(f(e.field()), e.to_string()))?;
+        let m = MeasuredMaterial::new(
+            Arc::new(board),
+            face.rect(size),
+            scale,
+            beta.to_radians(),
+            self.range(&f("eta"), *eta, 1.0, 4.0)?,
+            self.range(&f("roughness"), *roughness, 0.0, 1.0)?,
+        );
+        if m.clamped > 0 {
+            self.warnings.push(format!(
+                "{}: {}: {} of {} texels have 2π · fiber_color_scale · fiber_color above 1 and were scaled down to 1 (hue kept)",
+                self.path,
+                f("fiber_color_scale"),
+                m.clamped,
+                m.board.fiber_color.len()
+            ));
+        }
+        Ok(Material::Measured(Box::new(m)))
     }
 
     fn objects(
