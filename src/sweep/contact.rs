@@ -92,11 +92,16 @@ pub fn sheet_columns(n: usize) -> usize {
 /// Lays out `thumbs` (all the same size) in a grid with `gap` pixels between them and draws each
 /// `labels[i]` in the thumbnail's lower-left corner.
 pub fn contact_sheet(thumbs: &[Rgb8], labels: &[String], gap: u32) -> Rgb8 {
+    contact_sheet_rows(thumbs, labels, sheet_columns(thumbs.len()), gap)
+}
+
+/// [`contact_sheet`] with `cols` thumbnails per row.
+pub fn contact_sheet_rows(thumbs: &[Rgb8], labels: &[String], cols: usize, gap: u32) -> Rgb8 {
     let Some(first) = thumbs.first() else {
         return Rgb8::filled(1, 1, [24, 24, 24]);
     };
     let (tw, th) = (first.width, first.height);
-    let cols = sheet_columns(thumbs.len()) as u32;
+    let cols = cols.clamp(1, thumbs.len()) as u32;
     let rows = (thumbs.len() as u32).div_ceil(cols);
     let mut sheet = Rgb8::filled(
         cols * tw + (cols + 1) * gap,

@@ -1,7 +1,8 @@
-//! `xylem validate [bsdf|sweep]`: runs the validation suite; exits non-zero when a check fails.
+//! `xylem validate [bsdf|sweep|appearance]`: runs the validation suite; exits non-zero when a check fails.
 
 use std::process::ExitCode;
 
+mod appearance;
 mod bsdf;
 mod sweep;
 
@@ -17,12 +18,15 @@ enum What {
     Bsdf(bsdf::Args),
     /// The light-sweep checks: highlight tracking, renderer against the BSDF, figure signatures.
     Sweep(sweep::Args),
+    /// Presets against Marschner 2005's measured boards → validation/APPEARANCE.md.
+    Appearance(appearance::Args),
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     match args.what {
         Some(What::Bsdf(a)) => bsdf::run(a),
         Some(What::Sweep(a)) => sweep::run(a),
+        Some(What::Appearance(a)) => appearance::run(a),
         None => {
             let b = bsdf::run(bsdf::Args::default())?;
             let s = sweep::run(sweep::Args::default())?;
