@@ -16,7 +16,7 @@ use crate::sweep::plot::{line_plot, PlotOptions, Series, PALETTE};
 use crate::validate::report::markdown_table;
 use crate::wood::{Needs, WoodVolume};
 use glam::Vec3;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// A board of `preset` seen straight down through an orthographic camera (1 mm pixels over
 /// 200 × 100 mm of a quartersawn face, as `scenes/sweep_board.toml` cuts it) under a uniform
@@ -230,7 +230,8 @@ impl BoardMaps {
 }
 
 /// Scale-free statistics of a board face (those [`BoardMaps`] can give; the rendered chatoyance
-/// is added by the sweep comparison). The measured boards' fibre colour has an unknown absolute
+/// is added by the sweep comparison). Dip quantiles are taken about the median: the median dip is
+/// the board's runout (how it was sawn), not the wood's figure. The measured boards' fibre colour has an unknown absolute
 /// scale (data README), and xylem's fibre colour another normalisation (notes/bsdf.md §2.2), so
 /// only its chromaticity and its per-channel ratio to the diffuse colour are compared.
 pub const BOARD_STATISTICS: [&str; 15] = [
@@ -240,11 +241,11 @@ pub const BOARD_STATISTICS: [&str; 15] = [
     "diffuse luminance p90/p10",
     "fibre chromaticity r",
     "fibre chromaticity g",
-    "fibre/diffuse ratio chromaticity r",
-    "fibre/diffuse ratio chromaticity g",
+    "fibre/diffuse ratio, green over red",
+    "fibre/diffuse ratio, blue over red",
     "fibre dip std (deg)",
-    "fibre dip p5 (deg)",
-    "fibre dip p95 (deg)",
+    "fibre dip p5 - median (deg)",
+    "fibre dip p95 - median (deg)",
     "in-plane angle p10-p90 width (deg)",
     "dip profile: dominant period / board length",
     "dip profile: power share of the peak",
@@ -332,7 +333,7 @@ pub fn board_statistics(maps: &BoardMaps, across: std::ops::Range<usize>) -> Vec
     let (d, f) = (mean(&maps.board.diffuse), mean(&maps.board.fiber_color));
     let dc = chromaticity(d);
     let fc = chromaticity(f);
-    let rc = chromaticity([0, 1, 2].map(|c| f[c] / d[c].max(1e-12)));
+    let ratio = [0, 1, 2].map(|c| f[c] / d[c].max(1e-12));
     let lum: Vec<f64> = idx
         .iter()
         .map(|&i| luminance(maps.board.diffuse[i]) as f64)
@@ -352,11 +353,11 @@ pub fn board_statistics(maps: &BoardMaps, across: std::ops::Range<usize>) -> Vec
         quantile(&lum, 0.9) / quantile(&lum, 0.1).max(1e-12),
         fc[0],
         fc[1],
-        rc[0],
-        rc[1],
+        ratio[1] / ratio[0],
+        ratio[2] / ratio[0],
         dip_std,
-        quantile(&dips, 0.05),
-        quantile(&dips, 0.95),
+        quantile(&dips, 0.05) - quantile(&dips, 0.5),
+        quantile(&dips, 0.95) - quantile(&dips, 0.5),
         quantile(&inplane, 0.9) - quantile(&inplane, 0.1),
         1.0 / k as f64,
         share,
@@ -418,7 +419,12 @@ pub fn compare_boards(preset: &BoardMaps, measured: &BoardMaps) -> Vec<Compariso
 /// A board to compare: a preset (with its tree placement) or a measured board's maps.
 #[derive(Clone, Debug)]
 pub enum Subject {
-    Preset { name: String, seed: u64 },
+    /// A preset by name: built in, or `dir/NAME.toml` when `dir` is given (for calibration).
+    Preset {
+        name: String,
+        seed: u64,
+        dir: Option<PathBuf>,
+    },
     Measured { dir: String, grain_along_x: bool },
 }
 
@@ -442,8 +448,14 @@ impl Subject {
     /// The scene material table and the board object's extra fields.
     fn material_toml(&self) -> (String, String) {
         match self {
-            Subject::Preset { name, seed } => (
-                format!("type = \"wood\"\npreset = \"{name}\"\nseed = {seed}\neta = 1.5\nroughness = 0.0\nbump = 0.0\n"),
+            Subject::Preset { name, seed, dir } => (
+                format!(
+                    "type = \"wood\"\n{}\nseed = {seed}\neta = 1.5\nroughness = 0.0\nbump = 0.0\n",
+                    match dir {
+                        Some(d) => format!("preset_file = {:?}", d.join(format!("{name}.toml"))),
+                        None => format!("preset = \"{name}\""),
+                    }
+                ),
                 format!("tree = {PRESET_TREE}\n"),
             ),
             Subject::Measured { dir, .. } => (
@@ -465,8 +477,17 @@ impl Subject {
                     grain_along_x: *grain_along_x,
                 })
             }
-            Subject::Preset { name, seed } => {
-                let params = crate::wood::preset(name).map_err(|e| e.to_string())?;
+            Subject::Preset { name, seed, dir } => {
+                let params = match dir {
+                    Some(d) => {
+                        let path = d.join(format!("{name}.toml"));
+                        let text = std::fs::read_to_string(&path)
+                            .map_err(|e| format!("{}: {e}", path.display()))?;
+                        crate::wood::WoodParams::from_toml_str(&text, &path.display().to_string())
+                    }
+                    None => crate::wood::preset(name),
+                }
+                .map_err(|e| e.to_string())?;
                 let volume = WoodVolume::new(params, *seed).map_err(|e| e.to_string())?;
                 let placement = Placement {
                     origin: Vec3::new(0.0, 120.0, 0.0),
@@ -672,10 +693,16 @@ impl PairReport {
 }
 
 /// Compares `pair.preset` (seed 7) with its measured board: maps and a rendered sweep each.
-pub fn compare_pair(pair: &Pair, base: &Path, sweep: SweepSettings) -> Result<PairReport, String> {
+pub fn compare_pair(
+    pair: &Pair,
+    base: &Path,
+    preset_dir: Option<&Path>,
+    sweep: SweepSettings,
+) -> Result<PairReport, String> {
     let preset = Subject::Preset {
         name: pair.preset.to_string(),
         seed: 7,
+        dir: preset_dir.map(Path::to_path_buf),
     };
     let measured = Subject::Measured {
         dir: pair.measured_dir.to_string(),
@@ -746,11 +773,12 @@ fn mean_cv(v: &[f64]) -> (f64, f64) {
 }
 
 /// [`WalnutCharacter`] of the walnut preset's board (seed 7).
-pub fn walnut_character(base: &Path) -> Result<WalnutCharacter, String> {
+pub fn walnut_character(base: &Path, preset_dir: Option<&Path>) -> Result<WalnutCharacter, String> {
     let maps = |name: &str| {
         Subject::Preset {
             name: name.into(),
             seed: 7,
+            dir: preset_dir.map(Path::to_path_buf),
         }
         .maps(base)
     };
@@ -839,6 +867,7 @@ fn side_by_side(r: &PairReport) -> Rgb8 {
 /// `dir/plots/`; returns the Markdown and whether every stated criterion passed.
 pub fn run_report(
     base: &Path,
+    preset_dir: Option<&Path>,
     dir: &Path,
     sweep: SweepSettings,
     progress: &dyn Fn(&str),
@@ -883,7 +912,7 @@ pub fn run_report(
     );
     for pair in &PAIRS {
         progress(pair.preset);
-        let r = compare_pair(pair, base, sweep)?;
+        let r = compare_pair(pair, base, preset_dir, sweep)?;
         ok &= r.passes();
         md += &format!(
             "\n## `{}` against the measured board `{}`\n\n\
@@ -975,7 +1004,7 @@ pub fn run_report(
         );
     }
     progress("walnut");
-    let w = walnut_character(base)?;
+    let w = walnut_character(base, preset_dir)?;
     ok &= w.passes();
     md += &format!(
         "\n## `walnut` against its published character\n\n\

@@ -12,6 +12,9 @@ pub struct Args {
     /// Report to write [default: validation/APPEARANCE.md]; plots go beside it in plots/.
     #[arg(long)]
     report: Option<PathBuf>,
+    /// Read the compared presets from DIR/NAME.toml instead of the built-in ones (calibration).
+    #[arg(long, value_name = "DIR")]
+    presets: Option<PathBuf>,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -23,7 +26,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         indicatif::ProgressStyle::with_template("validate appearance {bar:40} {pos}/{len} {msg}")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
-    let (md, ok) = run_report(Path::new("."), &dir, SweepSettings::FULL, &|name| {
+    let (md, ok) = run_report(Path::new("."), args.presets.as_deref(), &dir, SweepSettings::FULL, &|name| {
         bar.set_message(name.to_string());
         bar.inc(1);
     })
