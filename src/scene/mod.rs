@@ -33,6 +33,8 @@ pub enum SceneError {
     },
     #[error("scene {path}: {message}")]
     Parse { path: String, message: String },
+    #[error("cannot read scene {0}")]
+    Input(crate::render::resources::ResourceError),
     #[error("scene {path}: field `{field}`: {message}")]
     Invalid {
         path: String,
@@ -46,6 +48,10 @@ pub enum SceneError {
         source: mesh_io::MeshError,
     },
 }
+
+/// How far from the origin (mm) any object may reach: 1 km, so that f32 coordinates keep a
+/// resolution of 0.06 mm or better (2⁻²⁴ relative) where a scene has geometry.
+pub const MAX_EXTENT_MM: f32 = 1e6;
 
 /// A loaded scene: what to render and how.
 pub struct LoadedScene {
@@ -64,9 +70,12 @@ pub struct LoadedScene {
 
 /// Reads and builds a scene file.
 pub fn load(path: &Path) -> Result<LoadedScene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+    let bytes =
+        crate::render::resources::read_bounded(path, crate::render::resources::MAX_SCENE_BYTES)
+            .map_err(SceneError::Input)?;
+    let text = String::from_utf8(bytes).map_err(|_| SceneError::Parse {
         path: path.display().to_string(),
-        source,
+        message: "not UTF-8 text (a scene is a TOML file)".into(),
     })?;
     let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
     let name = path
@@ -521,6 +530,12 @@ impl Builder<'_> {
         materials: &HashMap<String, u32>,
         _mats: &[Material],
     ) -> Result<Vec<Instance>, SceneError> {
+        if tables.is_empty() {
+            return Err(self.invalid(
+                "objects",
+                "the scene has no objects (give at least one [[objects]] table)",
+            ));
+        }
         let mut cache: HashMap<PathBuf, Arc<TriMesh>> = HashMap::new();
         let mut out = Vec::new();
         for (i, o) in tables.iter().enumerate() {
@@ -557,6 +572,22 @@ impl Builder<'_> {
             ));
             if !transform.is_valid() {
                 return Err(self.invalid(f("scale"), "the transform is not invertible"));
+            }
+            let reach = mesh
+                .positions
+                .iter()
+                .map(|&v| transform.point_to_world(v).abs().max_element())
+                .fold(
+                    0.0f32,
+                    |a, b| if b.is_nan() { f32::INFINITY } else { a.max(b) },
+                );
+            if reach > MAX_EXTENT_MM {
+                return Err(self.invalid(
+                    f("translate"),
+                    format!(
+                        "with its scale and translation the object reaches {reach:e} mm from the origin (allowed within {MAX_EXTENT_MM:e} mm)"
+                    ),
+                ));
             }
             let placement = match &o.tree {
                 None => Placement::default(),
