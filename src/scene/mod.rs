@@ -147,8 +147,11 @@ impl Builder<'_> {
 
     fn unit3(&self, field: &str, a: [f32; 3]) -> Result<Vec3, SceneError> {
         let v = self.finite3(field, a)?;
-        if v.length_squared() > 1e-12 {
-            Ok(v.normalize())
+        // Divided by the largest component first: the squares of components ≥ ~2e19 overflow
+        // f32, which turned such a direction into a zero vector.
+        let m = v.abs().max_element();
+        if m > 1e-6 {
+            Ok((v / m).normalize())
         } else {
             Err(self.invalid(field, "must be a non-zero direction"))
         }
@@ -265,6 +268,18 @@ impl Builder<'_> {
                 }
             }
             ProjectionName::Orthographic => {
+                if c.lens_radius != 0.0 {
+                    return Err(self.invalid(
+                        "camera.lens_radius",
+                        "only for projection = \"perspective\" (an orthographic camera has no lens)",
+                    ));
+                }
+                if c.focus_distance.is_some() {
+                    return Err(self.invalid(
+                        "camera.focus_distance",
+                        "only for projection = \"perspective\"",
+                    ));
+                }
                 let w = c.width.ok_or_else(|| {
                     self.invalid(
                         "camera.width",
@@ -536,7 +551,7 @@ impl Builder<'_> {
                 "the scene has no objects (give at least one [[objects]] table)",
             ));
         }
-        let mut cache: HashMap<PathBuf, Arc<TriMesh>> = HashMap::new();
+        let mut cache: HashMap<(PathBuf, bool), Arc<TriMesh>> = HashMap::new();
         let mut out = Vec::new();
         for (i, o) in tables.iter().enumerate() {
             let f = |s: &str| format!("objects[{i}].{s}");
@@ -652,7 +667,17 @@ impl Builder<'_> {
             }
         };
         Ok(Placement {
-            origin: self.finite3(&f("origin"), t.origin)?,
+            origin: {
+                // Beyond the scene's extent the growth time loses all precision (NaN at 1e12).
+                let o = self.finite3(&f("origin"), t.origin)?;
+                if o.abs().max_element() > MAX_EXTENT_MM {
+                    return Err(self.invalid(
+                        f("origin"),
+                        format!("{o} is out of range (allowed within {MAX_EXTENT_MM:e} mm of the origin)"),
+                    ));
+                }
+                o
+            },
             axis: self.unit3(&f("axis"), t.axis)?,
             rotation: self
                 .range(&f("rotation_deg"), t.rotation_deg, -360.0, 360.0)?
@@ -668,7 +693,7 @@ impl Builder<'_> {
         &mut self,
         o: &ObjectTable,
         i: usize,
-        cache: &mut HashMap<PathBuf, Arc<TriMesh>>,
+        cache: &mut HashMap<(PathBuf, bool), Arc<TriMesh>>,
     ) -> Result<Arc<TriMesh>, SceneError> {
         let f = |s: &str| format!("objects[{i}].{s}");
         let (kind, used): (&str, &[&str]) = match o.shape {
@@ -760,7 +785,10 @@ impl Builder<'_> {
             ShapeKind::Mesh => {
                 let file = o.file.as_ref().ok_or_else(|| need("file"))?;
                 let p = self.base.join(file);
-                if let Some(m) = cache.get(&p) {
+                // Keyed by file and `smooth`: the second object using a file may want the
+                // other normals.
+                let key = (p.clone(), o.smooth);
+                if let Some(m) = cache.get(&key) {
                     return Ok(m.clone());
                 }
                 let mut m = mesh_io::load_mesh(&p).map_err(|source| SceneError::Mesh {
@@ -785,7 +813,7 @@ impl Builder<'_> {
                     m.normals = None;
                 }
                 let m = Arc::new(m);
-                cache.insert(p, m.clone());
+                cache.insert(key, m.clone());
                 return Ok(m);
             }
         };
