@@ -523,3 +523,36 @@ fn an_os_error_is_printed_once_and_the_output_folder_is_checked_first() {
         "rendered first"
     );
 }
+
+#[test]
+fn a_far_eye_and_far_tree_origins_are_named_not_blamed_on_other_fields() {
+    let board = std::fs::read_to_string(repo().join("scenes/sweep_board.toml")).unwrap();
+    let load = |text: &str| {
+        xylem::scene::from_str(text, "far.toml", repo(), "far")
+            .err()
+            .map(|e| e.to_string())
+    };
+    let eye = board.replace("eye = [0.0, -250.0, 190.0]", "eye = [0.0, -1e30, 190.0]");
+    assert_ne!(eye, board);
+    let e = load(&eye).expect("a far eye is an error");
+    assert!(e.contains("camera.eye") && !e.contains("camera.up"), "{e}");
+    let origin = board.replace("origin = [0.0, 120.0, 0.0]", "origin = [0.0, 1e12, 0.0]");
+    assert_ne!(origin, board);
+    let e = load(&origin).expect("a tree origin at 1e12 mm is an error");
+    assert!(e.contains("objects[1].tree.origin"), "{e}");
+    // A direction of huge components keeps its direction (it became a zero vector).
+    let key = board.replace(
+        "[sweep]\nframes = 48",
+        "[[lights]]\ntype = \"distant\"\ndirection = [3e19, 0.0, -3e19]\nirradiance = 1.0\n\n[sweep]\nframes = 48",
+    );
+    assert_ne!(key, board);
+    let loaded = xylem::scene::from_str(&key, "far.toml", repo(), "far").unwrap();
+    let dir = loaded.scene.lights.iter().find_map(|l| match l {
+        xylem::render::Light::Distant { direction, .. } => Some(*direction),
+        _ => None,
+    });
+    let want = xylem::math::Vec3::new(1.0, 0.0, -1.0).normalize();
+    let got = dir.expect("the distant light");
+    // (Stored towards the light or away from it: either way along ±(1, 0, −1)/√2, not zero.)
+    assert!(got.dot(want).abs() > 1.0 - 1e-6, "{got} (want ±{want})");
+}

@@ -145,6 +145,18 @@ impl Builder<'_> {
         }
     }
 
+    /// A finite point with every coordinate within `±max` mm.
+    fn point(&self, field: &str, a: [f32; 3], max: f32) -> Result<Vec3, SceneError> {
+        let p = self.finite3(field, a)?;
+        if p.abs().max_element() > max {
+            return Err(self.invalid(
+                field,
+                format!("{p} is out of range (every coordinate within ±{max:e} mm)"),
+            ));
+        }
+        Ok(p)
+    }
+
     fn unit3(&self, field: &str, a: [f32; 3]) -> Result<Vec3, SceneError> {
         let v = self.finite3(field, a)?;
         // Divided by the largest component first: the squares of components ≥ ~2e19 overflow
@@ -237,8 +249,9 @@ impl Builder<'_> {
     }
 
     fn camera(&self, c: &CameraTable, width: u32, height: u32) -> Result<Camera, SceneError> {
-        let eye = self.finite3("camera.eye", c.eye)?;
-        let target = self.finite3("camera.target", c.target)?;
+        // Bounded so that `target − eye` and its square stay finite (a far eye was blamed on `up`).
+        let eye = self.point("camera.eye", c.eye, 1e9)?;
+        let target = self.point("camera.target", c.target, 1e9)?;
         let up = self.unit3("camera.up", c.up)?;
         let dir = target - eye;
         if dir.length_squared() < 1e-12 {
@@ -667,17 +680,8 @@ impl Builder<'_> {
             }
         };
         Ok(Placement {
-            origin: {
-                // Beyond the scene's extent the growth time loses all precision (NaN at 1e12).
-                let o = self.finite3(&f("origin"), t.origin)?;
-                if o.abs().max_element() > MAX_EXTENT_MM {
-                    return Err(self.invalid(
-                        f("origin"),
-                        format!("{o} is out of range (allowed within {MAX_EXTENT_MM:e} mm of the origin)"),
-                    ));
-                }
-                o
-            },
+            // Beyond the scene's extent the growth time loses all precision (NaN at 1e12).
+            origin: self.point(&f("origin"), t.origin, MAX_EXTENT_MM)?,
             axis: self.unit3(&f("axis"), t.axis)?,
             rotation: self
                 .range(&f("rotation_deg"), t.rotation_deg, -360.0, 360.0)?
