@@ -12,6 +12,7 @@ pub mod field;
 pub mod material;
 pub mod math;
 pub mod noise;
+pub mod output;
 pub mod render;
 pub mod scene;
 pub mod sweep;

@@ -27,6 +27,9 @@ pub struct Args {
     /// Do not show the progress bar.
     #[arg(long)]
     quiet: bool,
+    /// Render even when the memory or disk estimate exceeds what the machine has.
+    #[arg(long)]
+    ignore_limits: bool,
 }
 
 /// Parses `WxH` with both in 1..=16384.
@@ -49,6 +52,7 @@ fn parse_res(s: &str) -> Result<(u32, u32), String> {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    crate::render::resources::check_threads(args.threads)?;
     let mut loaded = crate::scene::load(&args.scene)?;
     for w in &loaded.warnings {
         eprintln!("warning: {w}");
@@ -80,9 +84,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         loaded.scene.accel.triangle_count(),
         loaded.scene.accel.build_time.as_secs_f64() * 1e3
     );
-    let out = crate::render::render(&loaded.scene, &loaded.settings, &run)?;
+    crate::render::resources::Resources::render(cam.width, cam.height)
+        .check(&args.out, args.ignore_limits)?;
+    // The output folder is made (and so checked) before the render, not after it.
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create output folder {}", args.out.display()))?;
+    crate::output::Staged::new(&args.out.join(format!("{}.exr", loaded.name)))
+        .with_context(|| format!("cannot write into output folder {}", args.out.display()))?;
+    let out = crate::render::render(&loaded.scene, &loaded.settings, &run)?;
     let exr = args.out.join(format!("{}.exr", loaded.name));
     let png = args.out.join(format!("{}.png", loaded.name));
     write_outputs(&out.image, &exr, &png, loaded.exposure)?;
@@ -104,19 +113,27 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// Writes the EXR and the PNG as one pair: both are encoded to temporary files first, then, under
+/// the folder's lock (so two renders into one folder never leave one's EXR beside the other's
+/// PNG), the old PNG is removed, the EXR renamed into place and the PNG last. The PNG therefore
+/// marks a complete pair even when the run is killed between the renames.
 fn write_outputs(
     image: &crate::render::Image,
     exr: &Path,
     png: &Path,
     exposure: f32,
 ) -> anyhow::Result<()> {
-    crate::render::image_io::write_image_exr(exr, image)?;
-    crate::render::image_io::write_png_linear(
-        png,
-        image.width,
-        image.height,
-        &image.beauty,
-        exposure,
-    )?;
+    use crate::render::image_io::{commit, stage_image_exr, stage_png_linear};
+    let (staged_exr, staged_png) = rayon::join(
+        || stage_image_exr(exr, image),
+        || stage_png_linear(png, image.width, image.height, &image.beauty, exposure),
+    );
+    let (staged_exr, staged_png) = (staged_exr?, staged_png?);
+    let folder = png.parent().unwrap_or(Path::new("."));
+    let _lock = crate::output::FolderLock::wait_exclusive(folder)?;
+    crate::output::remove_if_present(png)
+        .with_context(|| format!("cannot replace {}", png.display()))?;
+    commit(staged_exr)?;
+    commit(staged_png)?;
     Ok(())
 }

@@ -50,6 +50,9 @@ pub struct Args {
     /// Largest thumbnail width on the contact sheet, in pixels.
     #[arg(long, default_value_t = 240)]
     pub thumb_width: u32,
+    /// Render even when the memory or disk estimate exceeds what the machine has.
+    #[arg(long)]
+    pub ignore_limits: bool,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -59,7 +62,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let Some(scene) = &args.scene else {
         anyhow::bail!("give a scene file (or --assemble DIR)");
     };
+    crate::render::resources::check_threads(args.threads)?;
     let mut loaded = crate::scene::load(scene)?;
+    // The scene file's digest, recorded with every frame so that `--assemble` refuses slices
+    // of different scene files (the load above has already bounded and read it).
+    let scene_crc = crc32fast::hash(&std::fs::read(scene)?);
     for w in &loaded.warnings {
         eprintln!("warning: {w}");
     }
@@ -91,6 +98,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             progress: !args.quiet,
         },
         exr: args.exr_compression,
+        ignore_limits: args.ignore_limits,
+        provenance: format!(
+            "scene crc32 {scene_crc:08x}, quality {}",
+            args.quality
+                .map_or("none".to_string(), |q| format!("{q:?}").to_lowercase())
+        ),
     };
     let cam = &loaded.scene.camera;
     eprintln!(
@@ -138,7 +151,9 @@ fn assemble_dir(dir: &Path, thumb_width: u32) -> anyhow::Result<ExitCode> {
         thumb_width: thumb_width.max(8),
         ..Default::default()
     };
-    let done = assemble(dir, &opts)
+    let done = crate::output::FolderLock::try_new(dir, crate::output::LockMode::Exclusive)
+        .map_err(anyhow::Error::from)
+        .and_then(|_lock| assemble(dir, &opts).map_err(anyhow::Error::from))
         .with_context(|| format!("assembling the sweep in {}", dir.display()))?;
     println!("assembled {} frames:", done.frames);
     for f in &done.files {

@@ -1,6 +1,7 @@
 //! Writing images people look at: sRGB PNG previews of linear RGB buffers, and multi-layer
 //! OpenEXR files (beauty plus AOV layers) through the `exr` crate.
 
+use crate::output::Staged;
 use glam::Vec3;
 use std::io::BufWriter;
 use std::path::Path;
@@ -57,9 +58,27 @@ pub fn to_srgb8(pixels: &[Vec3], exposure: f32) -> Vec<u8> {
         .collect()
 }
 
-/// Writes 8-bit RGB bytes as a PNG. The file is written to a temporary name and renamed, so a
-/// failure never leaves a half-written image behind.
+/// Writes 8-bit RGB bytes as a PNG, whole or not at all ([`crate::output::Staged`]).
 pub fn write_png_rgb8(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<(), ImageError> {
+    let staged = stage_png_rgb8(path, width, height, rgb)?;
+    commit(staged)
+}
+
+/// Renames a staged image over its final name.
+pub fn commit(staged: Staged) -> Result<(), ImageError> {
+    let path = staged.path().display().to_string();
+    staged
+        .commit()
+        .map_err(|source| ImageError::Io { path, source })
+}
+
+/// Encodes a PNG into a uniquely named temporary file beside `path`, to [`commit`] later.
+pub fn stage_png_rgb8(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgb: &[u8],
+) -> Result<Staged, ImageError> {
     let name = path.display().to_string();
     let want = width as usize * height as usize;
     if rgb.len() != want * 3 {
@@ -71,13 +90,12 @@ pub fn write_png_rgb8(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Resul
             want,
         });
     }
-    let tmp = path.with_extension("png.partial");
-    let io = |source| ImageError::Io {
+    let mut staged = Staged::new(path).map_err(|source| ImageError::Io {
         path: name.clone(),
         source,
-    };
-    let file = std::fs::File::create(&tmp).map_err(io)?;
-    let mut enc = png::Encoder::new(BufWriter::new(file), width, height);
+    })?;
+    let mut out = BufWriter::new(staged.file());
+    let mut enc = png::Encoder::new(&mut out, width, height);
     enc.set_color(png::ColorType::Rgb);
     enc.set_depth(png::BitDepth::Eight);
     enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
@@ -88,7 +106,8 @@ pub fn write_png_rgb8(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Resul
     let mut w = enc.write_header().map_err(png_err)?;
     w.write_image_data(rgb).map_err(png_err)?;
     w.finish().map_err(png_err)?;
-    std::fs::rename(&tmp, path).map_err(io)
+    flush(out, &name)?;
+    Ok(staged)
 }
 
 /// Writes a linear RGB buffer as an sRGB PNG preview with exposure `exposure` stops.
@@ -100,6 +119,17 @@ pub fn write_png_linear(
     exposure: f32,
 ) -> Result<(), ImageError> {
     write_png_rgb8(path, width, height, &to_srgb8(pixels, exposure))
+}
+
+/// [`write_png_linear`] staged, to [`commit`] later.
+pub fn stage_png_linear(
+    path: &Path,
+    width: u32,
+    height: u32,
+    pixels: &[Vec3],
+    exposure: f32,
+) -> Result<Staged, ImageError> {
+    stage_png_rgb8(path, width, height, &to_srgb8(pixels, exposure))
 }
 
 /// One named layer of a multi-layer EXR: `channels` are the channel suffixes (e.g. `["R","G","B"]`
@@ -132,7 +162,12 @@ impl ExrCompression {
         use exr::prelude::Encoding;
         match self {
             ExrCompression::Zip => Encoding::SMALL_LOSSLESS,
-            ExrCompression::Rle => Encoding::FAST_LOSSLESS,
+            // Chunks in increasing order: the parallel compressor otherwise writes them as they
+            // finish, so equal pixels gave different bytes run to run.
+            ExrCompression::Rle => Encoding {
+                line_order: exr::prelude::LineOrder::Increasing,
+                ..Encoding::FAST_LOSSLESS
+            },
             ExrCompression::None => Encoding::UNCOMPRESSED,
         }
     }
@@ -158,6 +193,18 @@ pub fn write_exr_layers_with(
     layers: &[ExrLayer],
     compression: ExrCompression,
 ) -> Result<(), ImageError> {
+    commit(stage_exr_layers(path, width, height, layers, compression)?)
+}
+
+/// Encodes a multi-layer EXR into a uniquely named temporary file beside `path`, to [`commit`]
+/// later.
+pub fn stage_exr_layers(
+    path: &Path,
+    width: u32,
+    height: u32,
+    layers: &[ExrLayer],
+    compression: ExrCompression,
+) -> Result<Staged, ImageError> {
     use exr::prelude::*;
     let name = path.display().to_string();
     let n = width as usize * height as usize;
@@ -189,17 +236,26 @@ pub fn write_exr_layers_with(
         compression.encoding(),
         AnyChannels::sort(SmallVec::from_vec(channels)),
     );
-    let tmp = path.with_extension("exr.partial");
-    let err = |message: String| ImageError::ExrWrite {
+    let mut staged = Staged::new(path).map_err(|source| ImageError::Io {
         path: name.clone(),
-        message,
-    };
+        source,
+    })?;
+    let mut out = BufWriter::new(staged.file());
     Image::from_layer(layer)
         .write()
-        .to_file(&tmp)
-        .map_err(|e| err(e.to_string()))?;
-    std::fs::rename(&tmp, path).map_err(|source| ImageError::Io {
-        path: name.clone(),
+        .to_buffered(&mut out)
+        .map_err(|e| ImageError::ExrWrite {
+            path: name.clone(),
+            message: e.to_string(),
+        })?;
+    flush(out, &name)?;
+    Ok(staged)
+}
+
+/// Flushes a buffered writer, naming the file on failure (a dropped `BufWriter` would hide it).
+fn flush(mut out: BufWriter<&mut std::fs::File>, name: &str) -> Result<(), ImageError> {
+    std::io::Write::flush(&mut out).map_err(|source| ImageError::Io {
+        path: name.to_string(),
         source,
     })
 }
@@ -207,6 +263,11 @@ pub fn write_exr_layers_with(
 /// Writes a rendered image as EXR: beauty `R G B` plus the AOV layers `albedo` (RGB), `normal`
 /// (XYZ), `depth` (Z), `fiber` (XYZ), `ray_mask` (Y), `growth_time` (Y) and `std_error` (Y).
 pub fn write_image_exr(path: &Path, image: &super::Image) -> Result<(), ImageError> {
+    commit(stage_image_exr(path, image)?)
+}
+
+/// [`write_image_exr`] staged, to [`commit`] later.
+pub fn stage_image_exr(path: &Path, image: &super::Image) -> Result<Staged, ImageError> {
     let mut layers = vec![ExrLayer {
         name: "",
         channels: &["R", "G", "B"],
@@ -218,7 +279,13 @@ pub fn write_image_exr(path: &Path, image: &super::Image) -> Result<(), ImageErr
         channels: &["Y"],
         data: image.std_error.clone(),
     });
-    write_exr_layers(path, image.width, image.height, &layers)
+    stage_exr_layers(
+        path,
+        image.width,
+        image.height,
+        &layers,
+        ExrCompression::Zip,
+    )
 }
 
 /// The AOV layers of [`write_image_exr`] (`albedo` … `growth_time`), e.g. for a file of AOVs that

@@ -14,6 +14,7 @@ pub mod geometry;
 pub mod image_io;
 pub mod integrator;
 pub mod light;
+pub mod resources;
 pub mod wide_bvh;
 
 pub use camera::{Camera, Projection};

@@ -101,7 +101,7 @@ pub struct WideHit {
 }
 
 /// The 8-wide BVH over a triangle list.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct WideBvh {
     nodes: Vec<Node>,
     packets: Vec<Packet>,
@@ -111,6 +111,20 @@ pub struct WideBvh {
     stack_need: usize,
     /// Whether the AVX2 compilation of the traversal is used (decided once, at build).
     avx2: bool,
+}
+
+/// The BVH of no triangles: its root is `EMPTY`, so every ray misses (a derived default would
+/// point the root at a node that does not exist).
+impl Default for WideBvh {
+    fn default() -> Self {
+        WideBvh {
+            nodes: Vec::new(),
+            packets: Vec::new(),
+            root: EMPTY,
+            stack_need: 0,
+            avx2: false,
+        }
+    }
 }
 
 /// Per-ray data shared by the node and triangle tests.

@@ -23,8 +23,14 @@ fn bad(path: &Path, message: impl Into<String>) -> MeshError {
     }
 }
 
-/// Loads an OBJ or PLY file by extension.
+/// Loads an OBJ or PLY file by extension (a regular file of at most
+/// [`MAX_MESH_BYTES`](crate::render::resources::MAX_MESH_BYTES); `/dev/zero` is refused).
 pub fn load_mesh(path: &Path) -> Result<TriMesh, MeshError> {
+    use crate::render::resources::{check_regular, ResourceError, MAX_MESH_BYTES};
+    check_regular(path, MAX_MESH_BYTES).map_err(|e| match e {
+        ResourceError::Input { message, .. } => bad(path, message),
+        other => bad(path, other.to_string()),
+    })?;
     match path
         .extension()
         .and_then(|e| e.to_str())

@@ -36,6 +36,8 @@ pub enum SceneError {
     },
     #[error("scene {path}: {message}")]
     Parse { path: String, message: String },
+    #[error("cannot read scene {0}")]
+    Input(crate::render::resources::ResourceError),
     #[error("scene {path}: field `{field}`: {message}")]
     Invalid {
         path: String,
@@ -49,6 +51,10 @@ pub enum SceneError {
         source: mesh_io::MeshError,
     },
 }
+
+/// How far from the origin (mm) any object may reach: 1 km, so that f32 coordinates keep a
+/// resolution of 0.06 mm or better (2⁻²⁴ relative) where a scene has geometry.
+pub const MAX_EXTENT_MM: f32 = 1e6;
 
 /// A loaded scene: what to render and how.
 pub struct LoadedScene {
@@ -67,9 +73,12 @@ pub struct LoadedScene {
 
 /// Reads and builds a scene file.
 pub fn load(path: &Path) -> Result<LoadedScene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+    let bytes =
+        crate::render::resources::read_bounded(path, crate::render::resources::MAX_SCENE_BYTES)
+            .map_err(SceneError::Input)?;
+    let text = String::from_utf8(bytes).map_err(|_| SceneError::Parse {
         path: path.display().to_string(),
-        source,
+        message: "not UTF-8 text (a scene is a TOML file)".into(),
     })?;
     let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
     let name = path
@@ -139,10 +148,25 @@ impl Builder<'_> {
         }
     }
 
+    /// A finite point with every coordinate within `±max` mm.
+    fn point(&self, field: &str, a: [f32; 3], max: f32) -> Result<Vec3, SceneError> {
+        let p = self.finite3(field, a)?;
+        if p.abs().max_element() > max {
+            return Err(self.invalid(
+                field,
+                format!("{p} is out of range (every coordinate within ±{max:e} mm)"),
+            ));
+        }
+        Ok(p)
+    }
+
     fn unit3(&self, field: &str, a: [f32; 3]) -> Result<Vec3, SceneError> {
         let v = self.finite3(field, a)?;
-        if v.length_squared() > 1e-12 {
-            Ok(v.normalize())
+        // Divided by the largest component first: the squares of components ≥ ~2e19 overflow
+        // f32, which turned such a direction into a zero vector.
+        let m = v.abs().max_element();
+        if m > 1e-6 {
+            Ok((v / m).normalize())
         } else {
             Err(self.invalid(field, "must be a non-zero direction"))
         }
@@ -228,8 +252,9 @@ impl Builder<'_> {
     }
 
     fn camera(&self, c: &CameraTable, width: u32, height: u32) -> Result<Camera, SceneError> {
-        let eye = self.finite3("camera.eye", c.eye)?;
-        let target = self.finite3("camera.target", c.target)?;
+        // Bounded so that `target − eye` and its square stay finite (a far eye was blamed on `up`).
+        let eye = self.point("camera.eye", c.eye, 1e9)?;
+        let target = self.point("camera.target", c.target, 1e9)?;
         let up = self.unit3("camera.up", c.up)?;
         let dir = target - eye;
         if dir.length_squared() < 1e-12 {
@@ -259,6 +284,18 @@ impl Builder<'_> {
                 }
             }
             ProjectionName::Orthographic => {
+                if c.lens_radius != 0.0 {
+                    return Err(self.invalid(
+                        "camera.lens_radius",
+                        "only for projection = \"perspective\" (an orthographic camera has no lens)",
+                    ));
+                }
+                if c.focus_distance.is_some() {
+                    return Err(self.invalid(
+                        "camera.focus_distance",
+                        "only for projection = \"perspective\"",
+                    ));
+                }
                 let w = c.width.ok_or_else(|| {
                     self.invalid(
                         "camera.width",
@@ -590,7 +627,13 @@ impl Builder<'_> {
         materials: &HashMap<String, u32>,
         _mats: &[Material],
     ) -> Result<Vec<Instance>, SceneError> {
-        let mut cache: HashMap<PathBuf, Arc<TriMesh>> = HashMap::new();
+        if tables.is_empty() {
+            return Err(self.invalid(
+                "objects",
+                "the scene has no objects (give at least one [[objects]] table)",
+            ));
+        }
+        let mut cache: HashMap<(PathBuf, bool), Arc<TriMesh>> = HashMap::new();
         let mut out = Vec::new();
         for (i, o) in tables.iter().enumerate() {
             let f = |s: &str| format!("objects[{i}].{s}");
@@ -626,6 +669,22 @@ impl Builder<'_> {
             ));
             if !transform.is_valid() {
                 return Err(self.invalid(f("scale"), "the transform is not invertible"));
+            }
+            let reach = mesh
+                .positions
+                .iter()
+                .map(|&v| transform.point_to_world(v).abs().max_element())
+                .fold(
+                    0.0f32,
+                    |a, b| if b.is_nan() { f32::INFINITY } else { a.max(b) },
+                );
+            if reach > MAX_EXTENT_MM {
+                return Err(self.invalid(
+                    f("translate"),
+                    format!(
+                        "with its scale and translation the object reaches {reach:e} mm from the origin (allowed within {MAX_EXTENT_MM:e} mm)"
+                    ),
+                ));
             }
             let placement = match &o.tree {
                 None => Placement::default(),
@@ -690,7 +749,8 @@ impl Builder<'_> {
             }
         };
         Ok(Placement {
-            origin: self.finite3(&f("origin"), t.origin)?,
+            // Beyond the scene's extent the growth time loses all precision (NaN at 1e12).
+            origin: self.point(&f("origin"), t.origin, MAX_EXTENT_MM)?,
             axis: self.unit3(&f("axis"), t.axis)?,
             rotation: self
                 .range(&f("rotation_deg"), t.rotation_deg, -360.0, 360.0)?
@@ -706,7 +766,7 @@ impl Builder<'_> {
         &mut self,
         o: &ObjectTable,
         i: usize,
-        cache: &mut HashMap<PathBuf, Arc<TriMesh>>,
+        cache: &mut HashMap<(PathBuf, bool), Arc<TriMesh>>,
     ) -> Result<Arc<TriMesh>, SceneError> {
         let f = |s: &str| format!("objects[{i}].{s}");
         let (kind, used): (&str, &[&str]) = match o.shape {
@@ -798,7 +858,10 @@ impl Builder<'_> {
             ShapeKind::Mesh => {
                 let file = o.file.as_ref().ok_or_else(|| need("file"))?;
                 let p = self.base.join(file);
-                if let Some(m) = cache.get(&p) {
+                // Keyed by file and `smooth`: the second object using a file may want the
+                // other normals.
+                let key = (p.clone(), o.smooth);
+                if let Some(m) = cache.get(&key) {
                     return Ok(m.clone());
                 }
                 let mut m = mesh_io::load_mesh(&p).map_err(|source| SceneError::Mesh {
@@ -823,7 +886,7 @@ impl Builder<'_> {
                     m.normals = None;
                 }
                 let m = Arc::new(m);
-                cache.insert(p, m.clone());
+                cache.insert(key, m.clone());
                 return Ok(m);
             }
         };

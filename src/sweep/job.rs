@@ -5,12 +5,15 @@
 use super::cache::{render_naive, render_sweep, SetupError, SweepPath, SweepRender};
 use super::path::{parse_frames_range, PathError};
 use super::sequence::{
-    assemble, frame_stem, read_records, write_frame, AssembleOptions, Assembled, FrameRecord,
-    Region, SequenceError,
+    assemble, clear_assembled, frame_stem, unmark_frame, write_record, AssembleOptions, Assembled,
+    FrameRecord, Region, SequenceError, SweepSettings,
 };
+use crate::output::{remove_if_present, FolderLock, LockError, LockMode};
 use crate::render::image_io::{
-    aov_layers, write_exr_layers, write_exr_layers_with, ExrCompression, ExrLayer, ImageError,
+    aov_layers, commit, stage_exr_layers, stage_png_linear, write_exr_layers, ExrCompression,
+    ExrLayer, ImageError,
 };
+use crate::render::resources::{ResourceError, Resources};
 use crate::render::{RenderError, RunOptions};
 use crate::scene::LoadedScene;
 use rayon::prelude::*;
@@ -33,6 +36,10 @@ pub enum SweepError {
     Image(#[from] ImageError),
     #[error("cannot create output folder {path}: {cause}")]
     OutDir { path: String, cause: std::io::Error },
+    #[error(transparent)]
+    Lock(#[from] LockError),
+    #[error(transparent)]
+    Resources(#[from] ResourceError),
 }
 
 /// What to render and where.
@@ -50,6 +57,11 @@ pub struct SweepJob {
     pub run: RunOptions,
     /// Compression of each frame's EXR (the shared AOV file is always ZIP).
     pub exr: ExrCompression,
+    /// Skip the memory and disk estimate (`--ignore-limits`).
+    pub ignore_limits: bool,
+    /// What else decides the frames (scene file digest, quality preset), recorded with each frame
+    /// so that `--assemble` refuses slices that disagree.
+    pub provenance: String,
 }
 
 /// What a job did.
@@ -78,12 +90,16 @@ pub fn scene_regions(loaded: &LoadedScene) -> Vec<Region> {
         .collect()
 }
 
-/// The file holding the first-hit AOV layers that every frame of a sweep shares.
+/// The file holding the first-hit AOV layers that every frame of a sweep shares. It is written
+/// by the job that renders frame 0 (the whole sweep, or the first slice of a farmed one), so no
+/// two slices ever write it.
 pub const AOV_FILE: &str = "aov.exr";
 
-/// Writes every frame of `render` (EXR of radiance and standard error, PNG, record) into `dir`,
-/// frames in parallel, and the AOVs they share once into [`AOV_FILE`] (the camera and geometry
-/// do not move, so the AOVs are the same in every frame).
+/// Writes every frame of `render` into `dir`, frames in parallel. Each frame's old record goes
+/// first, then its EXR (radiance and standard error) and PNG are renamed into place and its new
+/// record is written last, so a record always describes the images beside it, even when the run
+/// is killed. The job that renders frame 0 also writes the AOVs every frame shares into
+/// [`AOV_FILE`] (the camera and geometry do not move).
 pub fn write_frames(
     dir: &Path,
     render: &SweepRender,
@@ -91,10 +107,14 @@ pub fn write_frames(
     exposure: f32,
     regions: &[Region],
     compression: ExrCompression,
+    settings: &SweepSettings,
 ) -> Result<(), SweepError> {
     let (w, h) = (render.width, render.height);
-    write_exr_layers(&dir.join(AOV_FILE), w, h, &aov_layers(&render.aov))?;
+    if render.frames.first().is_some_and(|f| f.index == 0) {
+        write_exr_layers(&dir.join(AOV_FILE), w, h, &aov_layers(&render.aov))?;
+    }
     render.frames.par_iter().try_for_each(|f| {
+        let stem = frame_stem(f.index);
         let layers = [
             ExrLayer {
                 name: "",
@@ -107,20 +127,21 @@ pub fn write_frames(
                 data: f.std_error.clone(),
             },
         ];
-        write_exr_layers_with(
-            &dir.join(format!("{}.exr", frame_stem(f.index))),
-            w,
-            h,
-            &layers,
-            compression,
-        )?;
-        let rec = FrameRecord::measure(f.index, total, f.light_deg, (w, h), &f.beauty, regions);
-        write_frame(dir, &rec, &f.beauty, exposure)?;
+        let exr = stage_exr_layers(&dir.join(format!("{stem}.exr")), w, h, &layers, compression)?;
+        let png = stage_png_linear(&dir.join(format!("{stem}.png")), w, h, &f.beauty, exposure)?;
+        let mut rec = FrameRecord::measure(f.index, total, f.light_deg, (w, h), &f.beauty, regions);
+        rec.sweep = settings.clone();
+        unmark_frame(dir, f.index)?;
+        commit(exr)?;
+        commit(png)?;
+        write_record(dir, &rec)?;
         Ok(())
     })
 }
 
-/// Runs a sweep job on a loaded scene.
+/// Runs a sweep job on a loaded scene. A whole sweep holds its output folder alone, clears what
+/// an earlier sweep left there and assembles at the end; a slice (`range` set) shares the folder
+/// with the other slices, writes only its own frames and leaves assembling to `--assemble`.
 pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepError> {
     let (path, moving) = SweepPath::from_scene(loaded, job.frames, job.arc)?;
     let total = path.arc.frames;
@@ -128,10 +149,21 @@ pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepE
         Some(text) => parse_frames_range(text, total)?,
         None => 0..total,
     };
+    let cam = &loaded.scene.camera;
+    let need = Resources::sweep(cam.width, cam.height, range.len(), job.naive);
+    need.check(&job.out, job.ignore_limits)?;
     std::fs::create_dir_all(&job.out).map_err(|cause| SweepError::OutDir {
         path: job.out.display().to_string(),
         cause,
     })?;
+    let mode = if job.range.is_some() {
+        LockMode::Shared
+    } else {
+        LockMode::Exclusive
+    };
+    let _lock = FolderLock::try_new(&job.out, mode)?;
+    // The old viewer, CSV and sheet describe frames about to change: they go before any frame.
+    clear_assembled(&job.out)?;
     if job.range.is_none() {
         clear_frames(&job.out)?;
     }
@@ -148,6 +180,13 @@ pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepE
         range.clone(),
         &job.run,
     )?;
+    let settings = SweepSettings {
+        scene: loaded.name.clone(),
+        arc_deg: [path.arc.from_deg, path.arc.to_deg],
+        spp: loaded.settings.spp,
+        seed: loaded.settings.seed,
+        provenance: job.provenance.clone(),
+    };
     write_frames(
         &job.out,
         &r,
@@ -155,14 +194,9 @@ pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepE
         loaded.exposure,
         &scene_regions(loaded),
         job.exr,
+        &settings,
     )?;
-    // Assemble when the folder now holds the complete sweep (always, unless farming slices).
-    let complete = match read_records(&job.out) {
-        Ok(_) => true,
-        Err(SequenceError::Missing { .. }) => false,
-        Err(e) => return Err(e.into()),
-    };
-    let assembled = if complete {
+    let assembled = if job.range.is_none() {
         let opts = AssembleOptions {
             title: format!("{} — light sweep", loaded.name),
             ..Default::default()
@@ -179,13 +213,15 @@ pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepE
     })
 }
 
-/// Removes the frame files (`frame_NNNN.{json,png,exr}`) a previous sweep left in `dir`, so a new
-/// complete sweep never mixes with them.
+/// Removes the frame files (`frame_NNNN.{json,png,exr}`) and the AOV file a previous sweep left
+/// in `dir`, so a new complete sweep never mixes with them. The records go first: a frame whose
+/// record is gone no longer looks complete.
 fn clear_frames(dir: &Path) -> Result<(), SweepError> {
     let io = |cause| SweepError::OutDir {
         path: dir.display().to_string(),
         cause,
     };
+    let mut stale = vec![dir.join(AOV_FILE)];
     for entry in std::fs::read_dir(dir).map_err(io)? {
         let p = entry.map_err(io)?.path();
         let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
@@ -196,8 +232,12 @@ fn clear_frames(dir: &Path) -> Result<(), SweepError> {
                 digits.bytes().all(|b| b.is_ascii_digit()) && ["json", "png", "exr"].contains(&ext)
             });
         if is_frame {
-            std::fs::remove_file(&p).map_err(io)?;
+            stale.push(p);
         }
+    }
+    stale.sort_by_key(|p| p.extension().is_none_or(|e| e != "json"));
+    for p in stale {
+        remove_if_present(&p).map_err(io)?;
     }
     Ok(())
 }

@@ -25,9 +25,12 @@ pub enum PathError {
         end: usize,
         frames: usize,
     },
-    #[error("frames = {0}: a sweep needs at least 1 frame (allowed 1..=100000)")]
+    #[error("frames = {0}: out of range (allowed 1 to {MAX_FRAMES})")]
     Frames(usize),
 }
+
+/// The most frames a sweep may have.
+pub const MAX_FRAMES: usize = 100_000;
 
 /// The light angles of a sweep: `frames` angles spread evenly from `from_deg` to `to_deg`
 /// (inclusive), measured from the zenith towards the arc direction.
@@ -41,7 +44,7 @@ pub struct LightArc {
 impl LightArc {
     /// Checks the frame count and that both ends lie above the horizon.
     pub fn new(from_deg: f32, to_deg: f32, frames: usize) -> Result<Self, PathError> {
-        if frames == 0 || frames > 100_000 {
+        if frames == 0 || frames > MAX_FRAMES {
             return Err(PathError::Frames(frames));
         }
         let ok = |a: f32| a.is_finite() && (-90.0..=90.0).contains(&a);
@@ -117,8 +120,16 @@ impl ArcPlane {
 pub fn parse_arc(text: &str) -> Result<(f32, f32), PathError> {
     let err = || PathError::ArcSyntax(text.to_string());
     let (a, b) = text.trim().split_once("..").ok_or_else(err)?;
-    let from: f32 = a.trim().parse().map_err(|_| err())?;
-    let to: f32 = b.trim().parse().map_err(|_| err())?;
+    // A number that starts or ends with its decimal point would let `1...2` read as 1..0.2.
+    let number = |t: &str| -> Result<f32, PathError> {
+        let t = t.trim();
+        let digits = t.trim_start_matches(['+', '-']);
+        if digits.starts_with('.') || digits.ends_with('.') {
+            return Err(err());
+        }
+        t.parse().map_err(|_| err())
+    };
+    let (from, to) = (number(a)?, number(b)?);
     if !from.is_finite() || !to.is_finite() {
         return Err(err());
     }
@@ -140,7 +151,7 @@ pub fn parse_frames_range(text: &str, frames: usize) -> Result<Range<usize>, Pat
     } else {
         let b: usize = b.trim().parse().map_err(|_| syntax())?;
         if inclusive {
-            b + 1
+            b.checked_add(1).ok_or_else(syntax)?
         } else {
             b
         }
@@ -207,7 +218,9 @@ mod tests {
     fn arcs_parse_with_negative_ends() {
         assert_eq!(parse_arc("-60..60"), Ok((-60.0, 60.0)));
         assert_eq!(parse_arc(" 45 .. -45.5 "), Ok((45.0, -45.5)));
-        for bad in ["", "60", "a..b", "1..", "..3", "nan..2", "1..inf"] {
+        for bad in [
+            "", "60", "a..b", "1..", "..3", "nan..2", "1..inf", "1...2", "1.5...2", "1....2",
+        ] {
             assert!(
                 matches!(parse_arc(bad), Err(PathError::ArcSyntax(_))),
                 "{bad}"

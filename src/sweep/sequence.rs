@@ -4,8 +4,10 @@
 //! animated PNG, the CSV and the `index.html` viewer. One code path serves both cases.
 
 use super::contact::{contact_sheet, Rgb8};
+use super::path::MAX_FRAMES;
 use super::viewer::viewer_html;
 use crate::math::{luminance, Vec3};
+use crate::output::{remove_if_present, write_atomic, Staged};
 use crate::render::image_io::{write_png_linear, write_png_rgb8, ImageError};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -102,11 +104,53 @@ pub struct RegionMean {
     pub luminance: f32,
 }
 
+/// Everything besides the frame index that decides a sweep's frames, so that `--assemble` can
+/// refuse slices rendered with different settings.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct SweepSettings {
+    /// The scene's name (file stem).
+    pub scene: String,
+    /// The arc's ends in degrees.
+    pub arc_deg: [f32; 2],
+    pub spp: u32,
+    pub seed: u64,
+    /// What else the run was given: the scene file's CRC-32 and the `--quality` preset.
+    pub provenance: String,
+}
+
+impl SweepSettings {
+    /// The first setting in which `self` differs from `other`, as `name = mine (others: theirs)`.
+    pub fn difference(&self, other: &SweepSettings) -> Option<String> {
+        let pairs = [
+            ("scene", self.scene.clone(), other.scene.clone()),
+            (
+                "arc_deg",
+                format!("{:?}", self.arc_deg),
+                format!("{:?}", other.arc_deg),
+            ),
+            ("spp", self.spp.to_string(), other.spp.to_string()),
+            ("seed", self.seed.to_string(), other.seed.to_string()),
+            (
+                "provenance",
+                self.provenance.clone(),
+                other.provenance.clone(),
+            ),
+        ];
+        pairs
+            .into_iter()
+            .find(|(_, a, b)| a != b)
+            .map(|(name, a, b)| format!("{name} = {a} (the others: {b})"))
+    }
+}
+
 /// What a frame leaves beside its images: enough to assemble the sequence without the scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FrameRecord {
     pub index: usize,
     pub frames: usize,
+    /// The settings of the sweep the frame belongs to (empty in records of older versions).
+    #[serde(default)]
+    pub sweep: SweepSettings,
     pub light_deg: f32,
     pub width: u32,
     pub height: u32,
@@ -133,6 +177,7 @@ impl FrameRecord {
         FrameRecord {
             index,
             frames,
+            sweep: SweepSettings::default(),
             light_deg,
             width,
             height,
@@ -154,15 +199,29 @@ pub fn frame_stem(index: usize) -> String {
     format!("frame_{index:04}")
 }
 
-/// Writes `text` to `path` through a temporary file, so a failure leaves no half-written file.
+/// Writes `text` to `path` through a uniquely named temporary file, so a failure leaves no
+/// half-written file and concurrent writers never mix.
 pub fn write_text_atomic(path: &Path, text: &str) -> Result<(), SequenceError> {
-    let io = |cause| SequenceError::Io {
+    write_atomic(path, text.as_bytes()).map_err(|cause| io_error(path, cause))
+}
+
+fn io_error(path: &Path, cause: std::io::Error) -> SequenceError {
+    SequenceError::Io {
         path: path.display().to_string(),
         cause,
-    };
-    let tmp = path.with_extension("partial");
-    std::fs::write(&tmp, text).map_err(io)?;
-    std::fs::rename(&tmp, path).map_err(io)
+    }
+}
+
+/// The record of frame `index` in `dir`.
+pub fn record_path(dir: &Path, index: usize) -> PathBuf {
+    dir.join(format!("{}.json", frame_stem(index)))
+}
+
+/// Removes frame `index`'s record, so that while its images are being replaced it does not look
+/// complete (a record marks a frame complete).
+pub fn unmark_frame(dir: &Path, index: usize) -> Result<(), SequenceError> {
+    let path = record_path(dir, index);
+    remove_if_present(&path).map_err(|cause| io_error(&path, cause))
 }
 
 /// Writes a frame's PNG preview (exposure in stops) and then its record, which marks it complete.
@@ -175,7 +234,12 @@ pub fn write_frame(
     let stem = frame_stem(record.index);
     let png = dir.join(format!("{stem}.png"));
     write_png_linear(&png, record.width, record.height, pixels, exposure)?;
-    let json = dir.join(format!("{stem}.json"));
+    write_record(dir, record)
+}
+
+/// Writes a frame's record, which marks the frame complete: call it after its images.
+pub fn write_record(dir: &Path, record: &FrameRecord) -> Result<(), SequenceError> {
+    let json = record_path(dir, record.index);
     let text = serde_json::to_string_pretty(record).map_err(|cause| SequenceError::Json {
         path: json.display().to_string(),
         cause,
@@ -239,8 +303,31 @@ pub fn read_records(dir: &Path) -> Result<Vec<FrameRecord>, SequenceError> {
         });
     };
     let (frames, size) = (first.frames, (first.width, first.height));
-    for (path, r) in &records {
-        let what = if r.frames != frames {
+    let settings = first.sweep.clone();
+    for (k, (path, r)) in records.iter().enumerate() {
+        let stem = path.file_stem().and_then(|n| n.to_str()).unwrap_or("");
+        let what = if !(1..=MAX_FRAMES).contains(&r.frames) {
+            Some(format!(
+                "claims a {}-frame sweep (allowed 1 to {MAX_FRAMES})",
+                r.frames
+            ))
+        } else if stem != frame_stem(r.index) {
+            Some(format!(
+                "holds the record of frame {} (its file would be {}.json)",
+                r.index,
+                frame_stem(r.index)
+            ))
+        } else if k > 0 && records[k - 1].1.index == r.index {
+            Some(format!(
+                "is a second record of frame {} (the other: {})",
+                r.index,
+                records[k - 1].0.display()
+            ))
+        } else if let Some(d) = r.sweep.difference(&settings) {
+            Some(format!(
+                "belongs to a sweep with {d}; every slice must be rendered with the same settings"
+            ))
+        } else if r.frames != frames {
             Some(format!(
                 "belongs to a {}-frame sweep, the others to a {frames}-frame one",
                 r.frames
@@ -362,9 +449,9 @@ pub fn write_apng(path: &Path, frames: &[Rgb8], fps: u16) -> Result<(), Sequence
         path: name.clone(),
         cause,
     };
-    let tmp = path.with_extension("png.partial");
-    let file = std::fs::File::create(&tmp).map_err(io)?;
-    let mut enc = png::Encoder::new(BufWriter::new(file), first.width, first.height);
+    let mut staged = Staged::new(path).map_err(io)?;
+    let mut out = BufWriter::new(staged.file());
+    let mut enc = png::Encoder::new(&mut out, first.width, first.height);
     enc.set_color(png::ColorType::Rgb);
     enc.set_depth(png::BitDepth::Eight);
     enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
@@ -375,7 +462,9 @@ pub fn write_apng(path: &Path, frames: &[Rgb8], fps: u16) -> Result<(), Sequence
         w.write_image_data(&f.data).map_err(enc_err)?;
     }
     w.finish().map_err(enc_err)?;
-    std::fs::rename(&tmp, path).map_err(io)
+    std::io::Write::flush(&mut out).map_err(io)?;
+    drop(out);
+    staged.commit().map_err(io)
 }
 
 /// The CSV of light angle and mean radiance per frame, one column per named region.
@@ -421,9 +510,24 @@ pub struct Assembled {
     pub files: Vec<PathBuf>,
 }
 
+/// The files [`assemble`] writes, the viewer (written last, so it marks the sweep complete) first.
+pub const ASSEMBLED: [&str; 4] = [VIEWER, CSV, CONTACT_SHEET, ANIMATION];
+
+/// Removes the outputs of an earlier assembly (the viewer first), so that a sweep being
+/// re-rendered never looks complete with the old viewer, CSV and sheet beside new frames.
+pub fn clear_assembled(dir: &Path) -> Result<(), SequenceError> {
+    for name in ASSEMBLED {
+        let path = dir.join(name);
+        remove_if_present(&path).map_err(|cause| io_error(&path, cause))?;
+    }
+    Ok(())
+}
+
 /// Builds the contact sheet, the animated PNG, the CSV and the viewer from the frames in `dir`.
+/// The stale outputs of an earlier assembly go first and the viewer is written last.
 pub fn assemble(dir: &Path, opts: &AssembleOptions) -> Result<Assembled, SequenceError> {
     let records = read_records(dir)?;
+    clear_assembled(dir)?;
     // Decoding and shrinking are per frame: in parallel, each frame giving its thumbnail and its
     // animation frame.
     let shrunk: Vec<(Rgb8, Rgb8)> = records
@@ -515,6 +619,7 @@ mod tests {
         let rec = |i| FrameRecord {
             index: i,
             frames: 2,
+            sweep: SweepSettings::default(),
             light_deg: i as f32 * 10.0,
             width: 1,
             height: 1,

@@ -143,6 +143,7 @@ mod tests {
         FrameRecord {
             index: i,
             frames: 3,
+            sweep: Default::default(),
             light_deg: -30.0 + 30.0 * i as f32,
             width: 8,
             height: 4,

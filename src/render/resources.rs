@@ -1,0 +1,227 @@
+//! What a render or a sweep will need — memory, disk, threads, input bytes — estimated before any
+//! large allocation or write, and refused with a clear error above what the machine has.
+
+use super::film::{Aov, PixelSum};
+use glam::Vec3;
+use std::mem::size_of;
+use std::path::Path;
+
+/// The most worker threads per core `--threads` may ask for (more only adds switching, and
+/// 100000 threads exhaust the machine).
+pub const MAX_THREADS_PER_CORE: usize = 16;
+/// The largest scene file read (a scene is text; this bounds `/dev/zero` and the like).
+pub const MAX_SCENE_BYTES: u64 = 16 << 20;
+/// The largest mesh file read.
+pub const MAX_MESH_BYTES: u64 = 4 << 30;
+
+/// A limit a run would exceed, with the flag that overrides it where one does.
+#[derive(Debug, thiserror::Error)]
+pub enum ResourceError {
+    #[error("{what} needs about {need} of {kind} but {have} is available; lower the resolution or the frame count, or pass --ignore-limits to try anyway")]
+    TooLarge {
+        what: String,
+        kind: &'static str,
+        need: Bytes,
+        have: Bytes,
+    },
+    #[error("--threads {threads}: out of range (allowed 0 = all cores, up to {max} = {MAX_THREADS_PER_CORE} per core)")]
+    Threads { threads: usize, max: usize },
+    #[error("{path}: {message}")]
+    Input { path: String, message: String },
+}
+
+/// A byte count printed in binary units.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub struct Bytes(pub u64);
+
+impl std::fmt::Display for Bytes {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let gib = self.0 as f64 / (1u64 << 30) as f64;
+        if gib >= 1.0 {
+            write!(f, "{gib:.1} GiB")
+        } else {
+            write!(f, "{:.1} MiB", self.0 as f64 / (1u64 << 20) as f64)
+        }
+    }
+}
+
+/// Memory and disk a run needs (estimates from the sizes of the buffers it allocates).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Resources {
+    pub what: String,
+    pub memory: u64,
+    pub disk: u64,
+}
+
+/// Channels of a render's EXR: beauty RGB, albedo RGB, normal XYZ, depth, fibre XYZ, ray mask,
+/// growth time, standard error.
+const RENDER_EXR_CHANNELS: u64 = 17;
+/// Channels of a sweep frame's EXR (RGB and standard error).
+const FRAME_EXR_CHANNELS: u64 = 4;
+
+impl Resources {
+    /// A still render of `width × height`: the film's sums, the finished image with its AOVs,
+    /// and the EXR's channel copies; on disk an uncompressed EXR and PNG at most.
+    pub fn render(width: u32, height: u32) -> Self {
+        let px = width as u64 * height as u64;
+        let image = (size_of::<Vec3>() + size_of::<f32>() + size_of::<Aov>()) as u64;
+        Resources {
+            what: format!("a {width}x{height} render"),
+            memory: px * (size_of::<PixelSum>() as u64 + image + 2 * 4 * RENDER_EXR_CHANNELS),
+            disk: px * (4 * RENDER_EXR_CHANNELS + 3),
+        }
+    }
+
+    /// `frames` frames of a `width × height` sweep: every frame's pixel sums and finished
+    /// radiance are held until written (the cache itself is per tile), plus the shared AOVs.
+    pub fn sweep(width: u32, height: u32, frames: usize, naive: bool) -> Self {
+        let px = width as u64 * height as u64;
+        let per_frame = (size_of::<PixelSum>() + size_of::<Vec3>() + size_of::<f32>()) as u64;
+        let held = if naive { 1 } else { frames as u64 };
+        Resources {
+            what: format!("{frames} frames of a {width}x{height} sweep"),
+            memory: px * (held * per_frame + size_of::<Aov>() as u64),
+            disk: frames as u64 * px * (4 * FRAME_EXR_CHANNELS + 3) + px * 4 * 14,
+        }
+    }
+
+    /// Refuses when the estimate exceeds the available memory or the free space of the file
+    /// system holding `out` (unless `ignore`); unknown amounts are not checked.
+    pub fn check(&self, out: &Path, ignore: bool) -> Result<(), ResourceError> {
+        if ignore {
+            return Ok(());
+        }
+        let too_large = |kind, need, have| ResourceError::TooLarge {
+            what: self.what.clone(),
+            kind,
+            need: Bytes(need),
+            have: Bytes(have),
+        };
+        if let Some(have) = available_memory() {
+            if self.memory > have {
+                return Err(too_large("memory", self.memory, have));
+            }
+        }
+        if let Some(have) = available_disk(out) {
+            if self.disk > have {
+                return Err(too_large("disk space", self.disk, have));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Checks `--threads` (0 means all cores).
+pub fn check_threads(threads: usize) -> Result<(), ResourceError> {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let max = cores * MAX_THREADS_PER_CORE;
+    if threads > max {
+        return Err(ResourceError::Threads { threads, max });
+    }
+    Ok(())
+}
+
+/// Memory available to this process: `MemAvailable` of /proc/meminfo, lowered to the cgroup's
+/// remaining allowance (`memory.max − memory.current`) where one is set. None where unknown.
+pub fn available_memory() -> Option<u64> {
+    let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let kib: u64 = meminfo
+        .lines()
+        .find_map(|l| l.strip_prefix("MemAvailable:"))?
+        .trim()
+        .trim_end_matches("kB")
+        .trim()
+        .parse()
+        .ok()?;
+    let mut have = kib * 1024;
+    let read = |p: &str| -> Option<u64> { std::fs::read_to_string(p).ok()?.trim().parse().ok() };
+    if let (Some(max), Some(cur)) = (
+        read("/sys/fs/cgroup/memory.max"),
+        read("/sys/fs/cgroup/memory.current"),
+    ) {
+        have = have.min(max.saturating_sub(cur));
+    }
+    Some(have)
+}
+
+/// Free space (for unprivileged users) on the file system that holds `dir` or, when it does not
+/// exist yet, its nearest existing ancestor. None where unknown.
+pub fn available_disk(dir: &Path) -> Option<u64> {
+    use std::os::unix::ffi::OsStrExt;
+    let abs = std::path::absolute(dir).ok()?;
+    let existing = abs.ancestors().find(|p| p.exists())?;
+    let c = std::ffi::CString::new(existing.as_os_str().as_bytes()).ok()?;
+    let mut st: libc::statvfs = unsafe { std::mem::zeroed() };
+    // SAFETY: `c` is a valid NUL-terminated path and `st` a writable statvfs.
+    if unsafe { libc::statvfs(c.as_ptr(), &mut st) } != 0 {
+        return None;
+    }
+    Some(st.f_bavail as u64 * st.f_frsize as u64)
+}
+
+/// Reads an input file whole, refusing what is not a regular file (a device such as /dev/zero,
+/// a folder) or is larger than `max` bytes.
+pub fn read_bounded(path: &Path, max: u64) -> Result<Vec<u8>, ResourceError> {
+    use std::io::Read;
+    check_regular(path, max)?;
+    let input = |e: std::io::Error| ResourceError::Input {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    };
+    let mut bytes = Vec::new();
+    // `take` also bounds a file that grows after the check.
+    std::fs::File::open(path)
+        .map_err(input)?
+        .take(max)
+        .read_to_end(&mut bytes)
+        .map_err(input)?;
+    Ok(bytes)
+}
+
+/// [`read_bounded`]'s checks alone, for files another library opens itself.
+pub fn check_regular(path: &Path, max: u64) -> Result<(), ResourceError> {
+    let input = |message: String| ResourceError::Input {
+        path: path.display().to_string(),
+        message,
+    };
+    let meta = std::fs::metadata(path).map_err(|e| input(e.to_string()))?;
+    if !meta.is_file() {
+        return Err(input("not a regular file".into()));
+    }
+    if meta.len() > max {
+        return Err(input(format!(
+            "{} is larger than the {} allowed",
+            Bytes(meta.len()),
+            Bytes(max)
+        )));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_documented_maximum_resolution_is_refused_on_a_small_machine() {
+        // 16384² pixels at ≥ 100 bytes each is ≥ 26 GiB, far beyond any of 8 GiB.
+        let r = Resources::render(16384, 16384);
+        assert!(r.memory > 26 << 30, "{}", Bytes(r.memory));
+        // 100000 frames of 512×384 at ≥ 16 bytes of radiance each: ≥ 290 GiB.
+        let s = Resources::sweep(512, 384, 100_000, false);
+        assert!(s.memory > 290 << 30 && s.disk > 290 << 30);
+        assert!(check_threads(100_000).is_err());
+        assert!(check_threads(0).is_ok() && check_threads(1).is_ok());
+    }
+
+    #[test]
+    fn devices_and_oversized_files_are_refused_before_reading() {
+        let e = read_bounded(Path::new("/dev/zero"), 1 << 20).unwrap_err();
+        assert!(e.to_string().contains("not a regular file"), "{e}");
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("big.toml");
+        std::fs::write(&p, vec![b' '; 2048]).unwrap();
+        assert!(read_bounded(&p, 1024).is_err());
+        assert_eq!(read_bounded(&p, 4096).unwrap().len(), 2048);
+    }
+}
