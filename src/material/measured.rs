@@ -15,8 +15,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// How the 8-bit colours of the maps decode to linear RGB.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum ColorSpace {
     /// v/255, as the ported GLSL shader uses the maps (the default).
     #[default]
@@ -259,24 +258,31 @@ pub fn energy_bounded_fiber_color(published: Vec3) -> Vec3 {
 
 /// Which face of the object the board lies on (object space); the image is seen from outside
 /// that face with its top row towards `up`: +z (up +y), −z (up −y), ±x and ±y (up +z).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum BoardFace {
     #[default]
-    #[serde(rename = "+z")]
     PosZ,
-    #[serde(rename = "-z")]
     NegZ,
-    #[serde(rename = "+x")]
     PosX,
-    #[serde(rename = "-x")]
     NegX,
-    #[serde(rename = "+y")]
     PosY,
-    #[serde(rename = "-y")]
     NegY,
 }
 
 impl BoardFace {
+    /// The face named "+z", "-z", "+x", "-x", "+y" or "-y".
+    pub fn from_name(name: &str) -> Option<BoardFace> {
+        Some(match name {
+            "+z" => BoardFace::PosZ,
+            "-z" => BoardFace::NegZ,
+            "+x" => BoardFace::PosX,
+            "-x" => BoardFace::NegX,
+            "+y" => BoardFace::PosY,
+            "-y" => BoardFace::NegY,
+            _ => return None,
+        })
+    }
+
     /// The `size` rectangle on this face centred on the object's origin (the plane's offset along
     /// the normal does not matter: points are projected onto it).
     pub fn rect(self, size: Vec2) -> FaceRect {

@@ -232,12 +232,12 @@ pub enum MaterialTable {
         /// The published lobe's k_f per stored unit (notes/measured.md).
         #[serde(default = "default_fiber_color_scale")]
         fiber_color_scale: f32,
-        #[serde(default)]
-        color_space: crate::material::ColorSpace,
+        /// "linear" (default) or "srgb".
+        color_space: Option<String>,
         /// [width, height] of the image on the face (object-space mm).
         size_mm: [f32; 2],
-        #[serde(default)]
-        face: crate::material::BoardFace,
+        /// "+z" (default), "-z", "+x", "-x", "+y" or "-y".
+        face: Option<String>,
         #[serde(default = "default_eta")]
         eta: f32,
         #[serde(default)]

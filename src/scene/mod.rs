@@ -12,8 +12,8 @@ pub use format::{SceneFile, SweepRegion, SweepTable};
 
 use crate::bsdf::{WoodBsdf, WoodBsdfParams};
 use crate::material::{
-    Cutting, Material, MeasuredBoard, MeasuredFiles, MeasuredMaterial, Placement, TextureMaterial,
-    WoodMaterial,
+    BoardFace, ColorSpace, Cutting, Material, MeasuredBoard, MeasuredFiles, MeasuredMaterial,
+    Placement, TextureMaterial, WoodMaterial,
 };
 use crate::render::{
     self, Accel, Camera, EnvMap, Environment, Filter, Instance, Integrator, Light, Projection,
@@ -593,13 +593,35 @@ impl Builder<'_> {
             self.range(&f("size_mm"), size_mm[0], 1e-3, 1e6)?,
             self.range(&f("size_mm"), size_mm[1], 1e-3, 1e6)?,
         );
+        let face = match face
+            .as_deref()
+            .map_or(Some(BoardFace::PosZ), BoardFace::from_name)
+        {
+            Some(face) => face,
+            None => {
+                return Err(self.invalid(
+                    f("face"),
+                    "allowed \"+z\", \"-z\", \"+x\", \"-x\", \"+y\", \"-y\"",
+                ))
+            }
+        };
+        let colors = match color_space.as_deref() {
+            None | Some("linear") => ColorSpace::Linear,
+            Some("srgb") => ColorSpace::Srgb,
+            Some(other) => {
+                return Err(self.invalid(
+                    f("color_space"),
+                    format!("`{other}` (allowed \"linear\" or \"srgb\")"),
+                ))
+            }
+        };
         let files = MeasuredFiles {
             diffuse: self.base.join(diffuse),
             fiber_color: self.base.join(fiber_color),
             fiber_axis: self.base.join(fiber_axis),
             highlight_width: highlight_width.as_ref().map(|p| self.base.join(p)),
         };
-        let board = MeasuredBoard::from_files(&files, *color_space)
+        let board = MeasuredBoard::from_files(&files, colors)
             .map_err(|e| self.invalid(f(e.field()), e.to_string()))?;
         let m = MeasuredMaterial::new(
             Arc::new(board),
