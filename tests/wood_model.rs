@@ -174,9 +174,9 @@ fn growth_noise_bounds_hold_and_are_tight() {
             max_d = max_d.max(d.abs() * h);
         }
     }
-    assert!(max_v <= 1.0 && max_v >= 0.95, "|n| reaches {max_v}");
+    assert!((0.95..=1.0).contains(&max_v), "|n| reaches {max_v}");
     let bound = wood::GROWTH_NOISE_SLOPE_BOUND;
-    assert!(bound >= 2.54615 && bound < 2.5463, "bound {bound}");
+    assert!((2.54615..2.5463).contains(&bound), "bound {bound}");
     assert!(max_d <= bound * (1.0 + 1e-6), "slope {max_d}");
     assert!(
         max_d >= 0.95 * bound,
