@@ -35,13 +35,19 @@ impl Kernel {
         }
         let a = 1.0 - q;
         match self {
-            Kernel::Wyvill => (a * a * a, -3.0 * a * a),
+            Kernel::Wyvill => wyvill(a),
             Kernel::Bump { sharpness } => {
                 let k = (-sharpness * q / a).exp();
                 (k, -sharpness * k / (a * a))
             }
         }
     }
+}
+
+/// The Wyvill kernel (Liu 2016 eq. 4) as `(K, dK/dq)` at `a = 1 − q`, `q = r²`: `(a³, −3a²)`.
+#[inline(always)]
+fn wyvill(a: f32) -> (f32, f32) {
+    (a * a * a, -3.0 * a * a)
 }
 
 /// How the impulses are weighted.
@@ -1107,11 +1113,15 @@ impl SparseConvolution1 {
         let base = floor_i32(xc);
         let f = xc - base as f32;
         let (mut value, mut deriv) = (0.0, 0.0);
-        for o in -1..=1 {
+        // An array, not `-1..=1`: an inclusive range is not unrolled, and the caller's loop then
+        // does not vectorise.
+        for o in [-1i32, 0, 1] {
             let h = cell3_offset(base.wrapping_add(o), 0, 0, &self.offsets);
             let half_sign = if h[1] >> 31 == 0 { 0.5 } else { -0.5 };
             let t = f - o as f32 - unit_f32(h[0]);
-            let (k, dk) = Kernel::Wyvill.eval_q(t * t);
+            // Clamped instead of `Kernel::eval_q`'s early return (the same values where the kernel
+            // reaches, zeros beyond), so that loops over many x vectorise.
+            let (k, dk) = wyvill((1.0 - t * t).max(0.0));
             value += half_sign * k;
             deriv += half_sign * 2.0 * dk * t;
         }
