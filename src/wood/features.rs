@@ -4,7 +4,7 @@
 
 use super::params::{NoiseParams, PoreParams, RayParams};
 use crate::math::Frame;
-use crate::noise::{gradient1_grad, Cells, Kernel, SeededSparse, SparseConvolution, Weights};
+use crate::noise::{Cells, Kernel, SeededSparse, SparseConvolution, SparseConvolution1, Weights};
 use glam::Vec3;
 
 /// Cell size in units of the kernel's (fitted) semi-axes: cells as large as the kernel's diameter
@@ -284,20 +284,28 @@ impl Rays {
     }
 }
 
-/// 1D gradient noise scaled to amplitude `amp` over feature length `1 / inv_scale` (value and
-/// derivative with respect to x).
+/// 1D sparse convolution noise ([`SparseConvolution1`]) scaled to its largest value `amp`:
+/// |value| ≤ amp, |derivative| ≤ amp · MAX_SLOPE / width (notes/wood.md §2, §4).
 #[derive(Clone, Copy, Debug)]
 pub struct Noise1 {
     pub amp: f32,
-    pub inv_scale: f32,
-    pub seed: u32,
+    noise: SparseConvolution1,
 }
 
 impl Noise1 {
-    #[inline]
+    /// Largest value `amp`, kernel half-width `width`.
+    pub fn new(amp: f32, width: f32, seed: u32) -> Self {
+        Noise1 {
+            amp,
+            noise: SparseConvolution1::new(width, seed),
+        }
+    }
+
+    /// Value and derivative with respect to x.
+    #[inline(always)]
     pub fn eval(&self, x: f32) -> (f32, f32) {
-        let (v, d) = gradient1_grad(x * self.inv_scale, self.seed);
-        (self.amp * v, self.amp * self.inv_scale * d)
+        let (v, d) = self.noise.eval(x);
+        (self.amp * v, self.amp * d)
     }
 }
 

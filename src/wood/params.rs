@@ -4,6 +4,7 @@
 
 use super::error::WoodError;
 use super::growth::SmoothTriangleWave;
+use crate::noise::SparseConvolution1;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -40,7 +41,8 @@ pub struct RingParams {
     pub proportions: [f32; 4],
 }
 
-/// Slow / fast growth periods (§6.1.3, eq. 23–24): a C¹ triangle wave in radius plus 1D noise.
+/// Slow / fast growth periods (§6.1.3, eq. 23–24): a C¹ triangle wave in radius plus 1D sparse
+/// convolution noise n(t_pre) (App. A.3: Wyvill kernel, one band, magnitude, kernel width).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GrowthParams {
@@ -48,21 +50,22 @@ pub struct GrowthParams {
     pub wave: [f32; 4],
     /// Peak-to-peak amplitude of the wave, years.
     pub amplitude: f32,
-    /// Amplitude of the 1D growth noise n(t_pre), years.
+    /// Largest |n(t_pre)|, years (a bound; the standard deviation is 0.413 of it). At most
+    /// 0.95 · noise_scale / 2.5462, so that time grows with radius (notes/wood.md §2).
     #[serde(default)]
     pub noise_amplitude: f32,
-    /// Feature length of the growth noise, years.
+    /// Kernel half-width of the growth noise, years.
     #[serde(default = "one")]
     pub noise_scale: f32,
 }
 
-/// Interlocked grain (§6.1.5): the fibre helix angle is 1D noise of r.
+/// Interlocked grain (§6.1.5): the fibre helix angle is 1D sparse convolution noise of r (App. A.3).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct InterlockParams {
-    /// Largest helix angle, degrees.
+    /// Largest helix angle |φ|, degrees (a bound; the standard deviation is 0.413 of it).
     pub angle: f32,
-    /// Feature length of the angle noise along r, mm (about half the reversal period).
+    /// Mean distance along r between reversals of the helix (sign changes of φ), mm.
     pub period: f32,
 }
 
@@ -213,10 +216,10 @@ fn one_u32() -> u32 {
     1
 }
 
-/// Bound on |dn/du| for the unit 1D gradient noise `noise::gradient1` (slopes in [−1, 1], quintic
-/// fade): sup over t of |1 − u − t u'| + |u − (1 − t) u'| = 1.3472 (notes/wood.md); used to keep the
-/// time volume monotone.
-pub const GROWTH_NOISE_SLOPE_BOUND: f32 = 1.35;
+/// Bound on |dn/dt_pre| · noise_scale / noise_amplitude for the growth noise (the unit 1D sparse
+/// convolution noise's [`SparseConvolution1::MAX_SLOPE`]); keeps the time volume monotone
+/// (notes/wood.md §2).
+pub const GROWTH_NOISE_SLOPE_BOUND: f32 = SparseConvolution1::MAX_SLOPE;
 
 struct Checker<'a> {
     file: &'a str,

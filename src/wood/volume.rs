@@ -13,6 +13,7 @@ use crate::field::{
     rotate_by, Cylindrical, Displacement, Distortion, JacobianModel,
 };
 use crate::math::Frame;
+use crate::noise::SparseConvolution1;
 use glam::Vec3;
 
 /// A wood volume ready to evaluate: parameters turned into precomputed waves, colours and noise.
@@ -73,26 +74,28 @@ impl WoodVolume {
             .growth
             .as_ref()
             .map(|g| SmoothTriangleWave::new(g.wave, g.amplitude));
+        // Growth-rate noise n(t_pre) (eq. 24) and the helix angle (§6.1.5): 1D sparse convolution
+        // noise scaled to its largest value; the interlock's kernel width gives mean reversal
+        // spacing `period` (notes/wood.md §2, §4).
         let growth_noise = p
             .growth
             .as_ref()
             .filter(|g| g.noise_amplitude > 0.0)
-            .map(|g| Noise1 {
-                amp: g.noise_amplitude,
-                inv_scale: 1.0 / g.noise_scale,
-                seed: sub_seed(seed, salt::GROWTH),
+            .map(|g| {
+                Noise1::new(
+                    g.noise_amplitude,
+                    g.noise_scale,
+                    sub_seed(seed, salt::GROWTH),
+                )
             });
-        // gradient1 lies within ±0.5, so the helix angle is 2 · angle · n(r / period).
-        let interlock = p
-            .interlock
-            .as_ref()
-            .filter(|i| i.angle > 0.0)
-            .map(|i| Noise1 {
-                amp: 2.0 * i.angle.to_radians(),
-                inv_scale: 1.0 / i.period,
-                seed: sub_seed(seed, salt::INTERLOCK),
-            });
-        let max_tilt = interlock.map_or(0.0, |i| 0.5 * i.amp);
+        let interlock = p.interlock.as_ref().filter(|i| i.angle > 0.0).map(|i| {
+            Noise1::new(
+                i.angle.to_radians(),
+                i.period / SparseConvolution1::ZERO_SPACING,
+                sub_seed(seed, salt::INTERLOCK),
+            )
+        });
+        let max_tilt = interlock.map_or(0.0, |i| i.amp);
         let d = &p.distortion;
         let distortion = [&d.radial, &d.tangential, &d.longitudinal]
             .into_iter()
@@ -192,8 +195,8 @@ impl WoodVolume {
         (t, dt)
     }
 
-    /// The interlocked-grain helix angle (radians) at radius r (§6.1.5): 1D gradient noise of r,
-    /// which crosses zero at every multiple of the period, so the helix reverses with radius.
+    /// The interlocked-grain helix angle (radians) at radius r (§6.1.5): 1D sparse convolution
+    /// noise of r, within ±`angle`, reversing on average once per `period` (notes/wood.md §4).
     #[inline]
     pub fn interlock_angle(&self, r: f32) -> f32 {
         self.interlock.map_or(0.0, |n| n.eval(r).0)
