@@ -26,10 +26,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         indicatif::ProgressStyle::with_template("validate appearance {bar:40} {pos}/{len} {msg}")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
-    let (md, ok) = run_report(Path::new("."), args.presets.as_deref(), &dir, SweepSettings::FULL, &|name| {
-        bar.set_message(name.to_string());
-        bar.inc(1);
-    })
+    let (md, ok) = run_report(
+        Path::new("."),
+        args.presets.as_deref(),
+        &dir,
+        SweepSettings::FULL,
+        &|name| {
+            bar.set_message(name.to_string());
+            bar.inc(1);
+        },
+    )
     .map_err(anyhow::Error::msg)?;
     bar.finish_and_clear();
     let tmp = report.with_extension("md.partial");
