@@ -514,7 +514,9 @@ pub fn curly_maple_bands(
     plots: Option<&Path>,
     run: &RunOptions,
 ) -> Result<CheckOutcome, SweepCheckError> {
-    let (frames, arc) = (41, (-60.0, 60.0));
+    // 1.5° steps: the calibrated curl (fibre dips of ≈ 2° std, as Marschner 2005's measured
+    // maple; validation/APPEARANCE.md) moves each column's peak by ≈ 4° of light angle.
+    let (frames, arc) = (81, (-60.0, 60.0));
     let loaded = load(
         "curly_maple_bands",
         &preset_board_toml("curly_maple", frames, arc, (128, 48)),
