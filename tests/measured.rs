@@ -284,7 +284,7 @@ fn beta_maps_are_range_checked() {
         assert!(e.contains(w), "`{w}` missing from: {e}");
     }
     let text = format!(
-        "[camera]\neye = [0.0, -10.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\n[materials.m]\ntype = \"measured\"\n{}\n",
+        "[camera]\neye = [0.0, -10.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\n[materials.m]\ntype = \"measured\"\n{}\n[[objects]]\nshape = \"quad\"\nsize = [10.0, 10.0]\nmaterial = \"m\"\n",
         with_map(&full)
     );
     let ok = xylem::scene::from_str(&text, "ok.toml", &root(), "ok");
