@@ -977,14 +977,16 @@ pub fn run_report(
         let dips = |m: &BoardMaps| -> Vec<f64> {
             (0..m.board.diffuse.len()).map(|i| m.dip_deg(i)).collect()
         };
-        let plot = line_plot(
-            &[
-                series(histogram(&dips(&r.preset_maps), -20.0, 20.0, 80), 0),
-                series(histogram(&dips(&r.measured_maps), -20.0, 20.0, 80), 1),
-            ],
-            &PlotOptions::default(),
-        );
-        write_png(dir, &format!("plots/appearance_{tag}_dips.png"), &plot)?;
+        // Preset (blue) against measured (red), one plot per statistic.
+        let compare = |name: &str, preset: Vec<(f64, f64)>, measured: Vec<(f64, f64)>| {
+            let plot = line_plot(
+                &[series(preset, 0), series(measured, 1)],
+                &PlotOptions::default(),
+            );
+            write_png(dir, &format!("plots/appearance_{tag}_{name}.png"), &plot)
+        };
+        let dip_hist = |m: &BoardMaps| histogram(&dips(m), -20.0, 20.0, 80);
+        compare("dips", dip_hist(&r.preset_maps), dip_hist(&r.measured_maps))?;
         let profile = |m: &BoardMaps| -> Vec<(f64, f64)> {
             let p = m.dip_profile(0..m.grain_dims().1);
             let n = p.len() as f64;
@@ -993,31 +995,13 @@ pub fn run_report(
                 .map(|(i, y)| (i as f64 / n, y))
                 .collect()
         };
-        let plot = line_plot(
-            &[
-                series(profile(&r.preset_maps), 0),
-                series(profile(&r.measured_maps), 1),
-            ],
-            &PlotOptions::default(),
-        );
-        write_png(
-            dir,
-            &format!("plots/appearance_{tag}_dip_profile.png"),
-            &plot,
+        compare(
+            "dip_profile",
+            profile(&r.preset_maps),
+            profile(&r.measured_maps),
         )?;
         let chat = |s: &SweepLuminance| histogram(&s.chatoyance(), 1.0, 6.0, 50);
-        let plot = line_plot(
-            &[
-                series(chat(&r.preset_sweep), 0),
-                series(chat(&r.measured_sweep), 1),
-            ],
-            &PlotOptions::default(),
-        );
-        write_png(
-            dir,
-            &format!("plots/appearance_{tag}_chatoyance.png"),
-            &plot,
-        )?;
+        compare("chatoyance", chat(&r.preset_sweep), chat(&r.measured_sweep))?;
         write_png(
             dir,
             &format!("plots/appearance_{tag}_frames.png"),
