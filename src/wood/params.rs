@@ -57,6 +57,19 @@ pub struct GrowthParams {
     /// Kernel half-width of the growth noise, years.
     #[serde(default = "one")]
     pub noise_scale: f32,
+    /// Largest shift of the wave's phase, years: the wave is read at u + a·m(u), m a unit 1D
+    /// sparse convolution noise of its own seed, so slow and fast periods come at different radii
+    /// in different trees instead of at the same r for every seed (ours; notes/wood.md §2). At
+    /// most 0.95 · phase_scale · (1/s_down − 1) / 2.5462 (monotone time). 0 = eq. 23 as printed.
+    #[serde(default)]
+    pub phase_amplitude: f32,
+    /// Kernel half-width of the phase noise, years.
+    #[serde(default = "phase_scale_default")]
+    pub phase_scale: f32,
+}
+
+fn phase_scale_default() -> f32 {
+    8.0
 }
 
 /// Interlocked grain (§6.1.5): the fibre helix angle is 1D sparse convolution noise of r (App. A.3).
@@ -313,6 +326,15 @@ impl WoodParams {
                     ),
                 ));
             }
+            // Phase warp: dt_pre/du = 1 + w′(v)(1 + a m′) ≥ 1 − s_down (1 + a · 2.5462/h) > 0.
+            c.positive("growth.phase_scale", g.phase_scale, 1000.0)?;
+            let max_phase = if descent > 0.0 {
+                (0.95 * g.phase_scale * (1.0 / descent - 1.0) / GROWTH_NOISE_SLOPE_BOUND)
+                    .min(1000.0)
+            } else {
+                1000.0
+            };
+            c.range("growth.phase_amplitude", g.phase_amplitude, 0.0, max_phase)?;
             c.positive("growth.noise_scale", g.noise_scale, 1000.0)?;
             let max_noise = 0.95 * g.noise_scale / GROWTH_NOISE_SLOPE_BOUND;
             c.range("growth.noise_amplitude", g.noise_amplitude, 0.0, max_noise)?;

@@ -25,6 +25,8 @@ pub struct WoodVolume {
     inv_ring_width: f32,
     growth: Option<SmoothTriangleWave>,
     growth_noise: Option<Noise1>,
+    /// The growth wave's phase warp a·m(u) (ours, notes/wood.md §2).
+    growth_phase: Option<Noise1>,
     interlock: Option<Noise1>,
     /// Distortion magnitudes along r̂, θ̂, ẑ.
     distortion: [Option<DistortionNoise>; 3],
@@ -47,6 +49,7 @@ mod salt {
     pub const DISTORT: [u32; 3] = [3, 4, 5];
     pub const PORES: u32 = 6;
     pub const RAYS: u32 = 7;
+    pub const PHASE: u32 = 8;
     pub const KNOTS: u64 = 0x6b6e_6f74;
 }
 
@@ -86,6 +89,17 @@ impl WoodVolume {
                     g.noise_amplitude,
                     g.noise_scale,
                     sub_seed(seed, salt::GROWTH),
+                )
+            });
+        let growth_phase = p
+            .growth
+            .as_ref()
+            .filter(|g| g.phase_amplitude > 0.0 && g.amplitude > 0.0)
+            .map(|g| {
+                Noise1::new(
+                    g.phase_amplitude,
+                    g.phase_scale,
+                    sub_seed(seed, salt::PHASE),
                 )
             });
         let interlock = p.interlock.as_ref().filter(|i| i.angle > 0.0).map(|i| {
@@ -128,6 +142,7 @@ impl WoodVolume {
             inv_ring_width: 1.0 / p.rings.width,
             growth,
             growth_noise,
+            growth_phase,
             interlock,
             distortion,
             rings,
@@ -179,13 +194,21 @@ impl WoodVolume {
         let u = r * self.inv_ring_width;
         let (mut t, mut dt) = (u, self.inv_ring_width);
         if let Some(w) = &self.growth {
+            // The wave read at the warped year v = u + a·m(u), dv/du = 1 + a·m′(u).
+            let (v, dv) = match &self.growth_phase {
+                Some(m) => {
+                    let (mv, md) = m.eval(u);
+                    (u + mv, 1.0 + md)
+                }
+                None => (u, 1.0),
+            };
             let (wv, wd) = if CHECKED {
-                w.eval(u)
+                w.eval(v)
             } else {
-                w.eval_unchecked(u)
+                w.eval_unchecked(v)
             };
             t += wv;
-            dt *= 1.0 + wd;
+            dt *= 1.0 + wd * dv;
         }
         if let Some(n) = &self.growth_noise {
             let (nv, nd) = n.eval(t);
@@ -482,7 +505,8 @@ impl WoodVolume {
         if let Some(w) = &self.growth {
             let mut ok = true;
             for &r in &r {
-                ok &= w.in_fast_range(r * self.inv_ring_width);
+                let shift = self.growth_phase.map_or(0.0, |m| m.amp);
+                ok &= w.in_fast_range((r * self.inv_ring_width).abs() + shift);
             }
             if !ok {
                 return false;
