@@ -135,13 +135,18 @@ fn ring_porous_pores_are_earlywood_diffuse_porous_uniform() {
 
 #[test]
 fn time_is_monotone_in_radius() {
-    // notes/wood.md: dt/dr = (1 + w'(u)) (1 + n'(t_pre)) / W > 0 when the wave's steepest descent
-    // s_down < 1 and the noise slope |n'| ≤ 2.5462 A / h < 1; validation enforces both with a 5 %
-    // margin. Checked on every preset and on a preset pushed to the edge of the bound.
+    // notes/wood.md: dt/dr = (1 + w'(v)(1 + a m'(u))) (1 + n'(t_pre)) / W > 0 when the wave's
+    // steepest descent s_down < 1, the phase warp's slope a · 2.5462 / h_a < 1/s_down − 1 and the
+    // noise slope |n'| ≤ 2.5462 A / h < 1; validation enforces all three with a 5 % margin. Checked on every preset and on a preset pushed to the edge of the bound.
     let mut edge = wood::preset("walnut").unwrap();
     let g = edge.growth.as_mut().unwrap();
     g.noise_amplitude = 0.94 * g.noise_scale / wood::GROWTH_NOISE_SLOPE_BOUND;
     g.amplitude = 2.9; // s_down ≈ 0.83 for the walnut wave
+                       // The wave's phase warp at 94 % of its bound a ≤ 0.95 h (1/s_down − 1)/2.5462 too, so
+                       // dt_pre/du = 1 + w′(v)(1 + a m′) comes within 1 % of its limit where w′ = −s_down.
+    let s_down = wood::SmoothTriangleWave::new(g.wave, g.amplitude).max_descent();
+    g.phase_amplitude =
+        0.94 * g.phase_scale * (1.0 / s_down - 1.0) / wood::GROWTH_NOISE_SLOPE_BOUND;
     let mut volumes: Vec<WoodVolume> = PRESET_NAMES.iter().map(|n| volume(n)).collect();
     volumes.push(WoodVolume::new(edge, 3).unwrap());
     for v in &volumes {
