@@ -599,9 +599,9 @@ pub struct SweepLuminance {
 }
 
 impl SweepLuminance {
-    /// Per-pixel chatoyance: max / min luminance over the sweep (Marschner et al. 2005's
-    /// "highlight that moves": 1 for a Lambertian board under a light at constant distance...
-    /// divided by the cosine's range, so it is reported next to a Lambertian reference).
+    /// Per-pixel chatoyance: max / min luminance over the sweep, the strength of the highlight
+    /// that moves with the light (a Lambertian board under the distant light of ±60° gives
+    /// cos 0 / cos 60° = 2; NaN where a pixel is black in some frame).
     pub fn chatoyance(&self) -> Vec<f64> {
         let n = (self.width * self.height) as usize;
         (0..n)
@@ -846,7 +846,7 @@ fn write_png(dir: &Path, rel: &str, img: &Rgb8) -> Result<(), String> {
 /// Frames of the two sweeps side by side (preset above, measured below) at five light angles.
 fn side_by_side(r: &PairReport) -> Rgb8 {
     let thumb = |s: &SweepLuminance, k: usize| {
-        // Both boards at one exposure: the measured sweep's median frame-0 luminance to 0.18.
+        // Both boards at one exposure (0 stops), so their brightness compares directly.
         Rgb8 {
             width: s.width,
             height: s.height,
