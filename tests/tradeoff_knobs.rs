@@ -350,7 +350,7 @@ mod baked {
         let mat = Material::BakedWood(Box::new(BakedWoodMaterial {
             maps: std::sync::Arc::new(maps),
             face,
-            fiber_saturation: preset("walnut").unwrap().color.fiber_saturation,
+            fiber_saturation: preset("walnut").unwrap().color.fiber_saturation.into(),
             fibers: BakedFibers::Anisotropy,
             eta: 1.5,
             roughness: 0.0,

@@ -128,3 +128,24 @@ fn xylem_texture_renders_every_preset_in_three_cuts() {
     assert!(!dir.join("bad.png").exists());
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `color.fiber_saturation` is one scale or one per channel (notes/wood.md §8); each in [0, 2].
+#[test]
+fn fiber_saturation_is_a_number_or_one_per_channel() {
+    let with = |v: &str| {
+        let text = base().replace("fiber_saturation = 0.5", &format!("fiber_saturation = {v}"));
+        WoodParams::from_toml_str(&text, "bad.toml")
+    };
+    assert_eq!(with("0.7").unwrap().color.fiber_saturation, [0.7; 3]);
+    assert_eq!(
+        with("[0.7, 0.8, 1.1]").unwrap().color.fiber_saturation,
+        [0.7, 0.8, 1.1]
+    );
+    let msg = with("[0.7, 0.8]").unwrap_err().to_string();
+    assert!(
+        msg.contains("bad.toml") && msg.contains("three numbers"),
+        "{msg}"
+    );
+    let msg = with("[0.7, 0.8, 2.5]").unwrap_err().to_string();
+    assert!(msg.contains("color.fiber_saturation[2]"), "{msg}");
+}

@@ -112,8 +112,8 @@ pub struct BakedWoodMaterial {
     pub maps: Arc<BakedMaps>,
     /// The face the maps cover, in object space.
     pub face: FaceRect,
-    /// Fibre colour = base colour ^ this (the preset's `color.fiber_saturation`).
-    pub fiber_saturation: f32,
+    /// Fibre colour = base colour ^ this, per channel (the preset's `color.fiber_saturation`).
+    pub fiber_saturation: Vec3,
     /// Where the fibre direction comes from.
     pub fibers: BakedFibers,
     /// Refractive index and GGX roughness of the finish, and the normal-map strength (0 = off).
@@ -147,9 +147,12 @@ impl BakedWoodMaterial {
         let diffuse = t.base_color.clamp(Vec3::ZERO, Vec3::ONE);
         let texel = FaceTexel {
             diffuse,
-            fiber_color: diffuse
-                .powf(self.fiber_saturation)
-                .clamp(Vec3::ZERO, Vec3::ONE),
+            fiber_color: Vec3::new(
+                diffuse.x.powf(self.fiber_saturation.x),
+                diffuse.y.powf(self.fiber_saturation.y),
+                diffuse.z.powf(self.fiber_saturation.z),
+            )
+            .clamp(Vec3::ZERO, Vec3::ONE),
             fiber,
             ray_mask: t.ray_mask.clamp(0.0, 1.0),
             highlight_width: t.highlight_width.clamp(1e-3, 0.5 * std::f32::consts::PI),

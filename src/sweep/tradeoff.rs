@@ -173,7 +173,7 @@ pub fn apply(loaded: &mut LoadedScene, k: &Knobs) -> Result<(), TradeoffError> {
                 *m = Material::BakedWood(Box::new(BakedWoodMaterial {
                     maps: Arc::new(maps),
                     face,
-                    fiber_saturation: w.volume.params().color.fiber_saturation,
+                    fiber_saturation: w.volume.params().color.fiber_saturation.into(),
                     fibers: k.baked_fibers,
                     eta: w.eta,
                     roughness: w.roughness,

@@ -1000,7 +1000,7 @@ pub fn run_report(
             profile(&r.preset_maps),
             profile(&r.measured_maps),
         )?;
-        let chat = |s: &SweepLuminance| histogram(&s.chatoyance(), 1.0, 6.0, 50);
+        let chat = |s: &SweepLuminance| histogram(&s.chatoyance(), 1.0, 12.0, 88);
         compare("chatoyance", chat(&r.preset_sweep), chat(&r.measured_sweep))?;
         write_png(
             dir,
@@ -1009,7 +1009,7 @@ pub fn run_report(
         )?;
         md += &format!(
             "\nBlue: preset, red: measured. Fibre dip histogram (−20…20°), dip profile along the \
-             grain (mean over the width, position 0…1), chatoyance histogram (1…6):\n\n\
+             grain (mean over the width, position 0…1), chatoyance histogram (1…12):\n\n\
              ![dips](plots/appearance_{tag}_dips.png) ![profile](plots/appearance_{tag}_dip_profile.png) \
              ![chatoyance](plots/appearance_{tag}_chatoyance.png)\n\n\
              Sweep frames at five light angles, preset (top) and measured board (bottom), one \

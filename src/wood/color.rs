@@ -13,7 +13,7 @@ pub struct BeerColor {
     late: Vec3,
     pore_path: f32,
     ray_path: f32,
-    fiber_saturation: f32,
+    fiber_saturation: Vec3,
 }
 
 impl BeerColor {
@@ -26,7 +26,7 @@ impl BeerColor {
             late,
             pore_path: p.pore_path,
             ray_path: p.ray_path,
-            fiber_saturation: p.fiber_saturation,
+            fiber_saturation: Vec3::from(p.fiber_saturation),
         }
     }
 
@@ -38,14 +38,14 @@ impl BeerColor {
         Vec3::new(channel(0), channel(1), channel(2))
     }
 
-    /// (diffuse, fibre) colours of an absorbance; the fibre colour uses a scaled absorbance so it is
-    /// less saturated than the diffuse (App. A.3). Clamped to [0, 1] (a negative path may lighten).
+    /// (diffuse, fibre) colours of an absorbance; the fibre colour uses the absorbance scaled per
+    /// channel by the fibre saturation (App. A.3; below 1: less saturated than the diffuse). Clamped to [0, 1] (a negative path may lighten).
     #[inline(always)]
     pub fn colors(&self, absorbance: Vec3) -> (Vec3, Vec3) {
         let (r, g, b) = (
-            self.channel_colors(absorbance.x),
-            self.channel_colors(absorbance.y),
-            self.channel_colors(absorbance.z),
+            self.channel_colors(0, absorbance.x),
+            self.channel_colors(1, absorbance.y),
+            self.channel_colors(2, absorbance.z),
         );
         (Vec3::new(r.0, g.0, b.0), Vec3::new(r.1, g.1, b.1))
     }
@@ -59,13 +59,13 @@ impl BeerColor {
             + self.late[ch] * (self.pore_path * pore + self.ray_path * ray + extra)
     }
 
-    /// One channel of [`BeerColor::colors`]: (diffuse, fibre), by the branch-free `exp` that
+    /// Channel `ch` of [`BeerColor::colors`]: (diffuse, fibre), by the branch-free `exp` that
     /// vectorises.
     #[inline(always)]
-    pub fn channel_colors(&self, absorbance: f32) -> (f32, f32) {
+    pub fn channel_colors(&self, ch: usize, absorbance: f32) -> (f32, f32) {
         use crate::math::elementary::exp;
         let a = absorbance.max(0.0);
-        (exp(-a), exp(-a * self.fiber_saturation))
+        (exp(-a), exp(-a * self.fiber_saturation[ch]))
     }
 }
 
@@ -80,7 +80,7 @@ mod tests {
             latewood: [0.3, 0.15, 0.05],
             pore_path: 0.5,
             ray_path: 0.0,
-            fiber_saturation: 0.5,
+            fiber_saturation: [0.5; 3],
         };
         let b = BeerColor::new(&p);
         let (e, _) = b.colors(b.absorbance(0.0, 0.0, 0.0, 0.0));
@@ -97,5 +97,21 @@ mod tests {
         // Pores darken by (c_late)^(ℓ_p).
         let (pc, _) = b.colors(b.absorbance(0.0, 1.0, 0.0, 0.0));
         assert!((pc.x - 0.6 * 0.3f32.powf(0.5)).abs() < 1e-5);
+    }
+
+    #[test]
+    fn fibre_saturation_scales_each_channel_on_its_own() {
+        let p = ColorParams {
+            earlywood: [0.6, 0.4, 0.2],
+            latewood: [0.3, 0.15, 0.05],
+            pore_path: 0.0,
+            ray_path: 0.0,
+            fiber_saturation: [0.5, 1.0, 2.0],
+        };
+        let b = BeerColor::new(&p);
+        let (d, f) = b.colors(b.absorbance(0.0, 0.0, 0.0, 0.0));
+        // Beer's law with absorbance × s_c: fibre_c = diffuse_c ^ s_c.
+        let expect = Vec3::new(0.6f32.sqrt(), 0.4, 0.2 * 0.2);
+        assert!((f - expect).abs().max_element() < 1e-5, "{d} {f}");
     }
 }

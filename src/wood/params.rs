@@ -170,9 +170,12 @@ pub struct ColorParams {
     /// Extra path length inside rays (negative: rays lighter).
     #[serde(default)]
     pub ray_path: f32,
-    /// Fibre colour absorbance as a fraction of the diffuse absorbance (less saturated, App. A.3).
-    #[serde(default = "half")]
-    pub fiber_saturation: f32,
+    /// Fibre colour absorbance as a multiple of the diffuse absorbance, per channel (App. A.3's
+    /// "absorption coefficients as diffuse times a scale", one scale per channel so a measured
+    /// fibre colour that is greener but less blue than its diffuse can be reached; notes/wood.md).
+    /// A number sets all three channels.
+    #[serde(default = "half_rgb", deserialize_with = "number_or_rgb")]
+    pub fiber_saturation: [f32; 3],
 }
 
 /// Fibre highlight width (App. A.3): a rectangle wave of time between earlywood and latewood.
@@ -224,6 +227,26 @@ fn two() -> f32 {
 }
 fn half() -> f32 {
     0.5
+}
+fn half_rgb() -> [f32; 3] {
+    [0.5; 3]
+}
+
+/// A number (all channels) or an array of three numbers (red, green, blue).
+fn number_or_rgb<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f32; 3], D::Error> {
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum NumberOrRgb {
+        Number(f32),
+        Rgb([f32; 3]),
+    }
+    match NumberOrRgb::deserialize(d) {
+        Ok(NumberOrRgb::Number(v)) => Ok([v; 3]),
+        Ok(NumberOrRgb::Rgb(c)) => Ok(c),
+        Err(_) => Err(serde::de::Error::custom(
+            "expected a number or an array of three numbers [red, green, blue]",
+        )),
+    }
 }
 fn one_u32() -> u32 {
     1
@@ -378,12 +401,9 @@ impl WoodParams {
         }
         c.range("color.pore_path", self.color.pore_path, -1.0, 10.0)?;
         c.range("color.ray_path", self.color.ray_path, -1.0, 10.0)?;
-        c.range(
-            "color.fiber_saturation",
-            self.color.fiber_saturation,
-            0.0,
-            1.0,
-        )?;
+        for (i, v) in self.color.fiber_saturation.iter().enumerate() {
+            c.range(&format!("color.fiber_saturation[{i}]"), *v, 0.0, 2.0)?;
+        }
         c.range("highlight.earlywood", self.highlight.earlywood, 0.5, 45.0)?;
         c.range("highlight.latewood", self.highlight.latewood, 0.5, 45.0)?;
         if let Some(k) = &self.knots {

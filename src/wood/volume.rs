@@ -559,7 +559,7 @@ impl WoodVolume {
                 let a = self
                     .color
                     .channel_absorbance(ch, g[i], pore[i], ray[i], 0.0);
-                (diffuse[ch][i], fiber[ch][i]) = self.color.channel_colors(a);
+                (diffuse[ch][i], fiber[ch][i]) = self.color.channel_colors(ch, a);
             }
         }
         for i in 0..BATCH {
