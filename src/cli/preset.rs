@@ -41,6 +41,25 @@ enum What {
         #[arg(long, default_value_t = 1)]
         seed: u64,
     },
+    /// Render each preset on the README's board (scenes/sweep_board.toml: its camera, light and
+    /// finish) at three light angles along the grain: `NAME.png` per preset and `gallery.png`.
+    Gallery {
+        /// Output folder.
+        #[arg(long, default_value = "out/gallery")]
+        out: PathBuf,
+        /// Frame size WxH in pixels.
+        #[arg(long, default_value = "480x240", value_parser = super::render::parse_res)]
+        res: (u32, u32),
+        /// Samples per pixel.
+        #[arg(long, default_value_t = 16)]
+        spp: u32,
+        /// Light angles from the zenith along the grain, degrees (the sweep's arc).
+        #[arg(long, num_args = 1.., default_values_t = [-40.0, 0.0, 40.0], allow_negative_numbers = true)]
+        angles: Vec<f32>,
+        /// Only these presets (default: all).
+        #[arg(long)]
+        only: Vec<String>,
+    },
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -60,6 +79,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             flat,
             seed,
         } => cuts(&out, res, size, &only, !flat, seed)?,
+        What::Gallery {
+            out,
+            res,
+            spp,
+            angles,
+            only,
+        } => gallery(&out, res, spp, &angles, &only)?,
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -155,5 +181,110 @@ fn cuts(
     write_png_linear(&path, 3 * res, res * names.len() as u32, &sheet, 0.0)
         .with_context(|| format!("writing {}", path.display()))?;
     println!("wrote {} cuts and {}", 3 * names.len(), path.display());
+    Ok(())
+}
+
+/// The README board scene, the gallery renders every preset on.
+const GALLERY_SCENE: &str = "scenes/sweep_board.toml";
+/// The gallery's camera: 65° above the board, 330 mm from it, the board filling a 2:1 frame.
+const GALLERY_EYE: [f32; 3] = [0.0, -140.0, 300.0];
+const GALLERY_FOV_DEG: f64 = 24.0;
+
+/// Each preset on [`GALLERY_SCENE`] with only the board's preset, the frame size and the spp
+/// changed; the light moves along the scene's own sweep arc to each of `angles`. One row of
+/// frames per preset, one exposure for all, so the presets' brightness compares directly.
+fn gallery(
+    out: &Path,
+    (width, height): (u32, u32),
+    spp: u32,
+    angles: &[f32],
+    only: &[String],
+) -> anyhow::Result<()> {
+    use crate::render::image_io::{to_srgb8, write_png_rgb8};
+    use crate::sweep::cache::{render_sweep, SweepPath};
+    use crate::sweep::contact::{contact_sheet_rows, Rgb8};
+    if angles.is_empty() || angles.iter().any(|a| !(-89.0..=89.0).contains(a)) {
+        anyhow::bail!("--angles: each light angle must lie in [-89, 89] degrees");
+    }
+    let names: Vec<&str> = if only.is_empty() {
+        wood::PRESET_NAMES.to_vec()
+    } else {
+        only.iter().map(String::as_str).collect()
+    };
+    for name in &names {
+        wood::preset(name)?;
+    }
+    let text = std::fs::read_to_string(GALLERY_SCENE)
+        .with_context(|| format!("reading {GALLERY_SCENE} (run from the repository root)"))?;
+    let mut scene: toml::Table = text
+        .parse()
+        .with_context(|| format!("parsing {GALLERY_SCENE}"))?;
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let (mut thumbs, mut labels) = (Vec::new(), Vec::new());
+    for name in &names {
+        let set = |t: &mut toml::Table, path: &[&str], v: toml::Value| {
+            let (last, tables) = path.split_last().unwrap();
+            let mut at = t;
+            for k in tables {
+                at = at.get_mut(*k).and_then(|v| v.as_table_mut()).unwrap();
+            }
+            at.insert(last.to_string(), v);
+        };
+        set(
+            &mut scene,
+            &["materials", "board", "preset"],
+            (*name).into(),
+        );
+        set(&mut scene, &["render", "width"], i64::from(width).into());
+        set(&mut scene, &["render", "height"], i64::from(height).into());
+        set(&mut scene, &["render", "spp"], i64::from(spp).into());
+        // Closer and steeper than the README's sweep camera, so the board fills the frame.
+        set(
+            &mut scene,
+            &["camera", "eye"],
+            GALLERY_EYE.map(f64::from).to_vec().into(),
+        );
+        set(&mut scene, &["camera", "fov_deg"], GALLERY_FOV_DEG.into());
+        let loaded = crate::scene::from_str(
+            &toml::to_string(&scene)?,
+            GALLERY_SCENE,
+            Path::new("scenes"),
+            name,
+        )?;
+        let mut row = Vec::new();
+        for &angle in angles {
+            let (path, moving) = SweepPath::from_scene(&loaded, Some(1), Some((angle, angle)))?;
+            let r = render_sweep(
+                &loaded.scene,
+                &loaded.settings,
+                &path,
+                moving,
+                0..1,
+                &crate::render::RunOptions {
+                    threads: 0,
+                    progress: true,
+                },
+            )?;
+            let exposure = loaded.exposure;
+            row.push(Rgb8 {
+                width,
+                height,
+                data: to_srgb8(&r.frames[0].beauty, exposure),
+            });
+            labels.push(format!("{angle:+.0}°"));
+        }
+        let sheet = contact_sheet_rows(&row, &labels[labels.len() - row.len()..], row.len(), 4);
+        write_png_rgb8(
+            &out.join(format!("{name}.png")),
+            sheet.width,
+            sheet.height,
+            &sheet.data,
+        )?;
+        thumbs.extend(row);
+    }
+    let sheet = contact_sheet_rows(&thumbs, &labels, angles.len(), 4);
+    let path = out.join("gallery.png");
+    write_png_rgb8(&path, sheet.width, sheet.height, &sheet.data)?;
+    println!("wrote {} presets and {}", names.len(), path.display());
     Ok(())
 }

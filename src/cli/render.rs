@@ -33,7 +33,7 @@ pub struct Args {
 }
 
 /// Parses `WxH` with both in 1..=16384.
-fn parse_res(s: &str) -> Result<(u32, u32), String> {
+pub(crate) fn parse_res(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("`{s}`: expected WxH, e.g. 512x512"))?;

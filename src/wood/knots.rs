@@ -8,7 +8,7 @@
 
 use super::params::KnotParams;
 use crate::math::{Pcg32, PI};
-use glam::Vec3;
+use glam::{Mat3, Vec3};
 
 /// The golden angle π (3 − √5), radians.
 const GOLDEN_ANGLE: f32 = 2.399_963;
@@ -43,12 +43,13 @@ pub struct KnotSample {
     pub inside: f32,
     /// 1 on the bark rim of a dead knot.
     pub bark: f32,
-    /// Unit branch axis.
+    /// Unit axis of the governing branch (the one the point is inside, or nearest in time).
     pub axis: Vec3,
-    /// Offset of the point from the axis, perpendicular to it (mm).
-    pub offset: Vec3,
-    /// Knot radius at this point's position along the axis (mm).
+    /// Knot radius of the governing branch at this point's position along its axis (mm).
     pub radius: f32,
+    /// The trunk fibre's deflection by the nearby knots, as one linear map: outside every knot
+    /// the fibre is v + flow·v (see [`Knots::deflect_fiber`]).
+    pub flow: Mat3,
 }
 
 impl Knots {
@@ -70,108 +71,117 @@ impl Knots {
         }
     }
 
-    /// The branch of whorl `k` nearest in azimuth to `theta`: (origin on the pith, unit axis).
+    /// Branch `j` of whorl `k`: (origin on the pith, unit axis, azimuth). Whorls turn by the
+    /// golden angle (phyllotaxis), so knots of successive whorls do not line up.
     #[inline]
-    fn branch(&self, k: i64, theta: f32) -> (Vec3, Vec3) {
+    fn branch(&self, k: i64, j: f32) -> (Vec3, Vec3, f32) {
         let mut rng = Pcg32::new(self.seed, k as u64);
-        let step = 2.0 * PI / self.per_whorl as f32;
-        // Whorls turn by the golden angle (phyllotaxis), so knots of successive whorls do not line up.
-        let phase = (k as f32 * GOLDEN_ANGLE).rem_euclid(step);
-        let j = ((theta - phase) / step).round();
-        let az = phase + j * step;
+        let az = self.phase(k) + j * self.step();
         let z0 = (k as f32 + (rng.next_f32() - 0.5) * 0.2) * self.spacing;
         let (s, c) = az.sin_cos();
         let axis = Vec3::new(c * self.cos_rise, s * self.cos_rise, self.sin_rise);
-        (Vec3::new(0.0, 0.0, z0), axis)
+        (Vec3::new(0.0, 0.0, z0), axis, az)
+    }
+
+    /// Azimuth between the branches of a whorl, radians.
+    #[inline]
+    fn step(&self) -> f32 {
+        2.0 * PI / self.per_whorl as f32
+    }
+
+    /// Azimuth of branch 0 of whorl `k`, radians.
+    #[inline]
+    fn phase(&self, k: i64) -> f32 {
+        (k as f32 * GOLDEN_ANGLE).rem_euclid(self.step())
     }
 
     /// The knot field at `q` (tree space after distortion) with polar angle `theta`, radius `r` and
-    /// trunk time `t_trunk`; `None` far from every knot.
+    /// trunk time `t_trunk`; `None` far from every knot. The candidates are the two branches
+    /// bracketing `theta` in each of the two whorls bracketing `q` (a branch of whorl k passes
+    /// height z_k + r tan α at radius r); the one the point is inside (or nearest in time) governs
+    /// time and colour, and all four deflect the fibres (superposed flows, each tapered to zero
+    /// before it leaves the candidate set, so the fibre field has no seams).
     pub fn eval(&self, q: Vec3, theta: f32, r: f32, t_trunk: f32) -> Option<KnotSample> {
-        // A branch of whorl k passes height z_k + r tan α at radius r: check the two nearest whorls.
         let kf = (q.z - r * self.tan_rise) / self.spacing;
-        let mut best: Option<KnotSample> = None;
+        let (step, mut best, mut flow) = (self.step(), None::<KnotSample>, Mat3::ZERO);
         for k in [kf.floor() as i64, kf.floor() as i64 + 1] {
-            let (origin, axis) = self.branch(k, theta);
-            let d = q - origin;
-            let s = d.dot(axis);
-            if s <= 0.0 {
-                continue;
-            }
-            let offset = d - s * axis;
-            let rho = offset.length();
-            let t_branch = rho * self.inv_branch_ring;
-            let radius_live = t_trunk.max(0.0) / self.inv_branch_ring;
-            let sample = match self.death_year {
-                Some(death) => {
-                    // Dead: the branch's rings stop at `death`; a bark rim surrounds the stub.
-                    let radius = death / self.inv_branch_ring;
-                    if t_branch < t_trunk && t_branch <= death {
-                        KnotSample {
-                            time: t_branch,
-                            inside: 1.0,
-                            bark: 0.0,
-                            axis,
-                            offset,
-                            radius,
-                        }
-                    } else if t_trunk > death && rho < radius + BARK_RIM {
-                        KnotSample {
-                            time: t_trunk,
-                            inside: 0.0,
-                            bark: 1.0,
-                            axis,
-                            offset,
-                            radius,
-                        }
-                    } else {
-                        KnotSample {
-                            time: t_trunk,
-                            inside: 0.0,
-                            bark: 0.0,
-                            axis,
-                            offset,
-                            radius: radius.min(radius_live),
-                        }
-                    }
+            let j0 = ((theta - self.phase(k)) / step).floor();
+            for j in [j0, j0 + 1.0] {
+                let (origin, axis, az) = self.branch(k, j);
+                let d = q - origin;
+                let s = d.dot(axis);
+                if s <= 0.0 {
+                    continue;
                 }
-                None => KnotSample {
-                    time: smooth_min(t_trunk, t_branch, self.blend),
-                    inside: if t_branch < t_trunk { 1.0 } else { 0.0 },
-                    bark: 0.0,
-                    axis,
-                    offset,
-                    radius: radius_live,
-                },
-            };
-            let nearer = match &best {
-                Some(b) => sample.time < b.time || sample.inside > b.inside,
-                None => true,
-            };
-            if nearer {
-                best = Some(sample);
+                let offset = d - s * axis;
+                let rho = offset.length();
+                let sample = self.sample(axis, rho, t_trunk);
+                // Whorl k leaves the candidates at |kf − k| = 1 (jitter ±0.1), branch j at one
+                // step of azimuth: the taper reaches zero before either, and is 1 over the knot.
+                let weight = taper((kf - origin.z / self.spacing).abs())
+                    * taper(((theta - az) / step).abs())
+                    * (2.0 * s / d.length()).min(1.0);
+                if rho > 1e-6 && sample.inside == 0.0 && weight > 0.0 {
+                    flow += weight * cylinder_flow(axis, offset / rho, sample.radius / rho);
+                }
+                // Inside a knot beats its bark rim beats outside, then the earlier time.
+                let rank = |k: &KnotSample| 2.0 * k.inside + k.bark;
+                let nearer = match &best {
+                    Some(b) => {
+                        rank(&sample) > rank(b)
+                            || (rank(&sample) == rank(b) && sample.time < b.time)
+                    }
+                    None => true,
+                };
+                if nearer {
+                    best = Some(sample);
+                }
             }
         }
-        best
+        best.map(|b| KnotSample { flow, ..b })
     }
 
-    /// Trunk fibre `v` deflected around the knot as 2D potential flow past a cylinder of radius R in
-    /// the plane across the axis: u = v⊥ − (R²/ρ²)(2 (v⊥·e) e − v⊥) + (v·a) a, with e the unit offset
-    /// (Milne-Thomson, "Theoretical Hydrodynamics", flow past a circular cylinder); tangent to the
-    /// knot on its boundary, undisturbed far away. Inside the knot the fibre is the branch axis.
+    /// The knot of the branch with unit `axis` at distance `rho` from it, trunk time `t_trunk`.
+    #[inline]
+    fn sample(&self, axis: Vec3, rho: f32, t_trunk: f32) -> KnotSample {
+        let t_branch = rho * self.inv_branch_ring;
+        let radius_live = t_trunk.max(0.0) / self.inv_branch_ring;
+        let knot = |time, inside, bark, radius| KnotSample {
+            time,
+            inside,
+            bark,
+            axis,
+            radius,
+            flow: Mat3::ZERO,
+        };
+        match self.death_year {
+            Some(death) => {
+                // Dead: the branch's rings stop at `death`; a bark rim surrounds the stub.
+                let radius = death / self.inv_branch_ring;
+                if t_branch < t_trunk && t_branch <= death {
+                    knot(t_branch, 1.0, 0.0, radius)
+                } else if t_trunk > death && rho < radius + BARK_RIM {
+                    knot(t_trunk, 0.0, 1.0, radius)
+                } else {
+                    knot(t_trunk, 0.0, 0.0, radius.min(radius_live))
+                }
+            }
+            None => knot(
+                smooth_min(t_trunk, t_branch, self.blend),
+                if t_branch < t_trunk { 1.0 } else { 0.0 },
+                0.0,
+                radius_live,
+            ),
+        }
+    }
+
+    /// Trunk fibre `v` deflected around the nearby knots (the sample's superposed flows); inside
+    /// a knot the fibre is the branch axis.
     pub fn deflect_fiber(&self, v: Vec3, k: &KnotSample) -> Vec3 {
         if k.inside > 0.5 {
             return k.axis;
         }
-        let rho2 = k.offset.length_squared();
-        if !(rho2 > 1e-12) {
-            return v;
-        }
-        let along = v.dot(k.axis) * k.axis;
-        let perp = v - along;
-        let e = k.offset / rho2.sqrt();
-        let ratio = (k.radius * k.radius / rho2).min(1.0);
-        let u = perp - ratio * (2.0 * perp.dot(e) * e - perp) + along;
+        let u = v + k.flow * v;
         let len = u.length();
         if len > 1e-6 {
             u / len
@@ -179,6 +189,26 @@ impl Knots {
             v
         }
     }
+}
+
+/// 2D potential flow past a cylinder of radius R in the plane across the unit `axis`, as the
+/// linear map v ↦ u − v: u = v⊥ − (R²/ρ²)(2 (v⊥·e) e − v⊥) + (v·a) a, e the unit offset of the
+/// point from the axis (Milne-Thomson, "Theoretical Hydrodynamics", flow past a circular
+/// cylinder): tangent to the knot on its boundary, undisturbed far away. `ratio` = R/ρ.
+#[inline]
+fn cylinder_flow(axis: Vec3, e: Vec3, ratio: f32) -> Mat3 {
+    let outer = |a: Vec3, b: Vec3| Mat3::from_cols(a * b.x, a * b.y, a * b.z);
+    let perp = Mat3::IDENTITY - outer(axis, axis);
+    let mirror = 2.0 * outer(e, e) - Mat3::IDENTITY;
+    -(ratio * ratio).min(1.0) * (mirror * perp)
+}
+
+/// 1 for x ≤ 0.4, 0 for x ≥ 0.8, C¹ (smoothstep) between: the fade of a knot's flow with its
+/// distance from the point in whorl spacings or in branch steps of azimuth.
+#[inline]
+fn taper(x: f32) -> f32 {
+    let t = ((0.8 - x) / 0.4).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
 }
 
 /// Polynomial smooth minimum of width `k` (Quílez 2013, "smooth minimum"): C¹, equals min(a, b)
@@ -209,7 +239,7 @@ mod tests {
         let w = 4.0;
         let knots = Knots::new(&params(None), w, 1);
         // Walk along a branch axis: points on it are inside; far off it, outside.
-        let (o, a) = knots.branch(0, 0.0);
+        let (o, a, _) = knots.branch(0, 0.0);
         for s in [20.0, 60.0, 120.0] {
             let q = o + a * s;
             let r = (q.x * q.x + q.y * q.y).sqrt();
@@ -233,7 +263,7 @@ mod tests {
             Knots::new(&params(Some(10.0)), w, 1),
             Knots::new(&params(None), w, 1),
         );
-        let (o, a) = dead.branch(0, 0.0);
+        let (o, a, _) = dead.branch(0, 0.0);
         let side = a.cross(Vec3::Z).normalize();
         let at = |k: &Knots, s: f32, rho: f32| {
             let q = o + a * s + side * rho;
@@ -257,22 +287,95 @@ mod tests {
         assert!(live_in.radius > 3.0 * rd);
     }
 
+    /// The knot sample of `knots` at `q` with the trunk time of ring width `w`.
+    fn at(knots: &Knots, q: Vec3, w: f32) -> Option<KnotSample> {
+        let r = (q.x * q.x + q.y * q.y).sqrt();
+        knots.eval(q, q.y.atan2(q.x), r, r / w)
+    }
+
     #[test]
     fn deflected_fibre_is_tangent_on_the_boundary() {
-        let knots = Knots::new(&params(None), 4.0, 1);
-        let k = KnotSample {
-            time: 0.0,
-            inside: 0.0,
-            bark: 0.0,
-            axis: Vec3::X,
-            offset: Vec3::new(0.0, 0.0, 2.0),
-            radius: 2.0,
-        };
-        let u = knots.deflect_fiber(Vec3::Z, &k);
-        // Flow straight at the knot stagnates; pick an oblique one instead.
-        let u2 = knots.deflect_fiber(Vec3::new(0.0, 0.6, 0.8), &k);
-        assert!(u2.dot(Vec3::Z).abs() < 1e-5 && (u2.length() - 1.0).abs() < 1e-5);
-        assert!(u.is_finite());
+        let (w, death) = (4.0, 10.0);
+        let knots = Knots::new(&params(Some(death)), w, 1);
+        let (o, a, _) = knots.branch(0, 0.0);
+        let side = a.cross(Vec3::Z).normalize();
+        let up = a.cross(side);
+        // Just outside the dead knot's bark rim, on both sides and above it.
+        let s = 150.0;
+        let radius = at(&knots, o + a * s, w).unwrap().radius;
+        for e in [side, -side, up] {
+            let k = at(&knots, o + a * s + e * (radius + BARK_RIM + 1e-3), w).unwrap();
+            assert_eq!((k.inside, k.bark), (0.0, 0.0));
+            // A trunk fibre with a component across the knot is turned along its boundary: no
+            // component along the offset e (potential flow is tangent on the cylinder).
+            let u = knots.deflect_fiber(Vec3::new(0.0, 0.6, 0.8).normalize(), &k);
+            let tangent_ratio = (radius / (radius + BARK_RIM)).powi(2);
+            assert!(
+                u.dot(e).abs() < 0.02 + (1.0 - tangent_ratio),
+                "{e}: u·e = {}",
+                u.dot(e)
+            );
+            assert!((u.length() - 1.0).abs() < 1e-5);
+        }
+    }
+
+    /// Outside the knots the deflected fibre field is continuous: along lines through several
+    /// whorls and around the tree, every step of 0.05 mm that turns the fibre by more than 0.002°
+    /// is split in 50; a continuous field turns by at most a fifth of it in any sub-step (a
+    /// seam, as where the old nearest-branch choice switched whorl or branch, keeps its whole
+    /// jump in one sub-step).
+    #[test]
+    fn fibre_field_has_no_seams_between_knots() {
+        let w = 4.0;
+        // 2 asin(|a − b| / 2): exact for small angles, where acos of an f32 dot is quantised.
+        let angle =
+            |a: Vec3, b: Vec3| (2.0 * (0.5 * (a - b).length()).min(1.0).asin()).to_degrees();
+        for death in [None, Some(20.0)] {
+            let knots = Knots::new(&params(death), w, 3);
+            let fibre = |t: f32, around: bool| {
+                // Along the tree axis 120 mm out (a board's length, three whorls), or around
+                // the tree at r = 120 mm, 30 mm above a whorl.
+                let q = if around {
+                    let phi = std::f32::consts::PI * t;
+                    Vec3::new(120.0 * phi.cos(), 120.0 * phi.sin(), 75.0)
+                } else {
+                    Vec3::new(0.0, 120.0, -50.0 + 900.0 * t)
+                };
+                at(&knots, q, w)
+                    .filter(|k| k.inside == 0.0 && k.bark == 0.0)
+                    .map(|k| knots.deflect_fiber(Vec3::Z, &k))
+            };
+            for (around, length) in [(false, 900.0), (true, 120.0 * std::f32::consts::PI)] {
+                let n = (length / 0.05) as usize;
+                let mut checked = 0;
+                for i in 0..n {
+                    let (t0, t1) = (i as f32 / n as f32, (i + 1) as f32 / n as f32);
+                    let (Some(a), Some(b)) = (fibre(t0, around), fibre(t1, around)) else {
+                        continue;
+                    };
+                    let step = angle(a, b);
+                    if step < 0.002 {
+                        continue;
+                    }
+                    checked += 1;
+                    let sub = (0..50)
+                        .filter_map(|k| {
+                            let u = fibre(t0 + (t1 - t0) * k as f32 / 50.0, around)?;
+                            let v = fibre(t0 + (t1 - t0) * (k + 1) as f32 / 50.0, around)?;
+                            Some(angle(u, v))
+                        })
+                        .fold(0.0f32, f32::max);
+                    assert!(
+                        sub < 0.2 * step,
+                        "{death:?} around {around} at t = {t0}: step {step}°, sub-step {sub}°"
+                    );
+                }
+                assert!(
+                    checked > 0,
+                    "the line passes no knot: the test tests nothing"
+                );
+            }
+        }
     }
 
     #[test]
