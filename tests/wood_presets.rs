@@ -149,3 +149,34 @@ fn fiber_saturation_is_a_number_or_one_per_channel() {
     let msg = with("[0.7, 0.8, 2.5]").unwrap_err().to_string();
     assert!(msg.contains("color.fiber_saturation[2]"), "{msg}");
 }
+
+/// `xylem preset gallery` renders a preset on the README board into a PNG row of three frames,
+/// and refuses a light angle out of range naming the option.
+#[test]
+fn preset_gallery_renders_a_row_per_preset() {
+    let out = tempfile::tempdir().unwrap();
+    let run = |extra: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_xylem"))
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .args([
+                "preset", "gallery", "--only", "walnut", "--res", "40x20", "--spp", "1",
+            ])
+            .arg("--out")
+            .arg(out.path())
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let o = run(&[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let file = std::fs::File::open(out.path().join("walnut.png")).unwrap();
+    let info = png::Decoder::new(std::io::BufReader::new(file))
+        .read_info()
+        .unwrap()
+        .info()
+        .clone();
+    assert!(info.width >= 3 * 40 && info.height >= 20, "{info:?}");
+    let o = run(&["--angles", "95"]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--angles"));
+}

@@ -186,6 +186,19 @@ fn cuts(
 
 /// The README board scene, the gallery renders every preset on.
 const GALLERY_SCENE: &str = "scenes/sweep_board.toml";
+/// Presets shown flat-sawn (the face tangential to the rings, 120 mm from the pith), where their
+/// figure shows: quilt and birdseye on the tangential face, oak's and cherry's cathedral arches,
+/// round knots. The rest are quartersawn, as the README board (ribbon stripe of interlocked grain,
+/// oak ray fleck, curl across the grain).
+const FLAT_SAWN: [&str; 7] = [
+    "quilted_maple",
+    "birdseye_maple",
+    "red_oak",
+    "walnut",
+    "cherry",
+    "knotty_pine",
+    "yellowheart",
+];
 /// The gallery's camera: 65° above the board, 330 mm from it, the board filling a 2:1 frame.
 const GALLERY_EYE: [f32; 3] = [0.0, -140.0, 300.0];
 const GALLERY_FOV_DEG: f64 = 24.0;
@@ -220,6 +233,10 @@ fn gallery(
         .parse()
         .with_context(|| format!("parsing {GALLERY_SCENE}"))?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    // The sweep's measurement regions are in pixels of the scene's own frame size.
+    if let Some(sweep) = scene.get_mut("sweep").and_then(|s| s.as_table_mut()) {
+        sweep.remove("regions");
+    }
     let (mut thumbs, mut labels) = (Vec::new(), Vec::new());
     for name in &names {
         let set = |t: &mut toml::Table, path: &[&str], v: toml::Value| {
@@ -245,6 +262,20 @@ fn gallery(
             GALLERY_EYE.map(f64::from).to_vec().into(),
         );
         set(&mut scene, &["camera", "fov_deg"], GALLERY_FOV_DEG.into());
+        let board = scene["objects"]
+            .as_array_mut()
+            .and_then(|o| {
+                o.iter_mut()
+                    .find(|o| o.get("name").and_then(|n| n.as_str()) == Some("board"))
+            })
+            .and_then(|o| o.as_table_mut())
+            .context("the gallery scene has no object named `board`")?;
+        let origin = if FLAT_SAWN.contains(name) {
+            [0.0, 0.0, -120.0]
+        } else {
+            [0.0, 120.0, 0.0]
+        };
+        set(board, &["tree", "origin"], origin.to_vec().into());
         let loaded = crate::scene::from_str(
             &toml::to_string(&scene)?,
             GALLERY_SCENE,
