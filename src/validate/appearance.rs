@@ -866,24 +866,6 @@ fn side_by_side(r: &PairReport) -> Rgb8 {
     contact_sheet_rows(&thumbs, &labels, 5, 4)
 }
 
-/// Why a statistic of a calibrated preset misses its measured board, where we know (stated in
-/// the report next to the figure; the row still counts as failed).
-fn known_limit(preset: &str, statistic: &str) -> &'static str {
-    match (preset, statistic) {
-        ("padauk", "fibre/diffuse ratio, blue over red") => {
-            "the measured blue channel is quantised away (mean diffuse blue 0.0022 = 0.56 of 255 \
-             counts), and Beer's law with one fibre saturation s gives blue over red = \
-             (ρ_b/ρ_r)^(s−1) > 1 whenever green over red > 1 (s < 1); the measured fibre colour \
-             is greener but *less* blue than the diffuse, which one absorption scale cannot give"
-        }
-        ("padauk", "chatoyance p90/p10") => {
-            "the measured maps carry per-texel fitting noise (the speckled fibre axes of the dip \
-             map, pores fitted as fibres), which scatters the per-pixel chatoyance; the model's \
-             fibre field is smooth at 0.75 mm pixels, so its chatoyance varies less over the board"
-        }
-        _ => "not analysed yet",
-    }
-}
 
 /// Runs every appearance check and writes validation/APPEARANCE.md's figures into
 /// `dir/plots/`; returns the Markdown and whether every stated criterion passed.
@@ -968,9 +950,9 @@ pub fn run_report(
         );
         let failed: Vec<&Comparison> = r.rows.iter().filter(|c| !c.passes()).collect();
         if !failed.is_empty() {
-            md += "\nWhere the model does not reach the measurement, and why:\n\n";
+            md += "\nNot reached (the calibration of notes/appearance.md §3 no longer holds):\n\n";
             for c in failed {
-                md += &format!("- **{}**: {}\n", c.name, known_limit(pair.preset, &c.name));
+                md += &format!("- **{}**\n", c.name);
             }
         }
         let tag = pair.preset;
