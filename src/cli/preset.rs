@@ -302,7 +302,7 @@ fn gallery(
                 height,
                 data: to_srgb8(&r.frames[0].beauty, exposure),
             });
-            labels.push(format!("{angle:+.0}°"));
+            labels.push(format!("{name} {angle:+.0}°"));
         }
         let sheet = contact_sheet_rows(&row, &labels[labels.len() - row.len()..], row.len(), 4);
         write_png_rgb8(

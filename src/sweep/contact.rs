@@ -120,8 +120,9 @@ pub fn contact_sheet_rows(thumbs: &[Rgb8], labels: &[String], cols: usize, gap: 
     sheet
 }
 
-/// A 3×5 pixel font for light-angle labels: digits, sign, point, degree sign, `e`, `x` and `%` (rows top to
-/// bottom, bit 2 = left column). Characters without a glyph are drawn as blanks.
+/// A 3×5 pixel font for labels: digits, sign, point, degree sign, `%`, `_` and the lowercase
+/// letters (drawn as capitals, except `e` and `x`) (rows top to bottom, bit 2 = left column).
+/// Characters without a glyph are drawn as blanks.
 fn glyph(c: char) -> [u8; 5] {
     match c {
         '0' => [7, 5, 5, 5, 7],
@@ -141,6 +142,31 @@ fn glyph(c: char) -> [u8; 5] {
         'e' => [0, 7, 7, 4, 7],
         'x' => [0, 5, 2, 5, 0],
         '%' => [5, 1, 2, 4, 5],
+        'a' => [2, 5, 7, 5, 5],
+        'b' => [6, 5, 6, 5, 6],
+        'c' => [3, 4, 4, 4, 3],
+        'd' => [6, 5, 5, 5, 6],
+        'f' => [7, 4, 6, 4, 4],
+        'g' => [3, 4, 5, 5, 3],
+        'h' => [5, 5, 7, 5, 5],
+        'i' => [7, 2, 2, 2, 7],
+        'j' => [1, 1, 1, 5, 2],
+        'k' => [5, 5, 6, 5, 5],
+        'l' => [4, 4, 4, 4, 7],
+        'm' => [5, 7, 7, 5, 5],
+        'n' => [6, 5, 5, 5, 5],
+        'o' => [2, 5, 5, 5, 2],
+        'p' => [6, 5, 6, 4, 4],
+        'q' => [2, 5, 5, 6, 3],
+        'r' => [6, 5, 6, 5, 5],
+        's' => [3, 4, 2, 1, 6],
+        't' => [7, 2, 2, 2, 2],
+        'u' => [5, 5, 5, 5, 7],
+        'v' => [5, 5, 5, 5, 2],
+        'w' => [5, 5, 7, 7, 5],
+        'y' => [5, 5, 2, 2, 2],
+        'z' => [7, 1, 2, 4, 7],
+        '_' => [0, 0, 0, 0, 7],
         _ => [0; 5],
     }
 }

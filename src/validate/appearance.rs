@@ -866,7 +866,6 @@ fn side_by_side(r: &PairReport) -> Rgb8 {
     contact_sheet_rows(&thumbs, &labels, 5, 4)
 }
 
-
 /// Runs every appearance check and writes validation/APPEARANCE.md's figures into
 /// `dir/plots/`; returns the Markdown and whether every stated criterion passed.
 pub fn run_report(
