@@ -53,7 +53,7 @@ fn parse_res(s: &str) -> Result<(u32, u32), String> {
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     crate::render::resources::check_threads(args.threads)?;
-    let mut loaded = crate::scene::load(&args.scene)?;
+    let mut loaded = crate::scene::load_with(&args.scene, args.ignore_limits)?;
     for w in &loaded.warnings {
         eprintln!("warning: {w}");
     }

@@ -63,7 +63,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         anyhow::bail!("give a scene file (or --assemble DIR)");
     };
     crate::render::resources::check_threads(args.threads)?;
-    let mut loaded = crate::scene::load(scene)?;
+    let mut loaded = crate::scene::load_with(scene, args.ignore_limits)?;
     // The scene file's digest, recorded with every frame so that `--assemble` refuses slices
     // of different scene files (the load above has already bounded and read it).
     let scene_crc = crc32fast::hash(&std::fs::read(scene)?);

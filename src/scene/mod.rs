@@ -38,6 +38,11 @@ pub enum SceneError {
     Parse { path: String, message: String },
     #[error("cannot read scene {0}")]
     Input(crate::render::resources::ResourceError),
+    #[error("scene {path}: {source}")]
+    Resources {
+        path: String,
+        source: crate::render::resources::ResourceError,
+    },
     #[error("scene {path}: field `{field}`: {message}")]
     Invalid {
         path: String,
@@ -71,8 +76,13 @@ pub struct LoadedScene {
     pub warnings: Vec<String>,
 }
 
-/// Reads and builds a scene file.
+/// Reads and builds a scene file, refusing geometry whose BVH build would not fit in memory.
 pub fn load(path: &Path) -> Result<LoadedScene, SceneError> {
+    load_with(path, false)
+}
+
+/// [`load`], with the geometry memory check skipped when `ignore_limits` (`--ignore-limits`).
+pub fn load_with(path: &Path, ignore_limits: bool) -> Result<LoadedScene, SceneError> {
     let bytes =
         crate::render::resources::read_bounded(path, crate::render::resources::MAX_SCENE_BYTES)
             .map_err(SceneError::Input)?;
@@ -85,7 +95,14 @@ pub fn load(path: &Path) -> Result<LoadedScene, SceneError> {
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "scene".into());
-    from_str(&text, &path.display().to_string(), &base, &name)
+    let file = parse(&text, &path.display().to_string())?;
+    Builder {
+        path: &path.display().to_string(),
+        base: &base,
+        warnings: Vec::new(),
+        ignore_limits,
+    }
+    .build(file, &name)
 }
 
 /// Parses the scene text only (no meshes built), for checks and the sweep setup.
@@ -108,6 +125,7 @@ pub fn from_str(
         path,
         base,
         warnings: Vec::new(),
+        ignore_limits: false,
     }
     .build(file, name)
 }
@@ -116,6 +134,8 @@ struct Builder<'a> {
     path: &'a str,
     base: &'a Path,
     warnings: Vec<String>,
+    /// Skip the geometry memory check.
+    ignore_limits: bool,
 }
 
 fn v3(a: [f32; 3]) -> Vec3 {
@@ -229,6 +249,13 @@ impl Builder<'_> {
         if let Some(s) = &file.sweep {
             self.check_sweep(s, &light_names, width, height)?;
         }
+        // Checked before the BVHs are built (the largest allocation a scene makes).
+        crate::render::resources::Resources::geometry(&instances)
+            .check(self.base, self.ignore_limits)
+            .map_err(|source| SceneError::Resources {
+                path: self.path.to_string(),
+                source,
+            })?;
         let scene = render::Scene {
             accel: Accel::new(instances),
             materials,
