@@ -75,7 +75,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     let cam = &loaded.scene.camera;
     eprintln!(
-        "{}: {}x{}, {} spp, {:?}, {} triangles (BVH built in {:.1} ms)",
+        "{}: {}x{}, {} spp, {}, {} triangles (BVH built in {:.1} ms)",
         loaded.name,
         cam.width,
         cam.height,

@@ -72,7 +72,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     if let Some(q) = args.quality {
         crate::sweep::tradeoff::apply(&mut loaded, &q.knobs())
-            .with_context(|| format!("applying --quality {q:?}"))?;
+            .with_context(|| format!("applying --quality {q}"))?;
     }
     if let Some(spp) = args.spp {
         anyhow::ensure!(spp >= 1, "--spp 0: need at least 1 sample per pixel");
@@ -101,13 +101,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         ignore_limits: args.ignore_limits,
         provenance: format!(
             "scene crc32 {scene_crc:08x}, quality {}",
-            args.quality
-                .map_or("none".to_string(), |q| format!("{q:?}").to_lowercase())
+            args.quality.map_or("none".to_string(), |q| q.to_string())
         ),
     };
     let cam = &loaded.scene.camera;
     eprintln!(
-        "{}: {}x{}, {} spp, {:?}, {}",
+        "{}: {}x{}, {} spp, {}, {}",
         loaded.name,
         cam.width,
         cam.height,

@@ -299,7 +299,12 @@ impl Builder<'_> {
                 }
                 Projection::Perspective {
                     fov_y: self
-                        .range("camera.fov_deg", c.fov_deg, 0.01, 179.0)?
+                        .range(
+                            "camera.fov_deg",
+                            c.fov_deg.unwrap_or(DEFAULT_FOV_DEG),
+                            0.01,
+                            179.0,
+                        )?
                         .to_radians(),
                     lens_radius: self.range("camera.lens_radius", c.lens_radius, 0.0, 1e6)?,
                     focus_distance: self.range(
@@ -311,6 +316,12 @@ impl Builder<'_> {
                 }
             }
             ProjectionName::Orthographic => {
+                if c.fov_deg.is_some() {
+                    return Err(self.invalid(
+                        "camera.fov_deg",
+                        "only for projection = \"perspective\" (an orthographic camera's view is `width` mm wide)",
+                    ));
+                }
                 if c.lens_radius != 0.0 {
                     return Err(self.invalid(
                         "camera.lens_radius",
