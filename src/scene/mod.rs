@@ -470,7 +470,7 @@ impl Builder<'_> {
 
     fn env_map(&self, field: &str, file: &str, rotate_deg: f32) -> Result<EnvMap, SceneError> {
         let p = self.base.join(file);
-        let (w, h, mut texels) =
+        let (w, h, texels) =
             render::image_io::read_exr_rgb(&p).map_err(|e| self.invalid(field, e.to_string()))?;
         if w < 2 || h < 1 {
             return Err(self.invalid(field, format!("{} is too small ({w}x{h})", p.display())));
@@ -484,18 +484,7 @@ impl Builder<'_> {
                 format!("{} holds negative or non-finite texels", p.display()),
             ));
         }
-        // Rotation about z: shift columns.
-        let shift = ((rotate_deg / 360.0) * w as f32).round() as i64;
-        if shift != 0 {
-            let old = texels.clone();
-            for y in 0..h {
-                for x in 0..w {
-                    let sx = (x as i64 - shift).rem_euclid(w as i64) as usize;
-                    texels[y * w + x] = old[y * w + sx];
-                }
-            }
-        }
-        Ok(EnvMap::new(w, h, texels))
+        Ok(EnvMap::new(w, h, texels).rotated(rotate_deg))
     }
 
     fn materials(
