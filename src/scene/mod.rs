@@ -107,9 +107,61 @@ pub fn load_with(path: &Path, ignore_limits: bool) -> Result<LoadedScene, SceneE
 
 /// Parses the scene text only (no meshes built), for checks and the sweep setup.
 pub fn parse(text: &str, path: &str) -> Result<SceneFile, SceneError> {
-    toml::from_str(text).map_err(|e| SceneError::Parse {
-        path: path.to_string(),
-        message: e.to_string().trim_end().replace('\n', "\n  "),
+    toml::from_str(text).map_err(|e| match tagged_field_error(text) {
+        Some((field, message)) => SceneError::Invalid {
+            path: path.to_string(),
+            field,
+            message,
+        },
+        None => SceneError::Parse {
+            path: path.to_string(),
+            message: e.to_string().trim_end().replace('\n', "\n  "),
+        },
+    })
+}
+
+/// The field at fault in a `type`-tagged table (`[[lights]]`, `[materials.NAME]`) and serde's
+/// message. serde buffers such a table before choosing the variant, so toml's error points at
+/// the table's header, not the field. Each table is deserialized alone; in the failing one the
+/// key whose removal changes the error is the one at fault (serde reports the first bad value,
+/// and missing fields only after all values). None when no tagged table fails on its own.
+fn tagged_field_error(text: &str) -> Option<(String, String)> {
+    use serde::de::DeserializeOwned;
+    fn error<T: DeserializeOwned>(t: &toml::Table) -> Option<String> {
+        let e = toml::Value::Table(t.clone()).try_into::<T>().err()?;
+        Some(e.message().to_string())
+    }
+    fn culprit<T: DeserializeOwned>(name: String, t: &toml::Table) -> Option<(String, String)> {
+        let e = error::<T>(t)?;
+        // A missing field names itself (and removing any other key would change nothing).
+        if let Some(k) = e
+            .strip_prefix("missing field `")
+            .and_then(|r| r.split('`').next())
+        {
+            return Some((format!("{name}.{k}"), "required".into()));
+        }
+        if e.starts_with("unknown variant") {
+            return Some((format!("{name}.type"), e));
+        }
+        let key = t.keys().filter(|k| *k != "type").find(|k| {
+            let mut less = t.clone();
+            less.remove(*k);
+            error::<T>(&less).as_ref() != Some(&e)
+        });
+        Some((key.map_or(name.clone(), |k| format!("{name}.{k}")), e))
+    }
+    let doc: toml::Table = toml::from_str(text).ok()?;
+    let lights = doc.get("lights").and_then(toml::Value::as_array);
+    let from_lights = lights
+        .into_iter()
+        .flatten()
+        .enumerate()
+        .find_map(|(i, l)| culprit::<LightTable>(format!("lights[{i}]"), l.as_table()?));
+    let materials = doc.get("materials").and_then(toml::Value::as_table);
+    from_lights.or_else(|| {
+        materials.into_iter().flatten().find_map(|(name, m)| {
+            culprit::<MaterialTable>(format!("materials.{name}"), m.as_table()?)
+        })
     })
 }
 
