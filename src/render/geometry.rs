@@ -193,8 +193,10 @@ pub struct Accel {
     flat: Vec<u32>,
     /// One object-space BVH per mesh placed more than once.
     shared: Vec<WideBvh>,
-    /// The placements of shared meshes, in top-level primitive order.
+    /// The placements of shared meshes (the top level's primitive ids index this).
     placed: Vec<Placed>,
+    /// Per instance: true when its mesh is shared (traced in object space).
+    instanced: Vec<bool>,
     /// The top-level BVH over the widened world boxes of `placed` (None when nothing is shared).
     top: Option<Bvh2>,
     pub instances: Vec<Instance>,
@@ -289,16 +291,19 @@ impl Accel {
         let (mut shared, mut placed, mut boxes) = (Vec::new(), Vec::new(), Vec::new());
         let mut bounds_radius = 1.0f32;
         let mut stored_triangles = 0;
+        let mut instanced = vec![false; instances.len()];
         for user in &users {
             let mesh = &instances[user[0] as usize].mesh;
             stored_triangles += mesh.indices.len();
             let used = used_vertices(mesh);
+            if used.is_empty() {
+                continue; // nothing to hit, and no box to bound it
+            }
             for &i in user {
                 let (lo, hi) = world_bounds(&instances[i as usize], &used);
-                if !used.is_empty() {
-                    bounds_radius = bounds_radius.max(lo.abs().max(hi.abs()).max_element());
-                }
+                bounds_radius = bounds_radius.max(lo.abs().max(hi.abs()).max_element());
                 if user.len() > 1 {
+                    instanced[i as usize] = true;
                     // Widened so that the top level's slab test never culls a box a ray
                     // grazes (the bottom level's own test is robust).
                     let m = (hi - lo).max(lo.abs().max(hi.abs())) * 1e-6;
@@ -337,6 +342,7 @@ impl Accel {
             flat,
             shared,
             placed,
+            instanced,
             top,
             instances,
             build_time: start.elapsed(),
@@ -344,6 +350,11 @@ impl Accel {
             scene_triangles,
             stored_triangles,
         }
+    }
+
+    /// True when instance `i`'s mesh is shared, so that it is traced in object space.
+    pub fn is_instanced(&self, i: usize) -> bool {
+        self.instanced[i]
     }
 
     /// Number of triangles over all instances (each placement of a mesh counted).
@@ -568,25 +579,34 @@ pub fn build_bvh2(world: &[Triangle], params: &BvhBuildParams) -> Bvh2 {
     bvh2
 }
 
-/// Brute-force closest hit over every world-space triangle with obvhs's own triangle test
-/// (`RtTriangle::intersect`), the independent reference the BVH is tested against.
+/// Brute-force closest hit over every triangle with obvhs's own triangle test
+/// (`RtTriangle::intersect`), the independent reference the BVH is tested against. Like
+/// [`Accel`], it tests an instanced mesh's triangles in object space with the ray mapped there
+/// (same `t`), the others in world space, so that both round alike.
 pub fn brute_force_closest(accel: &Accel, ray: &Ray, t_max: f32) -> Option<f32> {
     // +0.0 turns a −0.0 direction component into +0.0 (obvhs's ray setup mishandles −0.0).
-    let r = BvhRay::new(ray.o.into(), (ray.d + Vec3::ZERO).into(), 0.0, t_max);
-    accel
-        .instances
-        .iter()
-        .flat_map(|inst| {
-            let p: Vec<Vec3A> = (inst.mesh.positions.iter())
-                .map(|&v| inst.transform.point_to_world(v).into())
-                .collect();
-            inst.mesh
-                .indices
-                .iter()
-                .map(move |t| RtTriangle::new(p[t[0] as usize], p[t[1] as usize], p[t[2] as usize]))
+    let bvh_ray = |o: Vec3, d: Vec3| BvhRay::new(o.into(), (d + Vec3::ZERO).into(), 0.0, t_max);
+    (accel.instances.iter().enumerate())
+        .flat_map(|(i, inst)| {
+            let tf = inst.transform;
+            let (r, p): (BvhRay, Vec<Vec3A>) = if accel.is_instanced(i) {
+                let r = bvh_ray(
+                    tf.point_to_object(ray.o),
+                    tf.to_object.transform_vector3(ray.d),
+                );
+                (r, inst.mesh.positions.iter().map(|&v| v.into()).collect())
+            } else {
+                let p = inst.mesh.positions.iter();
+                (
+                    bvh_ray(ray.o, ray.d),
+                    p.map(|&v| tf.point_to_world(v).into()).collect(),
+                )
+            };
+            (inst.mesh.indices.iter())
+                .map(|t| RtTriangle::new(p[t[0] as usize], p[t[1] as usize], p[t[2] as usize]))
+                .map(|t| t.intersect(&r))
                 .collect::<Vec<_>>()
         })
-        .map(|t| t.intersect(&r))
         .filter(|t| *t < t_max)
         .min_by(|a, b| a.total_cmp(b))
 }
