@@ -556,3 +556,116 @@ fn a_far_eye_and_far_tree_origins_are_named_not_blamed_on_other_fields() {
     // (Stored towards the light or away from it: either way along ±(1, 0, −1)/√2, not zero.)
     assert!(got.dot(want).abs() > 1.0 - 1e-6, "{got} (want ±{want})");
 }
+
+/// Each case: a replacement in scenes/sweep_board.toml and the field its error must name.
+/// (On the old code: a type error in a tagged table named only its `[[lights]]` / `[materials.X]`
+/// header, a 4th number was dropped, an orthographic camera ignored `fov_deg`.)
+#[test]
+fn errors_name_the_field_inside_tables_and_arrays_have_exact_lengths() {
+    let board = std::fs::read_to_string(repo().join("scenes/sweep_board.toml")).unwrap();
+    let cases = [
+        (
+            "radiance = 4000.0",
+            "radiance = \"bright\"",
+            "lights[0].radiance",
+            "expected f32",
+        ),
+        ("radiance = 4000.0", "", "lights[0].radiance", "required"),
+        (
+            "type = \"sphere\"",
+            "type = \"spheer\"",
+            "lights[0].type",
+            "sphere",
+        ),
+        (
+            "albedo = [0.03, 0.03, 0.035]",
+            "albedo = \"dark\"",
+            "materials.table.albedo",
+            "sequence",
+        ),
+        (
+            "eta = 1.5 ",
+            "eta = \"glassy\" ",
+            "materials.board.eta",
+            "expected f32",
+        ),
+        (
+            "target = [0.0, 0.0, 5.0]",
+            "target = [0.0, 0.0, 5.0, 7.0]",
+            "target = [",
+            "3 numbers",
+        ),
+        (
+            "center = [250.0, 0.0, 433.0]",
+            "center = [250.0, 0.0, 433.0, 1.0]",
+            "lights[0].center",
+            "3 numbers",
+        ),
+        (
+            "arc_deg = [-60.0, 60.0]",
+            "arc_deg = [-60.0, 60.0, 0.0]",
+            "arc_deg",
+            "2 numbers",
+        ),
+        (
+            "projection = \"perspective\"",
+            "projection = \"orthographic\"\nwidth = 300.0",
+            "camera.fov_deg",
+            "perspective",
+        ),
+    ];
+    for (from, to, field, what) in cases {
+        let text = board.replacen(from, to, 1);
+        assert_ne!(text, board, "{from}");
+        let e = match xylem::scene::from_str(&text, "x.toml", repo(), "x") {
+            Ok(_) => panic!("{to:?} was accepted"),
+            Err(e) => e.to_string(),
+        };
+        assert!(
+            e.contains("x.toml") && e.contains(field) && e.contains(what),
+            "{to:?}: {e}"
+        );
+    }
+}
+
+#[test]
+fn messages_print_user_facing_names_not_rust_enum_variants() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = tiny_board(dir.path(), 8, 6, 2);
+    let text = std::fs::read_to_string(&scene).unwrap();
+    std::fs::write(
+        &scene,
+        text.replace(
+            "integrator = \"direct\"",
+            "integrator = \"path\"\nmax_depth = 5",
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let o = run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("path (max_depth 5)") && !e.contains("Path {"),
+        "{e}"
+    );
+    let o = run(&[
+        "texture",
+        "marble",
+        "--plane",
+        "xz",
+        "--res",
+        "8",
+        "--out",
+        dir.path().join("t.png").to_str().unwrap(),
+    ]);
+    let s = String::from_utf8_lossy(&o.stdout).to_string() + &stderr(&o);
+    assert!(o.status.success(), "{s}");
+    assert!(s.contains("plane xz") && !s.contains("Xz"), "{s}");
+}

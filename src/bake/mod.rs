@@ -27,17 +27,25 @@ pub enum BakeCut {
     Transverse,
 }
 
+/// The cuts by their command-line names (parsed and printed from this one table).
+const CUTS: [(BakeCut, &str); 3] = [
+    (BakeCut::Tangential, "tangential"),
+    (BakeCut::Radial, "radial"),
+    (BakeCut::Transverse, "transverse"),
+];
+
 impl std::str::FromStr for BakeCut {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "tangential" => Ok(BakeCut::Tangential),
-            "radial" => Ok(BakeCut::Radial),
-            "transverse" => Ok(BakeCut::Transverse),
-            _ => Err(format!(
-                "cut `{s}`: expected tangential, radial or transverse"
-            )),
-        }
+        (CUTS.iter().find(|(_, n)| *n == s).map(|(c, _)| *c))
+            .ok_or_else(|| format!("cut `{s}`: expected tangential, radial or transverse"))
+    }
+}
+
+/// The command-line name (`radial`), not the Rust variant.
+impl std::fmt::Display for BakeCut {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(CUTS.iter().find(|(c, _)| c == self).map_or("?", |(_, n)| n))
     }
 }
 

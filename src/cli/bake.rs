@@ -75,7 +75,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let maps = bake(&volume, &board, args.res);
     let files = write_maps(&args.out, &maps)?;
     println!(
-        "baked {} ({:?} cut, {}x{} texels) into {}:",
+        "baked {} ({} cut, {}x{} texels) into {}:",
         args.preset,
         args.cut,
         maps.width,

@@ -53,7 +53,7 @@ pub(crate) fn parse_res(s: &str) -> Result<(u32, u32), String> {
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     crate::render::resources::check_threads(args.threads)?;
-    let mut loaded = crate::scene::load(&args.scene)?;
+    let mut loaded = crate::scene::load_with(&args.scene, args.ignore_limits)?;
     for w in &loaded.warnings {
         eprintln!("warning: {w}");
     }
@@ -75,7 +75,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     let cam = &loaded.scene.camera;
     eprintln!(
-        "{}: {}x{}, {} spp, {:?}, {} triangles (BVH built in {:.1} ms)",
+        "{}: {}x{}, {} spp, {}, {} triangles (BVH built in {:.1} ms)",
         loaded.name,
         cam.width,
         cam.height,

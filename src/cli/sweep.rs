@@ -63,7 +63,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         anyhow::bail!("give a scene file (or --assemble DIR)");
     };
     crate::render::resources::check_threads(args.threads)?;
-    let mut loaded = crate::scene::load(scene)?;
+    let mut loaded = crate::scene::load_with(scene, args.ignore_limits)?;
     // The scene file's digest, recorded with every frame so that `--assemble` refuses slices
     // of different scene files (the load above has already bounded and read it).
     let scene_crc = crc32fast::hash(&std::fs::read(scene)?);
@@ -72,7 +72,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     if let Some(q) = args.quality {
         crate::sweep::tradeoff::apply(&mut loaded, &q.knobs())
-            .with_context(|| format!("applying --quality {q:?}"))?;
+            .with_context(|| format!("applying --quality {q}"))?;
     }
     if let Some(spp) = args.spp {
         anyhow::ensure!(spp >= 1, "--spp 0: need at least 1 sample per pixel");
@@ -101,13 +101,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         ignore_limits: args.ignore_limits,
         provenance: format!(
             "scene crc32 {scene_crc:08x}, quality {}",
-            args.quality
-                .map_or("none".to_string(), |q| format!("{q:?}").to_lowercase())
+            args.quality.map_or("none".to_string(), |q| q.to_string())
         ),
     };
     let cam = &loaded.scene.camera;
     eprintln!(
-        "{}: {}x{}, {} spp, {:?}, {}",
+        "{}: {}x{}, {} spp, {}, {}",
         loaded.name,
         cam.width,
         cam.height,

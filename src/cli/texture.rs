@@ -70,7 +70,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     write_png_linear(out, slice.res, slice.res, &pixels, args.exposure)
         .with_context(|| format!("writing {}", out.display()))?;
     println!(
-        "wrote {} ({}×{} px, {} mm, plane {:?} at {} mm)",
+        "wrote {} ({}×{} px, {} mm, plane {} at {} mm)",
         out.display(),
         slice.res,
         slice.res,

@@ -1,11 +1,13 @@
-//! Triangle meshes, instances with affine transforms, and the acceleration structure: every
-//! instance is flattened into world space, obvhs builds one BVH2 over all triangles (PLOC +
-//! reinsertion, its recommended builder), and [`WideBvh`] collapses it into the 8-wide layout the
-//! renderer traverses (faster than obvhs's CWBVH traversal here: notes/render.md).
+//! Triangle meshes, instances with affine transforms, and the acceleration structure: meshes
+//! placed once are flattened into world space, a mesh placed several times keeps one BVH in its
+//! object space under a top-level BVH of its placements ([`Accel`]); obvhs builds each BVH2 (PLOC
+//! + reinsertion, its recommended builder), and [`WideBvh`] collapses it into the 8-wide layout
+//! the renderer traverses (faster than obvhs's CWBVH traversal here: notes/render.md).
 
-use super::wide_bvh::WideBvh;
+use super::wide_bvh::{WideBvh, ROBUST_FAR};
 use crate::material::Placement;
 use glam::{Affine3A, Mat3, Vec2, Vec3, Vec3A};
+use obvhs::aabb::Aabb;
 use obvhs::bvh2::{reinsertion::ReinsertionOptimizer, Bvh2};
 use obvhs::ploc::PlocBuilder;
 use obvhs::ray::Ray as BvhRay;
@@ -13,6 +15,8 @@ use obvhs::rt_triangle::RtTriangle;
 use obvhs::splits::split_aabbs_preset;
 use obvhs::triangle::Triangle;
 use obvhs::BvhBuildParams;
+use std::collections::{HashMap, HashSet};
+use std::mem::size_of;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -63,6 +67,13 @@ impl TriMesh {
         self.positions.extend_from_slice(&other.positions);
         self.indices
             .extend(other.indices.iter().map(|t| t.map(|i| i + base)));
+    }
+
+    /// Bytes of the vertex, normal and index arrays.
+    pub fn bytes(&self) -> u64 {
+        let normals = self.normals.as_ref().map_or(0, Vec::len);
+        ((self.positions.len() + normals) * size_of::<Vec3>()
+            + self.indices.len() * size_of::<[u32; 3]>()) as u64
     }
 }
 
@@ -166,15 +177,43 @@ pub struct SurfaceHit {
     pub instance: u32,
 }
 
-/// All instances flattened into world-space triangles in one wide BVH.
+/// The scene's triangles in two levels (the design's "instancing" row): the meshes placed once
+/// are flattened into one world-space wide BVH (one traversal, as fast as a single mesh); a mesh
+/// placed two or more times (the same `Arc`) gets one wide BVH in its own object space, and its
+/// placements sit in a top-level BVH over their world boxes, traversed with the ray moved into
+/// object space by the inverse affine map. An affine map keeps the ray parameter, so a hit's `t`
+/// (and barycentrics) in object space is its world-space `t`: the levels share one `t_max`.
+/// Memory therefore grows with the distinct geometry, not with the copies.
 pub struct Accel {
-    bvh: WideBvh,
-    /// First global triangle id of each instance (prefix sums), plus the total at the end.
+    /// The meshes placed once, in world space.
+    world: WideBvh,
+    /// First global triangle id of each flattened instance (prefix sums), plus the total.
     offsets: Vec<u32>,
+    /// The instance each flattened range belongs to.
+    flat: Vec<u32>,
+    /// One object-space BVH per mesh placed more than once.
+    shared: Vec<WideBvh>,
+    /// The placements of shared meshes (the top level's primitive ids index this).
+    placed: Vec<Placed>,
+    /// Per instance: true when its mesh is shared (traced in object space).
+    instanced: Vec<bool>,
+    /// The top-level BVH over the widened world boxes of `placed` (None when nothing is shared).
+    top: Option<Bvh2>,
     pub instances: Vec<Instance>,
-    /// Time spent building: obvhs's BVH2 (PLOC, reinsertion) and its collapse to the wide BVH.
+    /// Time spent building: obvhs's BVH2s (PLOC, reinsertion) and their collapse to wide BVHs.
     pub build_time: Duration,
     bounds_radius: f32,
+    /// Triangles over all instances (each placement counted).
+    scene_triangles: usize,
+    /// Triangles stored in the BVHs (each shared mesh counted once).
+    stored_triangles: usize,
+}
+
+/// One placement of a shared mesh: which object-space BVH and which instance.
+#[derive(Clone, Copy, Debug)]
+struct Placed {
+    mesh: u32,
+    instance: u32,
 }
 
 /// The BVH build parameters used by the renderer (`medium_build`: PLOC with reinsertion; measured
@@ -182,57 +221,168 @@ pub struct Accel {
 /// CWBVH/BVH2 collapse settings are not used: the wide BVH makes leaves of up to 8 triangles).
 pub const BUILD_PARAMS: BvhBuildParams = BvhBuildParams::medium_build();
 
+/// The wide BVH of `triangles` (empty when there are none).
+fn wide_bvh(triangles: &[Triangle], params: &BvhBuildParams) -> WideBvh {
+    if triangles.is_empty() {
+        return WideBvh::default();
+    }
+    let corners: Vec<[Vec3; 3]> = triangles
+        .iter()
+        .map(|t| [t.v0.into(), t.v1.into(), t.v2.into()])
+        .collect();
+    WideBvh::from_bvh2(&build_bvh2(triangles, params), &corners)
+}
+
+/// The triangles of `mesh` with its vertices mapped by `to`.
+fn mapped_triangles(mesh: &TriMesh, to: impl Fn(Vec3) -> Vec3) -> Vec<Triangle> {
+    let p: Vec<Vec3A> = mesh.positions.iter().map(|&v| to(v).into()).collect();
+    mesh.indices
+        .iter()
+        .map(|t| Triangle {
+            v0: p[t[0] as usize],
+            v1: p[t[1] as usize],
+            v2: p[t[2] as usize],
+        })
+        .collect()
+}
+
+/// World bounds (min, max) of the vertices the triangles of `inst` use.
+fn world_bounds(inst: &Instance, used: &[u32]) -> (Vec3, Vec3) {
+    used.iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &i| {
+            let w = inst
+                .transform
+                .point_to_world(inst.mesh.positions[i as usize]);
+            (lo.min(w), hi.max(w))
+        })
+}
+
+/// The vertices the triangles of `mesh` use, each once, in index order.
+fn used_vertices(mesh: &TriMesh) -> Vec<u32> {
+    let mut seen = vec![false; mesh.positions.len()];
+    let mut used = Vec::new();
+    for &i in mesh.indices.iter().flatten() {
+        if !std::mem::replace(&mut seen[i as usize], true) {
+            used.push(i);
+        }
+    }
+    used
+}
+
 impl Accel {
     pub fn new(instances: Vec<Instance>) -> Self {
         Self::with_params(instances, BUILD_PARAMS)
     }
 
     pub fn with_params(instances: Vec<Instance>, params: BvhBuildParams) -> Self {
-        let mut world: Vec<Triangle> = Vec::new();
-        let mut offsets = Vec::with_capacity(instances.len() + 1);
-        for inst in &instances {
-            offsets.push(world.len() as u32);
-            let p: Vec<Vec3A> = inst
-                .mesh
-                .positions
-                .iter()
-                .map(|&v| inst.transform.point_to_world(v).into())
-                .collect();
-            world.extend(inst.mesh.indices.iter().map(|t| Triangle {
-                v0: p[t[0] as usize],
-                v1: p[t[1] as usize],
-                v2: p[t[2] as usize],
-            }));
+        let start = Instant::now();
+        // Distinct meshes by identity, in first-use order (deterministic), with their users.
+        let mut users: Vec<Vec<u32>> = Vec::new();
+        let mut slot: HashMap<*const TriMesh, usize> = HashMap::new();
+        for (i, inst) in instances.iter().enumerate() {
+            let k = *slot.entry(Arc::as_ptr(&inst.mesh)).or_insert(users.len());
+            if k == users.len() {
+                users.push(Vec::new());
+            }
+            users[k].push(i as u32);
         }
-        offsets.push(world.len() as u32);
+        let mut world: Vec<Triangle> = Vec::new();
+        let (mut offsets, mut flat) = (Vec::new(), Vec::new());
+        let (mut shared, mut placed, mut boxes) = (Vec::new(), Vec::new(), Vec::new());
         let mut bounds_radius = 1.0f32;
-        for t in &world {
-            for v in [t.v0, t.v1, t.v2] {
-                bounds_radius = bounds_radius.max(v.abs().max_element());
+        let mut stored_triangles = 0;
+        let mut instanced = vec![false; instances.len()];
+        for user in &users {
+            let mesh = &instances[user[0] as usize].mesh;
+            stored_triangles += mesh.indices.len();
+            let used = used_vertices(mesh);
+            if used.is_empty() {
+                continue; // nothing to hit, and no box to bound it
+            }
+            for &i in user {
+                let (lo, hi) = world_bounds(&instances[i as usize], &used);
+                bounds_radius = bounds_radius.max(lo.abs().max(hi.abs()).max_element());
+                if user.len() > 1 {
+                    instanced[i as usize] = true;
+                    // Widened so that the top level's slab test never culls a box a ray
+                    // grazes (the bottom level's own test is robust).
+                    let m = (hi - lo).max(lo.abs().max(hi.abs())) * 1e-6;
+                    boxes.push(Aabb::new((lo - m).into(), (hi + m).into()));
+                    placed.push(Placed {
+                        mesh: shared.len() as u32,
+                        instance: i,
+                    });
+                }
+            }
+            if user.len() > 1 {
+                shared.push(wide_bvh(&mapped_triangles(mesh, |v| v), &params));
+            } else {
+                let inst = &instances[user[0] as usize];
+                offsets.push(world.len() as u32);
+                flat.push(user[0]);
+                world.extend(mapped_triangles(mesh, |v| inst.transform.point_to_world(v)));
             }
         }
-        let start = Instant::now();
-        let bvh = if world.is_empty() {
-            WideBvh::default()
-        } else {
-            let corners: Vec<[Vec3; 3]> = world
-                .iter()
-                .map(|t| [t.v0.into(), t.v1.into(), t.v2.into()])
-                .collect();
-            WideBvh::from_bvh2(&build_bvh2(&world, &params), &corners)
-        };
+        offsets.push(world.len() as u32);
+        // `bounds_radius` ignores a non-finite vertex as the flat build did (max skips NaN).
+        let top = (!placed.is_empty()).then(|| {
+            let indices = (0..boxes.len() as u32).collect();
+            PlocBuilder::with_capacity(boxes.len()).build(
+                params.ploc_search_distance,
+                &boxes,
+                indices,
+                params.sort_precision,
+                params.search_depth_threshold,
+            )
+        });
+        let scene_triangles = instances.iter().map(|i| i.mesh.indices.len()).sum();
         Accel {
-            bvh,
+            world: wide_bvh(&world, &params),
             offsets,
+            flat,
+            shared,
+            placed,
+            instanced,
+            top,
             instances,
             build_time: start.elapsed(),
             bounds_radius,
+            scene_triangles,
+            stored_triangles,
         }
     }
 
-    /// Number of triangles over all instances.
+    /// True when instance `i`'s mesh is shared, so that it is traced in object space.
+    pub fn is_instanced(&self, i: usize) -> bool {
+        self.instanced[i]
+    }
+
+    /// Number of triangles over all instances (each placement of a mesh counted).
     pub fn triangle_count(&self) -> usize {
-        *self.offsets.last().unwrap_or(&0) as usize
+        self.scene_triangles
+    }
+
+    /// Number of triangles the BVHs store (a mesh placed many times counted once).
+    pub fn stored_triangle_count(&self) -> usize {
+        self.stored_triangles
+    }
+
+    /// Bytes held by the BVHs and the distinct meshes (what instancing keeps from growing).
+    pub fn memory_bytes(&self) -> u64 {
+        let bvhs: u64 = std::iter::once(&self.world)
+            .chain(&self.shared)
+            .map(WideBvh::bytes)
+            .sum();
+        let top = self.top.as_ref().map_or(0, |t| {
+            (t.nodes.len() * size_of::<obvhs::bvh2::node::Bvh2Node>()
+                + t.primitive_indices.len() * 4) as u64
+        });
+        let mut seen = HashSet::new();
+        let mesh_bytes: u64 = (self.instances.iter())
+            .filter(|i| seen.insert(Arc::as_ptr(&i.mesh)))
+            .map(|i| i.mesh.bytes())
+            .sum();
+        bvhs + top + mesh_bytes + (self.instances.len() * size_of::<Instance>()) as u64
     }
 
     /// A length that scales ray offsets: the largest coordinate magnitude in the scene (≥ 1 mm).
@@ -242,25 +392,122 @@ impl Accel {
 
     /// Closest hit with `t` in [0, t_max).
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
-        let hit = self.bvh.closest(ray.o, ray.d, t_max)?;
-        let global = hit.triangle;
-        let instance = self.offsets.partition_point(|&o| o <= global) as u32 - 1;
-        Some(Hit {
-            t: hit.t,
-            instance,
-            triangle: global - self.offsets[instance as usize],
-            uv: hit.uv,
-        })
+        let mut best = self.world.closest(ray.o, ray.d, t_max).map(|h| {
+            let k = self.offsets.partition_point(|&o| o <= h.triangle) - 1;
+            Hit {
+                t: h.t,
+                instance: self.flat[k],
+                triangle: h.triangle - self.offsets[k],
+                uv: h.uv,
+            }
+        });
+        if let Some(top) = &self.top {
+            let mut t_hit = best.map_or(t_max, |h| h.t);
+            self.traverse_top(top, ray, &mut t_hit, |p, o, d, t| {
+                let h = self.shared[p.mesh as usize].closest(o, d, t)?;
+                best = Some(Hit {
+                    t: h.t,
+                    instance: p.instance,
+                    triangle: h.triangle,
+                    uv: h.uv,
+                });
+                Some(h.t)
+            });
+        }
+        best
     }
 
     /// True when nothing blocks the segment `o + t·d`, t in [0, t_max) (early-out shadow query).
     pub fn unoccluded(&self, ray: &Ray, t_max: f32) -> bool {
-        self.bvh.unoccluded(ray.o, ray.d, t_max)
+        if !self.world.unoccluded(ray.o, ray.d, t_max) {
+            return false;
+        }
+        let Some(top) = &self.top else {
+            return true;
+        };
+        let mut t = t_max;
+        let mut blocked = false;
+        self.traverse_top(top, ray, &mut t, |p, o, d, t| {
+            blocked = !self.shared[p.mesh as usize].unoccluded(o, d, t);
+            // A negative distance ends the traversal (every box starts at t ≥ 0).
+            blocked.then_some(-1.0)
+        });
+        !blocked
     }
 
-    /// The wide BVH (for the benchmark and the test that its AVX2 and portable paths agree).
+    /// Visits the placements whose widened boxes the ray meets within [0, `t_max`), nearer child
+    /// first, with the ray in the placement's object space; `visit` returns the distance of a hit
+    /// it found (which lowers `t_max`; a negative one stops the traversal) or None. The slab test is Ize's robust one, as the wide
+    /// BVH's.
+    fn traverse_top(
+        &self,
+        top: &Bvh2,
+        ray: &Ray,
+        t_max: &mut f32,
+        mut visit: impl FnMut(Placed, Vec3, Vec3, f32) -> Option<f32>,
+    ) {
+        let o = Vec3A::from(ray.o);
+        let safe = |x: f32| {
+            1.0 / if x.abs() < 1e-20 {
+                1e-20f32.copysign(x)
+            } else {
+                x
+            }
+        };
+        let inv = Vec3A::new(safe(ray.d.x), safe(ray.d.y), safe(ray.d.z));
+        let enter = |n: usize, t_max: f32| -> Option<f32> {
+            let b = top.nodes[n].aabb();
+            let (t1, t2) = ((b.min - o) * inv, (b.max - o) * inv);
+            let tn = t1.min(t2).max_element().max(0.0);
+            let tf = t1.max(t2).min_element().min(t_max);
+            (tn <= tf * ROBUST_FAR).then_some(tn)
+        };
+        if enter(0, *t_max).is_none() {
+            return;
+        }
+        let mut stack: Vec<(usize, f32)> = vec![(0, 0.0)];
+        while let Some((n, tn)) = stack.pop() {
+            if tn > *t_max * ROBUST_FAR {
+                continue;
+            }
+            let node = &top.nodes[n];
+            if node.prim_count > 0 {
+                let f = node.first_index as usize;
+                for &k in &top.primitive_indices[f..f + node.prim_count as usize] {
+                    let p = self.placed[k as usize];
+                    let tf = &self.instances[p.instance as usize].transform;
+                    let (po, pd) = (
+                        tf.point_to_object(ray.o),
+                        tf.to_object.transform_vector3(ray.d),
+                    );
+                    if let Some(t) = visit(p, po, pd, *t_max) {
+                        *t_max = t;
+                    }
+                }
+                continue;
+            }
+            let (a, b) = (node.first_index as usize, node.first_index as usize + 1);
+            match (enter(a, *t_max), enter(b, *t_max)) {
+                (Some(ta), Some(tb)) => {
+                    let (near, far) = if ta <= tb {
+                        ((a, ta), (b, tb))
+                    } else {
+                        ((b, tb), (a, ta))
+                    };
+                    stack.push(far);
+                    stack.push(near);
+                }
+                (Some(ta), None) => stack.push((a, ta)),
+                (None, Some(tb)) => stack.push((b, tb)),
+                (None, None) => {}
+            }
+        }
+    }
+
+    /// The world-space BVH of the meshes placed once (for the benchmark and the test that its
+    /// AVX2 and portable paths agree).
     pub fn wide_bvh(&self) -> &WideBvh {
-        &self.bvh
+        &self.world
     }
 
     /// Position, normals and object-space point of a hit.
@@ -274,6 +521,7 @@ impl Accel {
         let p_object = a * w + b * u + c * v;
         let tf = &inst.transform;
         let n_object = (b - a).cross(c - a).normalize_or_zero();
+        // Normals by the inverse transpose (`Transform::normal_to_world`).
         let ng = tf.normal_to_world(n_object).normalize_or_zero();
         let ns = match &mesh.normals {
             Some(n) => {
@@ -287,7 +535,6 @@ impl Accel {
             }
             None => ng,
         };
-        let _ = ray;
         SurfaceHit {
             // The ray equation is the accurate hit point; the barycentric point is in object space.
             p: ray.at(hit.t),
@@ -332,25 +579,34 @@ pub fn build_bvh2(world: &[Triangle], params: &BvhBuildParams) -> Bvh2 {
     bvh2
 }
 
-/// Brute-force closest hit over every world-space triangle with obvhs's own triangle test
-/// (`RtTriangle::intersect`), the independent reference the BVH is tested against.
+/// Brute-force closest hit over every triangle with obvhs's own triangle test
+/// (`RtTriangle::intersect`), the independent reference the BVH is tested against. Like
+/// [`Accel`], it tests an instanced mesh's triangles in object space with the ray mapped there
+/// (same `t`), the others in world space, so that both round alike.
 pub fn brute_force_closest(accel: &Accel, ray: &Ray, t_max: f32) -> Option<f32> {
     // +0.0 turns a −0.0 direction component into +0.0 (obvhs's ray setup mishandles −0.0).
-    let r = BvhRay::new(ray.o.into(), (ray.d + Vec3::ZERO).into(), 0.0, t_max);
-    accel
-        .instances
-        .iter()
-        .flat_map(|inst| {
-            let p: Vec<Vec3A> = (inst.mesh.positions.iter())
-                .map(|&v| inst.transform.point_to_world(v).into())
-                .collect();
-            inst.mesh
-                .indices
-                .iter()
-                .map(move |t| RtTriangle::new(p[t[0] as usize], p[t[1] as usize], p[t[2] as usize]))
+    let bvh_ray = |o: Vec3, d: Vec3| BvhRay::new(o.into(), (d + Vec3::ZERO).into(), 0.0, t_max);
+    (accel.instances.iter().enumerate())
+        .flat_map(|(i, inst)| {
+            let tf = inst.transform;
+            let (r, p): (BvhRay, Vec<Vec3A>) = if accel.is_instanced(i) {
+                let r = bvh_ray(
+                    tf.point_to_object(ray.o),
+                    tf.to_object.transform_vector3(ray.d),
+                );
+                (r, inst.mesh.positions.iter().map(|&v| v.into()).collect())
+            } else {
+                let p = inst.mesh.positions.iter();
+                (
+                    bvh_ray(ray.o, ray.d),
+                    p.map(|&v| tf.point_to_world(v).into()).collect(),
+                )
+            };
+            (inst.mesh.indices.iter())
+                .map(|t| RtTriangle::new(p[t[0] as usize], p[t[1] as usize], p[t[2] as usize]))
+                .map(|t| t.intersect(&r))
                 .collect::<Vec<_>>()
         })
-        .map(|t| t.intersect(&r))
         .filter(|t| *t < t_max)
         .min_by(|a, b| a.total_cmp(b))
 }

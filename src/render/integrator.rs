@@ -27,6 +27,16 @@ pub enum Integrator {
     Path { max_depth: u32 },
 }
 
+/// The scene file's names (`direct`, `path (max_depth 8)`), not the Rust variants.
+impl std::fmt::Display for Integrator {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Integrator::Direct => f.write_str("direct"),
+            Integrator::Path { max_depth } => write!(f, "path (max_depth {max_depth})"),
+        }
+    }
+}
+
 /// A first hit ready to be lit: position, geometric normal, shading frame, outgoing direction in
 /// the local frame and the material's BSDF. `Copy`, so sweeps can cache one per pixel sample.
 #[derive(Clone, Copy, Debug)]

@@ -31,7 +31,8 @@ const LEAF: u32 = 1 << 31;
 const EMPTY: u32 = u32::MAX;
 /// Slab-test tolerance: t_far is scaled by 1 + 2γ₃ so that rounding in (b − o)·(1/d) never
 /// culls a box the ray touches (Ize 2013, "Robust BVH ray traversal", §3, with γₙ = nε/(1 − nε)).
-const ROBUST_FAR: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
+pub(crate) const ROBUST_FAR: f32 =
+    1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 
 /// One wide node: child bounds as `bounds[min = 0 | max = 1][axis][lane]`, child references.
 #[derive(Clone, Copy, Debug)]
@@ -474,6 +475,12 @@ impl WideBvh {
         );
         self.packets.push(Packet::new(prims, triangles));
         LEAF | (self.packets.len() - 1) as u32
+    }
+
+    /// Bytes of the nodes and leaf packets.
+    pub fn bytes(&self) -> u64 {
+        (self.nodes.len() * std::mem::size_of::<Node>()
+            + self.packets.len() * std::mem::size_of::<Packet>()) as u64
     }
 
     /// Number of wide nodes and leaf packets (for the benchmark report).

@@ -1,8 +1,32 @@
 //! The TOML scene format as plain serde data. Every table denies unknown fields, so a typo is an
 //! error naming the field and the allowed names. Documented field by field in scenes/README.md.
 
-use serde::Deserialize;
+use serde::{de::Error as _, Deserialize, Deserializer};
 use std::collections::BTreeMap;
+
+/// An array of exactly `N` numbers: serde's `[f32; N]` reads the first `N` of a longer TOML
+/// array and silently drops the rest (a 4-number position lost its 4th).
+fn exact<'de, D: Deserializer<'de>, const N: usize>(d: D) -> Result<[f32; N], D::Error> {
+    let v = Vec::<f32>::deserialize(d)?;
+    let n = v.len();
+    v.try_into()
+        .map_err(|_| D::Error::invalid_length(n, &format!("an array of {N} numbers").as_str()))
+}
+
+/// `profile`: (radius, z) pairs of exactly two numbers each.
+fn exact_pairs<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Vec<[f32; 2]>>, D::Error> {
+    let Some(v) = Option::<Vec<Vec<f32>>>::deserialize(d)? else {
+        return Ok(None);
+    };
+    v.into_iter()
+        .map(|p| {
+            let n = p.len();
+            <[f32; 2]>::try_from(p)
+                .map_err(|_| D::Error::invalid_length(n, &"a (radius, z) pair of 2 numbers"))
+        })
+        .collect::<Result<_, _>>()
+        .map(Some)
+}
 
 /// A whole scene file.
 #[derive(Debug, Clone, Deserialize)]
@@ -83,12 +107,15 @@ pub enum ProjectionName {
 pub struct CameraTable {
     #[serde(default)]
     pub projection: ProjectionName,
+    #[serde(deserialize_with = "exact")]
     pub eye: [f32; 3],
+    #[serde(deserialize_with = "exact")]
     pub target: [f32; 3],
     #[serde(default = "default_up")]
+    #[serde(deserialize_with = "exact")]
     pub up: [f32; 3],
-    #[serde(default = "default_fov")]
-    pub fov_deg: f32,
+    /// Perspective only (default [`DEFAULT_FOV_DEG`]); `None` when the file does not give it.
+    pub fov_deg: Option<f32>,
     #[serde(default)]
     pub lens_radius: f32,
     pub focus_distance: Option<f32>,
@@ -96,11 +123,11 @@ pub struct CameraTable {
     pub width: Option<f32>,
 }
 
+/// The perspective camera's vertical field of view when `fov_deg` is not given.
+pub const DEFAULT_FOV_DEG: f32 = 40.0;
+
 fn default_up() -> [f32; 3] {
     [0.0, 0.0, 1.0]
-}
-fn default_fov() -> f32 {
-    40.0
 }
 fn one() -> f32 {
     1.0
@@ -115,17 +142,22 @@ fn white() -> [f32; 3] {
 pub enum LightTable {
     Point {
         name: Option<String>,
+        #[serde(deserialize_with = "exact")]
         position: [f32; 3],
         intensity: f32,
         #[serde(default = "white")]
+        #[serde(deserialize_with = "exact")]
         color: [f32; 3],
     },
     Spot {
         name: Option<String>,
+        #[serde(deserialize_with = "exact")]
         position: [f32; 3],
+        #[serde(deserialize_with = "exact")]
         target: [f32; 3],
         intensity: f32,
         #[serde(default = "white")]
+        #[serde(deserialize_with = "exact")]
         color: [f32; 3],
         cone_deg: f32,
         #[serde(default)]
@@ -133,26 +165,34 @@ pub enum LightTable {
     },
     Distant {
         name: Option<String>,
+        #[serde(deserialize_with = "exact")]
         direction: [f32; 3],
         irradiance: f32,
         #[serde(default = "white")]
+        #[serde(deserialize_with = "exact")]
         color: [f32; 3],
     },
     Rect {
         name: Option<String>,
+        #[serde(deserialize_with = "exact")]
         corner: [f32; 3],
+        #[serde(deserialize_with = "exact")]
         edge_u: [f32; 3],
+        #[serde(deserialize_with = "exact")]
         edge_v: [f32; 3],
         radiance: f32,
         #[serde(default = "white")]
+        #[serde(deserialize_with = "exact")]
         color: [f32; 3],
     },
     Sphere {
         name: Option<String>,
+        #[serde(deserialize_with = "exact")]
         center: [f32; 3],
         radius: f32,
         radiance: f32,
         #[serde(default = "white")]
+        #[serde(deserialize_with = "exact")]
         color: [f32; 3],
     },
     Environment {
@@ -160,6 +200,7 @@ pub enum LightTable {
         #[serde(default = "one")]
         radiance: f32,
         #[serde(default = "white")]
+        #[serde(deserialize_with = "exact")]
         color: [f32; 3],
         map: Option<String>,
         #[serde(default)]
@@ -185,14 +226,19 @@ impl LightTable {
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum MaterialTable {
     Lambertian {
+        #[serde(deserialize_with = "exact")]
         albedo: [f32; 3],
     },
     /// The finished-wood BSDF with constant parameters; directions in object space.
     Fiber {
+        #[serde(deserialize_with = "exact")]
         diffuse: [f32; 3],
+        #[serde(deserialize_with = "exact")]
         fiber_color: [f32; 3],
+        #[serde(deserialize_with = "exact")]
         fiber_dir: [f32; 3],
         #[serde(default = "default_ray_dir")]
+        #[serde(deserialize_with = "exact")]
         ray_dir: [f32; 3],
         #[serde(default)]
         ray_mask: f32,
@@ -235,6 +281,7 @@ pub enum MaterialTable {
         /// "linear" (default) or "srgb".
         color_space: Option<String>,
         /// [width, height] of the image on the face (object-space mm).
+        #[serde(deserialize_with = "exact")]
         size_mm: [f32; 2],
         /// "+z" (default), "-z", "+x", "-x", "+y" or "-y".
         face: Option<String>,
@@ -254,12 +301,14 @@ pub enum MaterialTable {
     },
     Mirror {
         #[serde(default = "default_reflectance")]
+        #[serde(deserialize_with = "exact")]
         reflectance: [f32; 3],
     },
     Glass {
         #[serde(default = "default_eta")]
         eta: f32,
         #[serde(default = "white")]
+        #[serde(deserialize_with = "exact")]
         tint: [f32; 3],
     },
 }
@@ -285,7 +334,7 @@ fn default_reflectance() -> [f32; 3] {
 #[serde(untagged)]
 pub enum Scale {
     Uniform(f32),
-    Axes([f32; 3]),
+    Axes(#[serde(deserialize_with = "exact")] [f32; 3]),
 }
 
 impl Default for Scale {
@@ -309,14 +358,17 @@ pub struct ObjectTable {
     pub height: Option<f32>,
     pub segments: Option<u32>,
     /// lathe: (radius, z) points (mm).
+    #[serde(default, deserialize_with = "exact_pairs")]
     pub profile: Option<Vec<[f32; 2]>>,
     /// teapot: tessellation steps per patch side.
     pub resolution: Option<u32>,
     /// mesh: OBJ or PLY path, relative to the scene file.
     pub file: Option<String>,
     #[serde(default)]
+    #[serde(deserialize_with = "exact")]
     pub translate: [f32; 3],
     #[serde(default)]
+    #[serde(deserialize_with = "exact")]
     pub rotate_deg: [f32; 3],
     #[serde(default)]
     pub scale: Scale,
@@ -369,8 +421,10 @@ pub struct TreeTable {
     #[serde(default)]
     pub seed: u64,
     #[serde(default)]
+    #[serde(deserialize_with = "exact")]
     pub origin: [f32; 3],
     #[serde(default = "default_axis")]
+    #[serde(deserialize_with = "exact")]
     pub axis: [f32; 3],
     #[serde(default)]
     pub rotation_deg: f32,
@@ -408,14 +462,17 @@ pub struct SweepTable {
     #[serde(default = "default_frames")]
     pub frames: u32,
     /// Arc from / to, degrees from the zenith, each in [-90, 90].
+    #[serde(deserialize_with = "exact")]
     pub arc_deg: [f32; 2],
     /// Name of the light that moves (a point, spot or sphere light).
     pub light: String,
     #[serde(default)]
+    #[serde(deserialize_with = "exact")]
     pub pivot: [f32; 3],
     /// Distance from the pivot to the light (mm).
     pub radius: f32,
     #[serde(default = "default_sweep_axis")]
+    #[serde(deserialize_with = "exact")]
     pub axis: [f32; 3],
     /// Named image regions the sweep reports on (pixels, x0 < x1, y0 < y1, top-left origin).
     #[serde(default)]

@@ -38,6 +38,11 @@ pub enum SceneError {
     Parse { path: String, message: String },
     #[error("cannot read scene {0}")]
     Input(crate::render::resources::ResourceError),
+    #[error("scene {path}: {source}")]
+    Resources {
+        path: String,
+        source: crate::render::resources::ResourceError,
+    },
     #[error("scene {path}: field `{field}`: {message}")]
     Invalid {
         path: String,
@@ -71,8 +76,13 @@ pub struct LoadedScene {
     pub warnings: Vec<String>,
 }
 
-/// Reads and builds a scene file.
+/// Reads and builds a scene file, refusing geometry whose BVH build would not fit in memory.
 pub fn load(path: &Path) -> Result<LoadedScene, SceneError> {
+    load_with(path, false)
+}
+
+/// [`load`], with the geometry memory check skipped when `ignore_limits` (`--ignore-limits`).
+pub fn load_with(path: &Path, ignore_limits: bool) -> Result<LoadedScene, SceneError> {
     let bytes =
         crate::render::resources::read_bounded(path, crate::render::resources::MAX_SCENE_BYTES)
             .map_err(SceneError::Input)?;
@@ -85,14 +95,73 @@ pub fn load(path: &Path) -> Result<LoadedScene, SceneError> {
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "scene".into());
-    from_str(&text, &path.display().to_string(), &base, &name)
+    let file = parse(&text, &path.display().to_string())?;
+    Builder {
+        path: &path.display().to_string(),
+        base: &base,
+        warnings: Vec::new(),
+        ignore_limits,
+    }
+    .build(file, &name)
 }
 
 /// Parses the scene text only (no meshes built), for checks and the sweep setup.
 pub fn parse(text: &str, path: &str) -> Result<SceneFile, SceneError> {
-    toml::from_str(text).map_err(|e| SceneError::Parse {
-        path: path.to_string(),
-        message: e.to_string().trim_end().replace('\n', "\n  "),
+    toml::from_str(text).map_err(|e| match tagged_field_error(text) {
+        Some((field, message)) => SceneError::Invalid {
+            path: path.to_string(),
+            field,
+            message,
+        },
+        None => SceneError::Parse {
+            path: path.to_string(),
+            message: e.to_string().trim_end().replace('\n', "\n  "),
+        },
+    })
+}
+
+/// The field at fault in a `type`-tagged table (`[[lights]]`, `[materials.NAME]`) and serde's
+/// message. serde buffers such a table before choosing the variant, so toml's error points at
+/// the table's header, not the field. Each table is deserialized alone; in the failing one the
+/// key whose removal changes the error is the one at fault (serde reports the first bad value,
+/// and missing fields only after all values). None when no tagged table fails on its own.
+fn tagged_field_error(text: &str) -> Option<(String, String)> {
+    use serde::de::DeserializeOwned;
+    fn error<T: DeserializeOwned>(t: &toml::Table) -> Option<String> {
+        let e = toml::Value::Table(t.clone()).try_into::<T>().err()?;
+        Some(e.message().to_string())
+    }
+    fn culprit<T: DeserializeOwned>(name: String, t: &toml::Table) -> Option<(String, String)> {
+        let e = error::<T>(t)?;
+        // A missing field names itself (and removing any other key would change nothing).
+        if let Some(k) = e
+            .strip_prefix("missing field `")
+            .and_then(|r| r.split('`').next())
+        {
+            return Some((format!("{name}.{k}"), "required".into()));
+        }
+        if e.starts_with("unknown variant") {
+            return Some((format!("{name}.type"), e));
+        }
+        let key = t.keys().filter(|k| *k != "type").find(|k| {
+            let mut less = t.clone();
+            less.remove(*k);
+            error::<T>(&less).as_ref() != Some(&e)
+        });
+        Some((key.map_or(name.clone(), |k| format!("{name}.{k}")), e))
+    }
+    let doc: toml::Table = toml::from_str(text).ok()?;
+    let lights = doc.get("lights").and_then(toml::Value::as_array);
+    let from_lights = lights
+        .into_iter()
+        .flatten()
+        .enumerate()
+        .find_map(|(i, l)| culprit::<LightTable>(format!("lights[{i}]"), l.as_table()?));
+    let materials = doc.get("materials").and_then(toml::Value::as_table);
+    from_lights.or_else(|| {
+        materials.into_iter().flatten().find_map(|(name, m)| {
+            culprit::<MaterialTable>(format!("materials.{name}"), m.as_table()?)
+        })
     })
 }
 
@@ -108,6 +177,7 @@ pub fn from_str(
         path,
         base,
         warnings: Vec::new(),
+        ignore_limits: false,
     }
     .build(file, name)
 }
@@ -116,6 +186,8 @@ struct Builder<'a> {
     path: &'a str,
     base: &'a Path,
     warnings: Vec<String>,
+    /// Skip the geometry memory check.
+    ignore_limits: bool,
 }
 
 fn v3(a: [f32; 3]) -> Vec3 {
@@ -229,6 +301,13 @@ impl Builder<'_> {
         if let Some(s) = &file.sweep {
             self.check_sweep(s, &light_names, width, height)?;
         }
+        // Checked before the BVHs are built (the largest allocation a scene makes).
+        crate::render::resources::Resources::geometry(&instances)
+            .check(self.base, self.ignore_limits)
+            .map_err(|source| SceneError::Resources {
+                path: self.path.to_string(),
+                source,
+            })?;
         let scene = render::Scene {
             accel: Accel::new(instances),
             materials,
@@ -272,7 +351,12 @@ impl Builder<'_> {
                 }
                 Projection::Perspective {
                     fov_y: self
-                        .range("camera.fov_deg", c.fov_deg, 0.01, 179.0)?
+                        .range(
+                            "camera.fov_deg",
+                            c.fov_deg.unwrap_or(DEFAULT_FOV_DEG),
+                            0.01,
+                            179.0,
+                        )?
                         .to_radians(),
                     lens_radius: self.range("camera.lens_radius", c.lens_radius, 0.0, 1e6)?,
                     focus_distance: self.range(
@@ -284,6 +368,12 @@ impl Builder<'_> {
                 }
             }
             ProjectionName::Orthographic => {
+                if c.fov_deg.is_some() {
+                    return Err(self.invalid(
+                        "camera.fov_deg",
+                        "only for projection = \"perspective\" (an orthographic camera's view is `width` mm wide)",
+                    ));
+                }
                 if c.lens_radius != 0.0 {
                     return Err(self.invalid(
                         "camera.lens_radius",
@@ -432,7 +522,7 @@ impl Builder<'_> {
 
     fn env_map(&self, field: &str, file: &str, rotate_deg: f32) -> Result<EnvMap, SceneError> {
         let p = self.base.join(file);
-        let (w, h, mut texels) =
+        let (w, h, texels) =
             render::image_io::read_exr_rgb(&p).map_err(|e| self.invalid(field, e.to_string()))?;
         if w < 2 || h < 1 {
             return Err(self.invalid(field, format!("{} is too small ({w}x{h})", p.display())));
@@ -446,18 +536,7 @@ impl Builder<'_> {
                 format!("{} holds negative or non-finite texels", p.display()),
             ));
         }
-        // Rotation about z: shift columns.
-        let shift = ((rotate_deg / 360.0) * w as f32).round() as i64;
-        if shift != 0 {
-            let old = texels.clone();
-            for y in 0..h {
-                for x in 0..w {
-                    let sx = (x as i64 - shift).rem_euclid(w as i64) as usize;
-                    texels[y * w + x] = old[y * w + sx];
-                }
-            }
-        }
-        Ok(EnvMap::new(w, h, texels))
+        Ok(EnvMap::new(w, h, texels).rotated(rotate_deg))
     }
 
     fn materials(

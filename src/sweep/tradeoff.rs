@@ -83,6 +83,15 @@ pub enum Quality {
     Final,
 }
 
+/// The `--quality` name (`draft`), as clap spells it.
+impl std::fmt::Display for Quality {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        use clap::ValueEnum;
+        let v = self.to_possible_value().expect("no Quality is skipped");
+        f.write_str(v.get_name())
+    }
+}
+
 impl Quality {
     pub fn knobs(self) -> Knobs {
         let spp = match self {

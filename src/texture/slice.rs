@@ -14,15 +14,26 @@ pub enum Plane {
     Yz,
 }
 
+/// The planes by their command-line names (parsed and printed from this one table).
+const PLANES: [(Plane, &str); 3] = [(Plane::Xy, "xy"), (Plane::Xz, "xz"), (Plane::Yz, "yz")];
+
 impl FromStr for Plane {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        match s.to_ascii_lowercase().as_str() {
-            "xy" => Ok(Plane::Xy),
-            "xz" => Ok(Plane::Xz),
-            "yz" => Ok(Plane::Yz),
-            _ => Err(format!("unknown plane `{s}`; valid planes: xy, xz, yz")),
-        }
+        let s_low = s.to_ascii_lowercase();
+        (PLANES.iter().find(|(_, n)| *n == s_low).map(|(p, _)| *p))
+            .ok_or_else(|| format!("unknown plane `{s}`; valid planes: xy, xz, yz"))
+    }
+}
+
+/// The command-line name (`xz`), not the Rust variant.
+impl std::fmt::Display for Plane {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let name = PLANES
+            .iter()
+            .find(|(p, _)| p == self)
+            .map_or("?", |(_, n)| n);
+        f.write_str(name)
     }
 }
 
