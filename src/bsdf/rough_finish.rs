@@ -33,6 +33,10 @@ pub fn eta_node(k: usize) -> f32 {
     1.0 + 3.0 * s * s
 }
 
+/// R_ss is raised by 1 % where it sets what enters the finish, so that the table's
+/// interpolation error (≤ 2.5·10⁻³, tested) cannot push the white furnace above 1.
+pub const SS_MARGIN: f32 = 0.01;
+
 /// Smallest μ the quadrature is run at (μ = 0 itself is a horizontal view).
 const MU_FLOOR: f32 = 1e-4;
 
@@ -111,7 +115,7 @@ impl RoughFinish {
                 fa,
             );
             multiple[i] = r_ms.max(0.0);
-            reflectance[i] = (r_ss + multiple[i]).min(1.0);
+            reflectance[i] = (r_ss * (1.0 + SS_MARGIN) + multiple[i]).min(1.0);
             ms_avg += MU_WEIGHTS[i] * multiple[i];
             r_avg += MU_WEIGHTS[i] * reflectance[i];
         }
@@ -243,7 +247,7 @@ mod tests {
             let eta = 1.0 + 1.5 * r.next_f32();
             let f = RoughFinish::new(alpha, eta);
             let rs = single_scattering_reflectance(mu, alpha, &[eta], 128);
-            let got = (f.reflectance(mu) - f.ms_albedo(mu)) as f64;
+            let got = ((f.reflectance(mu) - f.ms_albedo(mu)) / (1.0 + SS_MARGIN)) as f64;
             worst = worst.max((got - rs[0]).abs());
         }
         assert!(worst < 2.5e-3, "{worst}");

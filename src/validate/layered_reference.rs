@@ -161,6 +161,11 @@ impl LayeredReference {
     ) -> Option<(DVec3, bool, u32)> {
         // Heights on the inner side are mirrored: the inside sees the surface flipped (h → −h,
         // normals → −normals), so each event is the upper-side event of the negated ray.
+        // Index-matched (η = 1): the microsurface is optically absent. (Walked, a grazing ray
+        // would cross it unchanged thousands of times.)
+        if self.eta == 1.0 {
+            return Some((d, d.z > 0.0, 0));
+        }
         let mut h = if outside { 2.0 } else { -2.0 };
         for events in 0..MAX_EVENTS {
             let u = rng.next_f32() as f64;

@@ -66,6 +66,10 @@ impl RoughRow {
         (self.model - self.reference).abs() <= s.tolerance * self.reference + 3.0 * self.sigma
     }
 
+    pub fn is_fiber(&self) -> bool {
+        self.substrate.starts_with("fibre")
+    }
+
     pub fn label(&self) -> String {
         format!(
             "{} α {} η {} θo {}°",
