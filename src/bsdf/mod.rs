@@ -7,6 +7,8 @@ mod fiber_albedo_table;
 mod fresnel;
 mod ggx;
 mod lambertian;
+pub mod rough_finish;
+mod rough_finish_table;
 mod specular;
 mod wood;
 pub mod workload;

@@ -7,7 +7,7 @@
 use super::fiber::{FiberAtWo, FiberAxis, FiberNormalization, BATCH};
 use super::fiber_albedo::{dip_of, max_lobe_albedo};
 use super::fresnel::{fresnel_dielectric, fresnel_diffuse_reflectance, refract_in, refract_out};
-use super::ggx::Ggx;
+use super::rough_finish::RoughFinish;
 use super::{Bsdf, BsdfError, BsdfSample, WoodBsdfParams};
 use crate::math::{cosine_hemisphere, luminance, safe_sqrt, INV_PI, PI};
 use glam::{Vec2, Vec3};
@@ -28,12 +28,15 @@ pub struct WoodBsdf {
     /// reflections under the finish (notes/bsdf.md §1.3), with ρ' = s ρ scaled just enough that
     /// ρ' ≤ 1 − k_f Ā in every channel ([`bounded_diffuse`], notes/bsdf.md §2.3).
     diffuse_eff: Vec3,
-    /// 1 − F̄_int = (1 − F̄_ext)/η²: fraction of Lambertian light from the substrate that leaves.
+    /// 1 − R̄_int = (1 − R̄)/η², R̄ the finish's hemispherical reflectance from outside (F̄_ext
+    /// when smooth): fraction of Lambertian light from the substrate that leaves (notes/bsdf.md
+    /// §1.3, §4.3).
     escape: f32,
     inv_eta2: f32,
     /// cos of the critical angle inside the finish: interior directions with z ≤ this cannot leave.
     z_crit: f32,
-    ggx: Option<Ggx>,
+    /// The rough finish (GGX with energy compensation), or `None` when smooth.
+    rough: Option<RoughFinish>,
     finish: FinishModel,
 }
 
@@ -171,7 +174,10 @@ impl WoodBsdf {
 
         let eta = params.eta;
         let f_ext = fresnel_diffuse_reflectance(eta);
-        let escape = (1.0 - f_ext) / (eta * eta);
+        let rough =
+            (params.roughness >= MIN_ROUGHNESS).then(|| RoughFinish::new(params.roughness, eta));
+        let r_avg = rough.map_or(f_ext, |r| r.avg_reflectance());
+        let escape = (1.0 - r_avg) / (eta * eta);
         let f_int = 1.0 - escape;
         let rho = bounded_diffuse(&params);
         let diffuse_eff = rho / (Vec3::ONE - rho * f_int);
@@ -185,9 +191,7 @@ impl WoodBsdf {
             escape,
             inv_eta2: 1.0 / (eta * eta),
             z_crit: safe_sqrt(1.0 - 1.0 / (eta * eta)),
-            ggx: (params.roughness >= MIN_ROUGHNESS).then_some(Ggx {
-                alpha: params.roughness,
-            }),
+            rough,
         })
     }
 
@@ -226,13 +230,17 @@ impl WoodBsdf {
 
     /// True when the finish reflects through a delta lobe (η > 1 and roughness below 1e-3).
     pub fn has_delta(&self) -> bool {
-        self.params.eta > 1.0 && self.ggx.is_none()
+        self.params.eta > 1.0 && self.rough.is_none()
     }
 
-    /// Fresnel transmittance of the finish for an exterior direction with cosine `cos`.
+    /// Transmittance of the finish for an exterior direction with cosine `cos`: 1 − F (smooth),
+    /// 1 − R(μ) with R all the rough finish reflects (notes/bsdf.md §4.3).
     #[inline]
     fn transmittance(&self, cos: f32) -> f32 {
-        1.0 - fresnel_dielectric(cos, self.params.eta)
+        match &self.rough {
+            Some(r) => 1.0 - r.reflectance(cos),
+            None => 1.0 - fresnel_dielectric(cos, self.params.eta),
+        }
     }
 
     /// The substrate BSDF for interior directions (no cosine): diffuse with its internal
@@ -251,29 +259,19 @@ impl WoodBsdf {
         self.diffuse_eff * INV_PI + p.fiber_color * fib
     }
 
-    /// Rough-finish reflection: GGX with the Fresnel factor taken at the macro-surface angles,
-    /// min(F(θo), F(θi)) D G2 / (4 cos θo cos θi): reciprocal, and its albedo is at most F(θo),
-    /// so together with the transmitted part it never exceeds 1 (notes/bsdf.md §4).
-    #[inline]
-    fn rough_reflection(&self, ggx: &Ggx, wo: Vec3, wi: Vec3) -> f32 {
-        let h = (wo + wi).normalize_or_zero();
-        if h.z <= 0.0 {
-            return 0.0;
-        }
-        let eta = self.params.eta;
-        let f = fresnel_dielectric(wo.z, eta).min(fresnel_dielectric(wi.z, eta));
-        f * ggx.d(h) * ggx.g2(wo, wi) / (4.0 * wo.z * wi.z)
-    }
-
     fn lobe_probs(&self, wo: Vec3) -> LobeProbs {
         let p = &self.params;
-        let spec = if p.eta > 1.0 {
-            fresnel_dielectric(wo.z, p.eta)
-        } else {
-            0.0
+        // The rough finish's multiple-scattering lobe is drawn with the diffuse (both cos θi/π).
+        let (spec, ms) = match &self.rough {
+            Some(r) => {
+                let ms = r.ms_albedo(wo.z);
+                ((r.reflectance(wo.z) - ms).max(0.0), ms)
+            }
+            None if p.eta > 1.0 => (fresnel_dielectric(wo.z, p.eta), 0.0),
+            None => (0.0, 0.0),
         };
-        let t = 1.0 - spec;
-        let diff = t * luminance(self.diffuse_eff) * self.escape;
+        let t = self.transmittance(wo.z);
+        let diff = t * luminance(self.diffuse_eff) * self.escape + ms;
         let fib_scale = match self.norm {
             FiberNormalization::EnergyBounded => INV_PI,
             FiberNormalization::Published => 2.0,
@@ -340,10 +338,10 @@ impl WoodBsdf {
             }
             pdf += p_int * jac;
         }
-        if let Some(ggx) = &self.ggx {
+        if let Some(r) = &self.rough {
             if probs.specular > 0.0 {
                 let h = (wo + wi).normalize_or_zero();
-                pdf += probs.specular * ggx.reflection_pdf(wo, h);
+                pdf += probs.specular * r.ggx.reflection_pdf(wo, h);
             }
         }
         if pdf.is_finite() {
@@ -480,8 +478,8 @@ impl WoodAtWo<'_> {
             fib += p.ray_mask * f_ray;
         }
         let mut f = (b.diffuse_eff * INV_PI + p.fiber_color * fib) * t;
-        if let Some(ggx) = &b.ggx {
-            f += Vec3::splat(b.rough_reflection(ggx, self.wo, wi));
+        if let Some(r) = &b.rough {
+            f += Vec3::splat(r.reflection(self.wo, wi));
         }
         if f.is_finite() {
             f.max(Vec3::ZERO)
@@ -506,10 +504,10 @@ impl WoodAtWo<'_> {
             }
             pdf += p_int * jac;
         }
-        if let Some(ggx) = &b.ggx {
+        if let Some(r) = &b.rough {
             if probs.specular > 0.0 {
                 let h = (self.wo + wi).normalize_or_zero();
-                pdf += probs.specular * ggx.reflection_pdf(self.wo, h);
+                pdf += probs.specular * r.ggx.reflection_pdf(self.wo, h);
             }
         }
         if pdf.is_finite() {
@@ -531,8 +529,8 @@ impl Bsdf for WoodBsdf {
         let (wo_in, wi_in) = (refract_in(wo, eta), refract_in(wi, eta));
         let t = self.transmittance(wo.z) * self.transmittance(wi.z) * self.inv_eta2;
         let mut f = self.substrate(wo_in, wi_in) * t;
-        if let Some(ggx) = &self.ggx {
-            f += Vec3::splat(self.rough_reflection(ggx, wo, wi));
+        if let Some(r) = &self.rough {
+            f += Vec3::splat(r.reflection(wo, wi));
         }
         if f.is_finite() {
             f.max(Vec3::ZERO)
@@ -557,7 +555,7 @@ impl Bsdf for WoodBsdf {
         let eta = self.params.eta;
         let beta = self.params.highlight_width;
         let wi = match lobe {
-            Lobe::Specular => match &self.ggx {
+            Lobe::Specular => match &self.rough {
                 None => {
                     if probs.specular <= 0.0 {
                         return None;
@@ -570,8 +568,8 @@ impl Bsdf for WoodBsdf {
                         is_delta: true,
                     });
                 }
-                Some(ggx) => {
-                    let h = ggx.sample_visible_normal(wo, u);
+                Some(r) => {
+                    let h = r.ggx.sample_visible_normal(wo, u);
                     2.0 * wo.dot(h) * h - wo
                 }
             },

@@ -9,13 +9,18 @@
 //!   by integrating `pdf` per bin, low-expectation bins pooled, significance with Šidák correction);
 //! - **pdf normalisation**: ∫pdf dω equals the fraction of non-delta samples `sample` returns;
 //! - **sample weights**: a sample's f and pdf equal `eval` and `pdf`;
-//! - **extremes**: no NaN, Inf or negative value at grazing and degenerate configurations.
+//! - **extremes**: no NaN, Inf or negative value at grazing and degenerate configurations;
+//! - **rough finish** ([`super::rough_finish`]): the analytic albedo against the layered
+//!   random-walk reference, and a white substrate under a rough finish.
 
 use crate::bsdf::{
     fresnel_dielectric, Bsdf, BsdfError, FiberNormalization, WoodBsdf, WoodBsdfParams,
 };
 use crate::math::{cosine_hemisphere, Pcg32, PI};
 use crate::validate::report::markdown_table;
+use crate::validate::rough_finish::{
+    run_rough, white_row_checked, white_row_ok, RoughRow, RoughSettings,
+};
 use glam::Vec3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -181,6 +186,9 @@ pub struct CasesFile {
     /// Parameter sets of the extremes check.
     #[serde(default)]
     pub extremes: Vec<CaseSpec>,
+    /// The rough-finish rows against the layered reference.
+    #[serde(default)]
+    pub rough_finish: Option<RoughSettings>,
 }
 
 /// A loaded, checked suite: the expanded case list.
@@ -189,6 +197,7 @@ pub struct Suite {
     pub settings: Settings,
     pub cases: Vec<CaseSpec>,
     pub extremes: Vec<CaseSpec>,
+    pub rough: Option<RoughSettings>,
 }
 
 impl CasesFile {
@@ -234,6 +243,7 @@ pub fn load_suite(path: &Path) -> Result<Suite, CasesError> {
         cases: file.expand(),
         extremes: file.extremes.clone(),
         settings: file.settings,
+        rough: file.rough_finish,
     };
     for c in suite.cases.iter().chain(&suite.extremes) {
         c.bsdf().map_err(|source| CasesError::Params {
@@ -661,6 +671,10 @@ pub struct BsdfValidation {
     pub settings: Settings,
     /// Largest albedo of the published (unnormalised) lobe cases, for notes/bsdf.md.
     pub published_max_albedo: Option<(f64, String)>,
+    #[serde(default)]
+    pub rough_rows: Vec<RoughRow>,
+    #[serde(default)]
+    pub rough_settings: Option<RoughSettings>,
 }
 
 impl BsdfValidation {
@@ -695,13 +709,22 @@ pub fn run_suite(suite: &Suite, progress: &(dyn Fn() + Sync)) -> BsdfValidation 
             )
         })
         .collect();
-    summarise(cases, extreme_violations, s.clone())
+    let rough_rows = suite.rough.as_ref().map(run_rough).unwrap_or_default();
+    summarise(
+        cases,
+        extreme_violations,
+        s.clone(),
+        rough_rows,
+        suite.rough.clone(),
+    )
 }
 
 fn summarise(
     cases: Vec<CaseResult>,
     extreme_violations: Vec<(String, u64)>,
     s: Settings,
+    rough_rows: Vec<RoughRow>,
+    rough: Option<RoughSettings>,
 ) -> BsdfValidation {
     let mut checks = Vec::new();
     let mut worst =
@@ -791,7 +814,7 @@ fn summarise(
         ),
         cases
             .iter()
-            .filter(|c| c.spec.white)
+            .filter(|c| c.spec.white && c.spec.roughness < 1e-3)
             .flat_map(|c| {
                 c.furnace
                     .iter()
@@ -902,6 +925,76 @@ fn summarise(
             .collect(),
         true,
     );
+    if let Some(r) = &rough {
+        worst(
+            "white substrate under rough finish: min albedo",
+            format!(
+                "≥ {} for θo ≤ {}°, α ≤ {} (≥ {} where the reference is)",
+                r.white_min_albedo,
+                r.white_max_theta_deg,
+                r.white_max_roughness,
+                r.white_strict_albedo
+            ),
+            rough_rows
+                .iter()
+                .filter(|x| white_row_checked(x, r))
+                .map(|x| (x.model, x.label(), white_row_ok(x, r)))
+                .collect(),
+            false,
+        );
+        worst(
+            "rough finish, Lambertian: albedo against the layered reference (max rel Δ)",
+            format!("|Δ| ≤ {} · reference + 3σ", r.tolerance),
+            rough_rows
+                .iter()
+                .filter(|x| !x.is_fiber())
+                .map(|x| (x.rel_diff(), x.label(), x.agrees(r)))
+                .collect(),
+            true,
+        );
+        // The fibre lobe is seen through the macro-surface refraction, not the rough one: off
+        // by more than 2 % from α ≈ 0.2 (notes/bsdf.md §4.5), reported until that is modelled.
+        worst(
+            "rough finish, fibre: albedo against the layered reference (max rel Δ)",
+            "reported (single pass; not yet within 2 %)".into(),
+            rough_rows
+                .iter()
+                .filter(|x| x.is_fiber())
+                .map(|x| (x.rel_diff(), x.label(), true))
+                .collect(),
+            true,
+        );
+        worst(
+            "rough finish: interface reflection against the reference (max abs Δ)",
+            "reported".into(),
+            rough_rows
+                .iter()
+                .map(|x| {
+                    let d = (x.model_interface - x.reference_interface).abs();
+                    (d, x.label(), true)
+                })
+                .collect(),
+            true,
+        );
+        worst(
+            "rough finish: BSDF shape, max |Δ| over direction bins",
+            "reported (fraction of incident light, 16 bins)".into(),
+            rough_rows
+                .iter()
+                .map(|x| (x.max_bin_diff, x.label(), true))
+                .collect(),
+            true,
+        );
+        worst(
+            "rough finish: analytic albedo ≤ 1",
+            "quadrature ≤ 1.001, reference paths cut = 0".into(),
+            rough_rows
+                .iter()
+                .map(|x| (x.model, x.label(), x.model <= 1.001 && x.truncated == 0))
+                .collect(),
+            true,
+        );
+    }
     let published_max_albedo = cases
         .iter()
         .filter(|c| !c.spec.bounded)
@@ -920,7 +1013,56 @@ fn summarise(
         extreme_violations,
         settings: s,
         published_max_albedo,
+        rough_rows,
+        rough_settings: rough,
     }
+}
+
+/// The rough-finish table of the report: model against reference per row.
+fn rough_markdown(rows: &[RoughRow], s: &RoughSettings) -> String {
+    let mut md = format!(
+        "\nRough finish against the layered random-walk reference (src/validate/layered_reference.rs; \
+         {} paths per row, seed {}; analytic albedo by a {}-point two-grid quadrature of `eval`). \
+         For the fibre the reference's light after internal reflections (`dropped`) is not in the \
+         model and not compared (notes/bsdf.md §4):\n\n",
+        s.paths, s.seed, s.quadrature_n
+    );
+    let table: Vec<Vec<String>> = rows
+        .iter()
+        .map(|r| {
+            vec![
+                r.substrate.clone(),
+                format!("{}", r.roughness),
+                format!("{}", r.eta),
+                format!("{}", r.theta_o_deg),
+                format!("{:.4}", r.model),
+                format!("{:.4} ± {:.4}", r.reference, r.sigma),
+                format!(
+                    "{:+.2} %",
+                    100.0 * (r.model - r.reference) / r.reference.max(1e-3)
+                ),
+                format!("{:.4} / {:.4}", r.model_interface, r.reference_interface),
+                format!("{:.4}", r.reference_dropped),
+                format!("{:.4}", r.max_bin_diff),
+            ]
+        })
+        .collect();
+    md += &markdown_table(
+        &[
+            "substrate",
+            "α",
+            "η",
+            "θo",
+            "model",
+            "reference",
+            "Δ",
+            "interface model / ref",
+            "dropped",
+            "max bin Δ",
+        ],
+        &table,
+    );
+    md
 }
 
 /// Points (x, y) of the curve f·cos θi in the incidence plane of `wo` (x = sin θi, y = cos θi,
@@ -979,6 +1121,9 @@ pub fn to_markdown(v: &BsdfValidation, plots: &[(String, String)]) -> String {
         &["check", "result", "worst value", "case", "criterion"],
         &rows,
     );
+    if let Some(r) = &v.rough_settings {
+        md += &rough_markdown(&v.rough_rows, r);
+    }
     if let Some((a, case)) = &v.published_max_albedo {
         md += &format!(
             "\nFor comparison, the published (unnormalised) fibre lobe reaches an albedo of {a:.3} ({case}); \

@@ -3,11 +3,15 @@
 //! - [`bsdf`]: white furnace, reciprocity, chi-square, pdf normalisation, sample weights and
 //!   extremes of the wood BSDF over the case grid of `validation/bsdf_cases.toml`;
 //! - [`sweep`]: highlight tracking, renderer against the BSDF, figure signatures of light sweeps;
+//! - [`layered_reference`]: the position-free random walk through a rough finish, ground truth
+//!   for [`rough_finish`], the rough-finish rows of `validate bsdf`;
 //! - [`report`]: validation/REPORT.md, one replaceable section per suite.
 
 pub mod appearance;
 pub mod bsdf;
+pub mod layered_reference;
 pub mod report;
+pub mod rough_finish;
 pub mod sweep;
 
 pub use report::update_report_section;

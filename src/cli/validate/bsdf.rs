@@ -43,6 +43,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         s.chi2_samples = (s.chi2_samples / k).max(10_000);
         s.reciprocity_pairs = (s.reciprocity_pairs / k).max(100);
         s.extreme_samples = (s.extreme_samples / k).max(100);
+        if let Some(r) = &mut suite.rough {
+            r.paths = (r.paths / k).max(2000);
+        }
     }
     let result: BsdfValidation = if let Some(path) = &args.from_json {
         let text =
