@@ -327,13 +327,26 @@ fn a_whole_sweep_refuses_a_folder_another_run_holds() {
     ]);
     assert_clean_error(&o, "in use by another xylem run");
     drop(held);
-    let o = run(&[
-        "sweep",
-        scene.to_str().unwrap(),
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    // Once released the folder is free. A child forked by another test thread of this binary
+    // shares the lock's open file until it execs (flock locks belong to the open file), so a
+    // busy answer within that moment is retried; a lock that stays held fails all three tries.
+    let mut o = None;
+    for _ in 0..3 {
+        let r = run(&[
+            "sweep",
+            scene.to_str().unwrap(),
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let busy = stderr(&r).contains("in use by another xylem run");
+        o = Some(r);
+        if !busy {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(300));
+    }
+    let o = o.unwrap();
     assert!(o.status.success(), "{}", stderr(&o));
 }
 
