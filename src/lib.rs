@@ -2,7 +2,7 @@
 //!
 //! The finished-wood fibre BSDF of Marschner et al. 2005, driven by the procedural
 //! solid-wood frame fields of Liu, Dong, Hašan and Marschner 2016, rendered by a BVH
-//! path tracer. Module layout and dependency direction: `../shared/DESIGN.md`
+//! path tracer. Module layout and dependency direction: `notes/design.md`
 //! (arrows point down the list below; only `cli` may use everything).
 
 pub mod bake;

@@ -1,9 +1,9 @@
 //! Marble. Sine-band marble: `½(1 + sin(ω x + γ T(p)))` with x along a vein direction and T a
 //! turbulence sum remapped to [−1, 1], a smooth threshold and a multi-stop ramp (Perlin 1985, "An
-//! Image Synthesizer", SIGGRAPH; in the form of the course report in ../shared/seeds/000, §2
-//! "Procedural Marble"). Slab marble: white / grey / black slabs of widths 4 / 5 / 3 / 5 (of a
+//! Image Synthesizer", SIGGRAPH; in the form of A. T. Jørgensen, "Procedural Solid Texturing",
+//! DTU 02562 report, 2025, §2 "Procedural Marble"). Slab marble: white / grey / black slabs of widths 4 / 5 / 3 / 5 (of a
 //! 17-unit period) displaced by turbulence, with per-slab intensity noise and the (0.9, 0.8, 0.6)
-//! tint (the HyperGraph texture-mapping notes, ../shared/seeds/003).
+//! tint (the HyperGraph notes on 3D texture mapping).
 
 use super::params::{p, ParamSpec, Values};
 use super::ramp::{smoothstep, Ramp};

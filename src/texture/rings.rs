@@ -1,8 +1,8 @@
 //! Wood from rings. Ring wood: concentric cylinders about a tilted axis, radius perturbed by
 //! `n sin(m θ + v / k)` (sinusoidal angular wobble with a twist along the axis), light and dark
-//! bands by the radius modulo the ring spacing (the HyperGraph texture-mapping notes,
-//! ../shared/seeds/003). Log wood: the log-coordinate model of the course report
-//! (../shared/seeds/000, §2 "Procedural Wood"): ring phase `f (r̃ + α r̃²)` for rings that thin
+//! bands by the radius modulo the ring spacing (the HyperGraph notes on 3D texture mapping).
+//! Log wood: the log-coordinate model of A. T. Jørgensen, "Procedural Solid Texturing" (DTU 02562
+//! report, 2025), §2 "Procedural Wood": ring phase `f (r̃ + α r̃²)` for rings that thin
 //! toward the bark, radius domain-warped by two noises `r̃ = r + β₁ N₁ + β₂ N₂`, longitudinal grain
 //! from fBm of (axial position, angle), two colours and a low-frequency tint.
 
