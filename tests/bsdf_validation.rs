@@ -56,6 +56,15 @@ fn reduced_validation_suite_passes() {
         .checks
         .iter()
         .any(|c| c.check.starts_with("white") && c.worst >= 0.99));
+    // A figure without a criterion (the fibre lobe under a rough finish, not yet within 2 % of the
+    // layered reference) is labelled "reported", never "pass".
+    let fibre = v
+        .checks
+        .iter()
+        .find(|c| c.check.starts_with("rough finish, fibre"))
+        .expect("the rough-finish fibre rows are in the reduced suite");
+    assert_eq!(fibre.status(), "reported");
+    assert!(v.checks.iter().any(|c| c.status() == "pass"));
 }
 
 #[test]

@@ -63,12 +63,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         r
     };
 
-    println!("{:<55} {:<6} {:>14}  case", "check", "result", "worst");
+    println!("{:<55} {:<8} {:>14}  case", "check", "result", "worst");
     for c in &result.checks {
         println!(
-            "{:<55} {:<6} {:>14.6}  {}",
+            "{:<55} {:<8} {:>14.6}  {}",
             c.check,
-            if c.passed { "pass" } else { "FAIL" },
+            c.status(),
             c.worst,
             c.case
         );
