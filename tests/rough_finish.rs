@@ -8,7 +8,7 @@ use glam::Vec3;
 use xylem::bsdf::{fresnel_dielectric, Bsdf, WoodBsdf, WoodBsdfParams};
 use xylem::math::{cosine_hemisphere, Pcg32};
 use xylem::validate::layered_reference::{LayeredReference, Substrate};
-use xylem::validate::rough_finish::{glossy_albedo_quadrature, rough_row};
+use xylem::validate::rough_finish::{glossy_albedo_quadrature, rough_row, RoughRow};
 
 fn white(eta: f32, roughness: f32) -> WoodBsdf {
     WoodBsdf::new(WoodBsdfParams {
@@ -19,6 +19,19 @@ fn white(eta: f32, roughness: f32) -> WoodBsdf {
         ..WoodBsdfParams::default()
     })
     .unwrap()
+}
+
+/// |model − reference| ≤ 2 % of the reference + 3σ (issue 12's criterion).
+fn assert_within_two_percent(row: &RoughRow) {
+    let tol = 0.02 * row.reference + 3.0 * row.sigma;
+    assert!(
+        (row.model - row.reference).abs() <= tol,
+        "{}: model {} reference {} ± {}",
+        row.label(),
+        row.model,
+        row.reference,
+        row.sigma
+    );
 }
 
 fn view(theta_deg: f32) -> Vec3 {
@@ -93,17 +106,34 @@ fn model_agrees_with_the_layered_reference() {
                     160,
                     &mut rng,
                 );
-                let tol = 0.02 * row.reference + 3.0 * row.sigma;
-                assert!(
-                    (row.model - row.reference).abs() <= tol,
-                    "{}: model {} reference {} ± {}",
-                    row.label(),
-                    row.model,
-                    row.reference,
-                    row.sigma
-                );
+                assert_within_two_percent(&row);
             }
         }
+    }
+}
+
+/// The fibre lobe (k_f = 1, in-plane fibres, β 15°) seen through a rough finish: interface plus
+/// single pass within 2 % (+3σ) of the random walk, at the views where seeing the lobe through the
+/// macro-surface refraction was furthest off (+43.5 % at α 1, η 2, θo 0°; +17.7 % at α 0.5,
+/// η 1.5, θo 0°; −24 % at α 1, η 1.5, θo 89°; notes/bsdf.md §4.5) and near-smooth; 40 000 paths.
+#[test]
+fn fibre_under_rough_finish_agrees_with_the_layered_reference() {
+    use xylem::bsdf::FiberAxis;
+    let mut rng = Pcg32::new(12, 4);
+    let fibre = Substrate::Fiber {
+        axis: FiberAxis::new(Vec3::X),
+        beta: 15f32.to_radians(),
+        k_f: 1.0,
+    };
+    for (alpha, eta, theta) in [
+        (1.0f32, 2.0f32, 0.0f32),
+        (0.5, 1.5, 0.0),
+        (1.0, 1.5, 89.0),
+        (0.2, 2.0, 30.0),
+        (0.05, 2.5, 60.0),
+    ] {
+        let row = rough_row(fibre, alpha, eta, theta, 40_000, 160, &mut rng);
+        assert_within_two_percent(&row);
     }
 }
 

@@ -4,6 +4,7 @@
 //! All directions here are *inside* the finish. The normalisation and the sampling density are
 //! derived in notes/bsdf.md.
 
+use super::rough_transmission::TransmittedPart;
 use crate::math::{safe_asin, safe_sqrt, Frame, PI};
 use glam::{Vec2, Vec3};
 
@@ -33,6 +34,15 @@ const MIN_ARC: f32 = PI / 8.0;
 pub struct FiberAtWo {
     psi_r: f32,
     cos_psi_r: f32,
+}
+
+/// One part of the light a rough finish transmits as a fibre sees it: its share of the
+/// transmitted energy and the mean and variance of its longitudinal angle ψ ([`FiberAxis::spread`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PsiSpread {
+    pub share: f32,
+    pub psi: f32,
+    pub var: f32,
 }
 
 /// A fibre axis `u` with a frame `(v, w)` around it for the azimuth of the reflection cone.
@@ -188,6 +198,51 @@ impl FiberAxis {
         }
     }
 
+    /// How this fibre sees the light a rough finish transmits from the exterior direction `w`
+    /// ([`TransmittedPart`]s): per part its share, the mean longitudinal angle ψ̄ = asin E[t·u]
+    /// and var ψ ≈ var(t·u)/(1 − E[t·u]²) (first-order propagation through asin).
+    pub fn spread(&self, w: Vec3, parts: &[TransmittedPart; 2]) -> [PsiSpread; 2] {
+        parts.map(|p| {
+            let (mean, var) = p.along(w, self.frame.n);
+            let mean = mean.clamp(-0.9999, 0.9999);
+            PsiSpread {
+                share: p.share,
+                psi: mean.asin(),
+                var: var / (1.0 - mean * mean),
+            }
+        })
+    }
+
+    /// The lobe seen through a rough finish (notes/bsdf.md §4.6): the lobe depends on the two
+    /// interior directions only through ψr and ψi, so with each spread as a Gaussian in ψ the
+    /// convolution of g(β, ψi + ψr) is g(√(β² + var ψr + var ψi), ψ̄i + ψ̄r); summed over the
+    /// single- and multiple-scattering parts of both ends with their shares. The normalisation
+    /// is taken at the mean angles.
+    pub fn eval_spread(
+        o: &[PsiSpread; 2],
+        i: &[PsiSpread; 2],
+        beta: f32,
+        norm: FiberNormalization,
+    ) -> f32 {
+        let mut f = 0.0;
+        for a in o {
+            for b in i {
+                let w = a.share * b.share;
+                if w <= 0.0 {
+                    continue;
+                }
+                let width = (beta * beta + a.var + b.var).sqrt();
+                let g = gaussian(width, a.psi + b.psi);
+                let at = FiberAtWo {
+                    psi_r: a.psi,
+                    cos_psi_r: a.psi.cos(),
+                };
+                f += w * lobe_value(norm, g, lobe_cos(norm, b.psi, &at), &at);
+            }
+        }
+        f
+    }
+
     /// What [`FiberAxis::eval_pdf_at`] needs of `wo` alone, worked out once for many `wi`.
     #[inline]
     pub fn at_wo(&self, wo: Vec3) -> FiberAtWo {
@@ -322,7 +377,11 @@ impl FiberAxis {
     /// outside (−π/2, π/2) or φ off the arc; [`FiberAxis::pdf`] is the density of the returned
     /// directions exactly.
     pub fn sample(&self, wo: Vec3, u: Vec2, beta: f32, z_min: f32) -> Option<Vec3> {
-        let psi_r = self.psi(wo);
+        self.sample_about(self.psi(wo), u, beta, z_min)
+    }
+
+    /// [`FiberAxis::sample`] for a view given by its longitudinal angle ψr alone.
+    pub fn sample_about(&self, psi_r: f32, u: Vec2, beta: f32, z_min: f32) -> Option<Vec3> {
         let x = (2.0 * u.x - 1.0).clamp(-0.999_999_9, 0.999_999_9);
         let psi_i = -psi_r + beta * std::f32::consts::SQRT_2 * erf_inv(x);
         if !(psi_i.abs() < 0.5 * PI) {
@@ -353,10 +412,14 @@ impl FiberAxis {
     /// Density per unit solid angle of [`FiberAxis::sample`]: g(β, ψi + ψr) / (2 max(Δ(ψi), MIN_ARC) cos ψi),
     /// the Jacobian dω = cos ψ dψ dφ of the fibre's (ψ, φ) coordinates (notes/bsdf.md §3).
     pub fn pdf(&self, wo: Vec3, wi: Vec3, beta: f32, z_min: f32) -> f32 {
+        self.pdf_about(self.psi(wo), wi, beta, z_min)
+    }
+
+    /// [`FiberAxis::pdf`] for a view given by its longitudinal angle ψr alone.
+    pub fn pdf_about(&self, psi_r: f32, wi: Vec3, beta: f32, z_min: f32) -> f32 {
         if !(wi.z > z_min) {
             return 0.0;
         }
-        let psi_r = self.psi(wo);
         let sin_psi = wi.dot(self.frame.n).clamp(-1.0, 1.0);
         let cos_psi = safe_sqrt(1.0 - sin_psi * sin_psi);
         if cos_psi < MIN_COS_PSI {

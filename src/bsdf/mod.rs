@@ -9,6 +9,7 @@ mod ggx;
 mod lambertian;
 pub mod rough_finish;
 mod rough_finish_table;
+pub mod rough_transmission;
 mod specular;
 mod wood;
 pub mod workload;

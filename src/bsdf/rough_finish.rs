@@ -38,7 +38,7 @@ pub fn eta_node(k: usize) -> f32 {
 pub const SS_MARGIN: f32 = 0.01;
 
 /// Smallest μ the quadrature is run at (μ = 0 itself is a horizontal view).
-const MU_FLOOR: f32 = 1e-4;
+pub(crate) const MU_FLOOR: f32 = 1e-4;
 
 /// Single-scattering reflectance of the GGX interface seen from above at cos θo = `mu`,
 /// [R_ss(μ, α, η) for η in `etas`], by an n × n midpoint rule over the visible-normal sampling
@@ -71,7 +71,7 @@ pub fn single_scattering_reflectance(mu: f32, alpha: f32, etas: &[f32], n: usize
 
 /// Where `x` falls on nodes 0..n−1 spaced uniformly in √x·… : (lower node, weight of the upper).
 #[inline]
-fn locate(t: f32, n: usize) -> (usize, f32) {
+pub(crate) fn locate(t: f32, n: usize) -> (usize, f32) {
     let x = t.clamp(0.0, 1.0) * (n - 1) as f32;
     let i = (x as usize).min(n - 2);
     (i, x - i as f32)

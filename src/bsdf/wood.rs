@@ -4,10 +4,11 @@
 //! reciprocity, the closed-form internal reflections of the diffuse part and the sampling
 //! densities are derived in notes/bsdf.md.
 
-use super::fiber::{FiberAtWo, FiberAxis, FiberNormalization, BATCH};
+use super::fiber::{FiberAtWo, FiberAxis, FiberNormalization, PsiSpread, BATCH};
 use super::fiber_albedo::{dip_of, max_lobe_albedo};
 use super::fresnel::{fresnel_dielectric, fresnel_diffuse_reflectance, refract_in, refract_out};
 use super::rough_finish::RoughFinish;
+use super::rough_transmission::RoughTransmission;
 use super::{Bsdf, BsdfError, BsdfSample, WoodBsdfParams};
 use crate::math::{cosine_hemisphere, luminance, safe_sqrt, INV_PI, PI};
 use glam::{Vec2, Vec3};
@@ -37,6 +38,8 @@ pub struct WoodBsdf {
     z_crit: f32,
     /// The rough finish (GGX with energy compensation), or `None` when smooth.
     rough: Option<RoughFinish>,
+    /// Where the rough finish sends the light it transmits (for the fibre lobes).
+    transmission: Option<RoughTransmission>,
     finish: FinishModel,
 }
 
@@ -151,6 +154,35 @@ struct LobeProbs {
     ray: f32,
 }
 
+/// What the fibre lobes under a rough finish need of ωo alone: how each axis sees the light the
+/// finish transmits from ωo, and the longitudinal angle and width their samples are drawn about
+/// (the single-scattering part's mean angle; β widened by twice the mean spread, for the two
+/// ends of the path).
+#[derive(Clone, Copy, Debug)]
+struct RoughView {
+    fiber: [PsiSpread; 2],
+    ray: [PsiSpread; 2],
+    sample_fiber: (f32, f32),
+    sample_ray: (f32, f32),
+}
+
+/// What the fibre lobes' samples are drawn about: ωo refracted into a smooth finish, or the
+/// angles of a rough finish's [`RoughView`].
+#[derive(Clone, Copy, Debug)]
+enum About<'a> {
+    Refracted(Vec3),
+    Rough(&'a RoughView),
+}
+
+/// (ψ, β) to draw a fibre lobe's samples with, from ωo's spreads (see [`RoughView`]).
+fn sampling_about(spread: &[PsiSpread; 2], beta: f32) -> (f32, f32) {
+    let var: f32 = spread.iter().map(|p| p.share * p.var).sum();
+    (
+        spread[0].psi,
+        (beta * beta + 2.0 * var).sqrt().min(0.5 * PI),
+    )
+}
+
 impl WoodBsdf {
     /// Validates `params` (every field finite and in range) and precomputes what every call needs.
     pub fn new(params: WoodBsdfParams) -> Result<WoodBsdf, BsdfError> {
@@ -192,6 +224,7 @@ impl WoodBsdf {
             inv_eta2: 1.0 / (eta * eta),
             z_crit: safe_sqrt(1.0 - 1.0 / (eta * eta)),
             rough,
+            transmission: rough.map(|_| RoughTransmission::new(params.roughness, eta)),
         })
     }
 
@@ -249,14 +282,94 @@ impl WoodBsdf {
     fn substrate(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         let p = &self.params;
         let beta = p.highlight_width;
+        let f_fib = if p.ray_mask < 1.0 {
+            self.fiber.eval(wo, wi, beta, self.norm)
+        } else {
+            0.0
+        };
+        let f_ray = if p.ray_mask > 0.0 {
+            self.ray.eval(wo, wi, beta, self.norm)
+        } else {
+            0.0
+        };
+        self.blend(f_fib, f_ray)
+    }
+
+    /// [`RoughView`] of `wo`, or `None` for a smooth finish.
+    fn rough_view(&self, wo: Vec3) -> Option<RoughView> {
+        let parts = self.transmission?.parts(wo.z);
+        let (fiber, ray) = (self.fiber.spread(wo, &parts), self.ray.spread(wo, &parts));
+        let beta = self.params.highlight_width;
+        Some(RoughView {
+            fiber,
+            ray,
+            sample_fiber: sampling_about(&fiber, beta),
+            sample_ray: sampling_about(&ray, beta),
+        })
+    }
+
+    /// The fibre and ray lobes (without k_f) for exterior `wi` under the rough finish seen from
+    /// `view`'s ωo ([`FiberAxis::eval_spread`], notes/bsdf.md §4.6).
+    fn rough_lobes(&self, view: &RoughView, wi: Vec3) -> (f32, f32) {
+        let p = &self.params;
+        let parts = match &self.transmission {
+            Some(t) => t.parts(wi.z),
+            None => return (0.0, 0.0),
+        };
+        let (beta, norm) = (p.highlight_width, self.norm);
+        let lobe = |axis: &FiberAxis, at: &[PsiSpread; 2]| {
+            FiberAxis::eval_spread(at, &axis.spread(wi, &parts), beta, norm)
+        };
+        let f_fib = if p.ray_mask < 1.0 {
+            lobe(&self.fiber, &view.fiber)
+        } else {
+            0.0
+        };
+        let f_ray = if p.ray_mask > 0.0 {
+            lobe(&self.ray, &view.ray)
+        } else {
+            0.0
+        };
+        (f_fib, f_ray)
+    }
+
+    /// The substrate from the fibre and ray lobes' values: diffuse (with its internal
+    /// reflections) plus k_f times their ray-mask blend.
+    #[inline(always)]
+    fn blend(&self, f_fib: f32, f_ray: f32) -> Vec3 {
+        let p = &self.params;
         let mut fib = 0.0;
         if p.ray_mask < 1.0 {
-            fib += (1.0 - p.ray_mask) * self.fiber.eval(wo, wi, beta, self.norm);
+            fib += (1.0 - p.ray_mask) * f_fib;
         }
         if p.ray_mask > 0.0 {
-            fib += p.ray_mask * self.ray.eval(wo, wi, beta, self.norm);
+            fib += p.ray_mask * f_ray;
         }
         self.diffuse_eff * INV_PI + p.fiber_color * fib
+    }
+
+    /// The interior density of the fibre and ray lobes' samples for `wi_in` (0 for a lobe never
+    /// picked), drawn about ωo's refraction (smooth finish) or about its rough view's angles.
+    fn lobe_densities(&self, probs: &LobeProbs, about: About, wi_in: Vec3) -> (f32, f32) {
+        let (beta, z) = (self.params.highlight_width, self.z_crit);
+        let density = |axis: &FiberAxis, pick: fn(&RoughView) -> (f32, f32)| match about {
+            About::Refracted(wo_in) => axis.pdf(wo_in, wi_in, beta, z),
+            About::Rough(v) => {
+                let (psi, width) = pick(v);
+                axis.pdf_about(psi, wi_in, width, z)
+            }
+        };
+        let p_fib = if probs.fiber > 0.0 {
+            density(&self.fiber, |v| v.sample_fiber)
+        } else {
+            0.0
+        };
+        let p_ray = if probs.ray > 0.0 {
+            density(&self.ray, |v| v.sample_ray)
+        } else {
+            0.0
+        };
+        (p_fib, p_ray)
     }
 
     fn lobe_probs(&self, wo: Vec3) -> LobeProbs {
@@ -318,23 +431,27 @@ impl WoodBsdf {
         last
     }
 
-    fn pdf_with(&self, probs: &LobeProbs, wo: Vec3, wi: Vec3) -> f32 {
+    fn pdf_with(&self, probs: &LobeProbs, view: Option<&RoughView>, wo: Vec3, wi: Vec3) -> f32 {
         if !(wo.z > 0.0 && wi.z > 0.0) {
             return 0.0;
         }
         let eta = self.params.eta;
-        let beta = self.params.highlight_width;
         let mut pdf = probs.diffuse * wi.z * INV_PI;
         if probs.fiber > 0.0 || probs.ray > 0.0 {
             let (wo_in, wi_in) = (refract_in(wo, eta), refract_in(wi, eta));
             // dω_int/dω_ext = cos θi / (η² cos θi') (notes/bsdf.md §1.1).
             let jac = wi.z * self.inv_eta2 / wi_in.z.max(1e-7);
+            let about = match view {
+                Some(v) => About::Rough(v),
+                None => About::Refracted(wo_in),
+            };
+            let (p_fib, p_ray) = self.lobe_densities(probs, about, wi_in);
             let mut p_int = 0.0;
             if probs.fiber > 0.0 {
-                p_int += probs.fiber * self.fiber.pdf(wo_in, wi_in, beta, self.z_crit);
+                p_int += probs.fiber * p_fib;
             }
             if probs.ray > 0.0 {
-                p_int += probs.ray * self.ray.pdf(wo_in, wi_in, beta, self.z_crit);
+                p_int += probs.ray * p_ray;
             }
             pdf += p_int * jac;
         }
@@ -365,6 +482,7 @@ pub struct WoodAtWo<'a> {
     probs: LobeProbs,
     fiber: FiberAtWo,
     ray: FiberAtWo,
+    rough: Option<RoughView>,
 }
 
 impl WoodBsdf {
@@ -378,6 +496,7 @@ impl WoodBsdf {
             probs: self.lobe_probs(wo),
             fiber: self.fiber.at_wo(wo_in),
             ray: self.ray.at_wo(wo_in),
+            rough: self.rough_view(wo),
         }
     }
 }
@@ -391,6 +510,15 @@ impl WoodAtWo<'_> {
         }
         let p = &b.params;
         let wi_in = refract_in(wi, p.eta);
+        if let Some(view) = &self.rough {
+            let (f_fib, f_ray) = b.rough_lobes(view, wi);
+            let f = self.value(wi, self.transmission(wi.z), f_fib, f_ray);
+            if !with_pdf {
+                return (f, 0.0);
+            }
+            let (p_fib, p_ray) = b.lobe_densities(probs, About::Rough(view), wi_in);
+            return (f, self.density(wi, wi_in, p_fib, p_ray));
+        }
         let lobe = |axis: &FiberAxis, at: &FiberAtWo, in_f: bool, in_pdf: bool| {
             if in_f || (with_pdf && in_pdf) {
                 axis.eval_pdf_at(at, wi_in, p.highlight_width, b.norm, b.z_crit)
@@ -413,6 +541,13 @@ impl WoodAtWo<'_> {
     /// the arithmetic in SIMD lanes.
     pub fn eval_pdf_many(&self, wi: &[Vec3], with_pdf: bool, f: &mut [Vec3], pdf: &mut [f32]) {
         assert!(f.len() == wi.len() && pdf.len() == wi.len());
+        if self.rough.is_some() {
+            // Under a rough finish every direction has its own spreads: one at a time.
+            for k in 0..wi.len() {
+                (f[k], pdf[k]) = self.eval_pdf(wi[k], with_pdf);
+            }
+            return;
+        }
         let (b, probs) = (self.bsdf, &self.probs);
         let p = &b.params;
         for ((wi, f), pdf) in wi
@@ -469,15 +604,7 @@ impl WoodAtWo<'_> {
     #[inline(always)]
     fn value(&self, wi: Vec3, t: f32, f_fib: f32, f_ray: f32) -> Vec3 {
         let b = self.bsdf;
-        let p = &b.params;
-        let mut fib = 0.0;
-        if p.ray_mask < 1.0 {
-            fib += (1.0 - p.ray_mask) * f_fib;
-        }
-        if p.ray_mask > 0.0 {
-            fib += p.ray_mask * f_ray;
-        }
-        let mut f = (b.diffuse_eff * INV_PI + p.fiber_color * fib) * t;
+        let mut f = b.blend(f_fib, f_ray) * t;
         if let Some(r) = &b.rough {
             f += Vec3::splat(r.reflection(self.wo, wi));
         }
@@ -528,7 +655,14 @@ impl Bsdf for WoodBsdf {
         let eta = self.params.eta;
         let (wo_in, wi_in) = (refract_in(wo, eta), refract_in(wi, eta));
         let t = self.transmittance(wo.z) * self.transmittance(wi.z) * self.inv_eta2;
-        let mut f = self.substrate(wo_in, wi_in) * t;
+        let substrate = match self.rough_view(wo) {
+            Some(view) => {
+                let (f_fib, f_ray) = self.rough_lobes(&view, wi);
+                self.blend(f_fib, f_ray)
+            }
+            None => self.substrate(wo_in, wi_in),
+        };
+        let mut f = substrate * t;
         if let Some(r) = &self.rough {
             f += Vec3::splat(r.reflection(wo, wi));
         }
@@ -543,7 +677,7 @@ impl Bsdf for WoodBsdf {
         if !(wo.z > 0.0 && wi.z > 0.0) {
             return 0.0;
         }
-        self.pdf_with(&self.lobe_probs(wo), wo, wi)
+        self.pdf_with(&self.lobe_probs(wo), self.rough_view(wo).as_ref(), wo, wi)
     }
 
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
@@ -551,6 +685,8 @@ impl Bsdf for WoodBsdf {
             return None;
         }
         let probs = self.lobe_probs(wo);
+        let view = self.rough_view(wo);
+        let view = view.as_ref();
         let lobe = Self::pick(&probs, uc);
         let eta = self.params.eta;
         let beta = self.params.highlight_width;
@@ -580,14 +716,21 @@ impl Bsdf for WoodBsdf {
                 } else {
                     &self.ray
                 };
-                let wi_in = axis.sample(refract_in(wo, eta), u, beta, self.z_crit)?;
+                let about = view.map(|v| match lobe {
+                    Lobe::Fiber => v.sample_fiber,
+                    _ => v.sample_ray,
+                });
+                let wi_in = match about {
+                    Some((psi, width)) => axis.sample_about(psi, u, width, self.z_crit)?,
+                    None => axis.sample(refract_in(wo, eta), u, beta, self.z_crit)?,
+                };
                 refract_out(wi_in, eta)?
             }
         };
         if !(wi.z > 0.0) {
             return None;
         }
-        let pdf = self.pdf_with(&probs, wo, wi);
+        let pdf = self.pdf_with(&probs, view, wo, wi);
         if !(pdf > 0.0) {
             return None;
         }
