@@ -34,8 +34,15 @@ from . import WoodSurface
 _REGISTERED = False
 
 
+def _has(props, name):
+    try:
+        return name in props
+    except TypeError:  # Mitsuba before 3.6
+        return props.has_property(name)
+
+
 def _vector(props, name, default):
-    if not props.has_property(name):
+    if not _has(props, name):
         return tuple(float(x) for x in default)
     value = props.get(name)
     if isinstance(value, str):
@@ -97,8 +104,10 @@ def _bsdf_class(mi, dr):
     class XylemWood(mi.BSDF):
         def __init__(self, props):
             mi.BSDF.__init__(self, props)
-            preset = props.get("preset") if props.has_property("preset") else None
-            preset_file = props.get("preset_file") if props.has_property("preset_file") else None
+            preset = props.get("preset") if _has(props, "preset") else None
+            preset_file = (
+                props.get("preset_file") if _has(props, "preset_file") else None
+            )
             self.eta = float(props.get("eta", 1.5))
             self.roughness = float(props.get("roughness", 0.0))
             self.surface = WoodSurface(
