@@ -470,8 +470,13 @@ struct PyWoodSurface {
 }
 
 impl PyWoodSurface {
+    /// Shades world point `p` with shading normal `n` (normalised unless it is unit already).
     fn shade_one(&self, p: Vec3, n: Vec3) -> xylem::material::Shading {
-        let n = n.normalize_or(Vec3::Z);
+        let n = if (n.length_squared() - 1.0).abs() <= 1e-6 {
+            n
+        } else {
+            n.normalize_or(Vec3::Z)
+        };
         let hit = MaterialHit {
             p_object: p,
             p_world: p,
@@ -486,6 +491,30 @@ impl PyWoodSurface {
         };
         self.material.shade(&hit)
     }
+
+    /// `f(bsdf, wo, wi)` in xylem's local frame at every row of (p, n, wo, wi), world inputs.
+    fn at_pairs<T: Send>(
+        &self,
+        py: Python<'_>,
+        [p, n, wo, wi]: [&PyArrayLikeDyn<'_, f32, AllowTypeChange>; 4],
+        f: impl Fn(&xylem::material::SurfaceBsdf, Vec3, Vec3) -> T + Sync + Send,
+    ) -> PyResult<Vec<T>> {
+        let (p, nn) = (vec3_rows("p", p)?, vec3_rows("n", n)?);
+        let (wo, wi) = (vec3_rows("wo", wo)?, vec3_rows("wi", wi)?);
+        let count = broadcast(&[
+            ("p", p.len()),
+            ("n", nn.len()),
+            ("wo", wo.len()),
+            ("wi", wi.len()),
+        ])?;
+        Ok(py.allow_threads(|| {
+            map_indices(count, |i| {
+                let s = self.shade_one(at(&p, i), at(&nn, i));
+                let to_local = |d: Vec3| s.frame.to_local(d);
+                f(&s.bsdf, to_local(at(&wo, i)), to_local(at(&wi, i)))
+            })
+        }))
+    }
 }
 
 #[pymethods]
@@ -494,7 +523,7 @@ impl PyWoodSurface {
     /// origin=(0, 0, 0), axis=(0, 0, 1), rotation_deg=0.0, scale=1.0)`.
     #[new]
     #[pyo3(signature = (preset=None, *, preset_file=None, seed=0, eta=1.5, roughness=0.0,
-        origin=(0.0, 0.0, 0.0), axis=(0.0, 0.0, 1.0), rotation_deg=0.0, scale=1.0))]
+        origin=[0.0, 0.0, 0.0], axis=[0.0, 0.0, 1.0], rotation_deg=0.0, scale=1.0))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         preset: Option<String>,
@@ -502,8 +531,8 @@ impl PyWoodSurface {
         seed: u64,
         eta: f32,
         roughness: f32,
-        origin: (f32, f32, f32),
-        axis: (f32, f32, f32),
+        origin: [f32; 3],
+        axis: [f32; 3],
         rotation_deg: f32,
         scale: f32,
     ) -> PyResult<Self> {
@@ -616,21 +645,7 @@ impl PyWoodSurface {
         wo: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
         wi: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
     ) -> PyResult<Bound<'py, PyArray2<f32>>> {
-        let (p, nn) = (vec3_rows("p", &p)?, vec3_rows("n", &n)?);
-        let (wo, wi) = (vec3_rows("wo", &wo)?, vec3_rows("wi", &wi)?);
-        let count = broadcast(&[
-            ("p", p.len()),
-            ("n", nn.len()),
-            ("wo", wo.len()),
-            ("wi", wi.len()),
-        ])?;
-        let f = py.allow_threads(|| {
-            map_indices(count, |i| {
-                let s = self.shade_one(at(&p, i), at(&nn, i));
-                s.bsdf
-                    .eval(s.frame.to_local(at(&wo, i)), s.frame.to_local(at(&wi, i)))
-            })
-        });
+        let f = self.at_pairs(py, [&p, &n, &wo, &wi], |b, o, i| b.eval(o, i))?;
         vec3_array(py, &f)
     }
 
@@ -643,21 +658,7 @@ impl PyWoodSurface {
         wo: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
         wi: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
     ) -> PyResult<Bound<'py, PyArray1<f32>>> {
-        let (p, nn) = (vec3_rows("p", &p)?, vec3_rows("n", &n)?);
-        let (wo, wi) = (vec3_rows("wo", &wo)?, vec3_rows("wi", &wi)?);
-        let count = broadcast(&[
-            ("p", p.len()),
-            ("n", nn.len()),
-            ("wo", wo.len()),
-            ("wi", wi.len()),
-        ])?;
-        let pdf = py.allow_threads(|| {
-            map_indices(count, |i| {
-                let s = self.shade_one(at(&p, i), at(&nn, i));
-                s.bsdf
-                    .pdf(s.frame.to_local(at(&wo, i)), s.frame.to_local(at(&wi, i)))
-            })
-        });
+        let pdf = self.at_pairs(py, [&p, &n, &wo, &wi], |b, o, i| b.pdf(o, i))?;
         Ok(PyArray1::from_vec(py, pdf))
     }
 
