@@ -92,6 +92,17 @@ fn vec2_rows(name: &str, a: &PyArrayLikeDyn<'_, f32, AllowTypeChange>) -> PyResu
         .collect())
 }
 
+/// The arguments of a `sample` call: directions `wo`, lobe numbers `uc` and 2D numbers `u`.
+type SampleInputs = (Vec<Vec3>, Vec<f32>, Vec<Vec2>);
+
+fn sample_inputs(
+    wo: &PyArrayLikeDyn<'_, f32, AllowTypeChange>,
+    uc: &PyArrayLikeDyn<'_, f32, AllowTypeChange>,
+    u: &PyArrayLikeDyn<'_, f32, AllowTypeChange>,
+) -> PyResult<SampleInputs> {
+    Ok((vec3_rows("wo", wo)?, scalars("uc", uc)?, vec2_rows("u", u)?))
+}
+
 /// The common length of arrays that broadcast: each has length 1 or N.
 fn broadcast(lens: &[(&str, usize)]) -> PyResult<usize> {
     let n = lens.iter().map(|l| l.1).max().unwrap_or(1);
@@ -227,6 +238,22 @@ struct PyWoodBsdf {
     bsdfs: Vec<xylem::bsdf::WoodBsdf>,
 }
 
+impl PyWoodBsdf {
+    /// `f(bsdf, wo, wi)` at every row of the broadcast (bsdf, wo, wi), GIL released.
+    fn at_pairs<T: Send>(
+        &self,
+        py: Python<'_>,
+        wo: &PyArrayLikeDyn<'_, f32, AllowTypeChange>,
+        wi: &PyArrayLikeDyn<'_, f32, AllowTypeChange>,
+        f: impl Fn(&xylem::bsdf::WoodBsdf, Vec3, Vec3) -> T + Sync + Send,
+    ) -> PyResult<Vec<T>> {
+        let (wo, wi) = (vec3_rows("wo", wo)?, vec3_rows("wi", wi)?);
+        let b = &self.bsdfs;
+        let n = broadcast(&[("bsdf", b.len()), ("wo", wo.len()), ("wi", wi.len())])?;
+        Ok(py.allow_threads(|| map_indices(n, |i| f(&at(b, i), at(&wo, i), at(&wi, i)))))
+    }
+}
+
 #[pymethods]
 impl PyWoodBsdf {
     /// `WoodBsdf(params=None, **fields)`: fields `diffuse`, `fiber_color`, `fiber_dir`,
@@ -280,14 +307,7 @@ impl PyWoodBsdf {
         wo: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
         wi: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
     ) -> PyResult<Bound<'py, PyArray2<f32>>> {
-        let (wo, wi) = (vec3_rows("wo", &wo)?, vec3_rows("wi", &wi)?);
-        let n = broadcast(&[
-            ("bsdf", self.bsdfs.len()),
-            ("wo", wo.len()),
-            ("wi", wi.len()),
-        ])?;
-        let b = &self.bsdfs;
-        let f = py.allow_threads(|| map_indices(n, |i| at(b, i).eval(at(&wo, i), at(&wi, i))));
+        let f = self.at_pairs(py, &wo, &wi, |b, o, i| b.eval(o, i))?;
         vec3_array(py, &f)
     }
 
@@ -298,14 +318,7 @@ impl PyWoodBsdf {
         wo: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
         wi: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
     ) -> PyResult<Bound<'py, PyArray1<f32>>> {
-        let (wo, wi) = (vec3_rows("wo", &wo)?, vec3_rows("wi", &wi)?);
-        let n = broadcast(&[
-            ("bsdf", self.bsdfs.len()),
-            ("wo", wo.len()),
-            ("wi", wi.len()),
-        ])?;
-        let b = &self.bsdfs;
-        let p = py.allow_threads(|| map_indices(n, |i| at(b, i).pdf(at(&wo, i), at(&wi, i))));
+        let p = self.at_pairs(py, &wo, &wi, |b, o, i| b.pdf(o, i))?;
         Ok(PyArray1::from_vec(py, p))
     }
 
@@ -318,11 +331,7 @@ impl PyWoodBsdf {
         uc: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
         u: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let (wo, uc, u) = (
-            vec3_rows("wo", &wo)?,
-            scalars("uc", &uc)?,
-            vec2_rows("u", &u)?,
-        );
+        let (wo, uc, u) = sample_inputs(&wo, &uc, &u)?;
         let n = broadcast(&[
             ("bsdf", self.bsdfs.len()),
             ("wo", wo.len()),
@@ -673,11 +682,7 @@ impl PyWoodSurface {
         u: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let (p, nn) = (vec3_rows("p", &p)?, vec3_rows("n", &n)?);
-        let (wo, uc, u) = (
-            vec3_rows("wo", &wo)?,
-            scalars("uc", &uc)?,
-            vec2_rows("u", &u)?,
-        );
+        let (wo, uc, u) = sample_inputs(&wo, &uc, &u)?;
         let count = broadcast(&[
             ("p", p.len()),
             ("n", nn.len()),
