@@ -1,0 +1,158 @@
+"""The bindings give the Rust library's numbers: every value is compared with what
+tests/python.rs computed by calling the library directly (float32, bit for bit)."""
+
+import numpy as np
+import pytest
+
+import xylem
+
+
+def f32(x):
+    return np.asarray(x, dtype=np.float32)
+
+
+def same(a, b):
+    """Bit-for-bit equal float32 arrays (NaN nowhere)."""
+    a, b = f32(a), f32(b)
+    assert a.shape == b.shape, (a.shape, b.shape)
+    assert np.isfinite(a).all()
+    bad = np.argwhere(a != b)
+    assert bad.size == 0, f"{len(bad)} values differ, first at {bad[0]}: {a[tuple(bad[0])]} vs {b[tuple(bad[0])]}"
+
+
+@pytest.mark.parametrize("case", range(3))
+def test_wood_bsdf_matches_rust(reference, case):
+    c = reference["bsdf"][case]
+    b = xylem.WoodBsdf(c["params"])
+    same(b.eval(c["wo"], c["wi"]), c["f"])
+    same(b.pdf(c["wo"], c["wi"]), c["pdf"])
+    s = b.sample(c["wo"], c["uc"], c["u"])
+    same(s["wi"], c["sample_wi"])
+    same(s["f"], c["sample_f"])
+    same(s["pdf"], c["sample_pdf"])
+    assert (s["is_delta"] == np.array(c["sample_delta"])).all()
+    assert (s["valid"] == np.array(c["sample_valid"])).all()
+    # The smooth finish's mirror is sampled sometimes and flagged as a delta lobe.
+    if c["name"] == "smooth_finish":
+        assert s["is_delta"].any() and not s["is_delta"].all()
+
+
+def test_wood_bsdf_batch_of_shading_points(reference):
+    """N shading points in one WoodBsdf give, row by row, the single-point numbers."""
+    cases = reference["bsdf"]
+    fields = cases[0]["params"].keys()
+    n = len(cases[0]["wo"])
+    params = {k: np.array([cases[i % 3]["params"][k] for i in range(n)]) for k in fields}
+    b = xylem.WoodBsdf(params)
+    assert len(b) == n
+    wo = np.array([cases[i % 3]["wo"][i] for i in range(n)])
+    wi = np.array([cases[i % 3]["wi"][i] for i in range(n)])
+    want = np.array([cases[i % 3]["f"][i] for i in range(n)])
+    same(b.eval(wo, wi), want)
+    assert b.has_delta().tolist() == [i % 3 == 0 for i in range(n)]
+
+
+def test_wood_volume_matches_rust(reference):
+    v = reference["volume"]
+    vol = xylem.WoodVolume(v["preset"], seed=v["seed"])
+    got = vol.eval(np.array(v["points"]), "all")
+    for key in ["diffuse", "fiber_color", "fiber_dir", "ray_dir", "bump_grad", "ray_mask",
+                "pore_mask", "bump", "highlight_width", "growth_time"]:
+        same(got[key], v[key])
+    # Asking for less returns only those arrays, with the same values.
+    colour = vol.eval(np.array(v["points"]), needs="color")
+    assert "fiber_dir" not in colour and "bump" not in colour
+    same(colour["diffuse"], v["diffuse"])
+
+
+def test_wood_surface_matches_rust(reference):
+    s = reference["surface"]
+    surf = xylem.WoodSurface(s["preset"], seed=s["seed"], eta=s["eta"], roughness=s["roughness"],
+                             origin=s["origin"], axis=s["axis"], rotation_deg=s["rotation_deg"])
+    same(surf.eval(s["p"], s["n"], s["wo"], s["wi"]), s["f"])
+    same(surf.pdf(s["p"], s["n"], s["wo"], s["wi"]), s["pdf"])
+    shaded = surf.shade(s["p"], s["n"])
+    frames = shaded["frame"]
+    # xylem's shading frame: orthonormal rows, z = the given normal.
+    assert np.allclose(np.einsum("nij,nkj->nik", frames, frames), np.eye(3), atol=1e-5)
+    n = np.array(s["n"], dtype=np.float32)
+    assert np.allclose(frames[:, 2], n / np.linalg.norm(n, axis=1, keepdims=True), atol=1e-6)
+    # A WoodBsdf built from the shaded parameters gives the same f in the local frame.
+    local = lambda d: np.einsum("nij,nj->ni", frames, np.array(d, dtype=np.float32))
+    b = xylem.WoodBsdf({k: shaded[k] for k in shaded if k != "frame"})
+    np.testing.assert_allclose(b.eval(local(s["wo"]), local(s["wi"])), s["f"], rtol=2e-4, atol=1e-6)
+
+
+def test_render_and_sweep_match_rust(reference):
+    r = reference["render"]
+    w, h = r["res"]
+    img = xylem.render(r["scene"], spp=r["spp"], res=(w, h))
+    assert img["beauty"].shape == (h, w, 3)
+    same(img["beauty"].reshape(-1, 3), r["beauty"])
+    same(img["std_error"].reshape(-1), r["std_error"])
+    same(img["albedo"].reshape(-1, 3), r["albedo"])
+    # The image does not depend on the thread count.
+    same(xylem.render(r["scene"], spp=r["spp"], res=(w, h), threads=1)["beauty"], img["beauty"])
+    sw = xylem.sweep(r["scene"], frames=r["sweep_frames"], arc=tuple(r["sweep_arc"]),
+                     spp=r["spp"], res=(w, h))
+    assert sw["frames"].shape == (r["sweep_frames"], h, w, 3)
+    for k in range(r["sweep_frames"]):
+        same(sw["frames"][k].reshape(-1, 3), r["sweep"][k])
+    same(sw["light_deg"], r["sweep_light_deg"])
+
+
+def test_errors_name_the_field(root):
+    with pytest.raises(ValueError, match=r"roughness = 2: must be a finite value in \[0, 1\]"):
+        xylem.WoodBsdf(roughness=2.0)
+    with pytest.raises(ValueError, match=r"fiber_dir.*unit vector"):
+        xylem.WoodBsdf(fiber_dir=[1.0, 1.0, 0.0])
+    with pytest.raises(ValueError, match=r"highlight_width.*\(shading point 1\)"):
+        xylem.WoodBsdf(highlight_width=[0.1, 3.0])
+    with pytest.raises(ValueError, match=r"unknown field `colour`"):
+        xylem.WoodBsdf(colour=1.0)
+    with pytest.raises(ValueError, match=r"wo has 2 rows; every argument needs 1 or 3 rows"):
+        xylem.WoodBsdf().eval(np.ones((2, 3)), np.ones((3, 3)))
+    with pytest.raises(ValueError, match=r"wi: shape \[4\], expected \(3,\) or \(N, 3\)"):
+        xylem.WoodBsdf().eval([0, 0, 1], [0, 0, 1, 0])
+    with pytest.raises(ValueError, match=r"unknown wood preset `oak`; valid presets: african_mahogany"):
+        xylem.WoodVolume("oak")
+    with pytest.raises(ValueError, match=r"needs: unknown `colour`"):
+        xylem.WoodVolume("walnut").eval([[100.0, 0.0, 0.0]], needs="colour")
+    with pytest.raises(OSError, match=r"no_such_preset.toml"):
+        xylem.WoodVolume(preset_file="no_such_preset.toml")
+    with pytest.raises(ValueError, match=r"eta = 5: must be a finite index in \[1, 4\]"):
+        xylem.WoodSurface("walnut", eta=5.0)
+    scene = str(root / "scenes" / "sweep_board.toml")
+    with pytest.raises(ValueError, match=r"spp = 0"):
+        xylem.render(scene, spp=0)
+    with pytest.raises(ValueError, match=r"res width = 0: must be a whole number in 1..=16384"):
+        xylem.render(scene, res=(0, 10))
+    with pytest.raises(OSError, match=r"missing.toml"):
+        xylem.render(str(root / "missing.toml"))
+    with pytest.raises(ValueError, match=r"no \[sweep\] table"):
+        xylem.sweep(str(root / "scenes" / "teapot.toml"), spp=1, res=(4, 4))
+
+
+def test_render_releases_the_gil(root):
+    """A render on one thread lets another Python thread run meanwhile."""
+    import threading
+    import time
+
+    ticks = []
+    done = threading.Event()
+
+    def tick():
+        while not done.is_set():
+            ticks.append(time.perf_counter())
+            time.sleep(0.005)
+
+    t = threading.Thread(target=tick)
+    t.start()
+    start = time.perf_counter()
+    out = xylem.render(str(root / "scenes" / "sweep_board.toml"), spp=4, res=(96, 72), threads=1)
+    end = time.perf_counter()
+    done.set()
+    t.join()
+    assert out["seconds"] > 0.05, "render too short to tell"
+    during = [x for x in ticks if start < x < end]
+    assert len(during) >= 5, f"only {len(during)} ticks during a {end - start:.2f} s render"

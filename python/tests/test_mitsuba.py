@@ -1,0 +1,213 @@
+"""The Mitsuba 3 plugin `xylem_wood`: it evaluates what xylem evaluates, passes Mitsuba's own
+chi-square test of its sampling against its pdf, and renders a board as xylem renders it."""
+
+import json
+import math
+import os
+import pathlib
+
+import numpy as np
+import pytest
+
+import xylem
+
+mi = pytest.importorskip("mitsuba")
+import drjit as dr  # noqa: E402
+
+import xylem.mitsuba  # noqa: E402
+
+RESULTS = pathlib.Path(os.environ.get("XYLEM_REFERENCE", "reference.json")).with_name(
+    "mitsuba_results.json"
+)
+
+
+def record(key, value):
+    data = json.loads(RESULTS.read_text()) if RESULTS.exists() else {}
+    data[key] = value
+    RESULTS.write_text(json.dumps(data, indent=1, sort_keys=True))
+
+
+def use(variant):
+    mi.set_variant(variant)
+    xylem.mitsuba.register()
+
+
+BOARD = {
+    "type": "xylem_wood",
+    "preset": "african_mahogany",
+    "seed": 7,
+    "eta": 1.5,
+    "roughness": 0.25,
+    "origin": "0, 120, 0",
+    "axis": "1, 0, 0",
+    "rotation_deg": 20.0,
+}
+
+
+def board_surface():
+    return xylem.WoodSurface("african_mahogany", seed=7, eta=1.5, roughness=0.25,
+                             origin=(0, 120, 0), axis=(1, 0, 0), rotation_deg=20.0)
+
+
+def directions(rng, n):
+    z = rng.uniform(0.05, 1.0, n)
+    phi = rng.uniform(0, 2 * np.pi, n)
+    r = np.sqrt(1 - z * z)
+    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1).astype(np.float32)
+
+
+@pytest.mark.parametrize("variant", ["llvm_ad_rgb", "scalar_rgb"])
+def test_plugin_evaluates_xylem(variant):
+    """Plugin eval / pdf / sample at hit points with tilted shading frames equal xylem's
+    WoodSurface in world space (times the cosine for eval), i.e. the frame mapping is right."""
+    use(variant)
+    rng = np.random.default_rng(5)
+    n = 16
+    p = np.stack([rng.uniform(-80, 80, n), rng.uniform(-40, 40, n), rng.uniform(0, 5, n)], 1)
+    normals = directions(rng, n) + np.array([0, 0, 2.0])
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    wi_l, wo_l = directions(rng, n), directions(rng, n)
+    bsdf = mi.load_dict(BOARD)
+    surf = board_surface()
+    ctx = mi.BSDFContext()
+    got_f, got_pdf, want_f, want_pdf = [], [], [], []
+    lanes = [slice(0, n)] if variant.startswith("llvm") else [slice(i, i + 1) for i in range(n)]
+    for s in lanes:
+        k = s.stop - s.start
+        if variant.startswith("llvm"):
+            si = dr.zeros(mi.SurfaceInteraction3f, k)
+            si.p = mi.Point3f(p[s].T)
+            si.sh_frame = mi.Frame3f(mi.Vector3f(normals[s].T))
+            si.wi = mi.Vector3f(wi_l[s].T)
+            wo = mi.Vector3f(wo_l[s].T)
+        else:
+            si = dr.zeros(mi.SurfaceInteraction3f)
+            si.p = mi.Point3f(*p[s][0])
+            si.sh_frame = mi.Frame3f(mi.Vector3f(*normals[s][0]))
+            si.wi = mi.Vector3f(*wi_l[s][0])
+            wo = mi.Vector3f(*wo_l[s][0])
+        f = np.array(bsdf.eval(ctx, si, wo)).reshape(3, -1).T
+        pdf = np.array(bsdf.pdf(ctx, si, wo)).reshape(-1)
+        to_world = lambda v: np.array(si.sh_frame.to_world(v)).reshape(3, -1).T
+        w_o, w_i = to_world(si.wi), to_world(wo)
+        want_f.append(surf.eval(p[s], normals[s], w_o, w_i) * wo_l[s][:, 2:3])
+        want_pdf.append(surf.pdf(p[s], normals[s], w_o, w_i))
+        got_f.append(f)
+        got_pdf.append(pdf)
+    np.testing.assert_allclose(np.concatenate(got_f), np.concatenate(want_f), rtol=1e-4, atol=1e-7)
+    np.testing.assert_allclose(np.concatenate(got_pdf), np.concatenate(want_pdf), rtol=1e-4, atol=1e-7)
+    assert np.concatenate(want_f).max() > 0
+
+
+CHI2_CASES = [
+    ("rough_finish_normal", dict(BOARD), [0.0, 0.0, 1.0]),
+    ("rough_finish_grazing", dict(BOARD), [0.8, 0.1, 0.59]),
+    ("rough_finish_across_fibres", dict(BOARD, roughness=0.5), [0.0, -0.6, 0.8]),
+    ("unfinished_oak_rays", {"type": "xylem_wood", "preset": "quartersawn_white_oak", "seed": 2,
+                             "eta": 1.0, "origin": "0, 150, 0", "axis": "0, 1, 0"}, [0.5, 0.0, 0.866]),
+]
+
+
+@pytest.mark.parametrize("name,props,wi", CHI2_CASES, ids=[c[0] for c in CHI2_CASES])
+def test_chi2(name, props, wi):
+    """Mitsuba's chi-square goodness-of-fit test (mitsuba.chi2) of the plugin's sample() against
+    its pdf(), at the 1 % significance level (Mitsuba's own default)."""
+    use("llvm_ad_rgb")
+    from mitsuba.chi2 import BSDFAdapter, ChiSquareTest, SphericalDomain
+
+    wi = [float(x) for x in np.array(wi) / np.linalg.norm(wi)]
+    sample_func, pdf_func = BSDFAdapter("xylem_wood", props, wi=wi)
+    test = ChiSquareTest(domain=SphericalDomain(), sample_func=sample_func, pdf_func=pdf_func,
+                         sample_dim=3, sample_count=400_000, res=64, ires=4, seed=11)
+    ok = test.run(significance_level=0.01)
+    record(f"chi2/{name}", {"p_value": float(test.p_value), "wi": wi, "passed": bool(ok)})
+    assert ok, test.messages
+
+
+def luminance(rgb):
+    return rgb @ np.array([0.2126, 0.7152, 0.0722], dtype=np.float64)
+
+
+def mitsuba_board(root, spp, seed):
+    """scenes/board_match.toml as a Mitsuba 3 scene (the same camera, light and board)."""
+    T = mi.ScalarTransform4f
+    light_to = np.array([0.35, 0.25, 0.9])
+    light_to /= np.linalg.norm(light_to)
+    return mi.load_dict({
+        "type": "scene",
+        "integrator": {"type": "direct", "emitter_samples": 1, "bsdf_samples": 0},
+        "sensor": {
+            "type": "perspective", "fov": 30.0, "fov_axis": "y",
+            "to_world": T().look_at(origin=[0, -120, 160], target=[10, 0, 0], up=[0, 0, 1]),
+            "film": {"type": "hdrfilm", "width": 32, "height": 24, "pixel_format": "rgb",
+                     "rfilter": {"type": "box"}},
+            "sampler": {"type": "independent", "sample_count": spp, "seed": seed},
+        },
+        "light": {"type": "directional", "direction": (-light_to).tolist(),
+                  "irradiance": {"type": "rgb", "value": [3.0, 3.0, 3.0]}},
+        "board": {"type": "rectangle", "to_world": T().scale([300.0, 300.0, 1.0]),
+                  "bsdf": dict(BOARD)},
+    })
+
+
+def z_scores(xy, se_xy, n_x, mi_img, n_m):
+    """Per-pixel z of two independent estimates of one pixel's luminance: xylem's (its standard
+    error se_xy from n_x samples) and Mitsuba's (n_m samples of the same estimator: a uniform
+    point in the pixel, a box filter and a delta light, so its per-sample spread is xylem's)."""
+    sigma = se_xy * math.sqrt(n_x)
+    se = sigma * math.sqrt(1.0 / n_x + 1.0 / n_m)
+    return (luminance(mi_img) - xy) / np.maximum(se, 1e-12)
+
+
+def chi2_sf(stat, dof):
+    """P(chi2_dof > stat), Wilson-Hilferty normal approximation (good for dof in the hundreds)."""
+    z = ((stat / dof) ** (1 / 3) - (1 - 2 / (9 * dof))) / math.sqrt(2 / (9 * dof))
+    return 0.5 * math.erfc(z / math.sqrt(2))
+
+
+def test_render_matches_xylem(root):
+    """Mitsuba 3 with the plugin and xylem render the same board within noise: per-pixel z-test
+    on luminance; the pooled sum of z^2 (chi-square, 768 dof) and the Bonferroni-corrected
+    largest |z| must both have p > 0.001. The same test rejects a mirrored image (power)."""
+    use("llvm_ad_rgb")
+    scene = str(pathlib.Path(__file__).parent / "scenes" / "board_match.toml")
+    n_x, n_m = 4096, 128
+    x = xylem.render(scene, spp=n_x)
+    xy, se_xy = luminance(x["beauty"].astype(np.float64)), x["std_error"].astype(np.float64)
+    img = np.array(mi.render(mitsuba_board(root, n_m, 1)), dtype=np.float64)
+    assert img.shape == (24, 32, 3)
+    z = z_scores(xy, se_xy, n_x, img, n_m)
+    npx = z.size
+    p_pooled = chi2_sf(float((z ** 2).sum()), npx)
+    p_max = min(1.0, npx * math.erfc(float(np.abs(z).max()) / math.sqrt(2)))
+    mirrored = z_scores(xy[:, ::-1], se_xy[:, ::-1], n_x, img, n_m)
+    p_mirrored = chi2_sf(float((mirrored ** 2).sum()), npx)
+    record("render_match", {
+        "pixels": npx, "xylem_spp": n_x, "mitsuba_spp": n_m,
+        "mean_z": float(z.mean()), "rms_z": float(np.sqrt((z ** 2).mean())),
+        "max_abs_z": float(np.abs(z).max()), "p_pooled": p_pooled, "p_max": p_max,
+        "mean_luminance_xylem": float(xy.mean()), "mean_luminance_mitsuba": float(luminance(img).mean()),
+        "p_pooled_mirrored": p_mirrored,
+    })
+    assert xy.mean() > 1e-3, "the board is lit"
+    assert p_pooled > 1e-3 and p_max > 1e-3, (z.mean(), np.abs(z).max(), p_pooled, p_max)
+    assert p_mirrored < 1e-6, "the z-test cannot tell a mirrored image"
+
+
+def test_scalar_variant_renders():
+    """The plugin in the scalar variant renders a (tiny) image of the board."""
+    use("scalar_rgb")
+    T = mi.ScalarTransform4f
+    scene = mi.load_dict({
+        "type": "scene",
+        "integrator": {"type": "direct"},
+        "sensor": {"type": "perspective", "fov": 30.0,
+                   "to_world": T().look_at(origin=[0, -120, 160], target=[0, 0, 0], up=[0, 0, 1]),
+                   "film": {"type": "hdrfilm", "width": 6, "height": 4, "pixel_format": "rgb"},
+                   "sampler": {"type": "independent", "sample_count": 2}},
+        "light": {"type": "directional", "direction": [0, 0, -1], "irradiance": 3.0},
+        "board": {"type": "rectangle", "to_world": T().scale([300.0, 300.0, 1.0]),
+                  "bsdf": dict(BOARD)},
+    })
+    img = np.array(mi.render(scene))
+    assert img.shape == (4, 6, 3) and np.isfinite(img).all() and img.mean() > 1e-3

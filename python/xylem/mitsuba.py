@@ -1,0 +1,204 @@
+"""A Mitsuba 3 BSDF plugin, ``xylem_wood``: xylem's wood volume under a finish, shaded by
+xylem's finished-wood BSDF at every hit point.
+
+    import mitsuba as mi
+    mi.set_variant("llvm_ad_rgb")          # or "scalar_rgb"
+    import xylem.mitsuba
+    xylem.mitsuba.register()
+    bsdf = mi.load_dict({"type": "xylem_wood", "preset": "african_mahogany", "seed": 7,
+                         "eta": 1.5, "roughness": 0.0,
+                         "origin": "0, 120, 0", "axis": "1, 0, 0", "rotation_deg": 0.0})
+
+Parameters: ``preset`` (a built-in name) or ``preset_file`` (a preset TOML), ``seed`` (the tree),
+the finish ``eta`` (1-4) and ``roughness`` (0-1), and the tree placement of xylem's solid cutting
+in world space, ``p_tree = origin + scale * Rz(rotation_deg) * A * p`` with ``A`` turning
+``axis`` onto the pith: ``origin``, ``axis`` (3-vectors, as a "x, y, z" string or a sequence),
+``rotation_deg`` and ``scale`` (tree mm per scene unit).
+
+Frames: Mitsuba hands the BSDF directions in the hit's shading frame ``si.sh_frame``. The plugin
+maps them to world space with that frame, and xylem shades the world point with the frame it
+builds itself (z = the same shading normal, x along the fibre), exactly as xylem's renderer does,
+so cosines are the same in both frames. Mitsuba's ``si.wi`` is xylem's ``wo`` (towards the
+viewer) and Mitsuba's ``wo`` is xylem's ``wi`` (towards the light). Mitsuba's ``eval`` includes
+the cosine foreshortening, xylem's does not; ``sample`` returns the weight f cos / pdf.
+
+In the LLVM (JIT) variants the plugin reads its inputs into numpy, so Dr.Jit's symbolic loops
+and calls must be off (``register()`` turns them off): rendering then runs in evaluated
+(wavefront) mode.
+"""
+
+import numpy as np
+
+from . import WoodSurface
+
+_REGISTERED = False
+
+
+def _has(props, name):
+    try:
+        return name in props
+    except TypeError:  # Mitsuba before 3.6
+        return props.has_property(name)
+
+
+def _vector(props, name, default):
+    if not _has(props, name):
+        return tuple(float(x) for x in default)
+    value = props.get(name)
+    if isinstance(value, str):
+        parts = [p for p in value.replace(",", " ").split() if p]
+    else:
+        parts = list(value)
+    if len(parts) != 3:
+        raise ValueError(f"xylem_wood: `{name}` = {value!r}: expected three numbers x, y, z")
+    return tuple(float(x) for x in parts)
+
+
+def register():
+    """Registers the ``xylem_wood`` BSDF with Mitsuba 3 (a variant must be set first)."""
+    global _REGISTERED
+    import drjit as dr
+    import mitsuba as mi
+
+    if mi.variant() is None:
+        raise RuntimeError("xylem.mitsuba.register(): call mitsuba.set_variant(...) first")
+    if not mi.variant().startswith("scalar"):
+        # The plugin's methods read their inputs into numpy: symbolic tracing cannot.
+        dr.set_flag(dr.JitFlag.SymbolicLoops, False)
+        dr.set_flag(dr.JitFlag.SymbolicCalls, False)
+        dr.set_flag(dr.JitFlag.SymbolicConditionals, False)
+    mi.register_bsdf("xylem_wood", lambda props: _make(mi, dr, props))
+    _REGISTERED = True
+
+
+def _make(mi, dr, props):
+    return _bsdf_class(mi, dr)(props)
+
+
+_CLASSES = {}
+
+
+def _bsdf_class(mi, dr):
+    """The BSDF class for the current variant (Mitsuba's types differ per variant)."""
+    key = mi.variant()
+    if key in _CLASSES:
+        return _CLASSES[key]
+    scalar = key.startswith("scalar")
+
+    def to_np3(v):
+        """A Mitsuba 3-vector (scalar or wide) as an (N, 3) float32 array."""
+        return np.ascontiguousarray(np.array(v, dtype=np.float32).reshape(3, -1).T)
+
+    def to_np1(v):
+        return np.array(v, dtype=np.float32).reshape(-1)
+
+    def from_np3(cls, a):
+        return cls(a[0]) if scalar else cls(np.ascontiguousarray(a.T))
+
+    def from_np1(a):
+        return mi.Float(float(a[0])) if scalar else mi.Float(np.ascontiguousarray(a))
+
+    def from_bool(a):
+        return mi.Bool(bool(a[0])) if scalar else mi.Bool(np.ascontiguousarray(a))
+
+    class XylemWood(mi.BSDF):
+        def __init__(self, props):
+            mi.BSDF.__init__(self, props)
+            preset = props.get("preset") if _has(props, "preset") else None
+            preset_file = (
+                props.get("preset_file") if _has(props, "preset_file") else None
+            )
+            self.eta = float(props.get("eta", 1.5))
+            self.roughness = float(props.get("roughness", 0.0))
+            self.surface = WoodSurface(
+                preset,
+                preset_file=preset_file,
+                seed=int(props.get("seed", 0)),
+                eta=self.eta,
+                roughness=self.roughness,
+                origin=_vector(props, "origin", (0, 0, 0)),
+                axis=_vector(props, "axis", (0, 0, 1)),
+                rotation_deg=float(props.get("rotation_deg", 0.0)),
+                scale=float(props.get("scale", 1.0)),
+            )
+            self.name = preset if preset is not None else preset_file
+            smooth = self.eta > 1.0 and self.roughness < 1e-3
+            lobes = (
+                mi.BSDFFlags.DiffuseReflection
+                | mi.BSDFFlags.GlossyReflection
+                | mi.BSDFFlags.FrontSide
+                | mi.BSDFFlags.SpatiallyVarying
+                | mi.BSDFFlags.Anisotropic
+            )
+            delta = mi.BSDFFlags.DeltaReflection | mi.BSDFFlags.FrontSide
+            # Component 0: everything but the smooth finish's mirror; component 1: the mirror.
+            self.m_components = [lobes, delta] if smooth else [lobes]
+            self.m_flags = (lobes | delta) if smooth else lobes
+
+        def _frame(self, si):
+            """Mitsuba's shading frame, or the identity where it is unset (a zero-initialised
+            interaction, as `mitsuba.chi2.BSDFAdapter` makes)."""
+            n = si.sh_frame.n
+            unset = dr.squared_norm(n) < 0.5
+            s = dr.select(unset, mi.Vector3f(1, 0, 0), si.sh_frame.s)
+            t = dr.select(unset, mi.Vector3f(0, 1, 0), si.sh_frame.t)
+            n = dr.select(unset, mi.Vector3f(0, 0, 1), n)
+            return mi.Frame3f(s, t, n)
+
+        def _inputs(self, si):
+            frame = self._frame(si)
+            return frame, to_np3(si.p), to_np3(frame.n), to_np3(frame.to_world(si.wi))
+
+        def eval(self, ctx, si, wo, active=True):
+            frame, p, n, wo_x = self._inputs(si)
+            wi_x = to_np3(frame.to_world(wo))
+            f = from_np3(mi.Color3f, self.surface.eval(p, n, wo_x, wi_x))
+            cos_o = mi.Frame3f.cos_theta(wo)
+            ok = active & (mi.Frame3f.cos_theta(si.wi) > 0) & (cos_o > 0)
+            return dr.select(ok, f * cos_o, 0.0)
+
+        def pdf(self, ctx, si, wo, active=True):
+            frame, p, n, wo_x = self._inputs(si)
+            wi_x = to_np3(frame.to_world(wo))
+            pdf = from_np1(self.surface.pdf(p, n, wo_x, wi_x))
+            ok = active & (mi.Frame3f.cos_theta(si.wi) > 0) & (mi.Frame3f.cos_theta(wo) > 0)
+            return dr.select(ok, pdf, 0.0)
+
+        def eval_pdf(self, ctx, si, wo, active=True):
+            return self.eval(ctx, si, wo, active), self.pdf(ctx, si, wo, active)
+
+        def sample(self, ctx, si, sample1, sample2, active=True):
+            frame, p, n, wo_x = self._inputs(si)
+            s = self.surface.sample(p, n, wo_x, to_np1(sample1), to_np3_2(sample2))
+            bs = dr.zeros(mi.BSDFSample3f, dr.width(sample1))
+            wo = frame.to_local(from_np3(mi.Vector3f, s["wi"]))
+            pdf = from_np1(s["pdf"])
+            delta = from_bool(s["is_delta"])
+            valid = from_bool(s["valid"]) & (pdf > 0)
+            ok = active & valid & (mi.Frame3f.cos_theta(si.wi) > 0) & (mi.Frame3f.cos_theta(wo) > 0)
+            bs.wo = wo
+            bs.pdf = dr.select(ok, pdf, 0.0)
+            bs.eta = 1.0
+            bs.sampled_type = dr.select(
+                delta,
+                mi.UInt32(+mi.BSDFFlags.DeltaReflection),
+                mi.UInt32(+mi.BSDFFlags.GlossyReflection),
+            )
+            bs.sampled_component = dr.select(delta, mi.UInt32(1), mi.UInt32(0))
+            f = from_np3(mi.Color3f, s["f"])
+            weight = f * mi.Frame3f.cos_theta(wo) / dr.select(ok, pdf, 1.0)
+            return bs, dr.select(ok, weight, 0.0)
+
+        def traverse(self, callback):
+            pass
+
+        def to_string(self):
+            return (
+                f"XylemWood[preset={self.name}, eta={self.eta}, roughness={self.roughness}]"
+            )
+
+    def to_np3_2(v):
+        return np.ascontiguousarray(np.array(v, dtype=np.float32).reshape(2, -1).T)
+
+    _CLASSES[key] = XylemWood
+    return XylemWood
