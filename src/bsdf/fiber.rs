@@ -42,6 +42,7 @@ pub struct FiberAtWo {
 pub struct PsiSpread {
     pub share: f32,
     pub psi: f32,
+    pub cos_psi: f32,
     pub var: f32,
 }
 
@@ -205,10 +206,12 @@ impl FiberAxis {
         parts.map(|p| {
             let (mean, var) = p.along(w, self.frame.n);
             let mean = mean.clamp(-0.9999, 0.9999);
+            let cos2 = 1.0 - mean * mean;
             PsiSpread {
                 share: p.share,
                 psi: mean.asin(),
-                var: var / (1.0 - mean * mean),
+                cos_psi: cos2.sqrt(),
+                var: var / cos2,
             }
         })
     }
@@ -235,9 +238,13 @@ impl FiberAxis {
                 let g = gaussian(width, a.psi + b.psi);
                 let at = FiberAtWo {
                     psi_r: a.psi,
-                    cos_psi_r: a.psi.cos(),
+                    cos_psi_r: a.cos_psi,
                 };
-                f += w * lobe_value(norm, g, lobe_cos(norm, b.psi, &at), &at);
+                let c = match norm {
+                    FiberNormalization::EnergyBounded => b.cos_psi,
+                    FiberNormalization::Published => lobe_cos(norm, b.psi, &at),
+                };
+                f += w * lobe_value(norm, g, c, &at);
             }
         }
         f

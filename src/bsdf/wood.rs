@@ -298,7 +298,15 @@ impl WoodBsdf {
     /// [`RoughView`] of `wo`, or `None` for a smooth finish.
     fn rough_view(&self, wo: Vec3) -> Option<RoughView> {
         let parts = self.transmission?.parts(wo.z);
-        let (fiber, ray) = (self.fiber.spread(wo, &parts), self.ray.spread(wo, &parts));
+        let m = self.params.ray_mask;
+        let spread = |axis: &FiberAxis, used: bool| {
+            if used {
+                axis.spread(wo, &parts)
+            } else {
+                [PsiSpread::default(); 2]
+            }
+        };
+        let (fiber, ray) = (spread(&self.fiber, m < 1.0), spread(&self.ray, m > 0.0));
         let beta = self.params.highlight_width;
         Some(RoughView {
             fiber,
