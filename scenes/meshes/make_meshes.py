@@ -45,13 +45,13 @@ class Obj:
         self.lines = [f"# {h}" for h in header]
         self.nv = 0
 
-    def prism(self, poly, z0, z1):
-        """A vertical prism over a CCW polygon, outward-facing triangles."""
+    def prism(self, poly, h0, h1, to3=lambda a, b, h: (a, b, h)):
+        """A prism over a CCW polygon in the (a, b) plane from height h0 to h1, outward-facing
+        triangles; `to3` places (a, b, h) in space (a rotation, so the winding is kept)."""
         n = len(poly)
-        for x, y in poly:
-            self.lines.append(f"v {x:.4f} {y:.4f} {z1:.4f}")
-        for x, y in poly:
-            self.lines.append(f"v {x:.4f} {y:.4f} {z0:.4f}")
+        for h in (h1, h0):
+            for a, b in poly:
+                self.lines.append("v %.4f %.4f %.4f" % to3(a, b, h))
         top = [self.nv + 1 + i for i in range(n)]
         bot = [self.nv + 1 + n + i for i in range(n)]
         self.nv += 2 * n
@@ -64,22 +64,9 @@ class Obj:
             self.lines.append(f"f {bot[i]} {top[j]} {top[i]}")
 
     def extrude_xz(self, poly, y0, y1):
-        """A prism along y over a polygon in the xz plane (CCW seen from -y)."""
-        n = len(poly)
-        for x, z in poly:
-            self.lines.append(f"v {x:.4f} {y0:.4f} {z:.4f}")
-        for x, z in poly:
-            self.lines.append(f"v {x:.4f} {y1:.4f} {z:.4f}")
-        front = [self.nv + 1 + i for i in range(n)]
-        back = [self.nv + 1 + n + i for i in range(n)]
-        self.nv += 2 * n
-        for i in range(1, n - 1):
-            self.lines.append(f"f {front[0]} {front[i]} {front[i + 1]}")
-            self.lines.append(f"f {back[0]} {back[i + 1]} {back[i]}")
-        for i in range(n):
-            j = (i + 1) % n
-            self.lines.append(f"f {front[i]} {back[i]} {back[j]}")
-            self.lines.append(f"f {front[i]} {back[j]} {front[j]}")
+        """A prism along y from y0 to y1 over a polygon in the xz plane (CCW seen from -y): the
+        rotation (a, b, h) -> (a, -h, b) puts the prism's top (h = -y0) on the face y = y0."""
+        self.prism(poly, -y1, -y0, lambda a, b, h: (a, -h, b))
 
     def write(self, path):
         with open(path, "w") as f:
