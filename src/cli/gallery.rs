@@ -25,7 +25,7 @@ pub struct Args {
     #[arg(long)]
     scene: Vec<String>,
     /// Frames of each sweep close-up.
-    #[arg(long, default_value_t = 24)]
+    #[arg(long, default_value_t = 12)]
     frames: usize,
 }
 
@@ -149,7 +149,7 @@ fn sweeps(out: &Path, frames: usize) -> anyhow::Result<()> {
     let board = super::preset::board_table()?;
     for name in FIGURED {
         let loaded =
-            super::preset::preset_board(&board, name, (320, 240), 16, CLOSE_EYE, CLOSE_FOV_DEG)?;
+            super::preset::preset_board(&board, name, (160, 120), 16, CLOSE_EYE, CLOSE_FOV_DEG)?;
         let (path, moving) = SweepPath::from_scene(&loaded, Some(frames), None)?;
         eprintln!("{name}: {frames} frames");
         let r = render_sweep(

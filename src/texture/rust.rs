@@ -128,14 +128,16 @@ mod tests {
             let p = p / 30.0;
             assert_eq!(warp.sample_drifting(p, d, 5).q, warp.sample(p + d, 5).q);
         }
-        // Time 0 is the still texture; a later time changes (almost) every point of rust and clouds.
+        // Time 0 is the still texture; a later time changes the colour wherever it depends on the
+        // warp: at least half the points (clear sky and bare steel stay as they are; with cover
+        // 0.45 and coverage 0.6 those are under half of the surface).
         for name in crate::texture::ANIMATED {
             let still = tex(name, &[]);
             let t0 = tex(name, &[("time", 0.0)]);
             let t1 = tex(name, &[("time", 20.0)]);
             let moved = points().filter(|&p| t1.eval(p) != still.eval(p)).count();
             assert!(points().all(|p| t0.eval(p) == still.eval(p)), "{name}");
-            assert!(moved > 180, "{name}: {moved} of 200 moved");
+            assert!(moved >= 100, "{name}: {moved} of 200 moved");
         }
     }
 
