@@ -6,6 +6,7 @@ use std::process::ExitCode;
 
 mod bake;
 mod bench;
+mod gallery;
 mod preset;
 mod render;
 mod sweep;
@@ -34,6 +35,9 @@ enum Command {
     Validate(validate::Args),
     /// Render a planar slice of a solid texture, a noise or a wood preset to PNG.
     Texture(texture::Args),
+    /// The README's images: every built-in scene with its subject check, the presets on one
+    /// board, and light-sweep close-ups of the figured presets.
+    Gallery(gallery::Args),
     /// Species presets.
     Preset(preset::Args),
     /// Benchmarks (tracing, BSDF, noise, wood).
@@ -52,6 +56,7 @@ pub fn main() -> ExitCode {
         Command::Sweep(a) => sweep::run(a),
         Command::Validate(a) => validate::run(a),
         Command::Texture(a) => texture::run(a),
+        Command::Gallery(a) => gallery::run(a),
         Command::Preset(a) => preset::run(a),
         Command::Bench(a) => bench::run(a),
         Command::Tradeoff(a) => tradeoff::run(a),

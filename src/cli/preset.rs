@@ -206,7 +206,7 @@ const GALLERY_FOV_DEG: f64 = 24.0;
 /// Each preset on [`GALLERY_SCENE`] with only the board's preset, the frame size and the spp
 /// changed; the light moves along the scene's own sweep arc to each of `angles`. One row of
 /// frames per preset, one exposure for all, so the presets' brightness compares directly.
-fn gallery(
+pub(super) fn gallery(
     out: &Path,
     (width, height): (u32, u32),
     spp: u32,
@@ -227,60 +227,17 @@ fn gallery(
     for name in &names {
         wood::preset(name)?;
     }
-    let text = std::fs::read_to_string(GALLERY_SCENE)
-        .with_context(|| format!("reading {GALLERY_SCENE} (run from the repository root)"))?;
-    let mut scene: toml::Table = text
-        .parse()
-        .with_context(|| format!("parsing {GALLERY_SCENE}"))?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    // The sweep's measurement regions are in pixels of the scene's own frame size.
-    if let Some(sweep) = scene.get_mut("sweep").and_then(|s| s.as_table_mut()) {
-        sweep.remove("regions");
-    }
+    let board = board_table()?;
     let (mut thumbs, mut labels) = (Vec::new(), Vec::new());
     for name in &names {
-        let set = |t: &mut toml::Table, path: &[&str], v: toml::Value| {
-            let (last, tables) = path.split_last().unwrap();
-            let mut at = t;
-            for k in tables {
-                at = at.get_mut(*k).and_then(|v| v.as_table_mut()).unwrap();
-            }
-            at.insert(last.to_string(), v);
-        };
-        set(
-            &mut scene,
-            &["materials", "board", "preset"],
-            (*name).into(),
-        );
-        set(&mut scene, &["render", "width"], i64::from(width).into());
-        set(&mut scene, &["render", "height"], i64::from(height).into());
-        set(&mut scene, &["render", "spp"], i64::from(spp).into());
-        // Closer and steeper than the README's sweep camera, so the board fills the frame.
-        set(
-            &mut scene,
-            &["camera", "eye"],
-            GALLERY_EYE.map(f64::from).to_vec().into(),
-        );
-        set(&mut scene, &["camera", "fov_deg"], GALLERY_FOV_DEG.into());
-        let board = scene["objects"]
-            .as_array_mut()
-            .and_then(|o| {
-                o.iter_mut()
-                    .find(|o| o.get("name").and_then(|n| n.as_str()) == Some("board"))
-            })
-            .and_then(|o| o.as_table_mut())
-            .context("the gallery scene has no object named `board`")?;
-        let origin = if FLAT_SAWN.contains(name) {
-            [0.0, 0.0, -120.0]
-        } else {
-            [0.0, 120.0, 0.0]
-        };
-        set(board, &["tree", "origin"], origin.to_vec().into());
-        let loaded = crate::scene::from_str(
-            &toml::to_string(&scene)?,
-            GALLERY_SCENE,
-            Path::new("scenes"),
+        let loaded = preset_board(
+            &board,
             name,
+            (width, height),
+            spp,
+            GALLERY_EYE,
+            GALLERY_FOV_DEG,
         )?;
         let mut row = Vec::new();
         for &angle in angles {
@@ -318,4 +275,69 @@ fn gallery(
     write_png_rgb8(&path, sheet.width, sheet.height, &sheet.data)?;
     println!("wrote {} presets and {}", names.len(), path.display());
     Ok(())
+}
+
+/// The README board scene ([`GALLERY_SCENE`]) as a TOML table, without its sweep's measurement
+/// regions (they are in pixels of the scene's own frame size).
+pub(super) fn board_table() -> anyhow::Result<toml::Table> {
+    let text = std::fs::read_to_string(GALLERY_SCENE)
+        .with_context(|| format!("reading {GALLERY_SCENE} (run from the repository root)"))?;
+    let mut scene: toml::Table = text
+        .parse()
+        .with_context(|| format!("parsing {GALLERY_SCENE}"))?;
+    if let Some(sweep) = scene.get_mut("sweep").and_then(|s| s.as_table_mut()) {
+        sweep.remove("regions");
+    }
+    Ok(scene)
+}
+
+/// Preset `name` on the board of `scene` ([`board_table`]), with only the board's preset and cut
+/// (quartersawn, or flat-sawn for [`FLAT_SAWN`]), the frame size, spp and camera changed.
+pub(super) fn preset_board(
+    scene: &toml::Table,
+    name: &str,
+    (width, height): (u32, u32),
+    spp: u32,
+    eye: [f32; 3],
+    fov_deg: f64,
+) -> anyhow::Result<crate::scene::LoadedScene> {
+    let mut scene = scene.clone();
+    let set = |t: &mut toml::Table, path: &[&str], v: toml::Value| {
+        let (last, tables) = path.split_last().unwrap();
+        let mut at = t;
+        for k in tables {
+            at = at.get_mut(*k).and_then(|v| v.as_table_mut()).unwrap();
+        }
+        at.insert(last.to_string(), v);
+    };
+    set(&mut scene, &["materials", "board", "preset"], name.into());
+    set(&mut scene, &["render", "width"], i64::from(width).into());
+    set(&mut scene, &["render", "height"], i64::from(height).into());
+    set(&mut scene, &["render", "spp"], i64::from(spp).into());
+    set(
+        &mut scene,
+        &["camera", "eye"],
+        eye.map(f64::from).to_vec().into(),
+    );
+    set(&mut scene, &["camera", "fov_deg"], fov_deg.into());
+    let board = scene["objects"]
+        .as_array_mut()
+        .and_then(|o| {
+            o.iter_mut()
+                .find(|o| o.get("name").and_then(|n| n.as_str()) == Some("board"))
+        })
+        .and_then(|o| o.as_table_mut())
+        .context("the gallery scene has no object named `board`")?;
+    let origin = if FLAT_SAWN.contains(&name) {
+        [0.0, 0.0, -120.0]
+    } else {
+        [0.0, 120.0, 0.0]
+    };
+    set(board, &["tree", "origin"], origin.to_vec().into());
+    Ok(crate::scene::from_str(
+        &toml::to_string(&scene)?,
+        GALLERY_SCENE,
+        Path::new("scenes"),
+        name,
+    )?)
 }

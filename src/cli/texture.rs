@@ -51,6 +51,13 @@ pub struct Args {
     /// Wood: plain diffuse colour, without the fibre highlight seen along the plane's normal.
     #[arg(long)]
     pub flat: bool,
+    /// Animate over this many seconds: write an animated PNG of `--frames` frames from time 0
+    /// (textures with a `time` parameter: clouds, rust).
+    #[arg(long, value_name = "SECONDS", conflicts_with_all = ["preset", "preset_file"])]
+    pub animate: Option<f32>,
+    /// Frames of an `--animate` sequence (12 per second of the animation file).
+    #[arg(long, default_value_t = 24)]
+    pub frames: usize,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -62,6 +69,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let Some(out) = args.out.as_ref() else {
         bail!("--out FILE.png is required");
     };
+    if let Some(seconds) = args.animate {
+        animate(&args, &slice, out, seconds)?;
+        return Ok(ExitCode::SUCCESS);
+    }
     let source = source(&args)?;
     let pixels = slice.render_rows(&|p, o| source.eval_many(p, o));
     if let Some((x, y)) = first_non_finite(&pixels, slice.res) {
@@ -82,6 +93,54 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 }
 
 /// What to slice: a wood preset, or a named texture with its `--param`s.
+/// The texture at times 0, T/n, …, (n−1)T/n as a looping APNG (12 frames/s).
+fn animate(args: &Args, slice: &Slice, out: &std::path::Path, seconds: f32) -> anyhow::Result<()> {
+    let Some(name) = args.name.as_deref() else {
+        bail!("--animate needs a texture name");
+    };
+    if !texture::ANIMATED.contains(&name) {
+        bail!(
+            "texture `{name}` has no `time` parameter; animated textures: {}",
+            texture::ANIMATED.join(", ")
+        );
+    }
+    if !(seconds.is_finite() && seconds > 0.0) {
+        bail!("--animate {seconds}: the duration must be a positive number of seconds");
+    }
+    if !(1..=1000).contains(&args.frames) {
+        bail!("--frames {}: allowed 1 to 1000", args.frames);
+    }
+    let mut params = parse_params(&args.params)?;
+    if params.contains_key("time") {
+        bail!("--param time: set by --animate; give --animate SECONDS instead");
+    }
+    let bar = indicatif::ProgressBar::new(args.frames as u64);
+    let mut frames = Vec::with_capacity(args.frames);
+    for i in 0..args.frames {
+        params.insert("time".into(), seconds * i as f32 / args.frames as f32);
+        let tex = texture::by_name(name, &params)?;
+        let pixels = slice.render_rows(&|p, o| tex.eval_many(p, o));
+        if let Some((x, y)) = first_non_finite(&pixels, slice.res) {
+            bail!("frame {i}: non-finite colour at pixel ({x}, {y}); nothing written");
+        }
+        frames.push(crate::sweep::contact::Rgb8 {
+            width: slice.res,
+            height: slice.res,
+            data: crate::render::image_io::to_srgb8(&pixels, args.exposure),
+        });
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    crate::sweep::sequence::write_apng(out, &frames, 12)
+        .with_context(|| format!("writing {}", out.display()))?;
+    println!(
+        "wrote {} ({} frames over {seconds} s)",
+        out.display(),
+        args.frames
+    );
+    Ok(())
+}
+
 fn source(args: &Args) -> anyhow::Result<Box<dyn SolidTexture>> {
     if let Some(wood) = wood_source(args)? {
         return Ok(wood);

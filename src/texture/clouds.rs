@@ -1,5 +1,7 @@
 //! Clouds: warped fBm (the q / r domain warp of Quilez, "Domain warping"), thresholded into cover
 //! over a sky colour, with the warp field q shading the cloud bodies (Quilez's colouring by |q|).
+//! `time` drifts the warp coordinates, so the clouds billow as they move ("Procedural Textures:
+//! wood, marble and beyond": "the warp coordinates themselves are animated").
 
 use super::params::{p, ParamSpec, Values};
 use super::ramp::smoothstep;
@@ -19,6 +21,14 @@ pub(crate) const CLOUD_PARAMS: &[ParamSpec] = &[
         "fraction of the sky covered, roughly",
     ),
     p("softness", 0.35, 0.001, 1.0, "width of the cloud edge"),
+    p("time", 0.0, -1e6, 1e6, "animation time (s)"),
+    p(
+        "flow",
+        0.05,
+        0.0,
+        100.0,
+        "speed of the warp coordinates (noise units per s)",
+    ),
     p("seed", 1.0, 0.0, 1e9, "noise seed"),
 ];
 
@@ -27,6 +37,7 @@ pub struct Clouds {
     warp: Warp,
     cover: f32,
     softness: f32,
+    drift: Vec3,
     seed: u32,
 }
 
@@ -41,6 +52,7 @@ impl Clouds {
             },
             cover: v.get("cover"),
             softness: v.get("softness"),
+            drift: super::drift(v),
             seed: v.seed(),
         }
     }
@@ -48,7 +60,9 @@ impl Clouds {
 
 impl SolidTexture for Clouds {
     fn eval(&self, p: Vec3) -> Vec3 {
-        let s = self.warp.sample(p / self.scale, self.seed);
+        let s = self
+            .warp
+            .sample_drifting(p / self.scale, self.drift, self.seed);
         // fBm of gradient noise has σ ≈ 0.33; map ±2σ to [0, 1].
         let v = 0.5 + 0.75 * s.value;
         let edge = 1.0 - self.cover;

@@ -8,17 +8,21 @@
 //! | `ring_wood` | concentric cylinders, tilted axis, angular wobble with twist | HyperGraph notes |
 //! | `log_wood` | ring phase f(r + α r²), warped radius, fBm grain, tint | course report (seeds/000) |
 //! | `stone` | Worley cells, F2 − F1 cracks, layered noise | Worley 1996 |
-//! | `clouds` | warped fBm with cover threshold | Quilez, domain warping |
+//! | `clouds` | warped fBm with cover threshold; `time` drifts the warp | Quilez, domain warping |
+//! | `rust` | aggressively warped fBm, colour stops of oxide over steel; `time` drifts the warp | "Procedural Textures: wood, marble and beyond" |
+//! | `fabric` | plain weave: sine thread profiles, warp and weft on top by turns | the same article |
 //! | `worley`, `value`, `gradient`, `fbm`, `warp`, `sparse_convolution` | views of the raw noises | see `noise` |
 //!
 //! Points are in millimetres; colours are linear RGB. Every texture is a pure function of the
 //! point and its parameters (including `seed` where it has noise).
 
 mod clouds;
+mod fabric;
 mod marble;
 mod params;
 mod ramp;
 mod rings;
+mod rust;
 mod slice;
 mod stone;
 mod views;
@@ -46,13 +50,15 @@ pub trait SolidTexture: Send + Sync {
 }
 
 /// The texture names [`by_name`] accepts.
-pub const NAMES: [&str; 12] = [
+pub const NAMES: [&str; 14] = [
     "marble",
     "slab_marble",
     "ring_wood",
     "log_wood",
     "stone",
     "clouds",
+    "rust",
+    "fabric",
     "worley",
     "value",
     "gradient",
@@ -71,6 +77,8 @@ pub fn params(name: &str) -> Option<&'static [ParamSpec]> {
         "log_wood" => rings::LOG_PARAMS,
         "stone" => stone::STONE_PARAMS,
         "clouds" => clouds::CLOUD_PARAMS,
+        "rust" => rust::RUST_PARAMS,
+        "fabric" => fabric::FABRIC_PARAMS,
         "worley" => views::WORLEY_PARAMS,
         "value" | "gradient" => views::LATTICE_PARAMS,
         "fbm" => views::FBM_PARAMS,
@@ -99,6 +107,8 @@ pub fn by_name(
         "log_wood" => Box::new(rings::LogWood::new(&v)),
         "stone" => Box::new(stone::Stone::new(&v)),
         "clouds" => Box::new(clouds::Clouds::new(&v)),
+        "rust" => Box::new(rust::Rust::new(&v)),
+        "fabric" => Box::new(fabric::Fabric::new(&v)),
         "worley" => Box::new(views::WorleyView::new(&v)),
         "value" => Box::new(views::LatticeView::new(&v, Basis::Value)),
         "gradient" => Box::new(views::LatticeView::new(&v, Basis::Gradient)),
@@ -116,4 +126,13 @@ pub fn by_name(
         }
         _ => unreachable!("every name in NAMES has a parameter table"),
     })
+}
+
+/// The textures with a `time` parameter (animated by drifting their warp coordinates).
+pub const ANIMATED: [&str; 2] = ["clouds", "rust"];
+
+/// How far the warp coordinates have drifted at the texture's `time`: `flow · time` noise units
+/// along a fixed oblique direction (so no axis is special).
+fn drift(v: &Values) -> Vec3 {
+    Vec3::new(1.0, 0.6, 0.3).normalize() * (v.get("flow") * v.get("time"))
 }

@@ -5,6 +5,7 @@
 //! - [`sweep`]: highlight tracking, renderer against the BSDF, figure signatures of light sweeps;
 //! - [`layered_reference`]: the position-free random walk through a rough finish, ground truth
 //!   for [`rough_finish`], the rough-finish rows of `validate bsdf`;
+//! - [`scenes`]: does each built-in scene show its subject (contrast, fireflies, figure);
 //! - [`report`]: validation/REPORT.md, one replaceable section per suite.
 
 pub mod appearance;
@@ -12,6 +13,7 @@ pub mod bsdf;
 pub mod layered_reference;
 pub mod report;
 pub mod rough_finish;
+pub mod scenes;
 pub mod sweep;
 
 pub use report::update_report_section;

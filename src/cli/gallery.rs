@@ -1,0 +1,178 @@
+//! `xylem gallery`: the README's images in one command: every built-in scene at its default
+//! settings with its subject check (`validate::scenes`), every preset on the README board
+//! (`xylem preset gallery`), and a light-sweep close-up (APNG) of each figured preset.
+
+use crate::render::image_io::{to_srgb8, write_png_rgb8};
+use crate::render::{render, RunOptions};
+use crate::sweep::cache::{render_sweep, SweepPath};
+use crate::sweep::contact::Rgb8;
+use crate::sweep::sequence::write_apng;
+use anyhow::Context;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Output folder (the README's images live in notes/gallery).
+    #[arg(long, default_value = "notes/gallery")]
+    out: PathBuf,
+    /// Only these parts: scenes, presets, sweeps (default: all three).
+    #[arg(long, value_parser = ["scenes", "presets", "sweeps"])]
+    only: Vec<String>,
+    /// Only these built-in scenes (file stems; default: all but the measured-board sweeps).
+    #[arg(long)]
+    scene: Vec<String>,
+    /// Frames of each sweep close-up.
+    #[arg(long, default_value_t = 12)]
+    frames: usize,
+}
+
+/// The built-in scenes the gallery shows (scenes/NAME.toml), hero renders first.
+pub const SCENES: [&str; 11] = [
+    "cornell_bunny",
+    "carved_bunny",
+    "dovetail",
+    "parquet_floor",
+    "cube_carved_vs_veneer",
+    "turned_bowl",
+    "box_joint",
+    "teapot",
+    "cornell_wood_marble",
+    "cornell_bunny_black",
+    "sweep_board",
+];
+
+/// The figured presets, whose figure moves with the light (chatoyance).
+const FIGURED: [&str; 4] = [
+    "african_mahogany",
+    "curly_maple",
+    "quilted_maple",
+    "birdseye_maple",
+];
+/// The sweep close-up's camera: 45 mm across at the board's centre from 150 mm above.
+const CLOSE_EYE: [f32; 3] = [0.0, -40.0, 150.0];
+const CLOSE_FOV_DEG: f64 = 18.0;
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let part = |p: &str| args.only.is_empty() || args.only.iter().any(|o| o == p);
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    let _lock = crate::output::FolderLock::try_new(&args.out, crate::output::LockMode::Exclusive)?;
+    let start = Instant::now();
+    let mut ok = true;
+    if part("scenes") {
+        ok &= scenes(&args.out.join("scenes"), &args.scene)?;
+    }
+    if part("presets") {
+        super::preset::gallery(
+            &args.out.join("presets"),
+            (480, 240),
+            16,
+            &[-40.0, 0.0, 40.0],
+            &[],
+        )?;
+    }
+    if part("sweeps") {
+        sweeps(&args.out.join("sweeps"), args.frames)?;
+    }
+    println!("gallery done in {:.0} s", start.elapsed().as_secs_f64());
+    Ok(if ok {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
+}
+
+/// Renders each scene at its defaults to `out/NAME.png`, measures its subject, and writes
+/// `out/checks.md` (time and numbers per scene). False when a check fails.
+fn scenes(out: &Path, only: &[String]) -> anyhow::Result<bool> {
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let names: Vec<&str> = if only.is_empty() {
+        SCENES.to_vec()
+    } else {
+        only.iter().map(String::as_str).collect()
+    };
+    let mut table = String::from(
+        "| scene | size, spp | render time | subject check |\n| --- | --- | --- | --- |\n",
+    );
+    let mut ok = true;
+    for name in names {
+        let path = PathBuf::from(format!("scenes/{name}.toml"));
+        let text = std::fs::read_to_string(&path).with_context(|| {
+            format!("reading {} (run from the repository root)", path.display())
+        })?;
+        let objects: Vec<Option<String>> = crate::scene::parse(&text, &path.display().to_string())?
+            .objects
+            .into_iter()
+            .map(|o| o.name)
+            .collect();
+        let s = crate::scene::load(&path)?;
+        let (w, h) = (s.scene.camera.width, s.scene.camera.height);
+        eprintln!("{name}: {w}x{h}, {} spp", s.settings.spp);
+        let r = render(
+            &s.scene,
+            &s.settings,
+            &RunOptions {
+                threads: 0,
+                progress: true,
+            },
+        )?;
+        let png = out.join(format!("{name}.png"));
+        write_png_rgb8(&png, w, h, &to_srgb8(&r.image.beauty, s.exposure))?;
+        let measures =
+            crate::validate::scenes::measure(name, &s.scene, &objects, &r.image, s.exposure);
+        let secs = r.elapsed.as_secs_f64();
+        println!("{name}: {secs:.1} s");
+        for m in &measures {
+            println!("  {m}");
+            ok &= m.pass();
+        }
+        let checks: Vec<String> = measures.iter().map(|m| m.to_string()).collect();
+        writeln!(
+            table,
+            "| `{name}` | {w}×{h}, {} | {secs:.1} s | {} |",
+            s.settings.spp,
+            checks.join("; ")
+        )?;
+    }
+    crate::output::write_atomic(&out.join("checks.md"), table.as_bytes())
+        .with_context(|| format!("writing {}", out.join("checks.md").display()))?;
+    Ok(ok)
+}
+
+/// A light sweep over a close-up of each figured preset on the README board, as a looping APNG
+/// (`out/NAME.png`, 12 frames/s), the light moving along the board's own arc (−60° to 60°).
+fn sweeps(out: &Path, frames: usize) -> anyhow::Result<()> {
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let board = super::preset::board_table()?;
+    for name in FIGURED {
+        let loaded =
+            super::preset::preset_board(&board, name, (160, 120), 16, CLOSE_EYE, CLOSE_FOV_DEG)?;
+        let (path, moving) = SweepPath::from_scene(&loaded, Some(frames), None)?;
+        eprintln!("{name}: {frames} frames");
+        let r = render_sweep(
+            &loaded.scene,
+            &loaded.settings,
+            &path,
+            moving,
+            0..frames,
+            &RunOptions {
+                threads: 0,
+                progress: true,
+            },
+        )?;
+        let (w, h) = (loaded.scene.camera.width, loaded.scene.camera.height);
+        let images: Vec<Rgb8> = (r.frames.iter())
+            .map(|f| Rgb8 {
+                width: w,
+                height: h,
+                data: to_srgb8(&f.beauty, loaded.exposure),
+            })
+            .collect();
+        write_apng(&out.join(format!("{name}.png")), &images, 12)?;
+        println!("{name}: sweep close-up written");
+    }
+    Ok(())
+}
