@@ -154,7 +154,7 @@ fn fit_in_pool(
     }
     // Frames in parallel, each sampled at every texel and dropped: memory is the samples.
     let black = capture.black()?;
-    let samples: Vec<Vec<Vec3>> = (0..capture.frames.len())
+    let read: Vec<Result<Vec<Vec3>, CaptureError>> = (0..capture.frames.len())
         .into_par_iter()
         .map(|k| {
             let img = capture.frame(k, black.as_deref())?;
@@ -163,7 +163,9 @@ fn fit_in_pool(
                 .map(|&(x, y)| bilinear(&img, cam.width, cam.height, x, y))
                 .collect())
         })
-        .collect::<Result<_, CaptureError>>()?;
+        .collect();
+    // The first bad frame in frame order is the one reported, whatever the threads did.
+    let samples: Vec<Vec<Vec3>> = read.into_iter().collect::<Result<_, CaptureError>>()?;
     let read_time = start.elapsed();
     let bar = progress_bar(opts.progress, n as u64);
     let start = Instant::now();

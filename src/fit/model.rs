@@ -246,14 +246,16 @@ fn levenberg_marquardt(prob: &Problem, mut p: [f32; 3], iters: usize, s: &mut Sc
             }
             let step = -(mat.inverse() * Vec3::from_array(jtr.map(|x| x as f32)));
             let q = clamp_params([p[0] + step.x, p[1] + step.y, p[2] + step.z]);
-            let c = prob.cost(q, s);
+            let c = prob.residuals(q, s, &mut rj);
             if c < cost {
                 let gain = (cost - c) / cost.max(1e-30);
                 p = q;
-                cost = prob.residuals(p, s, &mut r0);
+                cost = c;
+                std::mem::swap(&mut r0, &mut rj);
                 lambda = (lambda * 0.3).max(1e-6);
                 improved = true;
-                if gain < 1e-5 {
+                // Converged: the cost or the parameters no longer move.
+                if gain < 1e-4 || step.abs().max_element() < 2e-4 {
                     return p;
                 }
                 break;
