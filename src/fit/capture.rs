@@ -164,10 +164,11 @@ pub struct Capture {
     pub clip: Option<f32>,
 }
 
-/// The fewest arcs a fit accepts, and how far apart (mod 180°) two of them must be (notes/fit.md
-/// §3: one arc leaves the fibre's angle about the arc's normal unpinned).
-pub const MIN_ARCS: usize = 2;
-pub const MIN_ARC_SEPARATION_DEG: f32 = 30.0;
+/// The fewest arcs a fit accepts, and how far apart (mod 180°) each pair must be: two arcs leave
+/// a two-fold ambiguity of the fibre's in-plane angle whenever the highlights of both arcs peak
+/// at the same half-vector (an in-plane fibre seen from above; notes/fit.md §3).
+pub const MIN_ARCS: usize = 3;
+pub const MIN_ARC_SEPARATION_DEG: f32 = 20.0;
 
 fn vec3(a: [f32; 3]) -> Vec3 {
     Vec3::from_array(a)
@@ -414,34 +415,42 @@ impl Capture {
         arcs.into_iter().map(|a| a.1).collect()
     }
 
-    /// At least [`MIN_ARCS`] arcs, two of them [`MIN_ARC_SEPARATION_DEG`] apart modulo 180°.
+    /// At least [`MIN_ARCS`] arcs whose azimuths are pairwise [`MIN_ARC_SEPARATION_DEG`] apart
+    /// modulo 180° (arcs closer than that count as one).
     pub fn check_arcs(&self) -> Result<(), CaptureError> {
         let az = self.arc_azimuths();
-        let mut widest = 0.0f32;
+        let mut distinct: Vec<f32> = Vec::new();
         for a in &az {
-            for b in &az {
+            let far = distinct.iter().all(|b| {
                 let d = (a - b).rem_euclid(180.0);
-                widest = widest.max(d.min(180.0 - d));
+                d.min(180.0 - d) >= MIN_ARC_SEPARATION_DEG
+            });
+            if far {
+                distinct.push(*a);
             }
         }
-        if az.len() < MIN_ARCS || widest < MIN_ARC_SEPARATION_DEG {
+        if distinct.len() < MIN_ARCS {
             return Err(CaptureError::Field {
                 path: self.manifest_path.display().to_string(),
                 field: "frames[].arc".into(),
                 message: format!(
-                    "{} arc(s) at azimuths {az:?}°, widest separation {widest}°: a fit needs at least {MIN_ARCS} arcs, two of them at least {MIN_ARC_SEPARATION_DEG}° apart (one arc cannot pin the fibre's in-plane angle; notes/fit.md §3)",
-                    az.len()
+                    "{} arc(s) at azimuths {az:?}°, {} of them at least {MIN_ARC_SEPARATION_DEG}° apart (mod 180°): a fit needs at least {MIN_ARCS} arcs that far apart (fewer leave the fibre's in-plane angle ambiguous; notes/fit.md §3)",
+                    az.len(),
+                    distinct.len()
                 ),
             });
         }
         Ok(())
     }
 
-    /// Only the frames whose indices are in `keep` (in that order); checks the arcs again.
-    pub fn select(&self, keep: &[usize]) -> Result<Capture, CaptureError> {
+    /// Only the frames whose indices are in `keep` (in that order); checks the arcs again
+    /// unless `check_arcs` is false (the validation's curve over fewer arcs).
+    pub fn select(&self, keep: &[usize], check_arcs: bool) -> Result<Capture, CaptureError> {
         let mut c = self.clone();
         c.frames = keep.iter().map(|&k| self.frames[k].clone()).collect();
-        c.check_arcs()?;
+        if check_arcs {
+            c.check_arcs()?;
+        }
         Ok(c)
     }
 
