@@ -200,6 +200,7 @@ impl<'a> Problem<'a> {
 }
 
 fn clamp_params(p: [f32; 3]) -> [f32; 3] {
+    let p = p.map(|x| if x.is_finite() { x } else { 0.0 });
     [
         p[0],
         p[1].clamp(-DIP_MAX, DIP_MAX),
@@ -245,6 +246,11 @@ fn levenberg_marquardt(prob: &Problem, mut p: [f32; 3], iters: usize, s: &mut Sc
                 continue;
             }
             let step = -(mat.inverse() * Vec3::from_array(jtr.map(|x| x as f32)));
+            if !step.is_finite() {
+                // A degenerate Jacobian (e.g. too few arcs): damp harder, never step to NaN.
+                lambda *= 10.0;
+                continue;
+            }
             let q = clamp_params([p[0] + step.x, p[1] + step.y, p[2] + step.z]);
             let c = prob.residuals(q, s, &mut rj);
             if c < cost {

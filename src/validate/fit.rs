@@ -120,6 +120,12 @@ fn scene_text(maps: &Path, spec: &SweepSpec) -> String {
     // Radiance giving intensity 250 000 (π r² L): pixel values of order 0.1–1.
     let radiance = 250_000.0 / (std::f32::consts::PI * r * r);
     let d = |f: &str| maps.join(f).display().to_string();
+    // A fitted folder has a β map; the truth boards use the material's default β.
+    let beta_map = if maps.join("highlight_width.png").exists() {
+        format!("highlight_width = {:?}", d("highlight_width.png"))
+    } else {
+        String::new()
+    };
     format!(
         r#"
 [render]
@@ -147,6 +153,7 @@ type = "measured"
 diffuse = {diffuse:?}
 fiber_color = {fiber:?}
 fiber_axis = {axis:?}
+{beta_map}
 size_mm = [{size}, {size}]
 eta = 1.5
 roughness = 0.0
@@ -593,6 +600,8 @@ pub fn run_report(
         }
         noise_curve.push((name, nc));
     }
+    progress("re-render");
+    readme_figure(base, work, spec)?;
     let mut md = format!(
         "# Fit validation: per-texel fibre-BSDF parameters measured back from light sweeps\n\n\
          Written by `cargo run --release -- validate fit` (src/validate/fit.rs; derivations in \
@@ -689,4 +698,84 @@ pub fn run_report(
         );
     }
     Ok((md, all_ok))
+}
+
+/// notes/images/fit_maple.png: the measured maple crop rendered (light 20° from the zenith along
+/// the grain), its fitted maps (diffuse, fibre colour ×3, fibre axis), and the fitted maps
+/// re-rendered through the `measured` material under the same light.
+pub fn readme_figure(base: &Path, work: &Path, spec: &SweepSpec) -> Result<(), String> {
+    use crate::sweep::contact::{contact_sheet_rows, Rgb8};
+    let w = work.join("readme");
+    let source = Source::Measured {
+        dir: "data/marschner2005/maple".into(),
+    };
+    let rt = render_round_trip(&source, spec, base, &w)?;
+    let (_, maps, _) = fit_and_compare(&rt.sweep_dir, None, true, &rt)?;
+    let fit_dir = w.join("fitted");
+    crate::fit::write_maps(&fit_dir, &maps, &serde_json::json!({})).map_err(|e| e.to_string())?;
+    // One arc of 5 frames over ±40°: frame 3 is the light at +20°.
+    let one = SweepSpec {
+        frames_per_arc: 5,
+        azimuths_deg: vec![0.0],
+        arc_deg: 40.0,
+        ..spec.clone()
+    };
+    let frame = |maps_dir: &Path, out: &Path| -> Result<Rgb8, String> {
+        let text = scene_text(maps_dir, &one);
+        let loaded = scene::from_str(&text, "<fit figure>", base, "fit_figure")
+            .map_err(|e| e.to_string())?;
+        let job = SweepJob {
+            out: out.to_path_buf(),
+            ..SweepJob::default()
+        };
+        run_job(&loaded, &job).map_err(|e| e.to_string())?;
+        let (fw, fh, px) = read_exr_rgb(&out.join("frame_0003.exr")).map_err(|e| e.to_string())?;
+        Ok(Rgb8 {
+            width: fw as u32,
+            height: fh as u32,
+            data: crate::render::image_io::to_srgb8(&px, 0.0),
+        })
+    };
+    let measured = frame(&w.join("truth"), &w.join("render_truth"))?;
+    let refit = frame(&fit_dir, &w.join("render_fit"))?;
+    let k = spec.px_per_texel as u32;
+    let big = |v: &[Vec3], f: &dyn Fn(Vec3) -> Vec3| {
+        let n = maps.width as u32;
+        let mut data = Vec::with_capacity((n * k * n * k * 3) as usize);
+        for y in 0..n * k {
+            for x in 0..n * k {
+                let c = f(v[((y / k) * n + x / k) as usize]);
+                data.extend(
+                    c.to_array()
+                        .map(|x| (linear_to_srgb(x) * 255.0 + 0.5) as u8),
+                );
+            }
+        }
+        Rgb8 {
+            width: n * k,
+            height: n * k,
+            data,
+        }
+    };
+    let thumbs = vec![
+        measured,
+        big(&maps.diffuse, &|c| c),
+        big(&maps.fiber_color, &|c| c),
+        big(&maps.fiber_axis, &|u| 0.5 * (u + Vec3::ONE)),
+        refit,
+    ];
+    let labels: Vec<String> = [
+        "MEASURED",
+        "FIT DIFFUSE",
+        "FIT FIBRE",
+        "FIT AXIS",
+        "RE-RENDERED",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let sheet = contact_sheet_rows(&thumbs, &labels, 5, 4);
+    let path = base.join("notes/images/fit_maple.png");
+    crate::render::image_io::write_png_rgb8(&path, sheet.width, sheet.height, &sheet.data)
+        .map_err(|e| format!("{}: {e}", path.display()))
 }
