@@ -136,7 +136,6 @@ impl SweepPath {
                     source,
                 }
             })?;
-        let mut azimuths = [0.0; MAX_ARCS];
         let arcs = t.azimuths_deg.len();
         if arcs == 0 || arcs > MAX_ARCS {
             return Err(field(
@@ -144,24 +143,14 @@ impl SweepPath {
                 &format!("{arcs} azimuths (allowed 1 to {MAX_ARCS})"),
             ));
         }
-        azimuths[..arcs].copy_from_slice(&t.azimuths_deg);
         if arc.frames * arcs > super::path::MAX_FRAMES {
             return Err(SetupError::Path {
                 scene,
                 source: PathError::Frames(arc.frames * arcs),
             });
         }
-        Ok((
-            SweepPath {
-                arc,
-                plane,
-                pivot,
-                radius,
-                azimuths,
-                arcs,
-            },
-            moving,
-        ))
+        let path = SweepPath::with_arcs(arc, plane, pivot, radius, &t.azimuths_deg);
+        Ok((path, moving))
     }
 
     /// A path of one arc per entry of `azimuths_deg` (at most [`MAX_ARCS`]; extra ones are

@@ -25,6 +25,21 @@ enum What {
     Fit(fit::Args),
 }
 
+/// Writes a report (through a temporary name), prints it and turns `ok` into the exit code.
+fn finish_report(report: &std::path::Path, md: &str, ok: bool) -> anyhow::Result<ExitCode> {
+    use anyhow::Context;
+    let tmp = report.with_extension("md.partial");
+    std::fs::write(&tmp, md).with_context(|| format!("writing {}", tmp.display()))?;
+    std::fs::rename(&tmp, report).with_context(|| format!("writing {}", report.display()))?;
+    println!("{md}");
+    println!("report: {}", report.display());
+    Ok(if ok {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
+}
+
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     match args.what {
         Some(What::Bsdf(a)) => bsdf::run(a),
