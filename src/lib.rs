@@ -9,6 +9,7 @@ pub mod bake;
 pub mod bsdf;
 pub mod cli;
 pub mod field;
+pub mod fit;
 pub mod material;
 pub mod math;
 pub mod noise;

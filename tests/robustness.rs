@@ -235,6 +235,11 @@ fn assert_nothing_looks_complete_that_is_not(dir: &Path) {
             read_png_rgb8(&p).unwrap_or_else(|e| panic!("{name}: {e}"));
         } else if name.ends_with(".exr") {
             read_exr_channels(&p).unwrap_or_else(|e| panic!("{name}: {e}"));
+        } else if name == "manifest.json" {
+            // The capture manifest for `xylem fit`, written atomically: it must parse whole.
+            let text = std::fs::read_to_string(&p).unwrap();
+            serde_json::from_str::<xylem::sweep::manifest::Manifest>(&text)
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
         } else if name.ends_with(".json") {
             let rec: FrameRecord =
                 serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();

@@ -253,6 +253,22 @@ impl WoodBsdf {
         self.finish
     }
 
+    /// The diffuse albedo f carries (f_d = T T ρ''/(π η²)): ρ'' = ρ'/(1 − ρ' F̄_int) with every
+    /// internal reflection (closed form), or ρ' (single bounce); ρ' is the bounded albedo
+    /// (notes/bsdf.md §1.3, §2.3).
+    pub fn effective_diffuse(&self) -> Vec3 {
+        self.diffuse_eff
+    }
+
+    /// The substrate albedo ρ' whose [`WoodBsdf::effective_diffuse`] under this BSDF's finish is
+    /// `effective`: the series of notes/bsdf.md eq. 1.3 inverted, ρ' = ρ''/(1 + ρ'' F̄_int).
+    pub fn diffuse_from_effective(&self, effective: Vec3) -> Vec3 {
+        match self.finish {
+            FinishModel::ClosedForm => effective / (Vec3::ONE + effective * (1.0 - self.escape)),
+            FinishModel::SingleBounce => effective,
+        }
+    }
+
     pub fn params(&self) -> &WoodBsdfParams {
         &self.params
     }

@@ -7,6 +7,7 @@ use std::process::ExitCode;
 mod bake;
 mod bench;
 mod gallery;
+mod fit;
 mod preset;
 mod render;
 mod sweep;
@@ -46,6 +47,8 @@ enum Command {
     Tradeoff(tradeoff::Args),
     /// Bake texture maps of a preset for other tools.
     Bake(bake::Args),
+    /// Fit per-texel fibre-BSDF maps (measured-material encoding) to a light sweep.
+    Fit(fit::Args),
 }
 
 /// Entry point of the binary: runs the subcommand and turns an error into a message and exit code 1.
@@ -61,6 +64,7 @@ pub fn main() -> ExitCode {
         Command::Bench(a) => bench::run(a),
         Command::Tradeoff(a) => tradeoff::run(a),
         Command::Bake(a) => bake::run(a),
+        Command::Fit(a) => fit::run(a),
     };
     match result {
         Ok(code) => code,

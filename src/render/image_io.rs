@@ -48,6 +48,16 @@ pub fn linear_to_srgb(x: f32) -> f32 {
     }
 }
 
+/// The inverse sRGB transfer function (IEC 61966-2-1): the linear value of an encoded x in [0, 1].
+#[inline]
+pub fn srgb_to_linear(x: f32) -> f32 {
+    if x <= 0.040_45 {
+        x / 12.92
+    } else {
+        ((x + 0.055) / 1.055).powf(2.4)
+    }
+}
+
 /// 8-bit sRGB bytes (RGB, row-major, top row first) of a linear buffer scaled by `2^exposure`.
 pub fn to_srgb8(pixels: &[Vec3], exposure: f32) -> Vec<u8> {
     let scale = exposure.exp2();

@@ -477,6 +477,46 @@ pub struct SweepTable {
     /// Named image regions the sweep reports on (pixels, x0 < x1, y0 < y1, top-left origin).
     #[serde(default)]
     pub regions: Vec<SweepRegion>,
+    /// Azimuths of the arcs (degrees about +z from the arc that `axis` defines): the light runs
+    /// the whole arc once per azimuth, `frames` frames each (default: one arc, `[0]`). A fit of
+    /// the fibre axis needs two or more (notes/fit.md).
+    #[serde(default = "default_azimuths")]
+    pub azimuths_deg: Vec<f32>,
+    /// The measured board's plane, written to the sweep's manifest for `xylem fit`.
+    pub board: Option<SweepBoard>,
+}
+
+/// `[sweep.board]`: the flat board face a fit measures (world mm): the centre of the face,
+/// its x axis (image columns) and y axis (towards the image's top row), its size, and the index
+/// of its smooth finish.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SweepBoard {
+    #[serde(deserialize_with = "exact")]
+    pub origin: [f32; 3],
+    #[serde(default = "default_board_x")]
+    #[serde(deserialize_with = "exact")]
+    pub x_axis: [f32; 3],
+    #[serde(default = "default_board_y")]
+    #[serde(deserialize_with = "exact")]
+    pub y_axis: [f32; 3],
+    #[serde(deserialize_with = "exact")]
+    pub size_mm: [f32; 2],
+    #[serde(default = "default_eta")]
+    pub eta: f32,
+}
+
+/// The most arcs (`[sweep] azimuths_deg` entries) a sweep may have.
+pub const MAX_ARCS: usize = 8;
+
+fn default_azimuths() -> Vec<f32> {
+    vec![0.0]
+}
+fn default_board_x() -> [f32; 3] {
+    [1.0, 0.0, 0.0]
+}
+fn default_board_y() -> [f32; 3] {
+    [0.0, 1.0, 0.0]
 }
 
 fn default_frames() -> u32 {

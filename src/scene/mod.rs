@@ -8,7 +8,7 @@ pub mod mesh_io;
 pub mod shapes;
 pub mod teapot;
 
-pub use format::{SceneFile, SweepRegion, SweepTable};
+pub use format::{SceneFile, SweepBoard, SweepRegion, SweepTable, MAX_ARCS};
 
 use crate::bsdf::{WoodBsdf, WoodBsdfParams};
 use crate::material::{
@@ -1011,6 +1011,40 @@ impl Builder<'_> {
         self.range("sweep.radius", s.radius, 1e-3, 1e9)?;
         self.finite3("sweep.pivot", s.pivot)?;
         self.unit3("sweep.axis", s.axis)?;
+        if s.azimuths_deg.is_empty() || s.azimuths_deg.len() > format::MAX_ARCS {
+            return Err(self.invalid(
+                "sweep.azimuths_deg",
+                format!(
+                    "{} azimuths (allowed 1 to {})",
+                    s.azimuths_deg.len(),
+                    format::MAX_ARCS
+                ),
+            ));
+        }
+        for a in &s.azimuths_deg {
+            self.range("sweep.azimuths_deg", *a, -360.0, 360.0)?;
+        }
+        self.range(
+            "sweep.frames",
+            (s.frames as usize * s.azimuths_deg.len()) as f32,
+            1.0,
+            100_000.0,
+        )?;
+        if let Some(b) = &s.board {
+            self.finite3("sweep.board.origin", b.origin)?;
+            let x = self.unit3("sweep.board.x_axis", b.x_axis)?;
+            let y = self.unit3("sweep.board.y_axis", b.y_axis)?;
+            if x.dot(y).abs() > 1e-3 {
+                return Err(self.invalid(
+                    "sweep.board.y_axis",
+                    "must be perpendicular to x_axis (|x·y| ≤ 1e-3)".to_string(),
+                ));
+            }
+            for v in b.size_mm {
+                self.range("sweep.board.size_mm", v, 1e-3, 1e6)?;
+            }
+            self.range("sweep.board.eta", b.eta, 1.0, 4.0)?;
+        }
         if !names.iter().any(|n| n.as_deref() == Some(s.light.as_str())) {
             let known: Vec<&str> = names.iter().flatten().map(String::as_str).collect();
             return Err(self.invalid(

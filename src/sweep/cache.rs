@@ -23,6 +23,7 @@ use crate::render::{
     TILE,
 };
 use crate::scene::LoadedScene;
+use crate::scene::MAX_ARCS;
 use glam::{UVec2, Vec3, Vec3A};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -30,13 +31,16 @@ use std::ops::Range;
 use std::time::{Duration, Instant};
 
 /// Where the moving light goes: the arc's angles, its plane, and for lights with a position the
-/// pivot and distance.
+/// pivot and distance. The light runs the arc once per azimuth (`azimuths[..arcs]`, degrees
+/// about the zenith from `plane`): frame k is angle `k % arc.frames` of arc `k / arc.frames`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SweepPath {
     pub arc: LightArc,
     pub plane: ArcPlane,
     pub pivot: Vec3,
     pub radius: f32,
+    pub azimuths: [f32; MAX_ARCS],
+    pub arcs: usize,
 }
 
 /// Why a scene's sweep cannot be set up; each names the scene and the `[sweep]` field.
@@ -125,24 +129,89 @@ impl SweepPath {
             )
         })?;
         let (from, to) = arc.unwrap_or((t.arc_deg[0], t.arc_deg[1]));
-        let arc = LightArc::new(from, to, frames.unwrap_or(t.frames as usize))
-            .map_err(|source| SetupError::Path { scene, source })?;
-        Ok((
-            SweepPath {
-                arc,
-                plane,
-                pivot,
-                radius,
-            },
-            moving,
-        ))
+        let arc =
+            LightArc::new(from, to, frames.unwrap_or(t.frames as usize)).map_err(|source| {
+                SetupError::Path {
+                    scene: scene.clone(),
+                    source,
+                }
+            })?;
+        let arcs = t.azimuths_deg.len();
+        if arcs == 0 || arcs > MAX_ARCS {
+            return Err(field(
+                "azimuths_deg",
+                &format!("{arcs} azimuths (allowed 1 to {MAX_ARCS})"),
+            ));
+        }
+        if arc.frames * arcs > super::path::MAX_FRAMES {
+            return Err(SetupError::Path {
+                scene,
+                source: PathError::Frames(arc.frames * arcs),
+            });
+        }
+        let path = SweepPath::with_arcs(arc, plane, pivot, radius, &t.azimuths_deg);
+        Ok((path, moving))
     }
 
-    /// `light` moved to light angle `angle_deg`: point and sphere lights move to the arc point,
-    /// spot lights move there and aim at the pivot, distant lights shine from the arc direction.
+    /// A path of one arc per entry of `azimuths_deg` (at most [`MAX_ARCS`]; extra ones are
+    /// dropped).
+    pub fn with_arcs(
+        arc: LightArc,
+        plane: ArcPlane,
+        pivot: Vec3,
+        radius: f32,
+        azimuths_deg: &[f32],
+    ) -> SweepPath {
+        let given = azimuths_deg.len().min(MAX_ARCS);
+        let mut azimuths = [0.0; MAX_ARCS];
+        azimuths[..given].copy_from_slice(&azimuths_deg[..given]);
+        let arcs = given.max(1);
+        SweepPath {
+            arc,
+            plane,
+            pivot,
+            radius,
+            azimuths,
+            arcs,
+        }
+    }
+
+    /// Frames of the whole sweep: every arc's.
+    pub fn frames(&self) -> usize {
+        self.arc.frames * self.arcs
+    }
+
+    /// The light angle (degrees from the zenith along its arc) of frame `frame`.
+    pub fn light_deg(&self, frame: usize) -> f32 {
+        self.arc.angle_deg(frame % self.arc.frames)
+    }
+
+    /// The azimuth (degrees about the zenith) of the arc frame `frame` lies on.
+    pub fn azimuth_deg(&self, frame: usize) -> f32 {
+        self.azimuths[(frame / self.arc.frames).min(self.arcs - 1)]
+    }
+
+    /// The plane of the arc frame `frame` lies on: `plane` turned about its zenith by the arc's
+    /// azimuth (Rodrigues' rotation of `toward`, which is perpendicular to the zenith).
+    pub fn frame_plane(&self, frame: usize) -> ArcPlane {
+        let (s, c) = self.azimuth_deg(frame).to_radians().sin_cos();
+        let (z, a) = (self.plane.zenith, self.plane.toward);
+        ArcPlane {
+            zenith: z,
+            toward: (c * a + s * z.cross(a)).normalize(),
+        }
+    }
+
+    /// The unit direction from the pivot towards the light of frame `frame`.
+    pub fn direction(&self, frame: usize) -> Vec3 {
+        self.frame_plane(frame).direction(self.light_deg(frame))
+    }
+
+    /// `light` moved to frame `frame`: point and sphere lights move to the arc point, spot
+    /// lights move there and aim at the pivot, distant lights shine from the arc direction.
     /// Other lights (area, environment) have no position on an arc and are returned unchanged.
-    pub fn place(&self, light: &Light, angle_deg: f32) -> Light {
-        let dir = self.plane.direction(angle_deg);
+    pub fn place(&self, light: &Light, frame: usize) -> Light {
+        let dir = self.direction(frame);
         let at = self.pivot + self.radius * dir;
         match light.clone() {
             Light::Point { intensity, .. } => Light::Point {
@@ -178,13 +247,12 @@ impl SweepPath {
 
     /// The scene's lights for frame `frame`, the light at index `moving` placed on the arc.
     pub fn frame_lights(&self, lights: &[Light], moving: usize, frame: usize) -> Vec<Light> {
-        let angle = self.arc.angle_deg(frame);
         lights
             .iter()
             .enumerate()
             .map(|(i, l)| {
                 if i == moving {
-                    self.place(l, angle)
+                    self.place(l, frame)
                 } else {
                     l.clone()
                 }
@@ -258,7 +326,7 @@ pub fn render_sweep(
     let mut out: Vec<SweepFrame> = frames
         .map(|index| SweepFrame {
             index,
-            light_deg: path.arc.angle_deg(index),
+            light_deg: path.light_deg(index),
             beauty: vec![Vec3::ZERO; n],
             std_error: vec![0.0; n],
             nonfinite: 0,
@@ -658,7 +726,7 @@ pub fn render_naive(
         aov = img.aov;
         out.push(SweepFrame {
             index,
-            light_deg: path.arc.angle_deg(index),
+            light_deg: path.light_deg(index),
             beauty: img.beauty,
             std_error: img.std_error,
             nonfinite: img.nonfinite,

@@ -3,6 +3,7 @@
 //! of the sweep is in the output folder.
 
 use super::cache::{render_naive, render_sweep, SetupError, SweepPath, SweepRender};
+use super::manifest::{Manifest, MANIFEST_FILE};
 use super::path::{parse_frames_range, PathError};
 use super::sequence::{
     assemble, clear_assembled, frame_stem, unmark_frame, write_record, AssembleOptions, Assembled,
@@ -144,7 +145,7 @@ pub fn write_frames(
 /// with the other slices, writes only its own frames and leaves assembling to `--assemble`.
 pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepError> {
     let (path, moving) = SweepPath::from_scene(loaded, job.frames, job.arc)?;
-    let total = path.arc.frames;
+    let total = path.frames();
     let range = match &job.range {
         Some(text) => parse_frames_range(text, total)?,
         None => 0..total,
@@ -196,6 +197,13 @@ pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepE
         job.exr,
         &settings,
     )?;
+    // The capture manifest for `xylem fit` (the same text from every slice).
+    Manifest::of_sweep(loaded, &path, moving)
+        .write(&job.out)
+        .map_err(|cause| SweepError::OutDir {
+            path: job.out.join(MANIFEST_FILE).display().to_string(),
+            cause,
+        })?;
     let assembled = if job.range.is_none() {
         let opts = AssembleOptions {
             title: format!("{} — light sweep", loaded.name),
@@ -221,7 +229,7 @@ fn clear_frames(dir: &Path) -> Result<(), SweepError> {
         path: dir.display().to_string(),
         cause,
     };
-    let mut stale = vec![dir.join(AOV_FILE)];
+    let mut stale = vec![dir.join(MANIFEST_FILE), dir.join(AOV_FILE)];
     for entry in std::fs::read_dir(dir).map_err(io)? {
         let p = entry.map_err(io)?.path();
         let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");

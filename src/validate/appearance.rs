@@ -576,7 +576,7 @@ axis = {axis}
             &loaded.settings,
             &path,
             moving,
-            0..path.arc.frames,
+            0..path.frames(),
             &RunOptions::default(),
         )
         .map_err(|e| e.to_string())?;

@@ -6,10 +6,12 @@
 //! - [`layered_reference`]: the position-free random walk through a rough finish, ground truth
 //!   for [`rough_finish`], the rough-finish rows of `validate bsdf`;
 //! - [`scenes`]: does each built-in scene show its subject (contrast, fireflies, figure);
+//! - [`fit`]: `xylem fit` by round trip — known boards rendered, fitted back, compared;
 //! - [`report`]: validation/REPORT.md, one replaceable section per suite.
 
 pub mod appearance;
 pub mod bsdf;
+pub mod fit;
 pub mod layered_reference;
 pub mod report;
 pub mod rough_finish;

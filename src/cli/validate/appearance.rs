@@ -3,7 +3,6 @@
 //! sweep frames. Exits non-zero when a stated criterion fails.
 
 use crate::validate::appearance::{run_report, SweepSettings};
-use anyhow::Context;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -38,14 +37,5 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     )
     .map_err(anyhow::Error::msg)?;
     bar.finish_and_clear();
-    let tmp = report.with_extension("md.partial");
-    std::fs::write(&tmp, &md).with_context(|| format!("writing {}", tmp.display()))?;
-    std::fs::rename(&tmp, &report).with_context(|| format!("writing {}", report.display()))?;
-    println!("{md}");
-    println!("report: {}", report.display());
-    Ok(if ok {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::FAILURE
-    })
+    super::finish_report(&report, &md, ok)
 }

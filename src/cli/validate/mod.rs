@@ -1,9 +1,10 @@
-//! `xylem validate [bsdf|sweep|appearance]`: runs the validation suite; exits non-zero when a check fails.
+//! `xylem validate [bsdf|sweep|appearance|fit]`: runs the validation suite; exits non-zero when a check fails.
 
 use std::process::ExitCode;
 
 mod appearance;
 mod bsdf;
+mod fit;
 mod sweep;
 
 #[derive(clap::Args, Debug)]
@@ -20,6 +21,23 @@ enum What {
     Sweep(sweep::Args),
     /// Presets against Marschner 2005's measured boards → validation/APPEARANCE.md.
     Appearance(appearance::Args),
+    /// `xylem fit` by round trip on known boards → validation/FIT.md.
+    Fit(fit::Args),
+}
+
+/// Writes a report (through a temporary name), prints it and turns `ok` into the exit code.
+fn finish_report(report: &std::path::Path, md: &str, ok: bool) -> anyhow::Result<ExitCode> {
+    use anyhow::Context;
+    let tmp = report.with_extension("md.partial");
+    std::fs::write(&tmp, md).with_context(|| format!("writing {}", tmp.display()))?;
+    std::fs::rename(&tmp, report).with_context(|| format!("writing {}", report.display()))?;
+    println!("{md}");
+    println!("report: {}", report.display());
+    Ok(if ok {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -27,6 +45,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Some(What::Bsdf(a)) => bsdf::run(a),
         Some(What::Sweep(a)) => sweep::run(a),
         Some(What::Appearance(a)) => appearance::run(a),
+        Some(What::Fit(a)) => fit::run(a),
         None => {
             let b = bsdf::run(bsdf::Args::default())?;
             let s = sweep::run(sweep::Args::default())?;

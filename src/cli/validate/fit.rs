@@ -1,0 +1,41 @@
+//! `xylem validate fit`: round trips of known boards through sweep and fit; writes
+//! validation/FIT.md with its plots. Exits non-zero when a goal is missed.
+
+use crate::validate::fit::{run_report, SweepSpec};
+use anyhow::Context;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+#[derive(clap::Args, Debug, Default)]
+pub struct Args {
+    /// Report to write [default: validation/FIT.md]; plots go beside it in plots/.
+    #[arg(long)]
+    report: Option<PathBuf>,
+    /// Texels along each side of every board (default 64).
+    #[arg(long)]
+    texels: Option<usize>,
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let report = args
+        .report
+        .unwrap_or_else(|| PathBuf::from("validation/FIT.md"));
+    let dir = report.parent().map(Path::to_path_buf).unwrap_or_default();
+    let mut spec = SweepSpec::full();
+    if let Some(n) = args.texels {
+        anyhow::ensure!((4..=390).contains(&n), "--texels {n}: allowed 4 to 390");
+        spec.texels = n;
+    }
+    let work = tempfile::tempdir().context("creating a temporary folder for the captures")?;
+    let bar = indicatif::ProgressBar::new(4).with_style(
+        indicatif::ProgressStyle::with_template("validate fit {bar:40} {pos}/{len} {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let (md, ok) = run_report(Path::new("."), &dir, work.path(), &spec, &|name| {
+        bar.set_message(name.to_string());
+        bar.inc(1);
+    })
+    .map_err(anyhow::Error::msg)?;
+    bar.finish_and_clear();
+    super::finish_report(&report, &md, ok)
+}

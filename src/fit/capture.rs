@@ -1,0 +1,566 @@
+//! Reading a capture: the sweep folder's manifest checked field by field, the frames read (EXR
+//! radiance, or 8/16-bit sRGB PNG photographs with an optional black frame), and every texel of
+//! the board projected into the frames. The geometry of one texel — view direction, and per
+//! frame the light direction and irradiance — is what the model needs (notes/fit.md §1).
+
+use crate::math::Vec3;
+use crate::render::image_io::{read_exr_rgb, srgb_to_linear};
+use crate::sweep::manifest::{Manifest, MANIFEST_FILE};
+use std::path::{Path, PathBuf};
+
+/// Why a capture cannot be fitted; every message names the file and the field.
+#[derive(Debug, thiserror::Error)]
+pub enum CaptureError {
+    #[error("{path}: cannot read it: {cause}")]
+    Read { path: String, cause: String },
+    #[error("{path}: {cause} (the manifest format is described in notes/fit.md)")]
+    Parse { path: String, cause: String },
+    #[error("{path}: field `{field}`: {message}")]
+    Field {
+        path: String,
+        field: String,
+        message: String,
+    },
+    #[error("{path}: frame image {image} ({field}): {message}")]
+    Frame {
+        path: String,
+        field: String,
+        image: String,
+        message: String,
+    },
+}
+
+/// The camera of a capture, able to project world points to film coordinates (pixels).
+#[derive(Clone, Copy, Debug)]
+pub struct FilmCamera {
+    pub width: u32,
+    pub height: u32,
+    pub eye: Vec3,
+    right: Vec3,
+    up: Vec3,
+    forward: Vec3,
+    /// tan(fov_y/2) (perspective) or half the film height in mm (orthographic).
+    scale: f32,
+    orthographic: bool,
+}
+
+impl FilmCamera {
+    /// Film coordinates (pixels, (0, 0) the top-left corner) of world point `p`: the inverse of
+    /// `render::Camera::ray` (ndc = ((2x − w)/h, (h − 2y)/h), pinhole direction n + s·ndc.x·k +
+    /// t·ndc.y·k with k = tan(fov/2)). `None` behind a pinhole camera.
+    pub fn project(&self, p: Vec3) -> Option<(f32, f32)> {
+        let d = p - self.eye;
+        let (x, y) = if self.orthographic {
+            (d.dot(self.right) / self.scale, d.dot(self.up) / self.scale)
+        } else {
+            let z = d.dot(self.forward);
+            if z <= 0.0 {
+                return None;
+            }
+            (
+                d.dot(self.right) / (z * self.scale),
+                d.dot(self.up) / (z * self.scale),
+            )
+        };
+        let (w, h) = (self.width as f32, self.height as f32);
+        Some((0.5 * (x * h + w), 0.5 * (h - y * h)))
+    }
+
+    /// The unit direction from `p` towards the camera.
+    pub fn view_dir(&self, p: Vec3) -> Vec3 {
+        if self.orthographic {
+            -self.forward
+        } else {
+            (self.eye - p).normalize()
+        }
+    }
+}
+
+/// The board face: centre, orthonormal axes (x along the map's columns, y towards its top row,
+/// z = x × y out of the face), size and finish index.
+#[derive(Clone, Copy, Debug)]
+pub struct BoardPlane {
+    pub origin: Vec3,
+    pub x: Vec3,
+    pub y: Vec3,
+    pub z: Vec3,
+    pub size: [f32; 2],
+    pub eta: f32,
+}
+
+impl BoardPlane {
+    /// The world point at the centre of texel (col, row) of a `w` × `h` map (row 0 at the top).
+    pub fn texel_point(&self, col: usize, row: usize, w: usize, h: usize) -> Vec3 {
+        let u = ((col as f32 + 0.5) / w as f32 - 0.5) * self.size[0];
+        let v = (0.5 - (row as f32 + 0.5) / h as f32) * self.size[1];
+        self.origin + u * self.x + v * self.y
+    }
+
+    /// World direction `d` in the board frame.
+    pub fn local(&self, d: Vec3) -> Vec3 {
+        Vec3::new(d.dot(self.x), d.dot(self.y), d.dot(self.z))
+    }
+}
+
+/// A frame's light: a point (position) or a distant light (unit direction towards it).
+#[derive(Clone, Copy, Debug)]
+pub enum FrameLight {
+    Point { position: Vec3, radius: f32 },
+    Distant { direction: Vec3 },
+}
+
+/// One frame of the capture.
+#[derive(Clone, Debug)]
+pub struct CaptureFrame {
+    pub image: PathBuf,
+    pub light: FrameLight,
+    pub intensity: Vec3,
+    pub arc: usize,
+    pub azimuth_deg: f32,
+}
+
+impl CaptureFrame {
+    /// The light's direction from `p` (unit) and the irradiance factor: I/d² for a point light,
+    /// E for a distant one (the radiance of a pixel is f · cos θi times it per channel).
+    pub fn light_at(&self, p: Vec3) -> (Vec3, Vec3) {
+        match self.light {
+            FrameLight::Point { position, .. } => {
+                let d = position - p;
+                let r2 = d.length_squared();
+                (d / r2.sqrt(), self.intensity / r2)
+            }
+            FrameLight::Distant { direction } => (direction, self.intensity),
+        }
+    }
+
+    /// True when the finish's mirror reflection of the view from `p` (direction `wo`, world)
+    /// sees this frame's sphere light (with a 50 % margin): the delta glint the fibre model
+    /// has no term for, so the frame is dropped for that texel.
+    pub fn glint(&self, p: Vec3, wo: Vec3, n: Vec3) -> bool {
+        let FrameLight::Point { position, radius } = self.light else {
+            return false;
+        };
+        if radius <= 0.0 {
+            return false;
+        }
+        let r = 2.0 * wo.dot(n) * n - wo;
+        let d = position - p;
+        let along = d.dot(r);
+        along > 0.0 && (d - along * r).length() < 1.5 * radius
+    }
+}
+
+/// A read and checked manifest: camera, board, frames, and how pixel values decode.
+#[derive(Clone, Debug)]
+pub struct Capture {
+    pub dir: PathBuf,
+    pub manifest_path: PathBuf,
+    pub camera: FilmCamera,
+    pub board: BoardPlane,
+    pub frames: Vec<CaptureFrame>,
+    pub srgb: bool,
+    pub black_frame: Option<PathBuf>,
+    /// Linear value at or above which a photograph's pixel counts as clipped.
+    pub clip: Option<f32>,
+}
+
+/// The fewest arcs a fit accepts, and how far apart (mod 180°) each pair must be: two arcs leave
+/// a two-fold ambiguity of the fibre's in-plane angle whenever the highlights of both arcs peak
+/// at the same half-vector (an in-plane fibre seen from above; notes/fit.md §3).
+pub const MIN_ARCS: usize = 3;
+pub const MIN_ARC_SEPARATION_DEG: f32 = 20.0;
+
+fn vec3(a: [f32; 3]) -> Vec3 {
+    Vec3::from_array(a)
+}
+
+impl Capture {
+    /// Reads `dir/manifest.json` and checks every field (frames are read by [`Capture::frame`]).
+    pub fn open(dir: &Path) -> Result<Capture, CaptureError> {
+        let manifest_path = dir.join(MANIFEST_FILE);
+        let path = manifest_path.display().to_string();
+        let text = std::fs::read_to_string(&manifest_path).map_err(|e| CaptureError::Read {
+            path: path.clone(),
+            cause: e.to_string(),
+        })?;
+        let m: Manifest = serde_json::from_str(&text).map_err(|e| CaptureError::Parse {
+            path: path.clone(),
+            cause: e.to_string(),
+        })?;
+        Capture::from_manifest(dir, &m)
+    }
+
+    /// Checks a parsed manifest; `dir` is the folder its image paths are relative to.
+    pub fn from_manifest(dir: &Path, m: &Manifest) -> Result<Capture, CaptureError> {
+        let manifest_path = dir.join(MANIFEST_FILE);
+        let path = manifest_path.display().to_string();
+        let bad = |field: &str, message: String| CaptureError::Field {
+            path: path.clone(),
+            field: field.to_string(),
+            message,
+        };
+        if m.format != crate::sweep::manifest::FORMAT {
+            return Err(bad(
+                "format",
+                format!(
+                    "`{}` (allowed `{}`)",
+                    m.format,
+                    crate::sweep::manifest::FORMAT
+                ),
+            ));
+        }
+        let c = &m.camera;
+        if c.width == 0 || c.height == 0 || c.width > 16384 || c.height > 16384 {
+            return Err(bad(
+                "camera.width",
+                format!("{}x{} (allowed 1 to 16384 each)", c.width, c.height),
+            ));
+        }
+        let unit = |field: &str, a: [f32; 3]| -> Result<Vec3, CaptureError> {
+            let v = vec3(a);
+            if v.is_finite() && (v.length() - 1.0).abs() < 1e-3 {
+                Ok(v.normalize())
+            } else {
+                Err(bad(field, format!("{v} (allowed a unit vector)")))
+            }
+        };
+        let (right, up, forward) = (
+            unit("camera.right", c.right)?,
+            unit("camera.up", c.up)?,
+            unit("camera.forward", c.forward)?,
+        );
+        if !vec3(c.eye).is_finite() {
+            return Err(bad("camera.eye", "must be finite".into()));
+        }
+        let (scale, orthographic) = match c.projection.as_str() {
+            "perspective" => {
+                let fov = c
+                    .fov_y_deg
+                    .ok_or_else(|| bad("camera.fov_y_deg", "missing (perspective)".into()))?;
+                if !(fov > 0.01 && fov < 179.0) {
+                    return Err(bad(
+                        "camera.fov_y_deg",
+                        format!("{fov} (allowed 0.01 to 179)"),
+                    ));
+                }
+                ((0.5 * fov.to_radians()).tan(), false)
+            }
+            "orthographic" => {
+                let w = c
+                    .film_width_mm
+                    .ok_or_else(|| bad("camera.film_width_mm", "missing (orthographic)".into()))?;
+                if !(w > 0.0 && w.is_finite()) {
+                    return Err(bad("camera.film_width_mm", format!("{w} (allowed > 0)")));
+                }
+                (0.5 * w * c.height as f32 / c.width as f32, true)
+            }
+            other => {
+                return Err(bad(
+                    "camera.projection",
+                    format!("`{other}` (allowed `perspective`, `orthographic`)"),
+                ))
+            }
+        };
+        let camera = FilmCamera {
+            width: c.width,
+            height: c.height,
+            eye: vec3(c.eye),
+            right,
+            up,
+            forward,
+            scale,
+            orthographic,
+        };
+        let b = m.board.as_ref().ok_or_else(|| {
+            bad(
+                "board",
+                "missing (a scene's [sweep.board] table writes it; notes/fit.md)".into(),
+            )
+        })?;
+        let (x, y) = (
+            unit("board.x_axis", b.x_axis)?,
+            unit("board.y_axis", b.y_axis)?,
+        );
+        if x.dot(y).abs() > 1e-3 {
+            return Err(bad("board.y_axis", "not perpendicular to x_axis".into()));
+        }
+        if !vec3(b.origin).is_finite() {
+            return Err(bad("board.origin", "must be finite".into()));
+        }
+        if !b.size_mm.iter().all(|s| s.is_finite() && *s > 0.0) {
+            return Err(bad(
+                "board.size_mm",
+                format!("{:?} (allowed positive mm)", b.size_mm),
+            ));
+        }
+        if !(1.0..=4.0).contains(&b.eta) {
+            return Err(bad("board.eta", format!("{} (allowed 1 to 4)", b.eta)));
+        }
+        let board = BoardPlane {
+            origin: vec3(b.origin),
+            x,
+            y,
+            z: x.cross(y),
+            size: b.size_mm,
+            eta: b.eta,
+        };
+        let srgb = match m.color_space.as_str() {
+            "linear" => false,
+            "srgb" => true,
+            other => {
+                return Err(bad(
+                    "color_space",
+                    format!("`{other}` (allowed `linear`, `srgb`)"),
+                ))
+            }
+        };
+        if m.frames.is_empty() {
+            return Err(bad("frames", "empty (allowed one or more frames)".into()));
+        }
+        let mut frames = Vec::with_capacity(m.frames.len());
+        for (k, f) in m.frames.iter().enumerate() {
+            let field = |name: &str| format!("frames[{k}].{name}");
+            let intensity = vec3(f.intensity);
+            if !(intensity.is_finite()
+                && intensity.min_element() >= 0.0
+                && intensity.max_element() > 0.0)
+            {
+                return Err(bad(
+                    &field("intensity"),
+                    format!("{intensity} (allowed finite, ≥ 0, not all 0)"),
+                ));
+            }
+            let light = match f.light.as_str() {
+                "point" => {
+                    let p =
+                        vec3(f.position.ok_or_else(|| {
+                            bad(&field("position"), "missing (point light)".into())
+                        })?);
+                    if !p.is_finite() {
+                        return Err(bad(&field("position"), "must be finite".into()));
+                    }
+                    // The light must be above the board's plane (outside the board).
+                    let h = (p - board.origin).dot(board.z);
+                    if h <= 1e-3 * board.size[0].max(board.size[1]) {
+                        return Err(bad(
+                            &field("position"),
+                            format!(
+                                "{p} lies {h} mm from the board plane, inside or below the board (allowed: above the face)"
+                            ),
+                        ));
+                    }
+                    if !(f.radius.is_finite() && f.radius >= 0.0 && f.radius < h) {
+                        return Err(bad(
+                            &field("radius"),
+                            format!("{} (allowed 0 to the light's height {h} mm)", f.radius),
+                        ));
+                    }
+                    FrameLight::Point {
+                        position: p,
+                        radius: f.radius,
+                    }
+                }
+                "distant" => {
+                    let d = unit(
+                        &field("direction"),
+                        f.direction.ok_or_else(|| {
+                            bad(&field("direction"), "missing (distant light)".into())
+                        })?,
+                    )?;
+                    if d.dot(board.z) <= 0.0 {
+                        return Err(bad(
+                            &field("direction"),
+                            "below the board's horizon (allowed: towards the face)".into(),
+                        ));
+                    }
+                    FrameLight::Distant { direction: d }
+                }
+                other => {
+                    return Err(bad(
+                        &field("light"),
+                        format!("`{other}` (allowed `point`, `distant`)"),
+                    ))
+                }
+            };
+            frames.push(CaptureFrame {
+                image: dir.join(&f.image),
+                light,
+                intensity,
+                arc: f.arc,
+                azimuth_deg: f.azimuth_deg,
+            });
+        }
+        let capture = Capture {
+            dir: dir.to_path_buf(),
+            manifest_path,
+            camera,
+            board,
+            frames,
+            srgb,
+            black_frame: m.black_frame.as_ref().map(|b| dir.join(b)),
+            clip: m.clip,
+        };
+        capture.check_arcs()?;
+        Ok(capture)
+    }
+
+    /// The azimuths (degrees, one per distinct arc) of the frames.
+    pub fn arc_azimuths(&self) -> Vec<f32> {
+        let mut arcs: Vec<(usize, f32)> = Vec::new();
+        for f in &self.frames {
+            if !arcs.iter().any(|a| a.0 == f.arc) {
+                arcs.push((f.arc, f.azimuth_deg));
+            }
+        }
+        arcs.into_iter().map(|a| a.1).collect()
+    }
+
+    /// At least [`MIN_ARCS`] arcs whose azimuths are pairwise [`MIN_ARC_SEPARATION_DEG`] apart
+    /// modulo 180° (arcs closer than that count as one).
+    pub fn check_arcs(&self) -> Result<(), CaptureError> {
+        let az = self.arc_azimuths();
+        let mut distinct: Vec<f32> = Vec::new();
+        for a in &az {
+            let far = distinct.iter().all(|b| {
+                let d = (a - b).rem_euclid(180.0);
+                d.min(180.0 - d) >= MIN_ARC_SEPARATION_DEG
+            });
+            if far {
+                distinct.push(*a);
+            }
+        }
+        if distinct.len() < MIN_ARCS {
+            return Err(CaptureError::Field {
+                path: self.manifest_path.display().to_string(),
+                field: "frames[].arc".into(),
+                message: format!(
+                    "{} arc(s) at azimuths {az:?}°, {} of them at least {MIN_ARC_SEPARATION_DEG}° apart (mod 180°): a fit needs at least {MIN_ARCS} arcs that far apart (fewer leave the fibre's in-plane angle ambiguous; notes/fit.md §3)",
+                    az.len(),
+                    distinct.len()
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    /// Only the frames whose indices are in `keep` (in that order); checks the arcs again
+    /// unless `check_arcs` is false (the validation's curve over fewer arcs).
+    pub fn select(&self, keep: &[usize], check_arcs: bool) -> Result<Capture, CaptureError> {
+        let mut c = self.clone();
+        c.frames = keep.iter().map(|&k| self.frames[k].clone()).collect();
+        if check_arcs {
+            c.check_arcs()?;
+        }
+        Ok(c)
+    }
+
+    /// Reads frame `k` as linear RGB (black frame subtracted); a pixel at or above the clip
+    /// level in any channel comes back as NaN (rejected by the fit).
+    pub fn frame(&self, k: usize, black: Option<&[Vec3]>) -> Result<Vec<Vec3>, CaptureError> {
+        let f = &self.frames[k];
+        let mut px = self.read_image(&f.image, &format!("frames[{k}].image"))?;
+        if let Some(black) = black {
+            for (p, b) in px.iter_mut().zip(black) {
+                if p.is_finite() {
+                    *p -= *b;
+                }
+            }
+        }
+        Ok(px)
+    }
+
+    /// The black frame, if the manifest names one.
+    pub fn black(&self) -> Result<Option<Vec<Vec3>>, CaptureError> {
+        match &self.black_frame {
+            None => Ok(None),
+            Some(p) => self.read_image(p, "black_frame").map(Some),
+        }
+    }
+
+    fn read_image(&self, path: &Path, field: &str) -> Result<Vec<Vec3>, CaptureError> {
+        let fail = |message: String| CaptureError::Frame {
+            path: self.manifest_path.display().to_string(),
+            field: field.to_string(),
+            image: path.display().to_string(),
+            message,
+        };
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .unwrap_or("")
+            .to_ascii_lowercase();
+        let (w, h, mut px) = match ext.as_str() {
+            "exr" => {
+                let (w, h, px) = read_exr_rgb(path).map_err(|e| fail(e.to_string()))?;
+                (w as u32, h as u32, px)
+            }
+            "png" => read_png(path, self.srgb).map_err(fail)?,
+            other => return Err(fail(format!("extension `{other}` (allowed .exr, .png)"))),
+        };
+        if (w, h) != (self.camera.width, self.camera.height) {
+            return Err(fail(format!(
+                "is {w}x{h}, the manifest's camera is {}x{} (allowed: every frame the camera's size)",
+                self.camera.width, self.camera.height
+            )));
+        }
+        if let Some(clip) = self.clip {
+            for p in &mut px {
+                if p.max_element() >= clip {
+                    *p = Vec3::NAN;
+                }
+            }
+        }
+        for p in &mut px {
+            if !p.is_finite() {
+                *p = Vec3::NAN;
+            }
+        }
+        Ok(px)
+    }
+}
+
+/// An 8- or 16-bit PNG as linear RGB (sRGB decoded when `srgb`, IEC 61966-2-1), each channel
+/// v / (2^bits − 1) first.
+fn read_png(path: &Path, srgb: bool) -> Result<(u32, u32, Vec<Vec3>), String> {
+    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let mut decoder = png::Decoder::new(std::io::BufReader::new(file));
+    decoder.set_transformations(png::Transformations::EXPAND);
+    let mut reader = decoder.read_info().map_err(|e| e.to_string())?;
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).map_err(|e| e.to_string())?;
+    let channels = info.color_type.samples();
+    let sixteen = info.bit_depth == png::BitDepth::Sixteen;
+    let bytes = if sixteen { 2 } else { 1 };
+    let max = if sixteen { 65535.0 } else { 255.0 };
+    let decode = |v: f32| {
+        if srgb {
+            srgb_to_linear(v / max)
+        } else {
+            v / max
+        }
+    };
+    let data = &buf[..info.buffer_size()];
+    let px = data
+        .chunks_exact(channels * bytes)
+        .map(|p| {
+            let ch = |i: usize| -> f32 {
+                if sixteen {
+                    u16::from_be_bytes([p[2 * i], p[2 * i + 1]]) as f32
+                } else {
+                    p[i] as f32
+                }
+            };
+            let (r, g, b) = match channels {
+                1 | 2 => (ch(0), ch(0), ch(0)),
+                _ => (ch(0), ch(1), ch(2)),
+            };
+            // A channel at the top code is clipped: its true value is unknown.
+            if r >= max || g >= max || b >= max {
+                Vec3::NAN
+            } else {
+                Vec3::new(decode(r), decode(g), decode(b))
+            }
+        })
+        .collect();
+    Ok((info.width, info.height, px))
+}

@@ -1,0 +1,230 @@
+//! Measuring the wood back: per-texel fibre-BSDF parameters fitted to a light sweep, as
+//! Marschner et al. 2005 (§5, "Measuring and modeling the appearance of finished wood") fitted
+//! their boards — diffuse colour, fibre highlight colour, fibre axis and highlight width.
+//!
+//! - [`capture`]: the sweep folder (manifest, frames) read and checked, texels projected;
+//! - [`model`]: the model (the renderer's `WoodBsdf`) and the per-texel robust fit;
+//! - [`maps`]: the fitted maps in the encoding of the `measured` material, residual map, report.
+//!
+//! Derivations (parameterisation, initialisation, identifiability, arcs): notes/fit.md.
+
+pub mod capture;
+pub mod maps;
+pub mod model;
+
+pub use capture::{Capture, CaptureError};
+pub use maps::{write_maps, FittedMaps};
+pub use model::{fit_texel, Scratch, TexelData, TexelFit};
+
+use glam::Vec3;
+use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
+use std::time::{Duration, Instant};
+
+/// Anything that stops a fit.
+#[derive(Debug, thiserror::Error)]
+pub enum FitError {
+    #[error(transparent)]
+    Capture(#[from] CaptureError),
+    #[error("{path}: field `board`: texel (column {col}, row {row}) of the {w}x{h} map projects to film point ({x:.1}, {y:.1}), outside the {fw}x{fh} frames (allowed: the whole board in view)")]
+    OutOfView {
+        path: String,
+        col: usize,
+        row: usize,
+        w: usize,
+        h: usize,
+        x: f32,
+        y: f32,
+        fw: u32,
+        fh: u32,
+    },
+    #[error("--texels {w}x{h}: allowed 1 to 8192 each")]
+    Texels { w: usize, h: usize },
+    #[error("cannot start {threads} worker threads: {cause}")]
+    Threads { threads: usize, cause: String },
+    #[error(transparent)]
+    Output(#[from] maps::MapsError),
+}
+
+/// How to fit.
+#[derive(Clone, Debug, Default)]
+pub struct FitOptions {
+    /// Map size in texels; default: the board's size in pixels along each axis (about one texel
+    /// per pixel).
+    pub texels: Option<(usize, usize)>,
+    /// Worker threads; 0 = all cores.
+    pub threads: usize,
+    pub progress: bool,
+}
+
+/// Texels the board covers in the frames: its edges' lengths in pixels, rounded.
+pub fn default_texels(c: &Capture) -> (usize, usize) {
+    let b = &c.board;
+    let px = |d: Vec3| -> f32 {
+        match (
+            c.camera.project(b.origin - d),
+            c.camera.project(b.origin + d),
+        ) {
+            (Some(a), Some(z)) => ((z.0 - a.0).powi(2) + (z.1 - a.1).powi(2)).sqrt(),
+            _ => 1.0,
+        }
+    };
+    (
+        (px(0.5 * b.size[0] * b.x).round() as usize).clamp(1, 8192),
+        (px(0.5 * b.size[1] * b.y).round() as usize).clamp(1, 8192),
+    )
+}
+
+/// Bilinear sample of `img` (`w` × `h`, pixel centres at i + ½) at film point (x, y); NaN
+/// where a tap is NaN (a clipped or missing pixel).
+fn bilinear(img: &[Vec3], w: u32, h: u32, x: f32, y: f32) -> Vec3 {
+    let (fx, fy) = (
+        (x - 0.5).clamp(0.0, w as f32 - 1.0),
+        (y - 0.5).clamp(0.0, h as f32 - 1.0),
+    );
+    let (x0, y0) = (fx.floor() as u32, fy.floor() as u32);
+    let (x1, y1) = ((x0 + 1).min(w - 1), (y0 + 1).min(h - 1));
+    let (tx, ty) = (fx - x0 as f32, fy - y0 as f32);
+    let at = |x: u32, y: u32| img[(y * w + x) as usize];
+    let top = at(x0, y0) * (1.0 - tx) + at(x1, y0) * tx;
+    let bot = at(x0, y1) * (1.0 - tx) + at(x1, y1) * tx;
+    top * (1.0 - ty) + bot * ty
+}
+
+/// What [`fit`] measured besides the maps.
+#[derive(Clone, Debug)]
+pub struct FitStats {
+    pub read_time: Duration,
+    pub fit_time: Duration,
+    pub frames: usize,
+    pub texels_failed: usize,
+}
+
+/// Fits every texel of the capture's board (all cores, progress bar).
+pub fn fit(capture: &Capture, opts: &FitOptions) -> Result<(FittedMaps, FitStats), FitError> {
+    let (w, h) = opts.texels.unwrap_or_else(|| default_texels(capture));
+    if w == 0 || h == 0 || w > 8192 || h > 8192 {
+        return Err(FitError::Texels { w, h });
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.threads)
+        .build()
+        .map_err(|e| FitError::Threads {
+            threads: opts.threads,
+            cause: e.to_string(),
+        })?;
+    pool.install(|| fit_in_pool(capture, opts, w, h))
+}
+
+fn fit_in_pool(
+    capture: &Capture,
+    opts: &FitOptions,
+    w: usize,
+    h: usize,
+) -> Result<(FittedMaps, FitStats), FitError> {
+    let start = Instant::now();
+    let cam = &capture.camera;
+    let board = &capture.board;
+    let n = w * h;
+    let points: Vec<Vec3> = (0..n)
+        .map(|i| board.texel_point(i % w, i / w, w, h))
+        .collect();
+    let mut film = Vec::with_capacity(n);
+    for (i, p) in points.iter().enumerate() {
+        let f = cam.project(*p).filter(|(x, y)| {
+            (0.0..=cam.width as f32).contains(x) && (0.0..=cam.height as f32).contains(y)
+        });
+        match f {
+            Some(f) => film.push(f),
+            None => {
+                let (x, y) = cam.project(*p).unwrap_or((f32::NAN, f32::NAN));
+                return Err(FitError::OutOfView {
+                    path: capture.manifest_path.display().to_string(),
+                    col: i % w,
+                    row: i / w,
+                    w,
+                    h,
+                    x,
+                    y,
+                    fw: cam.width,
+                    fh: cam.height,
+                });
+            }
+        }
+    }
+    // Frames in parallel, each sampled at every texel and dropped: memory is the samples.
+    let black = capture.black()?;
+    let read: Vec<Result<Vec<Vec3>, CaptureError>> = (0..capture.frames.len())
+        .into_par_iter()
+        .map(|k| {
+            let img = capture.frame(k, black.as_deref())?;
+            Ok(film
+                .iter()
+                .map(|&(x, y)| bilinear(&img, cam.width, cam.height, x, y))
+                .collect())
+        })
+        .collect();
+    // The first bad frame in frame order is the one reported, whatever the threads did.
+    let samples: Vec<Vec<Vec3>> = read.into_iter().collect::<Result<_, CaptureError>>()?;
+    let read_time = start.elapsed();
+    let bar = progress_bar(opts.progress, n as u64);
+    let start = Instant::now();
+    let eta = board.eta;
+    let fits: Vec<Option<TexelFit>> = (0..n)
+        .into_par_iter()
+        .map_init(
+            || (Scratch::default(), TexelData::default()),
+            |(scratch, d), i| {
+                let p = points[i];
+                let wo_world = cam.view_dir(p);
+                d.wo = board.local(wo_world);
+                d.wi.clear();
+                d.z.clear();
+                d.w.clear();
+                for (k, f) in capture.frames.iter().enumerate() {
+                    let (l, irr) = f.light_at(p);
+                    let wi = board.local(l);
+                    let y = samples[k][i];
+                    let ok = y.is_finite()
+                        && wi.z > 0.02
+                        && d.wo.z > 0.02
+                        && irr.min_element() > 0.0
+                        && !f.glint(p, wo_world, board.z);
+                    d.wi.push(wi);
+                    d.z.push(if ok { y / irr } else { Vec3::ZERO });
+                    d.w.push(if ok { 1.0 } else { 0.0 });
+                }
+                if i % 256 == 0 {
+                    bar.inc(256.min((n - i) as u64));
+                }
+                fit_texel(d, eta, scratch)
+            },
+        )
+        .collect();
+    bar.finish_and_clear();
+    let failed = fits.iter().filter(|f| f.is_none()).count();
+    let maps = FittedMaps::from_fits(w, h, &fits);
+    Ok((
+        maps,
+        FitStats {
+            read_time,
+            fit_time: start.elapsed(),
+            frames: capture.frames.len(),
+            texels_failed: failed,
+        },
+    ))
+}
+
+fn progress_bar(show: bool, n: u64) -> ProgressBar {
+    if !show {
+        return ProgressBar::hidden();
+    }
+    let b = ProgressBar::new(n);
+    b.set_style(
+        ProgressStyle::with_template(
+            "{spinner} [{elapsed_precise}] {wide_bar} {pos}/{len} texels, eta {eta}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    b
+}
