@@ -18,6 +18,26 @@ const MIN_ROUGHNESS: f32 = 1e-3;
 
 /// The finished-wood BSDF for one shading point. Cheap to build (no allocation, one 12-point
 /// quadrature when η > 1).
+///
+/// ```
+/// use glam::{Vec2, Vec3};
+/// use xylem::bsdf::{Bsdf, WoodBsdf, WoodBsdfParams};
+///
+/// // Fibres along x in the surface, a smooth finish of index 1.5 (local frame: z = normal).
+/// let bsdf = WoodBsdf::new(WoodBsdfParams::default())?;
+/// let wo = Vec3::new(0.3, 0.0, 1.0).normalize();
+/// let wi = Vec3::new(-0.3, 0.0, 1.0).normalize(); // on the fibre's specular cone
+/// let f = bsdf.eval(wo, wi);
+/// assert!(f.min_element() > 0.0 && bsdf.pdf(wo, wi) > 0.0);
+/// // Importance sampling returns a direction with its f and density.
+/// if let Some(s) = bsdf.sample(wo, 0.5, Vec2::new(0.3, 0.7)) {
+///     assert!(s.wi.is_normalized());
+/// }
+/// // Out-of-range parameters are an error naming the field.
+/// let bad = WoodBsdfParams { eta: 0.5, ..Default::default() };
+/// assert!(WoodBsdf::new(bad).unwrap_err().to_string().contains("eta"));
+/// # Ok::<(), xylem::bsdf::BsdfError>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WoodBsdf {
     params: WoodBsdfParams,

@@ -131,6 +131,7 @@ pub fn shading_point(scene: &Scene, ray: &Ray, hit: &Hit, aov: Option<&mut Aov>)
             fiber: shading.aov.fiber,
             ray_mask: shading.aov.ray_mask,
             growth_time: shading.aov.growth_time,
+            coverage: 1.0,
         };
     }
     ShadingPoint {

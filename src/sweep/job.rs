@@ -10,8 +10,8 @@ use super::sequence::{
 };
 use crate::output::{remove_if_present, FolderLock, LockError, LockMode};
 use crate::render::image_io::{
-    aov_layers, commit, stage_exr_layers, stage_png_linear, write_exr_layers, ExrCompression,
-    ExrLayer, ImageError,
+    aov_layers, beauty_rgba, commit, stage_exr_layers, stage_png_linear, write_exr_layers,
+    ExrCompression, ExrLayer, ImageError,
 };
 use crate::render::resources::{ResourceError, Resources};
 use crate::render::{RenderError, RunOptions};
@@ -116,18 +116,25 @@ pub fn write_frames(
     render.frames.par_iter().try_for_each(|f| {
         let stem = frame_stem(f.index);
         let layers = [
-            ExrLayer {
-                name: "",
-                channels: &["R", "G", "B"],
-                data: f.beauty.iter().flat_map(|c| c.to_array()).collect(),
-            },
+            beauty_rgba(&f.beauty, &render.aov),
             ExrLayer {
                 name: "std_error",
                 channels: &["Y"],
                 data: f.std_error.clone(),
             },
         ];
-        let exr = stage_exr_layers(&dir.join(format!("{stem}.exr")), w, h, &layers, compression)?;
+        let meta = [
+            ("light_deg", format!("{}", f.light_deg)),
+            ("frame", format!("{} of {total}", f.index)),
+        ];
+        let exr = stage_exr_layers(
+            &dir.join(format!("{stem}.exr")),
+            w,
+            h,
+            &layers,
+            compression,
+            &meta,
+        )?;
         let png = stage_png_linear(&dir.join(format!("{stem}.png")), w, h, &f.beauty, exposure)?;
         let mut rec = FrameRecord::measure(f.index, total, f.light_deg, (w, h), &f.beauty, regions);
         rec.sweep = settings.clone();

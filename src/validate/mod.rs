@@ -5,10 +5,13 @@
 //! - [`sweep`]: highlight tracking, renderer against the BSDF, figure signatures of light sweeps;
 //! - [`layered_reference`]: the position-free random walk through a rough finish, ground truth
 //!   for [`rough_finish`], the rough-finish rows of `validate bsdf`;
+//! - [`gltf`]: the exported glTF material (a KHR_materials_anisotropy reference shader) against
+//!   xylem's fibre highlight;
 //! - [`report`]: validation/REPORT.md, one replaceable section per suite.
 
 pub mod appearance;
 pub mod bsdf;
+pub mod gltf;
 pub mod layered_reference;
 pub mod report;
 pub mod rough_finish;
