@@ -218,7 +218,7 @@ pub(crate) fn textures(m: &BakedMaps) -> DataCodes {
 }
 
 /// Writes every map as `NAME.png` and `NAME.exr` into `dir` and returns the files written.
-/// PNG: base colour in sRGB (tagged so); the data maps ([`DataCodes`]: anisotropy, normal,
+/// PNG: base colour in sRGB (tagged so); the data maps (`DataCodes`: anisotropy, normal,
 /// metallic-roughness, highlight width, ray mask, fibre direction) as linear codes with no
 /// colour-space chunk. EXR: the same maps as 32-bit floats, with the anisotropy and normal maps
 /// *decoded* (direction components in [−1, 1], strength; unit normal) and β in radians.

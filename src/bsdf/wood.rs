@@ -428,7 +428,7 @@ impl WoodAtWo<'_> {
     }
 
     /// [`WoodAtWo::eval_pdf`] of every `wi[k]` into `f[k]`, `pdf[k]` (`f`, `pdf` as long as
-    /// `wi`): the same stages, each run over [`BATCH`] directions at a time ([`FiberAxis::
+    /// `wi`): the same stages, each run over `BATCH` directions at a time ([`FiberAxis::
     /// eval_pdf_many_at`] for the fibre lobes), so that the same values come out (tested) with
     /// the arithmetic in SIMD lanes.
     pub fn eval_pdf_many(&self, wi: &[Vec3], with_pdf: bool, f: &mut [Vec3], pdf: &mut [f32]) {

@@ -195,7 +195,7 @@ pub fn offset_origin(sp: &ShadingPoint, dir: Vec3) -> Vec3 {
 }
 
 /// A shading point's BSDF with `wo` fixed, for lighting it by many light samples: the wood BSDF
-/// with its `wo`-only terms worked out once ([`WoodBsdf::at_wo`]), any other BSDF as it is.
+/// with its `wo`-only terms worked out once (`WoodBsdf::at_wo`), any other BSDF as it is.
 /// Values identical to `eval` and `pdf`.
 #[derive(Clone, Copy, Debug)]
 pub enum BsdfAtWo<'a> {

@@ -403,7 +403,7 @@ impl WoodVolume {
 
     /// [`WoodVolume::eval`] at every point of `points` into `out` (same length): the same texels,
     /// bit for bit. Colour alone (`Needs::COLOR`, no knots: what flat texture slices and colour
-    /// previews ask for) runs in blocks of [`BATCH`] points, stage by stage: the noise lookups
+    /// previews ask for) runs in blocks of `BATCH` points, stage by stage: the noise lookups
     /// (distortion, pores, rays) point by point, everything between them (frames, growth time,
     /// rings, interlock, Beer's law) in SIMD lanes. Anything else, and a last partial block, goes
     /// point by point.
