@@ -123,10 +123,12 @@ pub fn write_frames(
                 data: f.std_error.clone(),
             },
         ];
-        let meta = [
-            ("light_deg", format!("{}", f.light_deg)),
-            ("frame", format!("{} of {total}", f.index)),
-        ];
+        // One attribute: the exr crate writes its extra attributes in hash-map order, which
+        // differs run to run, and frames must be byte-stable (tests/robustness.rs).
+        let meta = [(
+            "sweep_frame",
+            format!("frame {} of {total}, light at {} deg", f.index, f.light_deg),
+        )];
         let exr = stage_exr_layers(
             &dir.join(format!("{stem}.exr")),
             w,
