@@ -7,6 +7,7 @@
 
 pub mod bake;
 pub mod bsdf;
+pub mod builtin;
 pub mod cli;
 pub mod field;
 pub mod fit;

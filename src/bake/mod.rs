@@ -10,8 +10,12 @@
 //! corner; tangent-space x points to the image's right (+u, along the board's length), y to the
 //! image's top, z out of the face. Data maps (anisotropy, normal) are stored linearly, not sRGB.
 
-pub use crate::material::{BakedMaps, FaceRect};
-use crate::render::image_io::{to_srgb8, write_exr_layers, write_png_rgb8, ExrLayer, ImageError};
+pub use crate::material::{across_fiber, BakedMaps, FaceRect};
+use crate::render::image_io::{
+    to_srgb8, write_exr_layers, write_png_data8, write_png_rgb8, ExrLayer, ImageError,
+};
+
+pub mod gltf;
 use crate::wood::{Needs, WoodVolume};
 use glam::{Affine3A, Vec2, Vec3};
 use rayon::prelude::*;
@@ -91,19 +95,24 @@ impl BoardCut {
     }
 }
 
-/// The anisotropy texel of a fibre direction `f` on a face with tangent-space axes `right`, `up`:
-/// the direction is f projected into the face (normalised), the strength is the length of that
-/// projection — 1 for fibres lying in the face, 0 for fibres straight out of it (end grain), where
-/// the highlight is no longer stretched along the face. Encoded as KHR_materials_anisotropy
-/// stores it: red, green = 0.5 + 0.5·direction, blue = strength.
+/// The anisotropy texel of a fibre direction `f` on a face with tangent-space axes `right`, `up`.
+/// KHR_materials_anisotropy's direction is the one in which the highlight *stretches* (its
+/// roughness α_t = mix(α, 1, s²) acts along it; the extension's "BRDF" section), and a fibre's
+/// highlight stretches *across* the fibre (Marschner et al. 2005 §4.2: a cylinder scatters into a
+/// cone about its axis, narrow along the axis, wide around it). So the direction is f projected
+/// into the face, normalised and turned 90° ([`across_fiber`]); the strength is the length of
+/// that projection — 1 for fibres lying in the face, 0 for fibres straight out of it (end grain),
+/// where the highlight is no longer stretched along the face. Encoded as the extension stores
+/// it: red, green = 0.5 + 0.5·direction, blue = strength.
 pub fn anisotropy_texel(f: Vec3, right: Vec3, up: Vec3) -> Vec3 {
     let proj = Vec2::new(f.dot(right), f.dot(up));
     let strength = proj.length().min(1.0);
-    let dir = if strength > 1e-6 {
+    let fiber = if strength > 1e-6 {
         proj / proj.length()
     } else {
         Vec2::X
     };
+    let dir = across_fiber(fiber);
     Vec3::new(0.5 + 0.5 * dir.x, 0.5 + 0.5 * dir.y, strength)
 }
 
@@ -173,34 +182,67 @@ fn data8(values: impl Iterator<Item = f32>) -> Vec<u8> {
         .collect()
 }
 
+/// The 8-bit RGB codes of the data maps (linear, no transfer curve), as the folder's PNGs and
+/// the `.glb` both carry them.
+pub(crate) struct DataCodes {
+    /// The KHR_materials_anisotropy texel as stored.
+    pub anisotropy: Vec<u8>,
+    /// 0.5 + 0.5·n.
+    pub normal: Vec<u8>,
+    /// glTF's metallic-roughness texture: R unused (255, no occlusion if read as one), G the
+    /// perceptual roughness of the fibre lobe ([`gltf::gltf_roughness`]), B metalness 0.
+    pub metallic_roughness: Vec<u8>,
+    /// β / 45° as grey.
+    pub highlight_width: Vec<u8>,
+    pub ray_mask: Vec<u8>,
+    /// 0.5 + 0.5·f, a tangent-space unit vector like the normal.
+    pub fiber: Vec<u8>,
+}
+
+pub(crate) fn textures(m: &BakedMaps) -> DataCodes {
+    let grey = |v: &[f32], scale: f32| data8(v.iter().flat_map(|x| [x * scale; 3]));
+    let unit = |v: &[Vec3]| data8(v.iter().flat_map(|c| (0.5 + 0.5 * *c).to_array()));
+    let beta_scale = 1.0 / 45f32.to_radians();
+    DataCodes {
+        anisotropy: data8(m.anisotropy.iter().flat_map(|c| c.to_array())),
+        normal: unit(&m.normal),
+        metallic_roughness: data8(
+            m.highlight_width
+                .iter()
+                .flat_map(|&b| [1.0, gltf::gltf_roughness(b), 0.0]),
+        ),
+        highlight_width: grey(&m.highlight_width, beta_scale),
+        ray_mask: grey(&m.ray_mask, 1.0),
+        fiber: unit(&m.fiber),
+    }
+}
+
 /// Writes every map as `NAME.png` and `NAME.exr` into `dir` and returns the files written.
-/// PNG: base colour in sRGB; anisotropy, normal and fibre direction (0.5 + 0.5·f, a tangent-space
-/// unit vector like the normal map) as linear codes;
-/// highlight width as β / 45° (grey); ray mask as is. EXR: the same maps as 32-bit floats, with
-/// the anisotropy and normal maps *decoded* (direction components in [−1, 1], strength; unit
-/// normal) and β in radians.
+/// PNG: base colour in sRGB (tagged so); the data maps (`DataCodes`: anisotropy, normal,
+/// metallic-roughness, highlight width, ray mask, fibre direction) as linear codes with no
+/// colour-space chunk. EXR: the same maps as 32-bit floats, with the anisotropy and normal maps
+/// *decoded* (direction components in [−1, 1], strength; unit normal) and β in radians.
 pub fn write_maps(
     dir: &std::path::Path,
     m: &BakedMaps,
 ) -> Result<Vec<std::path::PathBuf>, ImageError> {
     let (w, h) = (m.width, m.height);
     let mut files = Vec::new();
-    let grey = |v: &[f32], scale: f32| data8(v.iter().flat_map(|x| [x * scale; 3]));
-    let rgb = |v: &[Vec3]| data8(v.iter().flat_map(|c| c.to_array()));
-    let beta_scale = 1.0 / 45f32.to_radians();
-    let normal_code: Vec<Vec3> = m.normal.iter().map(|n| 0.5 + 0.5 * *n).collect();
-    let fiber_code: Vec<Vec3> = m.fiber.iter().map(|f| 0.5 + 0.5 * *f).collect();
+    let p = dir.join("base_color.png");
+    write_png_rgb8(&p, w, h, &to_srgb8(&m.base_color, 0.0))?;
+    files.push(p);
+    let c = textures(m);
     let pngs: [(&str, Vec<u8>); 6] = [
-        ("base_color", to_srgb8(&m.base_color, 0.0)),
-        ("anisotropy", rgb(&m.anisotropy)),
-        ("highlight_width", grey(&m.highlight_width, beta_scale)),
-        ("ray_mask", grey(&m.ray_mask, 1.0)),
-        ("normal", rgb(&normal_code)),
-        ("fiber_direction", rgb(&fiber_code)),
+        ("anisotropy", c.anisotropy),
+        ("metallic_roughness", c.metallic_roughness),
+        ("highlight_width", c.highlight_width),
+        ("ray_mask", c.ray_mask),
+        ("normal", c.normal),
+        ("fiber_direction", c.fiber),
     ];
     for (name, bytes) in pngs {
         let p = dir.join(format!("{name}.png"));
-        write_png_rgb8(&p, w, h, &bytes)?;
+        write_png_data8(&p, w, h, &bytes)?;
         files.push(p);
     }
     let flat = |v: &[Vec3]| v.iter().flat_map(|c| c.to_array()).collect::<Vec<f32>>();
@@ -273,16 +315,24 @@ mod tests {
     #[test]
     fn anisotropy_encodes_direction_and_in_plane_strength() {
         let (r, u) = (Vec3::X, Vec3::Y);
-        // A fibre along the image's right: direction (1, 0) → (1, 0.5), full strength.
-        assert_eq!(anisotropy_texel(Vec3::X, r, u), Vec3::new(1.0, 0.5, 1.0));
-        // Dipping 60° into the face: strength cos 60° = 0.5, direction still along x.
+        // A fibre along the image's right stretches its highlight up the image: direction
+        // (0, 1) → (0.5, 1), full strength.
+        assert_eq!(anisotropy_texel(Vec3::X, r, u), Vec3::new(0.5, 1.0, 1.0));
+        // Dipping 60° into the face: strength cos 60° = 0.5, direction still across x.
         let f = Vec3::new(60f32.to_radians().cos(), 0.0, -60f32.to_radians().sin());
         let a = anisotropy_texel(f, r, u);
-        assert!((a.z - 0.5).abs() < 1e-6 && (a.x - 1.0).abs() < 1e-6);
+        assert!((a.z - 0.5).abs() < 1e-6 && (a.y - 1.0).abs() < 1e-6 && (a.x - 0.5).abs() < 1e-6);
         // End grain: no strength, a defined direction.
         assert_eq!(anisotropy_texel(Vec3::Z, r, u).z, 0.0);
-        // Fibre up the image: green = 1.
-        assert!((anisotropy_texel(Vec3::Y, r, u).y - 1.0).abs() < 1e-6);
+        // Fibre up the image: the highlight stretches along x (red 0 or 1, green ½).
+        let a = anisotropy_texel(Vec3::Y, r, u);
+        assert!((a.x - 0.5).abs() > 0.499 && (a.y - 0.5).abs() < 1e-6);
+        // A diagonal fibre: direction ⟂ fibre, and decoding gives the fibre back.
+        let f = Vec3::new(0.6, 0.8, 0.0);
+        let a = anisotropy_texel(f, r, u);
+        let d = Vec2::new(2.0 * a.x - 1.0, 2.0 * a.y - 1.0);
+        assert!(d.dot(Vec2::new(0.6, 0.8)).abs() < 1e-6 && (d.length() - 1.0).abs() < 1e-6);
+        assert!((crate::material::fiber_from_anisotropy(a) - f).length() < 1e-5);
     }
 
     #[test]

@@ -380,7 +380,7 @@ impl FiberAxis {
     }
 
     /// Samples an interior direction: ψi from the Gaussian about −ψr (inverse CDF), φ uniform on
-    /// the arc of the cone above `z_min` (widened to at least ±[`MIN_ARC`]). `None` when ψi falls
+    /// the arc of the cone above `z_min` (widened to at least ±`MIN_ARC`). `None` when ψi falls
     /// outside (−π/2, π/2) or φ off the arc; [`FiberAxis::pdf`] is the density of the returned
     /// directions exactly.
     pub fn sample(&self, wo: Vec3, u: Vec2, beta: f32, z_min: f32) -> Option<Vec3> {

@@ -19,6 +19,26 @@ const MIN_ROUGHNESS: f32 = 1e-3;
 
 /// The finished-wood BSDF for one shading point. Cheap to build (no allocation, one 12-point
 /// quadrature when η > 1).
+///
+/// ```
+/// use glam::{Vec2, Vec3};
+/// use xylem::bsdf::{Bsdf, WoodBsdf, WoodBsdfParams};
+///
+/// // Fibres along x in the surface, a smooth finish of index 1.5 (local frame: z = normal).
+/// let bsdf = WoodBsdf::new(WoodBsdfParams::default())?;
+/// let wo = Vec3::new(0.3, 0.0, 1.0).normalize();
+/// let wi = Vec3::new(-0.3, 0.0, 1.0).normalize(); // on the fibre's specular cone
+/// let f = bsdf.eval(wo, wi);
+/// assert!(f.min_element() > 0.0 && bsdf.pdf(wo, wi) > 0.0);
+/// // Importance sampling returns a direction with its f and density.
+/// if let Some(s) = bsdf.sample(wo, 0.5, Vec2::new(0.3, 0.7)) {
+///     assert!(s.wi.is_normalized());
+/// }
+/// // Out-of-range parameters are an error naming the field.
+/// let bad = WoodBsdfParams { eta: 0.5, ..Default::default() };
+/// assert!(WoodBsdf::new(bad).unwrap_err().to_string().contains("eta"));
+/// # Ok::<(), xylem::bsdf::BsdfError>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WoodBsdf {
     params: WoodBsdfParams,
@@ -560,7 +580,7 @@ impl WoodAtWo<'_> {
     }
 
     /// [`WoodAtWo::eval_pdf`] of every `wi[k]` into `f[k]`, `pdf[k]` (`f`, `pdf` as long as
-    /// `wi`): the same stages, each run over [`BATCH`] directions at a time ([`FiberAxis::
+    /// `wi`): the same stages, each run over `BATCH` directions at a time ([`FiberAxis::
     /// eval_pdf_many_at`] for the fibre lobes), so that the same values come out (tested) with
     /// the arithmetic in SIMD lanes.
     pub fn eval_pdf_many(&self, wi: &[Vec3], with_pdf: bool, f: &mut [Vec3], pdf: &mut [f32]) {

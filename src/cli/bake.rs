@@ -1,6 +1,7 @@
-//! `xylem bake`: texture maps of a preset over a board's face, for other tools.
+//! `xylem bake`: texture maps of a preset over a board's face, and the board as a glTF 2.0
+//! binary (`DIR/PRESET.glb`), for other tools.
 
-use crate::bake::{bake, write_maps, BakeCut, BoardCut};
+use crate::bake::{bake, gltf::write_glb, write_maps, BakeCut, BoardCut};
 use anyhow::Context;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -73,7 +74,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let maps = bake(&volume, &board, args.res);
-    let files = write_maps(&args.out, &maps)?;
+    let mut files = write_maps(&args.out, &maps)?;
+    let glb = args.out.join(format!("{}.glb", args.preset));
+    write_glb(&glb, &board, &maps, &args.preset)?;
+    files.push(glb);
     println!(
         "baked {} ({} cut, {}x{} texels) into {}:",
         args.preset,

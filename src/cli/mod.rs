@@ -6,8 +6,8 @@ use std::process::ExitCode;
 
 mod bake;
 mod bench;
-mod gallery;
 mod fit;
+mod gallery;
 mod preset;
 mod render;
 mod sweep;

@@ -94,7 +94,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let out = crate::render::render(&loaded.scene, &loaded.settings, &run)?;
     let exr = args.out.join(format!("{}.exr", loaded.name));
     let png = args.out.join(format!("{}.png", loaded.name));
-    write_outputs(&out.image, &exr, &png, loaded.exposure)?;
+    let meta = loaded.settings.exr_meta(
+        &loaded.name,
+        &args.scene.display().to_string(),
+        &loaded.scene.camera,
+    );
+    write_outputs(&out.image, &exr, &png, loaded.exposure, &meta)?;
     let secs = out.elapsed.as_secs_f64();
     println!(
         "rendered {} in {:.2} s: {:.2} Mrays/s ({} rays)",
@@ -122,10 +127,11 @@ fn write_outputs(
     exr: &Path,
     png: &Path,
     exposure: f32,
+    meta: crate::render::image_io::ExrMeta,
 ) -> anyhow::Result<()> {
     use crate::render::image_io::{commit, stage_image_exr, stage_png_linear};
     let (staged_exr, staged_png) = rayon::join(
-        || stage_image_exr(exr, image),
+        || stage_image_exr(exr, image, meta),
         || stage_png_linear(png, image.width, image.height, &image.beauty, exposure),
     );
     let (staged_exr, staged_png) = (staged_exr?, staged_png?);

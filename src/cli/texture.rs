@@ -1,9 +1,10 @@
-//! `xylem texture`: render a planar slice of a solid texture or noise to PNG.
+//! `xylem texture`: render a planar slice of a solid texture or noise to PNG (sRGB preview) or
+//! EXR (linear 32-bit float RGB), chosen by the output's extension.
 //!
 //! The source of the colours is chosen in [`source`]; the slicing and output are shared, so
 //! further sources (wood presets) only add a branch there and their own options.
 
-use crate::render::image_io::write_png_linear;
+use crate::render::image_io::{write_exr_layers_with, write_png_linear, ExrCompression, ExrLayer};
 use crate::texture::{self, first_non_finite, Plane, Slice, SolidTexture};
 use anyhow::{bail, Context};
 use std::collections::BTreeMap;
@@ -30,10 +31,10 @@ pub struct Args {
     /// Image side in pixels.
     #[arg(long, default_value_t = 256)]
     pub res: u32,
-    /// Exposure of the PNG in stops.
+    /// Exposure of the PNG in stops (an EXR keeps the linear values).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
-    /// Output PNG.
+    /// Output file: `.png` (sRGB, exposure applied) or `.exr` (linear float RGB).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// List the textures and their parameters (default, range, meaning) and exit.
@@ -67,8 +68,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     let slice = slice(&args)?;
     let Some(out) = args.out.as_ref() else {
-        bail!("--out FILE.png is required");
+        bail!("--out FILE.png or FILE.exr is required");
     };
+    let format = OutFormat::of(out)?;
     if let Some(seconds) = args.animate {
         animate(&args, &slice, out, seconds)?;
         return Ok(ExitCode::SUCCESS);
@@ -78,8 +80,42 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if let Some((x, y)) = first_non_finite(&pixels, slice.res) {
         bail!("the texture gave a non-finite colour at pixel ({x}, {y}); nothing written");
     }
-    write_png_linear(out, slice.res, slice.res, &pixels, args.exposure)
-        .with_context(|| format!("writing {}", out.display()))?;
+    match format {
+        OutFormat::Png => write_png_linear(out, slice.res, slice.res, &pixels, args.exposure),
+        OutFormat::Exr => {
+            let what = match (&args.preset, &args.preset_file, &args.name) {
+                (Some(p), _, _) => format!("preset {p}"),
+                (_, Some(f), _) => format!("preset file {}", f.display()),
+                (_, _, n) => format!("texture {}", n.as_deref().unwrap_or("?")),
+            };
+            let meta = [
+                ("source", what),
+                ("params", args.params.join(" ")),
+                ("seed", args.seed.to_string()),
+                (
+                    "slice",
+                    format!(
+                        "plane {} at {} mm, {} mm square",
+                        slice.plane, slice.offset, slice.size
+                    ),
+                ),
+            ];
+            let layer = ExrLayer {
+                name: "",
+                channels: &["R", "G", "B"],
+                data: pixels.iter().flat_map(|c| c.to_array()).collect(),
+            };
+            write_exr_layers_with(
+                out,
+                slice.res,
+                slice.res,
+                &[layer],
+                ExrCompression::Zip,
+                &meta,
+            )
+        }
+    }
+    .with_context(|| format!("writing {}", out.display()))?;
     println!(
         "wrote {} ({}×{} px, {} mm, plane {} at {} mm)",
         out.display(),
@@ -90,6 +126,30 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         slice.offset
     );
     Ok(ExitCode::SUCCESS)
+}
+
+/// The output's format, by its extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum OutFormat {
+    Png,
+    Exr,
+}
+
+impl OutFormat {
+    fn of(path: &std::path::Path) -> anyhow::Result<Self> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("png") => Ok(OutFormat::Png),
+            Some("exr") => Ok(OutFormat::Exr),
+            _ => bail!(
+                "--out {}: the extension must be .png (sRGB preview) or .exr (linear float)",
+                path.display()
+            ),
+        }
+    }
 }
 
 /// What to slice: a wood preset, or a named texture with its `--param`s.

@@ -178,6 +178,7 @@ pub fn write_maps(
         h,
         &layers,
         ExrCompression::Zip,
+        &[("fit", "per-texel wood BSDF maps (xylem fit)".to_string())],
     )?);
     let text = serde_json::to_string_pretty(report).unwrap_or_default();
     let json_path = dir.join("fit.json");

@@ -24,7 +24,8 @@ pub struct BakedMaps {
     pub height: u32,
     /// Diffuse colour (linear RGB).
     pub base_color: Vec<Vec3>,
-    /// KHR_materials_anisotropy texel: (x, y) direction in [−1, 1] stored as 0.5 + 0.5·d, strength.
+    /// KHR_materials_anisotropy texel: the direction the highlight stretches (across the fibre,
+    /// [`across_fiber`]) in [−1, 1] stored as 0.5 + 0.5·d, and the strength.
     pub anisotropy: Vec<Vec3>,
     /// Fibre highlight width β (radians).
     pub highlight_width: Vec<f32>,
@@ -96,13 +97,25 @@ fn unit_or(v: Vec3, fallback: Vec3) -> Vec3 {
     }
 }
 
+/// The in-face direction a fibre with in-face direction `d` stretches its highlight along: `d`
+/// turned 90° counter-clockwise, (−d_y, d_x). KHR_materials_anisotropy stores this direction
+/// ([`crate::bake::anisotropy_texel`] says why); the sign is immaterial to the extension.
+pub fn across_fiber(d: Vec2) -> Vec2 {
+    Vec2::new(-d.y, d.x)
+}
+
 /// The fibre direction of an anisotropy texel in tangent space (x right, y up, z out of the
-/// face): the stored in-face direction scaled by the strength s, dipping into the face by
-/// √(1 − s²) (the sign the encoding drops is taken as "into").
+/// face): the stored in-face direction turned back by −90° (the inverse of [`across_fiber`])
+/// and scaled by the strength s, dipping into the face by √(1 − s²) (the sign the encoding drops
+/// is taken as "into").
 pub fn fiber_from_anisotropy(a: Vec3) -> Vec3 {
-    let d = Vec2::new(2.0 * a.x - 1.0, 2.0 * a.y - 1.0).normalize_or_zero();
+    let t = Vec2::new(2.0 * a.x - 1.0, 2.0 * a.y - 1.0).normalize_or_zero();
     let s = a.z.clamp(0.0, 1.0);
-    let d = if d == Vec2::ZERO { Vec2::X } else { d };
+    let d = if t == Vec2::ZERO {
+        Vec2::X
+    } else {
+        -across_fiber(t)
+    };
     Vec3::new(s * d.x, s * d.y, -safe_sqrt(1.0 - s * s))
 }
 
@@ -178,7 +191,7 @@ mod tests {
             width: 2,
             height: 1,
             base_color: vec![Vec3::new(0.2, 0.1, 0.0), Vec3::new(0.6, 0.3, 0.2)],
-            anisotropy: vec![Vec3::new(1.0, 0.5, 1.0); 2],
+            anisotropy: vec![Vec3::new(0.5, 1.0, 1.0); 2],
             highlight_width: vec![0.1, 0.3],
             ray_mask: vec![0.0, 1.0],
             normal: vec![Vec3::Z; 2],
@@ -199,10 +212,13 @@ mod tests {
 
     #[test]
     fn anisotropy_decodes_to_a_unit_fibre() {
-        let f = fiber_from_anisotropy(Vec3::new(1.0, 0.5, 1.0));
-        assert!((f - Vec3::X).length() < 1e-6);
-        // Strength ½: the in-face part has length ½ and the fibre dips into the face.
-        let g = fiber_from_anisotropy(Vec3::new(0.5, 1.0, 0.5));
+        // Highlight stretched up the image (0, 1): the fibre runs along x.
+        let f = fiber_from_anisotropy(Vec3::new(0.5, 1.0, 1.0));
+        assert!((f - Vec3::X).length() < 1e-6, "{f}");
+        // Strength ½, stretched along −x: the fibre runs along y, its in-face part has length ½
+        // and it dips into the face.
+        let g = fiber_from_anisotropy(Vec3::new(0.0, 0.5, 0.5));
         assert!((g.length() - 1.0).abs() < 1e-6 && (g.y - 0.5).abs() < 1e-6 && g.z < 0.0);
+        assert_eq!(across_fiber(Vec2::X), Vec2::Y);
     }
 }

@@ -127,8 +127,9 @@ fn read_png8(field: &'static str, path: &Path) -> Result<Rgb8, MeasuredError> {
         path: path.display().to_string(),
         cause,
     };
-    let file = std::fs::File::open(path).map_err(|e| fail(e.to_string()))?;
-    let mut decoder = png::Decoder::new(std::io::BufReader::new(file));
+    // From disk, or the embedded copy of the repository's measured boards (`crate::builtin`).
+    let bytes = crate::builtin::read(path).map_err(|e| fail(e.to_string()))?;
+    let mut decoder = png::Decoder::new(std::io::Cursor::new(&bytes[..]));
     decoder.set_transformations(png::Transformations::EXPAND);
     let mut reader = decoder.read_info().map_err(|e| fail(e.to_string()))?;
     let mut buf = vec![0; reader.output_buffer_size()];

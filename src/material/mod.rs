@@ -10,7 +10,9 @@ mod face;
 mod measured;
 mod placement;
 
-pub use baked::{fiber_from_anisotropy, BakedFibers, BakedMaps, BakedTexel, BakedWoodMaterial};
+pub use baked::{
+    across_fiber, fiber_from_anisotropy, BakedFibers, BakedMaps, BakedTexel, BakedWoodMaterial,
+};
 pub use face::{bilinear_taps, FaceRect};
 pub use measured::{
     energy_bounded_fiber_color, BoardFace, ColorSpace, MeasuredBoard, MeasuredError, MeasuredFiles,

@@ -68,11 +68,17 @@ pub struct Aov {
     pub albedo: Vec3,
     /// Shading normal (world).
     pub normal: Vec3,
-    /// Distance along the camera ray to the first hit (mm; 0 on a miss).
+    /// Distance along the camera ray to the first hit (mm): summed over the samples that hit
+    /// while accumulating, their mean once averaged, +∞ where no sample hit (the OpenEXR
+    /// convention for "nothing there": a compositor's depth test keeps anything in front).
     pub depth: f32,
     pub fiber: Vec3,
     pub ray_mask: f32,
     pub growth_time: f32,
+    /// Coverage: 1 for a sample whose camera ray hit something, 0 for a miss; once averaged, the
+    /// fraction of the pixel's samples that hit (the EXR's alpha, unpremultiplied radiance of
+    /// misses being the background's).
+    pub coverage: f32,
 }
 
 impl Aov {
@@ -83,12 +89,19 @@ impl Aov {
         self.fiber += o.fiber;
         self.ray_mask += o.ray_mask;
         self.growth_time += o.growth_time;
+        self.coverage += o.coverage;
     }
 
+    /// Averages a sum of `1/k` samples; depth is averaged over the samples that hit.
     fn scale(&mut self, k: f32) {
         self.albedo *= k;
         self.normal *= k;
-        self.depth *= k;
+        self.depth = if self.coverage > 0.0 {
+            self.depth / self.coverage
+        } else {
+            f32::INFINITY
+        };
+        self.coverage *= k;
         self.fiber *= k;
         self.ray_mask *= k;
         self.growth_time *= k;
@@ -203,5 +216,23 @@ mod tests {
         assert_eq!(img.nonfinite, 1);
         assert!(img.beauty[0].is_finite());
         assert_eq!(img.beauty[0], Vec3::splat(0.5));
+    }
+
+    #[test]
+    fn depth_is_the_mean_over_hits_and_infinite_on_misses() {
+        let hit = |t| Aov {
+            depth: t,
+            coverage: 1.0,
+            ..Aov::default()
+        };
+        let mut p = PixelSum::default();
+        for a in [hit(2.0), Aov::default(), hit(4.0), Aov::default()] {
+            p.add(Vec3::ONE, &a);
+        }
+        let img = Image::from_sums(2, 1, &[p, PixelSum::default()]);
+        // Two of four samples hit at 2 and 4 mm: depth 3, alpha ½.
+        assert_eq!((img.aov[0].depth, img.aov[0].coverage), (3.0, 0.5));
+        assert_eq!(img.aov[1].depth, f32::INFINITY);
+        assert_eq!(img.aov[1].coverage, 0.0);
     }
 }

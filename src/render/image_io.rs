@@ -82,40 +82,91 @@ pub fn commit(staged: Staged) -> Result<(), ImageError> {
         .map_err(|source| ImageError::Io { path, source })
 }
 
-/// Encodes a PNG into a uniquely named temporary file beside `path`, to [`commit`] later.
+/// How a PNG labels its samples: colour images carry an `sRGB` chunk; data maps (normals,
+/// anisotropy, roughness, masks) carry no colour-space chunk at all (no `sRGB`, `gAMA`, `cHRM`
+/// or `iCCP`), as glTF 2.0 §5.22 ("Image") asks of every image a glTF asset embeds: the asset,
+/// not the file, says how the samples are meant.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PngTag {
+    Srgb,
+    Untagged,
+}
+
+/// Encodes 8-bit RGB bytes (row-major, top row first) as a PNG into `out`.
+pub fn encode_png_rgb8(
+    out: impl std::io::Write,
+    width: u32,
+    height: u32,
+    rgb: &[u8],
+    tag: PngTag,
+) -> Result<(), png::EncodingError> {
+    let mut enc = png::Encoder::new(out, width, height);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    if tag == PngTag::Srgb {
+        enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+    }
+    let mut w = enc.write_header()?;
+    w.write_image_data(rgb)?;
+    w.finish()
+}
+
+/// Checks that `rgb` holds `width × height` RGB pixels, naming `path` if not.
+fn check_rgb8(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<(), ImageError> {
+    let want = width as usize * height as usize;
+    if rgb.len() == want * 3 {
+        return Ok(());
+    }
+    Err(ImageError::Size {
+        path: path.display().to_string(),
+        width,
+        height,
+        got: rgb.len() / 3,
+        want,
+    })
+}
+
+/// Encodes an sRGB-tagged PNG into a uniquely named temporary file beside `path`, to
+/// [`commit`] later.
 pub fn stage_png_rgb8(
     path: &Path,
     width: u32,
     height: u32,
     rgb: &[u8],
 ) -> Result<Staged, ImageError> {
+    stage_png_tagged(path, width, height, rgb, PngTag::Srgb)
+}
+
+/// Writes 8-bit codes of a data map (no transfer curve) as an untagged PNG ([`PngTag`]), whole
+/// or not at all.
+pub fn write_png_data8(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<(), ImageError> {
+    commit(stage_png_tagged(
+        path,
+        width,
+        height,
+        rgb,
+        PngTag::Untagged,
+    )?)
+}
+
+fn stage_png_tagged(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgb: &[u8],
+    tag: PngTag,
+) -> Result<Staged, ImageError> {
+    check_rgb8(path, width, height, rgb)?;
     let name = path.display().to_string();
-    let want = width as usize * height as usize;
-    if rgb.len() != want * 3 {
-        return Err(ImageError::Size {
-            path: name,
-            width,
-            height,
-            got: rgb.len() / 3,
-            want,
-        });
-    }
     let mut staged = Staged::new(path).map_err(|source| ImageError::Io {
         path: name.clone(),
         source,
     })?;
     let mut out = BufWriter::new(staged.file());
-    let mut enc = png::Encoder::new(&mut out, width, height);
-    enc.set_color(png::ColorType::Rgb);
-    enc.set_depth(png::BitDepth::Eight);
-    enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
-    let png_err = |source| ImageError::Png {
+    encode_png_rgb8(&mut out, width, height, rgb, tag).map_err(|source| ImageError::Png {
         path: name.clone(),
         source,
-    };
-    let mut w = enc.write_header().map_err(png_err)?;
-    w.write_image_data(rgb).map_err(png_err)?;
-    w.finish().map_err(png_err)?;
+    })?;
     flush(out, &name)?;
     Ok(staged)
 }
@@ -192,28 +243,40 @@ pub fn write_exr_layers(
     height: u32,
     layers: &[ExrLayer],
 ) -> Result<(), ImageError> {
-    write_exr_layers_with(path, width, height, layers, ExrCompression::Zip)
+    write_exr_layers_with(path, width, height, layers, ExrCompression::Zip, &[])
 }
 
-/// [`write_exr_layers`] with the compression chosen by the caller.
+/// [`write_exr_layers`] with the compression and header text attributes chosen by the caller.
 pub fn write_exr_layers_with(
     path: &Path,
     width: u32,
     height: u32,
     layers: &[ExrLayer],
     compression: ExrCompression,
+    meta: ExrMeta,
 ) -> Result<(), ImageError> {
-    commit(stage_exr_layers(path, width, height, layers, compression)?)
+    commit(stage_exr_layers(
+        path,
+        width,
+        height,
+        layers,
+        compression,
+        meta,
+    )?)
 }
 
 /// Encodes a multi-layer EXR into a uniquely named temporary file beside `path`, to [`commit`]
 /// later.
+///
+/// The header carries the standard `software` attribute ("xylem VERSION") and `meta`, text
+/// attributes (name, value) such as a render's scene, spp, seed and camera ([`ExrMeta`]).
 pub fn stage_exr_layers(
     path: &Path,
     width: u32,
     height: u32,
     layers: &[ExrLayer],
     compression: ExrCompression,
+    meta: ExrMeta,
 ) -> Result<Staged, ImageError> {
     use exr::prelude::*;
     let name = path.display().to_string();
@@ -240,9 +303,18 @@ pub fn stage_exr_layers(
             channels.push(AnyChannel::new(full.as_str(), FlatSamples::F32(samples)));
         }
     }
+    let mut attributes = LayerAttributes {
+        software_name: Some(exr_text(&format!("xylem {}", env!("CARGO_PKG_VERSION")))),
+        ..LayerAttributes::default()
+    };
+    for (key, value) in meta {
+        attributes
+            .other
+            .insert(exr_text(key), AttributeValue::Text(exr_text(value)));
+    }
     let layer = Layer::new(
         (width as usize, height as usize),
-        LayerAttributes::default(),
+        attributes,
         compression.encoding(),
         AnyChannels::sort(SmallVec::from_vec(channels)),
     );
@@ -262,6 +334,18 @@ pub fn stage_exr_layers(
     Ok(staged)
 }
 
+/// Text attributes of an EXR header, (name, value): e.g. `("spp", "64")`.
+pub type ExrMeta<'a> = &'a [(&'a str, String)];
+
+/// An EXR text attribute: OpenEXR text is 8-bit (Latin-1 here); other characters become `?`.
+fn exr_text(s: &str) -> exr::prelude::Text {
+    let latin1: String = s
+        .chars()
+        .map(|c| if (c as u32) < 256 { c } else { '?' })
+        .collect();
+    exr::prelude::Text::new_or_panic(latin1)
+}
+
 /// Flushes a buffered writer, naming the file on failure (a dropped `BufWriter` would hide it).
 fn flush(mut out: BufWriter<&mut std::fs::File>, name: &str) -> Result<(), ImageError> {
     std::io::Write::flush(&mut out).map_err(|source| ImageError::Io {
@@ -270,19 +354,22 @@ fn flush(mut out: BufWriter<&mut std::fs::File>, name: &str) -> Result<(), Image
     })
 }
 
-/// Writes a rendered image as EXR: beauty `R G B` plus the AOV layers `albedo` (RGB), `normal`
-/// (XYZ), `depth` (Z), `fiber` (XYZ), `ray_mask` (Y), `growth_time` (Y) and `std_error` (Y).
-pub fn write_image_exr(path: &Path, image: &super::Image) -> Result<(), ImageError> {
-    commit(stage_image_exr(path, image)?)
+/// Writes a rendered image as EXR: beauty `R G B A` (alpha = the fraction of the pixel's camera
+/// samples that hit something; misses add what they saw, black without an environment light)
+/// plus the AOV layers `albedo` (RGB), `normal` (XYZ), `depth` (Z, +∞ where nothing was hit),
+/// `fiber` (XYZ), `ray_mask` (Y), `growth_time` (Y) and `std_error` (Y), with `meta` in the
+/// header ([`stage_exr_layers`]).
+pub fn write_image_exr(path: &Path, image: &super::Image, meta: ExrMeta) -> Result<(), ImageError> {
+    commit(stage_image_exr(path, image, meta)?)
 }
 
 /// [`write_image_exr`] staged, to [`commit`] later.
-pub fn stage_image_exr(path: &Path, image: &super::Image) -> Result<Staged, ImageError> {
-    let mut layers = vec![ExrLayer {
-        name: "",
-        channels: &["R", "G", "B"],
-        data: image.beauty.iter().flat_map(|c| c.to_array()).collect(),
-    }];
+pub fn stage_image_exr(
+    path: &Path,
+    image: &super::Image,
+    meta: ExrMeta,
+) -> Result<Staged, ImageError> {
+    let mut layers = vec![beauty_rgba(&image.beauty, &image.aov)];
     layers.extend(aov_layers(&image.aov));
     layers.push(ExrLayer {
         name: "std_error",
@@ -295,7 +382,21 @@ pub fn stage_image_exr(path: &Path, image: &super::Image) -> Result<Staged, Imag
         image.height,
         &layers,
         ExrCompression::Zip,
+        meta,
     )
+}
+
+/// The beauty layer `R G B A` of radiance and the AOVs' coverage (alpha).
+pub fn beauty_rgba(beauty: &[Vec3], aov: &[super::Aov]) -> ExrLayer<'static> {
+    ExrLayer {
+        name: "",
+        channels: &["R", "G", "B", "A"],
+        data: beauty
+            .iter()
+            .zip(aov)
+            .flat_map(|(c, a)| [c.x, c.y, c.z, a.coverage])
+            .collect(),
+    }
 }
 
 /// The AOV layers of [`write_image_exr`] (`albedo` … `growth_time`), e.g. for a file of AOVs that
@@ -362,8 +463,10 @@ pub fn read_exr_rgb(path: &Path) -> Result<(usize, usize, Vec<Vec3>), ImageError
     Ok(img.layer_data.channel_data.pixels)
 }
 
-/// Reads every channel of the first layer of an EXR as (name, values).
-pub fn read_exr_channels(path: &Path) -> Result<Vec<(String, Vec<f32>)>, ImageError> {
+/// The first layer of an EXR with every channel and attribute.
+fn read_exr_layer(
+    path: &Path,
+) -> Result<exr::prelude::Layer<exr::prelude::AnyChannels<exr::prelude::FlatSamples>>, ImageError> {
     use exr::prelude::*;
     let img = read()
         .no_deep_data()
@@ -376,13 +479,52 @@ pub fn read_exr_channels(path: &Path) -> Result<Vec<(String, Vec<f32>)>, ImageEr
             path: path.display().to_string(),
             message: e.to_string(),
         })?;
-    Ok(img
-        .layer_data
+    Ok(img.layer_data)
+}
+
+/// Reads every channel of the first layer of an EXR as (name, values).
+pub fn read_exr_channels(path: &Path) -> Result<Vec<(String, Vec<f32>)>, ImageError> {
+    Ok(read_exr_layer(path)?
         .channel_data
         .list
         .iter()
         .map(|c| (c.name.to_string(), c.sample_data.values_as_f32().collect()))
         .collect())
+}
+
+/// The text attributes of an EXR's first layer as (name, value), with the standard `software`
+/// attribute first where present ([`stage_exr_layers`] writes both).
+pub fn read_exr_text(path: &Path) -> Result<Vec<(String, String)>, ImageError> {
+    let a = read_exr_layer(path)?.attributes;
+    let mut out: Vec<(String, String)> = a
+        .software_name
+        .iter()
+        .map(|t| ("software".to_string(), t.to_string()))
+        .collect();
+    let mut other: Vec<(String, String)> = a
+        .other
+        .iter()
+        .filter_map(|(k, v)| match v {
+            exr::prelude::AttributeValue::Text(t) => Some((k.to_string(), t.to_string())),
+            _ => None,
+        })
+        .collect();
+    other.sort();
+    out.extend(other);
+    Ok(out)
+}
+
+/// The chunk types of a PNG byte stream in order (PNG spec §5.3: after the 8-byte signature,
+/// length, type, data, CRC), e.g. to check which colour-space chunks a file carries.
+pub fn png_chunk_types(bytes: &[u8]) -> Vec<String> {
+    let mut at = 8;
+    let mut out = Vec::new();
+    while at + 8 <= bytes.len() {
+        let len = u32::from_be_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+        out.push(String::from_utf8_lossy(&bytes[at + 4..at + 8]).into_owned());
+        at += 12 + len;
+    }
+    out
 }
 
 #[cfg(test)]
@@ -396,6 +538,62 @@ mod tests {
         assert_eq!(linear_to_srgb(f32::NAN), 0.0);
         let a = 0.003_130_8_f32;
         assert!((12.92 * a - (1.055 * a.powf(1.0 / 2.4) - 0.055)).abs() < 1e-4);
+    }
+
+    #[test]
+    fn rendered_exr_has_alpha_infinite_depth_on_misses_and_header_metadata() {
+        let hit = crate::render::Aov {
+            depth: 250.0,
+            coverage: 1.0,
+            ..Default::default()
+        };
+        let miss = crate::render::Aov {
+            depth: f32::INFINITY,
+            ..Default::default()
+        };
+        let image = crate::render::Image {
+            width: 2,
+            height: 1,
+            beauty: vec![Vec3::new(0.5, 0.25, 0.125), Vec3::ZERO],
+            std_error: vec![0.0; 2],
+            aov: vec![hit, miss],
+            nonfinite: 0,
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("r.exr");
+        let meta = [
+            ("spp", "64".to_string()),
+            ("scene", "board – ø".to_string()),
+        ];
+        write_image_exr(&p, &image, &meta).unwrap();
+        let ch = read_exr_channels(&p).unwrap();
+        let get = |n: &str| ch.iter().find(|(c, _)| c == n).unwrap().1.clone();
+        assert_eq!(get("A"), vec![1.0, 0.0]);
+        assert_eq!(get("R"), vec![0.5, 0.0]);
+        assert_eq!(get("depth.Z"), vec![250.0, f32::INFINITY]);
+        let text = read_exr_text(&p).unwrap();
+        let version = format!("xylem {}", env!("CARGO_PKG_VERSION"));
+        let get = |k: &str| text.iter().find(|(n, _)| n == k).unwrap().1.clone();
+        assert_eq!(get("software"), version);
+        assert_eq!(get("spp"), "64");
+        assert_eq!(get("scene"), "board ? ø");
+    }
+
+    #[test]
+    fn data_pngs_carry_no_colour_space_chunk() {
+        let rgb = [10u8, 128, 255, 0, 0, 0];
+        let chunks = |tag| {
+            let mut v = Vec::new();
+            encode_png_rgb8(&mut v, 2, 1, &rgb, tag).unwrap();
+            png_chunk_types(&v)
+        };
+        let (srgb, data) = (chunks(PngTag::Srgb), chunks(PngTag::Untagged));
+        assert!(srgb.iter().any(|c| c == "sRGB"), "{srgb:?}");
+        for c in ["sRGB", "gAMA", "cHRM", "iCCP"] {
+            assert!(!data.iter().any(|d| d == c), "{c} in {data:?}");
+        }
+        assert_eq!(data.first().map(String::as_str), Some("IHDR"));
+        assert_eq!(data.last().map(String::as_str), Some("IEND"));
     }
 
     #[test]
@@ -430,7 +628,7 @@ mod tests {
             ExrCompression::Rle,
             ExrCompression::None,
         ] {
-            write_exr_layers_with(&e, 3, 2, &layers, c).unwrap();
+            write_exr_layers_with(&e, 3, 2, &layers, c, &[]).unwrap();
             let (w, h, rgb) = read_exr_rgb(&e).unwrap();
             assert_eq!((w, h), (3, 2), "{c:?}");
             assert_eq!(rgb, px, "{c:?}");

@@ -131,6 +131,7 @@ pub fn shading_point(scene: &Scene, ray: &Ray, hit: &Hit, aov: Option<&mut Aov>)
             fiber: shading.aov.fiber,
             ray_mask: shading.aov.ray_mask,
             growth_time: shading.aov.growth_time,
+            coverage: 1.0,
         };
     }
     ShadingPoint {
@@ -194,7 +195,7 @@ pub fn offset_origin(sp: &ShadingPoint, dir: Vec3) -> Vec3 {
 }
 
 /// A shading point's BSDF with `wo` fixed, for lighting it by many light samples: the wood BSDF
-/// with its `wo`-only terms worked out once ([`WoodBsdf::at_wo`]), any other BSDF as it is.
+/// with its `wo`-only terms worked out once (`WoodBsdf::at_wo`), any other BSDF as it is.
 /// Values identical to `eval` and `pdf`.
 #[derive(Clone, Copy, Debug)]
 pub enum BsdfAtWo<'a> {

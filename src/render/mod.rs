@@ -50,6 +50,52 @@ pub struct RenderSettings {
     pub seed: u64,
 }
 
+impl RenderSettings {
+    /// The EXR header attributes that say how an image of `scene` (its name and file) seen by
+    /// `camera` was made: scene, file, spp, seed, integrator and camera (the software attribute
+    /// carries xylem's version; [`image_io::stage_exr_layers`]). Camera axes as [`Camera`] has
+    /// them: right, up and view direction; lengths in mm.
+    pub fn exr_meta(
+        &self,
+        scene: &str,
+        file: &str,
+        camera: &Camera,
+    ) -> Vec<(&'static str, String)> {
+        let v = |v: glam::Vec3| format!("({}, {}, {})", v.x, v.y, v.z);
+        let f = &camera.frame;
+        let projection = match camera.projection {
+            camera::Projection::Perspective {
+                fov_y,
+                lens_radius,
+                focus_distance,
+            } => format!(
+                "perspective, fov_y {} deg, lens radius {lens_radius} mm, focus {focus_distance} mm",
+                fov_y.to_degrees()
+            ),
+            camera::Projection::Orthographic { width } => format!("orthographic, width {width} mm"),
+        };
+        vec![
+            ("scene", scene.to_string()),
+            ("scene_file", file.to_string()),
+            ("spp", self.spp.to_string()),
+            ("seed", self.seed.to_string()),
+            ("integrator", self.integrator.to_string()),
+            (
+                "camera",
+                format!(
+                    "eye {} right {} up {} view {}, {projection}, {}x{} px",
+                    v(camera.eye),
+                    v(f.s),
+                    v(f.t),
+                    v(f.n),
+                    camera.width,
+                    camera.height
+                ),
+            ),
+        ]
+    }
+}
+
 /// How to run a render (not part of the image: changing these never changes a pixel).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct RunOptions {
@@ -80,6 +126,21 @@ pub enum RenderError {
 pub const TILE: u32 = 16;
 
 /// Renders the scene with its own lights.
+///
+/// ```
+/// use std::path::Path;
+/// // A scene file (here a built-in one; `xylem::scene::load` reads any file), made small.
+/// let mut loaded = xylem::scene::load(Path::new("scenes/sweep_board.toml"))?;
+/// loaded.scene.camera = loaded.scene.camera.with_resolution(32, 24);
+/// loaded.settings.spp = 2;
+/// let out = xylem::render::render(&loaded.scene, &loaded.settings, &Default::default())?;
+/// assert_eq!(out.image.beauty.len(), 32 * 24);
+/// // Beauty with alpha, the AOV layers and the settings in the header:
+/// let dir = tempfile::tempdir()?;
+/// let meta = loaded.settings.exr_meta(&loaded.name, "scenes/sweep_board.toml", &loaded.scene.camera);
+/// xylem::render::image_io::write_image_exr(&dir.path().join("board.exr"), &out.image, &meta)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn render(
     scene: &Scene,
     settings: &RenderSettings,

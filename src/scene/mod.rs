@@ -83,9 +83,15 @@ pub fn load(path: &Path) -> Result<LoadedScene, SceneError> {
 
 /// [`load`], with the geometry memory check skipped when `ignore_limits` (`--ignore-limits`).
 pub fn load_with(path: &Path, ignore_limits: bool) -> Result<LoadedScene, SceneError> {
-    let bytes =
-        crate::render::resources::read_bounded(path, crate::render::resources::MAX_SCENE_BYTES)
-            .map_err(SceneError::Input)?;
+    // A built-in scene named by its repository path or name, where no such file exists here
+    // (an installed binary run from another folder; `crate::builtin`).
+    let bytes = match crate::builtin::lookup(path).filter(|_| !path.exists()) {
+        Some(embedded) => embedded.to_vec(),
+        None => {
+            crate::render::resources::read_bounded(path, crate::render::resources::MAX_SCENE_BYTES)
+                .map_err(SceneError::Input)?
+        }
+    };
     let text = String::from_utf8(bytes).map_err(|_| SceneError::Parse {
         path: path.display().to_string(),
         message: "not UTF-8 text (a scene is a TOML file)".into(),

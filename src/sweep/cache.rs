@@ -1,13 +1,13 @@
 //! Rendering a sweep with a per-sweep cache: the camera and geometry do not move, so what does
 //! not depend on the light — camera rays, first hits, shading frames, texels and BSDFs, i.e. the
 //! renderer's [`PrimarySample`]s — is computed once per pixel sample and reused by every frame;
-//! only the light-dependent part ([`direct_radiance`], or path tracing from the cached first hit)
+//! only the light-dependent part (`direct_radiance`, or path tracing from the cached first hit)
 //! runs per frame.
 //!
 //! Work is tile-major and, within a tile, pixel → sample → frame: each primary sample is lit for
 //! every frame as soon as it is computed, so the "cache" is one sample held in registers rather
 //! than a buffer, whatever the image size. For direct lighting the BSDF-sampled ray is
-//! light-independent too and is traced once per sample (see [`direct_for_frames`]). Every sample draws from the renderer's per-(seed, pixel, sample) streams and sums in the
+//! light-independent too and is traced once per sample (see `direct_for_frames`). Every sample draws from the renderer's per-(seed, pixel, sample) streams and sums in the
 //! same order as [`crate::render::render_with_lights`], so each frame is bit-identical to the
 //! naive render of that frame.
 
@@ -445,7 +445,7 @@ fn sweep_tile(
     TileFrames { aov, frames }
 }
 
-/// Per-sample buffers of [`direct_for_frames`], reused across samples.
+/// Per-sample buffers of `direct_for_frames`, reused across samples.
 #[derive(Default)]
 struct FrameScratch {
     /// Whether each frame's sample is shaded at the first hit (not a light seen in front).

@@ -122,9 +122,9 @@ pub fn contact_sheet_rows(thumbs: &[Rgb8], labels: &[String], cols: usize, gap: 
 
 /// A 3×5 pixel font for labels: digits, sign, point, degree sign, `%`, `_` and the lowercase
 /// letters (drawn as capitals, except `e` and `x`) (rows top to bottom, bit 2 = left column).
-/// Characters without a glyph are drawn as blanks.
+/// Capitals are drawn as their lowercase glyphs; characters without a glyph as blanks.
 fn glyph(c: char) -> [u8; 5] {
-    match c {
+    match c.to_ascii_lowercase() {
         '0' => [7, 5, 5, 5, 7],
         '1' => [2, 6, 2, 2, 7],
         '2' => [7, 1, 7, 4, 7],

@@ -11,8 +11,8 @@ use super::sequence::{
 };
 use crate::output::{remove_if_present, FolderLock, LockError, LockMode};
 use crate::render::image_io::{
-    aov_layers, commit, stage_exr_layers, stage_png_linear, write_exr_layers, ExrCompression,
-    ExrLayer, ImageError,
+    aov_layers, beauty_rgba, commit, stage_exr_layers, stage_png_linear, write_exr_layers,
+    ExrCompression, ExrLayer, ImageError,
 };
 use crate::render::resources::{ResourceError, Resources};
 use crate::render::{RenderError, RunOptions};
@@ -117,18 +117,27 @@ pub fn write_frames(
     render.frames.par_iter().try_for_each(|f| {
         let stem = frame_stem(f.index);
         let layers = [
-            ExrLayer {
-                name: "",
-                channels: &["R", "G", "B"],
-                data: f.beauty.iter().flat_map(|c| c.to_array()).collect(),
-            },
+            beauty_rgba(&f.beauty, &render.aov),
             ExrLayer {
                 name: "std_error",
                 channels: &["Y"],
                 data: f.std_error.clone(),
             },
         ];
-        let exr = stage_exr_layers(&dir.join(format!("{stem}.exr")), w, h, &layers, compression)?;
+        // One attribute: the exr crate writes its extra attributes in hash-map order, which
+        // differs run to run, and frames must be byte-stable (tests/robustness.rs).
+        let meta = [(
+            "sweep_frame",
+            format!("frame {} of {total}, light at {} deg", f.index, f.light_deg),
+        )];
+        let exr = stage_exr_layers(
+            &dir.join(format!("{stem}.exr")),
+            w,
+            h,
+            &layers,
+            compression,
+            &meta,
+        )?;
         let png = stage_png_linear(&dir.join(format!("{stem}.png")), w, h, &f.beauty, exposure)?;
         let mut rec = FrameRecord::measure(f.index, total, f.light_deg, (w, h), &f.beauty, regions);
         rec.sweep = settings.clone();

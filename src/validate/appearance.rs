@@ -78,7 +78,7 @@ impl WhiteLightOrder {
     }
 }
 
-/// Renders [`white_light_board_scene`] for `preset` and compares radiance with albedo.
+/// Renders `white_light_board_scene` for `preset` and compares radiance with albedo.
 pub fn white_light_ring_order(preset: &str, spp: u32) -> Result<WhiteLightOrder, String> {
     let text = white_light_board_scene(preset, spp);
     let loaded = scene::from_str(&text, "<white-light board>", Path::new("."), "white")

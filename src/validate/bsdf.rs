@@ -231,10 +231,12 @@ impl CasesFile {
 
 /// Reads and checks `path`: every case must make a valid `WoodBsdf`.
 pub fn load_suite(path: &Path) -> Result<Suite, CasesError> {
-    let text = std::fs::read_to_string(path).map_err(|source| CasesError::Io {
+    // From disk, or the embedded validation/bsdf_cases.toml (`crate::builtin`).
+    let bytes = crate::builtin::read(path).map_err(|source| CasesError::Io {
         path: path.to_owned(),
         source,
     })?;
+    let text = String::from_utf8_lossy(&bytes);
     let file: CasesFile = toml::from_str(&text).map_err(|source| CasesError::Toml {
         path: path.to_owned(),
         source,
@@ -1282,4 +1284,18 @@ pub fn normalisation_markdown(rows: &[(f32, f32, f64, f64)]) -> String {
         ],
         &body,
     )
+}
+
+#[cfg(test)]
+mod embedded_tests {
+    use super::*;
+
+    #[test]
+    fn the_embedded_cases_load_where_the_file_does_not_exist() {
+        // `missing/..` makes the path absent on disk; it folds to validation/bsdf_cases.toml.
+        let embedded = load_suite(Path::new("missing/../validation/bsdf_cases.toml")).unwrap();
+        let disk = load_suite(Path::new("validation/bsdf_cases.toml")).unwrap();
+        assert_eq!(embedded.cases.len(), disk.cases.len());
+        assert!(embedded.cases.len() > 10);
+    }
 }

@@ -7,11 +7,14 @@
 //!   for [`rough_finish`], the rough-finish rows of `validate bsdf`;
 //! - [`scenes`]: does each built-in scene show its subject (contrast, fireflies, figure);
 //! - [`fit`]: `xylem fit` by round trip — known boards rendered, fitted back, compared;
+//! - [`gltf`]: the exported glTF material (a KHR_materials_anisotropy reference shader) against
+//!   xylem's fibre highlight;
 //! - [`report`]: validation/REPORT.md, one replaceable section per suite.
 
 pub mod appearance;
 pub mod bsdf;
 pub mod fit;
+pub mod gltf;
 pub mod layered_reference;
 pub mod report;
 pub mod rough_finish;

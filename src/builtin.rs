@@ -1,0 +1,118 @@
+//! Repository files compiled into the binary, so an installed `xylem` (`cargo install --path .`)
+//! runs the built-in scenes, `validate` and the measured boards from any folder: the scene files
+//! (`scenes/*.toml`), the BSDF validation cases (`validation/bsdf_cases.toml`) and Marschner et
+//! al. 2005's measured maps (`data/marschner2005/`). A file on disk always wins; the embedded
+//! copy is used only where the path does not exist. (The species presets are embedded by
+//! `wood::preset` itself.)
+
+use std::borrow::Cow;
+use std::path::{Component, Path, PathBuf};
+
+macro_rules! embed {
+    ($($path:literal),* $(,)?) => {
+        [$(($path, include_bytes!(concat!("../", $path)) as &[u8])),*]
+    };
+}
+
+/// (path relative to the repository root, contents).
+const FILES: [(&str, &[u8]); 16] = embed![
+    "scenes/box_joint.toml",
+    "scenes/cornell_wood_marble.toml",
+    "scenes/cube_carved_vs_veneer.toml",
+    "scenes/measured_maple_sweep.toml",
+    "scenes/measured_padauk_sweep.toml",
+    "scenes/parquet_floor.toml",
+    "scenes/sweep_board.toml",
+    "scenes/teapot.toml",
+    "scenes/turned_bowl.toml",
+    "validation/bsdf_cases.toml",
+    "data/marschner2005/maple/diffuse.png",
+    "data/marschner2005/maple/fiber_axis.png",
+    "data/marschner2005/maple/fiber_color.png",
+    "data/marschner2005/padauk/diffuse.png",
+    "data/marschner2005/padauk/fiber_axis.png",
+    "data/marschner2005/padauk/fiber_color.png",
+];
+
+/// The built-in scenes' names (`sweep_board` for scenes/sweep_board.toml).
+pub fn scene_names() -> impl Iterator<Item = &'static str> {
+    FILES
+        .iter()
+        .filter_map(|(p, _)| p.strip_prefix("scenes/")?.strip_suffix(".toml"))
+}
+
+/// `path` with `.` dropped and `a/..` folded, lexically (no file system); `None` for an absolute
+/// path or one that climbs above its start.
+fn normalise(path: &Path) -> Option<PathBuf> {
+    let mut out = Vec::new();
+    for c in path.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                out.pop()?;
+            }
+            Component::Normal(s) => out.push(s),
+            Component::RootDir | Component::Prefix(_) => return None,
+        }
+    }
+    Some(out.iter().collect())
+}
+
+/// The embedded contents for `path`: its repository-relative form (`scenes/sweep_board.toml`,
+/// `scenes/../data/…` folded), or a built-in scene's bare name (`sweep_board`) or file name
+/// (`sweep_board.toml`).
+pub fn lookup(path: &Path) -> Option<&'static [u8]> {
+    let rel = normalise(path)?;
+    let scene = match rel.to_str() {
+        Some(s) if !s.contains('/') => Some(format!(
+            "scenes/{}.toml",
+            s.strip_suffix(".toml").unwrap_or(s)
+        )),
+        _ => None,
+    };
+    FILES
+        .iter()
+        .find(|(p, _)| Path::new(p) == rel || scene.as_deref() == Some(*p))
+        .map(|(_, bytes)| *bytes)
+}
+
+/// The bytes of `path` from disk, or the embedded copy where the path does not exist; the
+/// disk's error otherwise (naming nothing: callers name the file).
+pub fn read(path: &Path) -> std::io::Result<Cow<'static, [u8]>> {
+    match std::fs::read(path) {
+        Ok(b) => Ok(Cow::Owned(b)),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            lookup(path).map(Cow::Borrowed).ok_or(e)
+        }
+        Err(e) => Err(e),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lookups_fold_relative_paths_and_bare_names() {
+        let board = lookup(Path::new("scenes/sweep_board.toml")).unwrap();
+        assert_eq!(board, std::fs::read("scenes/sweep_board.toml").unwrap());
+        assert_eq!(lookup(Path::new("sweep_board")), Some(board));
+        assert_eq!(lookup(Path::new("./sweep_board.toml")), Some(board));
+        let png = lookup(Path::new("scenes/../data/marschner2005/maple/diffuse.png")).unwrap();
+        assert_eq!(&png[1..4], b"PNG");
+        for missing in [
+            "/scenes/sweep_board.toml",
+            "../scenes/sweep_board.toml",
+            "nope",
+        ] {
+            assert!(lookup(Path::new(missing)).is_none(), "{missing}");
+        }
+        assert_eq!(scene_names().count(), 9);
+        // Every scene file in the repository is embedded.
+        let on_disk = std::fs::read_dir("scenes")
+            .unwrap()
+            .filter(|e| e.as_ref().unwrap().path().extension() == Some("toml".as_ref()))
+            .count();
+        assert_eq!(on_disk, 9);
+    }
+}
