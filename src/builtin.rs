@@ -15,10 +15,15 @@ macro_rules! embed {
 }
 
 /// (path relative to the repository root, contents).
-const FILES: [(&str, &[u8]); 16] = embed![
+const FILES: [(&str, &[u8]); 21] = embed![
     "scenes/box_joint.toml",
+    "scenes/carved_bunny.toml",
+    "scenes/cornell_bunny.toml",
+    "scenes/cornell_bunny_black.toml",
     "scenes/cornell_wood_marble.toml",
     "scenes/cube_carved_vs_veneer.toml",
+    "scenes/dovetail.toml",
+    "scenes/fit_maple_sweep.toml",
     "scenes/measured_maple_sweep.toml",
     "scenes/measured_padauk_sweep.toml",
     "scenes/parquet_floor.toml",
@@ -107,12 +112,16 @@ mod tests {
         ] {
             assert!(lookup(Path::new(missing)).is_none(), "{missing}");
         }
-        assert_eq!(scene_names().count(), 9);
         // Every scene file in the repository is embedded.
-        let on_disk = std::fs::read_dir("scenes")
+        let mut on_disk: Vec<String> = std::fs::read_dir("scenes")
             .unwrap()
-            .filter(|e| e.as_ref().unwrap().path().extension() == Some("toml".as_ref()))
-            .count();
-        assert_eq!(on_disk, 9);
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension() == Some("toml".as_ref()))
+            .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
+            .collect();
+        on_disk.sort();
+        let mut embedded: Vec<String> = scene_names().map(String::from).collect();
+        embedded.sort();
+        assert_eq!(embedded, on_disk);
     }
 }

@@ -132,7 +132,7 @@ mod tests {
     #[test]
     fn saturating_i32_is_as() {
         let mut r = crate::math::Pcg32::new(11, 0);
-        let mut check = |x: f32| assert_eq!(saturating_i32(x), x as i32, "{x}");
+        let check = |x: f32| assert_eq!(saturating_i32(x), x as i32, "{x}");
         for x in [
             0.0f32,
             -0.0,
