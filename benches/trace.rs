@@ -4,8 +4,8 @@
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::sync::Arc;
+use xylem::bench::trace::{bumpy_sphere, coherent_rays, incoherent_rays};
 use xylem::material::Placement;
-use xylem::render::bench::{bumpy_sphere, coherent_rays, incoherent_rays};
 use xylem::render::{Accel, Instance, Transform};
 
 fn accel(triangles: usize) -> Accel {

@@ -6,6 +6,7 @@
 //! (arrows point down the list below; only `cli` may use everything).
 
 pub mod bake;
+pub mod bench;
 pub mod bsdf;
 pub mod builtin;
 pub mod cli;
@@ -15,6 +16,7 @@ pub mod material;
 pub mod math;
 pub mod noise;
 pub mod output;
+pub mod picture;
 pub mod render;
 pub mod scene;
 pub mod sweep;

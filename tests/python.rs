@@ -198,23 +198,17 @@ fn render_case() -> Value {
         .unwrap()
         .image;
     let (path, moving) =
-        xylem::sweep::cache::SweepPath::from_scene(&loaded, Some(3), Some((-40.0, 40.0))).unwrap();
-    let sweep = xylem::sweep::cache::render_sweep(
-        &loaded.scene,
-        &loaded.settings,
-        &path,
-        moving,
-        0..3,
-        &run,
-    )
-    .unwrap();
+        xylem::sweep::SweepPath::from_scene(&loaded, Some(3), Some((-40.0, 40.0))).unwrap();
+    let sweep =
+        xylem::sweep::render_sweep(&loaded.scene, &loaded.settings, &path, moving, 0..3, &run)
+            .unwrap();
     json!({
         "scene": scene.display().to_string(), "spp": 2, "res": [24, 18],
         "beauty": rows(&img.beauty), "std_error": img.std_error,
         "albedo": rows(&img.aov.iter().map(|a| a.albedo).collect::<Vec<_>>()),
         "sweep_frames": 3, "sweep_arc": [-40.0, 40.0],
         "sweep": sweep.frames.iter().map(|f| rows(&f.beauty)).collect::<Vec<_>>(),
-        "sweep_light_deg": sweep.frames.iter().map(|f| f.light_deg).collect::<Vec<_>>(),
+        "sweep_light_deg": (0..3).map(|k| path.light_deg(k)).collect::<Vec<_>>(),
     })
 }
 

@@ -78,7 +78,7 @@ proptest! {
 /// occlusion answers. (On a CPU without AVX2 both calls run the baseline code.)
 #[test]
 fn wide_bvh_avx2_path_equals_portable_path() {
-    use xylem::render::bench::{bumpy_sphere, coherent_rays, incoherent_rays};
+    use xylem::bench::trace::{bumpy_sphere, coherent_rays, incoherent_rays};
     let accel = Accel::new(vec![Instance {
         mesh: Arc::new(bumpy_sphere(20_000)),
         transform: Transform::identity(),

@@ -816,7 +816,7 @@ fn sweep<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let loaded = load_scene(scene, spp, res, seed)?;
     let (path, moving) =
-        xylem::sweep::cache::SweepPath::from_scene(&loaded, frames, arc).map_err(value_error)?;
+        xylem::sweep::SweepPath::from_scene(&loaded, frames, arc).map_err(value_error)?;
     let run = xylem::render::RunOptions {
         threads,
         progress: false,
@@ -824,7 +824,7 @@ fn sweep<'py>(
     let total = path.arc.frames;
     let r = py
         .allow_threads(|| {
-            xylem::sweep::cache::render_sweep(
+            xylem::sweep::render_sweep(
                 &loaded.scene,
                 &loaded.settings,
                 &path,
@@ -845,7 +845,7 @@ fn sweep<'py>(
         .iter()
         .flat_map(|fr| fr.std_error.clone())
         .collect();
-    let deg: Vec<f32> = r.frames.iter().map(|fr| fr.light_deg).collect();
+    let deg: Vec<f32> = (0..f).map(|k| path.light_deg(k)).collect();
     let d = PyDict::new(py);
     d.set_item(
         "frames",

@@ -2,11 +2,11 @@
 //! settings with its subject check (`validate::scenes`), every preset on the README board
 //! (`xylem preset gallery`), and a light-sweep close-up (APNG) of each figured preset.
 
+use crate::picture::contact::Rgb8;
 use crate::render::image_io::{to_srgb8, write_png_rgb8};
 use crate::render::{render, RunOptions};
-use crate::sweep::cache::{render_sweep, SweepPath};
-use crate::sweep::contact::Rgb8;
 use crate::sweep::sequence::write_apng;
+use crate::sweep::{render_sweep, SweepPath};
 use anyhow::Context;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

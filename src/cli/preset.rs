@@ -213,9 +213,9 @@ pub(super) fn gallery(
     angles: &[f32],
     only: &[String],
 ) -> anyhow::Result<()> {
+    use crate::picture::contact::{contact_sheet_rows, Rgb8};
     use crate::render::image_io::{to_srgb8, write_png_rgb8};
-    use crate::sweep::cache::{render_sweep, SweepPath};
-    use crate::sweep::contact::{contact_sheet_rows, Rgb8};
+    use crate::sweep::{render_sweep, SweepPath};
     if angles.is_empty() || angles.iter().any(|a| !(-89.0..=89.0).contains(a)) {
         anyhow::bail!("--angles: each light angle must lie in [-89, 89] degrees");
     }

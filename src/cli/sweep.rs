@@ -30,7 +30,7 @@ pub struct Args {
     /// Speed/accuracy preset measured in validation/TRADEOFF.md (spp and wood-model knobs);
     /// `--spp` still overrides its sample count.
     #[arg(long, value_enum)]
-    pub quality: Option<crate::sweep::tradeoff::Quality>,
+    pub quality: Option<crate::validate::tradeoff::Quality>,
     /// Render each frame from scratch, without the per-sweep cache (to time or check it).
     #[arg(long)]
     pub naive: bool,
@@ -71,7 +71,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         eprintln!("warning: {w}");
     }
     if let Some(q) = args.quality {
-        crate::sweep::tradeoff::apply(&mut loaded, &q.knobs())
+        crate::validate::tradeoff::apply(&mut loaded, &q.knobs())
             .with_context(|| format!("applying --quality {q}"))?;
     }
     if let Some(spp) = args.spp {

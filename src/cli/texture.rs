@@ -183,7 +183,7 @@ fn animate(args: &Args, slice: &Slice, out: &std::path::Path, seconds: f32) -> a
         if let Some((x, y)) = first_non_finite(&pixels, slice.res) {
             bail!("frame {i}: non-finite colour at pixel ({x}, {y}); nothing written");
         }
-        frames.push(crate::sweep::contact::Rgb8 {
+        frames.push(crate::picture::contact::Rgb8 {
             width: slice.res,
             height: slice.res,
             data: crate::render::image_io::to_srgb8(&pixels, args.exposure),

@@ -1,8 +1,8 @@
 //! `xylem tradeoff SCENE.toml`: measures every speed/accuracy knob against a reference render and
 //! writes validation/TRADEOFF.md with an error-against-time plot.
 
-use crate::sweep::plot::{line_plot, PlotOptions, Series};
-use crate::sweep::tradeoff::{relative_mse, render_with, settings, ssim, Knobs, Measurement};
+use crate::picture::plot::{line_plot, PlotOptions, Series};
+use crate::validate::tradeoff::{relative_mse, render_with, settings, ssim, Knobs, Measurement};
 use anyhow::Context;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;

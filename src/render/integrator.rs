@@ -1,17 +1,19 @@
-//! The integrators: direct lighting and unidirectional path tracing with next-event estimation,
-//! multiple importance sampling (power heuristic, Veach 1997 §9.2) and Russian roulette.
+//! The integrator: unidirectional path tracing with next-event estimation, multiple importance
+//! sampling (power heuristic, Veach 1997 §9.2) and Russian roulette, for every frame of a
+//! [`LightFrames`] at once; direct lighting is its one-bounce case.
 //!
-//! Per pixel sample the work is split in two so a light sweep can cache the first part:
+//! Per pixel sample the work is split in two:
 //! - [`primary_sample`]: everything that does not depend on the lights — the camera ray, the first
 //!   hit, its shading frame, `wo` and the evaluated material (a small `Copy` [`ShadingPoint`]);
-//! - [`shade_direct`] / [`direct_radiance`]: the light-dependent part.
+//! - `radiance_frames`: the path from there, its light-dependent terms per frame.
 //!
 //! Each part draws from its own random stream, derived only from (seed, pixel, sample) by
-//! [`sample_rngs`], so a render that caches primary samples and one that does not are bit-identical.
+//! [`sample_rngs`], so a frame rendered with others equals the frame rendered alone bit for bit.
 
 use super::film::Aov;
+use super::frames::LightFrames;
 use super::geometry::{Accel, Hit, Ray};
-use super::light::{Light, LightSample, LightSamples};
+use super::light::{Light, LightSample, LightSamples, LightU};
 use super::Scene;
 use crate::bsdf::{Bsdf, WoodAtWo};
 use crate::material::{MaterialHit, SurfaceBsdf};
@@ -21,10 +23,24 @@ use glam::{Mat3, UVec2, Vec2, Vec3, Vec3A};
 /// Which light transport to simulate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Integrator {
-    /// Emission plus single-bounce direct lighting (NEE + one MIS'd BSDF sample).
+    /// Emission plus single-bounce direct lighting (NEE + one MIS'd BSDF sample): the path
+    /// tracer with one bounce.
     Direct,
     /// Path tracing up to `max_depth` bounces, Russian roulette from bounce 3.
-    Path { max_depth: u32 },
+    Path {
+        /// Bounces after the camera ray's first hit at most (1 = direct lighting).
+        max_depth: u32,
+    },
+}
+
+impl Integrator {
+    /// The most bounces a path makes (direct lighting: 1).
+    pub fn max_depth(&self) -> u32 {
+        match *self {
+            Integrator::Direct => 1,
+            Integrator::Path { max_depth } => max_depth,
+        }
+    }
 }
 
 /// The scene file's names (`direct`, `path (max_depth 8)`), not the Rust variants.
@@ -174,9 +190,12 @@ pub fn light_rng(scene: &Scene, pixel: UVec2, sample: u32, seed: u64) -> Pcg32 {
     sample_rngs(seed, index, sample).1
 }
 
-/// The nearest light a ray meets before `t_max`: (light index, distance, radiance, light pdf).
-pub fn nearest_light(lights: &[Light], ray: &Ray, t_max: f32) -> Option<(usize, f32, Vec3, f32)> {
-    let mut best: Option<(usize, f32, Vec3, f32)> = None;
+/// A light met by a ray: (light index, distance, radiance, light pdf in solid angle).
+pub type LightHit = (usize, f32, Vec3, f32);
+
+/// The nearest light a ray meets before `t_max`.
+pub fn nearest_light(lights: &[Light], ray: &Ray, t_max: f32) -> Option<LightHit> {
+    let mut best: Option<LightHit> = None;
     for (i, l) in lights.iter().enumerate() {
         if let Some((t, le, pdf)) = l.hit(ray) {
             let limit = best.map_or(t_max, |b| b.1);
@@ -415,29 +434,7 @@ fn slab_misses(o: [f32; 3], inv: [f32; 3], t_max: f32, lo: [f32; 3], hi: [f32; 3
     !nan & (t0 > t1)
 }
 
-/// Next-event estimation: one sample of every light, weighted against BSDF sampling by the power
-/// heuristic (delta lights take weight 1). Returns reflected radiance towards `wo`.
-pub fn sample_lights(
-    scene: &Scene,
-    sp: &ShadingPoint,
-    lights: &[Light],
-    rng: &mut Pcg32,
-    rays: &mut RayCount,
-) -> Vec3 {
-    let mut l = Vec3::ZERO;
-    if sp.bsdf.is_delta() {
-        return l;
-    }
-    let bsdf = BsdfAtWo::new(sp);
-    let shadow = ShadowTest::bvh(&scene.accel);
-    for light in lights {
-        let u = rng.next_vec2();
-        l += light_term(&shadow, sp, &bsdf, light.sample(sp.p, u), rays);
-    }
-    l
-}
-
-/// The term of one light sample `ls` in [`sample_lights`]: f · Li · |cos θi| · w / pdf when
+/// The term of one light sample `ls` in next-event estimation: f · Li · |cos θi| · w / pdf when
 /// the light is unoccluded, w the power heuristic against BSDF sampling (1 for delta lights);
 /// zero when the sample failed, the BSDF vanishes or the light is occluded.
 #[inline]
@@ -580,92 +577,49 @@ pub fn light_terms(
     }
 }
 
-/// The light-dependent part of direct lighting at a shading point: next-event estimation over all
-/// `lights` plus one BSDF-sampled ray that collects the emission of the light it meets (MIS).
-pub fn shade_direct(scene: &Scene, sp: &ShadingPoint, lights: &[Light], rng: &mut Pcg32) -> Vec3 {
-    shade_direct_counted(scene, sp, lights, rng, &mut RayCount::default())
+/// Scratch of [`radiance_frames`], reused from sample to sample.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct FramesScratch {
+    /// Whether each frame's path still runs (it stops where a ray meets a light).
+    alive: Vec<bool>,
+    /// Each frame's next-event estimate at the current vertex.
+    nee: Vec<Vec3>,
+    /// Each light's next-event term; those of the lights that do not move hold for every frame.
+    terms: Vec<Vec3>,
+    /// The moving light's samples and terms in every frame, and their scratch columns.
+    samples: LightSamples,
+    moving_terms: Vec<Vec3>,
+    term_scratch: TermScratch,
 }
 
-fn shade_direct_counted(
+/// The radiance of one primary sample in every frame of `lights`, into `out` (one per frame):
+/// unidirectional path tracing (pbrt-v4 §13.4 structure) with next-event estimation at every
+/// non-delta vertex, the BSDF-sampled continuation MIS-weighted (power heuristic, Veach 1997
+/// eq. 9.13) where it meets a light, and Russian roulette with survival min(1, max throughput)
+/// from bounce 3 (pbrt-v4 §13.4). Direct lighting is the path of one bounce.
+///
+/// The frames share everything but the lights, so the path — its rays, hits, BSDF samples and
+/// roulette, all drawn from `rng` the same way whatever the lights — is traced once; per frame
+/// only the emission a ray meets (which also ends that frame's path) and the next-event terms
+/// are worked out: the fixed lights' terms once, the moving light's for all frames at once,
+/// frames in SIMD lanes ([`light_terms`]). Each frame sums its terms in the lights' order, so
+/// it equals the render of that frame alone bit for bit.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn radiance_frames(
     scene: &Scene,
-    sp: &ShadingPoint,
-    lights: &[Light],
-    rng: &mut Pcg32,
-    rays: &mut RayCount,
-) -> Vec3 {
-    let mut l = sample_lights(scene, sp, lights, rng, rays);
-    let uc = rng.next_f32();
-    let u = rng.next_vec2();
-    if lights.iter().all(Light::is_delta) {
-        return l;
-    }
-    let Some(bs) = sp.bsdf.sample(sp.wo, uc, u) else {
-        return l;
-    };
-    if !(bs.pdf > 0.0) {
-        return l;
-    }
-    let d = sp.frame.to_world(bs.wi);
-    let ray = Ray {
-        o: offset_origin(sp, d),
-        d,
-    };
-    rays.0 += 1;
-    let t_scene = scene
-        .accel
-        .intersect(&ray, f32::INFINITY)
-        .map_or(f32::INFINITY, |h| h.t);
-    if let Some((_, _, le, light_pdf)) = nearest_light(lights, &ray, t_scene) {
-        let w = if bs.is_delta {
-            1.0
-        } else {
-            power_heuristic(bs.pdf, light_pdf)
-        };
-        l += bs.f * le * (bs.wi.z.abs() * w / bs.pdf);
-    }
-    l
-}
-
-/// Emission seen directly along the camera ray plus direct lighting at the first hit.
-pub fn direct_radiance(
-    scene: &Scene,
+    lights: &LightFrames,
+    shadow: &ShadowTest,
     ps: &PrimarySample,
-    lights: &[Light],
-    rng: &mut Pcg32,
-) -> Vec3 {
-    direct_radiance_counted(scene, ps, lights, rng, &mut RayCount::default())
-}
-
-pub(crate) fn direct_radiance_counted(
-    scene: &Scene,
-    ps: &PrimarySample,
-    lights: &[Light],
-    rng: &mut Pcg32,
-    rays: &mut RayCount,
-) -> Vec3 {
-    if let Some((_, t, le, _)) = nearest_light(lights, &ps.ray, ps.t_hit) {
-        if t < ps.t_hit || ps.point.is_none() {
-            return le;
-        }
-    }
-    match &ps.point {
-        Some(sp) => shade_direct_counted(scene, sp, lights, rng, rays),
-        None => Vec3::ZERO,
-    }
-}
-
-/// Unidirectional path tracing from a primary sample (pbrt-v4 §13.4 structure): NEE at every
-/// non-delta vertex, BSDF-sampled continuation MIS-weighted when it meets a light, Russian
-/// roulette with survival probability min(1, max throughput) from bounce 3.
-pub(crate) fn path_radiance(
-    scene: &Scene,
-    ps: &PrimarySample,
-    lights: &[Light],
     rng: &mut Pcg32,
     max_depth: u32,
+    scratch: &mut FramesScratch,
+    out: &mut [Vec3],
     rays: &mut RayCount,
-) -> Vec3 {
-    let mut radiance = Vec3::ZERO;
+) {
+    let n = lights.len();
+    out[..n].fill(Vec3::ZERO);
+    scratch.alive.clear();
+    scratch.alive.resize(n, true);
     let mut beta = Vec3::ONE;
     let mut ray = ps.ray;
     let mut t_hit = ps.t_hit;
@@ -674,25 +628,39 @@ pub(crate) fn path_radiance(
     let mut specular = true;
     let mut depth = 0u32;
     loop {
-        // Emission along the current ray (a light in front of the surface, or the environment).
-        if let Some((_, t, le, light_pdf)) = nearest_light(lights, &ray, t_hit) {
-            if t < t_hit || sp_opt.is_none() {
-                let w = if specular {
-                    1.0
-                } else {
-                    power_heuristic(prev_pdf, light_pdf)
-                };
-                radiance += beta * le * w;
-                break;
+        // Emission along the current ray: a light in front of the surface, or the environment.
+        let hit_surface = t_hit.is_finite();
+        let alive = &mut scratch.alive;
+        lights.nearest_per_frame(&ray, t_hit, |k, hit| {
+            if let (true, Some((_, t, le, light_pdf))) = (alive[k], hit) {
+                if t < t_hit || !hit_surface {
+                    let w = if specular {
+                        1.0
+                    } else {
+                        power_heuristic(prev_pdf, light_pdf)
+                    };
+                    out[k] += beta * le * w;
+                    alive[k] = false;
+                }
             }
-        }
+        });
         let Some(sp) = sp_opt else { break };
-        if depth >= max_depth {
+        if depth >= max_depth || !scratch.alive.contains(&true) {
             break;
         }
-        radiance += beta * sample_lights(scene, &sp, lights, rng, rays);
+        if !sp.bsdf.is_delta() {
+            next_event_frames(lights, shadow, &sp, rng, scratch, rays);
+            for k in (0..n).filter(|&k| scratch.alive[k]) {
+                out[k] += beta * scratch.nee[k];
+            }
+        }
         let uc = rng.next_f32();
         let u = rng.next_vec2();
+        let last = depth + 1 >= max_depth;
+        if last && !lights.hittable() {
+            // The continuation could only collect emission, and no ray meets a delta light.
+            break;
+        }
         let Some(bs) = sp.bsdf.sample(sp.wo, uc, u) else {
             break;
         };
@@ -719,16 +687,74 @@ pub(crate) fn path_radiance(
             d,
         };
         rays.0 += 1;
-        match scene.accel.intersect(&ray, f32::INFINITY) {
-            Some(h) => {
-                t_hit = h.t;
-                sp_opt = Some(shading_point(scene, &ray, &h, None));
-            }
-            None => {
-                t_hit = f32::INFINITY;
-                sp_opt = None;
-            }
-        }
+        (t_hit, sp_opt) = match scene.accel.intersect(&ray, f32::INFINITY) {
+            // The last vertex only needs its distance (emission in front of it), not shading.
+            Some(h) if last => (h.t, None),
+            Some(h) => (h.t, Some(shading_point(scene, &ray, &h, None))),
+            None => (f32::INFINITY, None),
+        };
     }
-    radiance
+}
+
+/// Next-event estimation at `sp` in every live frame into `scratch.nee`: one sample of every
+/// light (two numbers per light from `rng`, whatever its place), each weighted against BSDF
+/// sampling by the power heuristic (delta lights take weight 1), summed in the lights' order.
+fn next_event_frames(
+    lights: &LightFrames,
+    shadow: &ShadowTest,
+    sp: &ShadingPoint,
+    rng: &mut Pcg32,
+    scratch: &mut FramesScratch,
+    rays: &mut RayCount,
+) {
+    let n = lights.len();
+    let FramesScratch {
+        alive,
+        nee,
+        terms,
+        samples,
+        moving_terms,
+        term_scratch,
+    } = scratch;
+    let bsdf = BsdfAtWo::new(sp);
+    let moving = lights.moving_index();
+    let mut moving_u = None;
+    terms.clear();
+    for (j, light) in lights.first().iter().enumerate() {
+        let u = LightU::new(rng.next_vec2());
+        terms.push(if Some(j) == moving {
+            moving_u = Some(u);
+            Vec3::ZERO
+        } else {
+            light_term(shadow, sp, &bsdf, light.sample_at(sp.p, &u), rays)
+        });
+    }
+    nee.clear();
+    nee.resize(n, Vec3::ZERO);
+    let (Some(m), Some(u)) = (moving, moving_u) else {
+        nee.fill(terms.iter().fold(Vec3::ZERO, |l, t| l + *t));
+        return;
+    };
+    match lights.sphere() {
+        Some(s) => samples.sample_sphere(sp.p, &s.centers, s.radius, s.radiance, &u),
+        None => samples.sample_each(sp.p, lights.moving_places(m), &u),
+    }
+    moving_terms.resize(n, Vec3::ZERO);
+    light_terms(
+        shadow,
+        sp,
+        &bsdf,
+        samples,
+        alive,
+        term_scratch,
+        moving_terms,
+        rays,
+    );
+    for k in (0..n).filter(|&k| alive[k]) {
+        let mut l = Vec3::ZERO;
+        for (j, t) in terms.iter().enumerate() {
+            l += if j == m { moving_terms[k] } else { *t };
+        }
+        nee[k] = l;
+    }
 }

@@ -5,11 +5,9 @@
 //! random numbers from streams keyed by (seed, pixel, sample) only, so the image is bit-identical
 //! for any thread count.
 
-pub mod bench;
 pub mod camera;
-#[cfg(feature = "embree-anchor")]
-pub mod embree;
 pub mod film;
+pub mod frames;
 pub mod geometry;
 pub mod image_io;
 pub mod integrator;
@@ -19,16 +17,17 @@ pub mod wide_bvh;
 
 pub use camera::{Camera, Projection};
 pub use film::{Aov, Filter, Image, PixelSum};
+pub use frames::LightFrames;
 pub use geometry::{Accel, Instance, Ray, Transform, TriMesh};
 pub use integrator::{
-    direct_radiance, light_rng, primary_sample, sample_rngs, shade_direct, Integrator,
-    PrimarySample, ShadingPoint,
+    light_rng, primary_sample, sample_rngs, Integrator, PrimarySample, ShadingPoint,
 };
 pub use light::{EnvMap, Environment, Light};
 
 use crate::material::Material;
-use glam::UVec2;
+use glam::{UVec2, Vec3};
 use indicatif::{ProgressBar, ProgressStyle};
+use integrator::{radiance_frames, FramesScratch, RayCount, ShadowTest};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
@@ -146,15 +145,78 @@ pub fn render(
     settings: &RenderSettings,
     run: &RunOptions,
 ) -> Result<RenderOutput, RenderError> {
-    render_with_lights(scene, &scene.lights, settings, run)
+    let mut frames = render_frames(scene, &LightFrames::fixed(&scene.lights), settings, run)?;
+    let frame = frames.frames.swap_remove(0);
+    Ok(RenderOutput {
+        image: Image {
+            width: frames.width,
+            height: frames.height,
+            beauty: frame.beauty,
+            std_error: frame.std_error,
+            aov: frames.aov,
+            nonfinite: frame.nonfinite,
+        },
+        elapsed: frames.elapsed,
+        rays: frames.rays,
+    })
 }
 
-/// What every tiled render starts with: the image size checked, a pool of `run.threads`
-/// threads, and the origins of the TILE×TILE tiles covering the image (row-major).
-pub fn tiled_job(
+/// One frame of a [`render_frames`] run: its radiance and per-pixel standard error (the AOVs,
+/// the same in every frame, are kept once in [`Frames`]).
+#[derive(Clone, Debug)]
+pub struct FrameImage {
+    /// Mean radiance per pixel (row-major, top row first).
+    pub beauty: Vec<Vec3>,
+    /// Standard error of each pixel's luminance.
+    pub std_error: Vec<f32>,
+    /// Samples that were not finite (counted, contributing zero).
+    pub nonfinite: u64,
+}
+
+/// The frames of a [`render_frames`] run with the first-hit AOVs they share.
+#[derive(Clone, Debug)]
+pub struct Frames {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// The first-hit AOVs, shared by every frame.
+    pub aov: Vec<Aov>,
+    /// One image per frame of the [`LightFrames`], in order.
+    pub frames: Vec<FrameImage>,
+    /// Wall time of the render.
+    pub elapsed: Duration,
+    /// Rays traced (camera, shadow and bounce rays).
+    pub rays: u64,
+}
+
+impl Frames {
+    /// Frame `k` as a renderer [`Image`] (for EXR output with the AOV layers).
+    pub fn image(&self, k: usize) -> Image {
+        let f = &self.frames[k];
+        Image {
+            width: self.width,
+            height: self.height,
+            beauty: f.beauty.clone(),
+            std_error: f.std_error.clone(),
+            aov: self.aov.clone(),
+            nonfinite: f.nonfinite,
+        }
+    }
+}
+
+/// Renders every frame of `lights` at once, tile by tile on a pool of `run.threads` threads.
+///
+/// Each pixel sample's light-independent part ([`primary_sample`]) and its path are computed
+/// once and lit for every frame straight away (pixel → sample → frame), so nothing but the
+/// tile's pixel sums is kept whatever the number of frames; each frame equals the render of
+/// that frame alone, bit for bit, on any thread count.
+pub fn render_frames(
     scene: &Scene,
+    lights: &LightFrames,
+    settings: &RenderSettings,
     run: &RunOptions,
-) -> Result<(rayon::ThreadPool, Vec<UVec2>), RenderError> {
+) -> Result<Frames, RenderError> {
     let (w, h) = (scene.camera.width, scene.camera.height);
     if w == 0 || h == 0 {
         return Err(RenderError::EmptyImage {
@@ -172,92 +234,145 @@ pub fn tiled_job(
     let tiles: Vec<UVec2> = (0..h.div_ceil(TILE))
         .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| UVec2::new(tx, ty) * TILE))
         .collect();
-    Ok((pool, tiles))
-}
-
-/// Renders the scene lit by `lights` instead of its own.
-pub fn render_with_lights(
-    scene: &Scene,
-    lights: &[Light],
-    settings: &RenderSettings,
-    run: &RunOptions,
-) -> Result<RenderOutput, RenderError> {
-    let (w, h) = (scene.camera.width, scene.camera.height);
-    let (pool, tiles) = tiled_job(scene, run)?;
-    let bar = if run.progress {
-        let b = ProgressBar::new(tiles.len() as u64);
-        b.set_style(
-            ProgressStyle::with_template(
-                "{spinner} [{elapsed_precise}] {wide_bar} {pos}/{len} tiles, eta {eta} {msg}",
-            )
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-        );
-        b
-    } else {
-        ProgressBar::hidden()
-    };
+    let shadow = ShadowTest::culled(&scene.accel);
+    let bar = progress_bar(run.progress, tiles.len() as u64, lights.len());
     let total_rays = AtomicU64::new(0);
     let start = Instant::now();
-    let results: Vec<(UVec2, Vec<PixelSum>)> = pool.install(|| {
+    let results: Vec<(UVec2, TileFrames)> = pool.install(|| {
         tiles
             .par_iter()
             .map(|&origin| {
-                let (sums, rays) = render_tile(scene, lights, settings, origin);
-                let total = total_rays.fetch_add(rays, Ordering::Relaxed) + rays;
+                let tile = render_tile(scene, lights, &shadow, settings, origin);
+                let total = total_rays.fetch_add(tile.rays, Ordering::Relaxed) + tile.rays;
                 let secs = start.elapsed().as_secs_f64().max(1e-9);
                 bar.set_message(format!("{:.2} Mrays/s", total as f64 / secs / 1e6));
                 bar.inc(1);
-                (origin, sums)
+                (origin, tile)
             })
             .collect()
     });
     bar.finish_and_clear();
-    let mut sums = vec![PixelSum::default(); (w * h) as usize];
+    let n = (w * h) as usize;
+    let mut frames: Vec<FrameImage> = (0..lights.len())
+        .map(|_| FrameImage {
+            beauty: vec![Vec3::ZERO; n],
+            std_error: vec![0.0; n],
+            nonfinite: 0,
+        })
+        .collect();
+    let mut aov = vec![Aov::default(); n];
     for (origin, tile) in results {
         let tw = TILE.min(w - origin.x);
-        for (i, s) in tile.into_iter().enumerate() {
+        let place = |i: usize| {
             let (x, y) = (origin.x + i as u32 % tw, origin.y + i as u32 / tw);
-            sums[(y * w + x) as usize] = s;
+            (y * w + x) as usize
+        };
+        for (i, a) in tile.aov.iter().enumerate() {
+            aov[place(i)] = *a;
+        }
+        for (f, img) in frames.iter_mut().zip(tile.frames) {
+            for i in 0..img.beauty.len() {
+                f.beauty[place(i)] = img.beauty[i];
+                f.std_error[place(i)] = img.std_error[i];
+            }
+            f.nonfinite += img.nonfinite;
         }
     }
-    Ok(RenderOutput {
-        image: Image::from_sums(w, h, &sums),
+    Ok(Frames {
+        width: w,
+        height: h,
+        aov,
+        frames,
         elapsed: start.elapsed(),
         rays: total_rays.into_inner(),
     })
 }
 
-/// Renders one tile; returns its pixel sums (row-major within the tile) and the rays traced.
+fn progress_bar(show: bool, tiles: u64, frames: usize) -> ProgressBar {
+    if !show {
+        return ProgressBar::hidden();
+    }
+    let per = if frames > 1 {
+        format!(" × {frames} frames")
+    } else {
+        String::new()
+    };
+    let b = ProgressBar::new(tiles);
+    b.set_style(
+        ProgressStyle::with_template(&format!(
+            "{{spinner}} [{{elapsed_precise}}] {{wide_bar}} {{pos}}/{{len}} tiles{per}, eta {{eta}} {{msg}}"
+        ))
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    b
+}
+
+/// One tile's frames (per frame the averaged pixels, an [`Image`] the size of the tile without
+/// AOVs), its AOVs once, and the rays traced.
+struct TileFrames {
+    aov: Vec<Aov>,
+    frames: Vec<Image>,
+    rays: u64,
+}
+
+/// One tile for every frame: each (pixel, frame) sums its samples in sample order; the AOVs,
+/// the same in every frame, are summed once.
 fn render_tile(
     scene: &Scene,
-    lights: &[Light],
+    lights: &LightFrames,
+    shadow: &ShadowTest,
     settings: &RenderSettings,
     origin: UVec2,
-) -> (Vec<PixelSum>, u64) {
+) -> TileFrames {
     let (w, h) = (scene.camera.width, scene.camera.height);
     let (tw, th) = (TILE.min(w - origin.x), TILE.min(h - origin.y));
-    let mut rays = integrator::RayCount::default();
-    let mut out = Vec::with_capacity((tw * th) as usize);
-    for y in origin.y..origin.y + th {
-        for x in origin.x..origin.x + tw {
-            let pixel = UVec2::new(x, y);
-            let mut sum = PixelSum::default();
-            for s in 0..settings.spp {
-                let ps = primary_sample(scene, pixel, s, settings.seed);
-                rays.0 += 1;
-                let mut rng = light_rng(scene, pixel, s, settings.seed);
-                let l = match settings.integrator {
-                    Integrator::Direct => {
-                        integrator::direct_radiance_counted(scene, &ps, lights, &mut rng, &mut rays)
-                    }
-                    Integrator::Path { max_depth } => integrator::path_radiance(
-                        scene, &ps, lights, &mut rng, max_depth, &mut rays,
-                    ),
-                };
-                sum.add(l, &ps.aov);
+    let n = (tw * th) as usize;
+    let frames = lights.len();
+    let max_depth = settings.integrator.max_depth();
+    // Pixel-major (pixel i, frame k at i·frames + k): a pixel's samples update one contiguous
+    // run of sums instead of one cache line in each of `frames` arrays.
+    let mut sums = vec![PixelSum::default(); n * frames];
+    let mut aov_sums = vec![PixelSum::default(); n];
+    let mut radiance = vec![Vec3::ZERO; frames];
+    let mut scratch = FramesScratch::default();
+    let mut rays = RayCount::default();
+    for (i, pixel) in (origin.y..origin.y + th)
+        .flat_map(|y| (origin.x..origin.x + tw).map(move |x| UVec2::new(x, y)))
+        .enumerate()
+    {
+        for s in 0..settings.spp {
+            let ps = primary_sample(scene, pixel, s, settings.seed);
+            rays.0 += 1;
+            let mut rng = light_rng(scene, pixel, s, settings.seed);
+            radiance_frames(
+                scene,
+                lights,
+                shadow,
+                &ps,
+                &mut rng,
+                max_depth,
+                &mut scratch,
+                &mut radiance,
+                &mut rays,
+            );
+            for (sum, l) in sums[i * frames..(i + 1) * frames].iter_mut().zip(&radiance) {
+                sum.add_radiance(*l);
             }
-            out.push(sum);
+            aov_sums[i].add(Vec3::ZERO, &ps.aov);
         }
     }
-    (out, rays.0)
+    let aov = Image::from_sums(tw, th, &aov_sums).aov;
+    let frames = (0..frames)
+        .map(|k| {
+            let frame_sums: Vec<PixelSum> = sums.iter().skip(k).step_by(frames).copied().collect();
+            let mut img = Image::from_sums(tw, th, &frame_sums);
+            img.aov = Vec::new();
+            img
+        })
+        .collect();
+    TileFrames {
+        aov,
+        frames,
+        rays: rays.0,
+    }
 }

@@ -2,19 +2,21 @@
 //! or naive), write each frame's EXR, PNG and record, and assemble the sequence once every frame
 //! of the sweep is in the output folder.
 
-use super::cache::{render_naive, render_sweep, SetupError, SweepPath, SweepRender};
 use super::manifest::{Manifest, MANIFEST_FILE};
 use super::path::{parse_frames_range, PathError};
+use super::path::{SetupError, SweepPath};
 use super::sequence::{
     assemble, clear_assembled, frame_stem, unmark_frame, write_record, AssembleOptions, Assembled,
     FrameRecord, Region, SequenceError, SweepSettings,
 };
+use super::{render_naive, render_sweep};
 use crate::output::{remove_if_present, FolderLock, LockError, LockMode};
 use crate::render::image_io::{
     aov_layers, beauty_rgba, commit, stage_exr_layers, stage_png_linear, write_exr_layers,
     ExrCompression, ExrLayer, ImageError,
 };
 use crate::render::resources::{ResourceError, Resources};
+use crate::render::Frames;
 use crate::render::{RenderError, RunOptions};
 use crate::scene::LoadedScene;
 use rayon::prelude::*;
@@ -100,10 +102,14 @@ pub const AOV_FILE: &str = "aov.exr";
 /// first, then its EXR (radiance and standard error) and PNG are renamed into place and its new
 /// record is written last, so a record always describes the images beside it, even when the run
 /// is killed. The job that renders frame 0 also writes the AOVs every frame shares into
-/// [`AOV_FILE`] (the camera and geometry do not move).
+/// [`AOV_FILE`] (the camera and geometry do not move). `render` holds frames `range` of the
+/// sweep `path`.
+#[allow(clippy::too_many_arguments)]
 pub fn write_frames(
     dir: &Path,
-    render: &SweepRender,
+    render: &Frames,
+    path: &SweepPath,
+    range: Range<usize>,
     total: usize,
     exposure: f32,
     regions: &[Region],
@@ -111,42 +117,48 @@ pub fn write_frames(
     settings: &SweepSettings,
 ) -> Result<(), SweepError> {
     let (w, h) = (render.width, render.height);
-    if render.frames.first().is_some_and(|f| f.index == 0) {
+    if range.start == 0 && !render.frames.is_empty() {
         write_exr_layers(&dir.join(AOV_FILE), w, h, &aov_layers(&render.aov))?;
     }
-    render.frames.par_iter().try_for_each(|f| {
-        let stem = frame_stem(f.index);
-        let layers = [
-            beauty_rgba(&f.beauty, &render.aov),
-            ExrLayer {
-                name: "std_error",
-                channels: &["Y"],
-                data: f.std_error.clone(),
-            },
-        ];
-        // One attribute: the exr crate writes its extra attributes in hash-map order, which
-        // differs run to run, and frames must be byte-stable (tests/robustness.rs).
-        let meta = [(
-            "sweep_frame",
-            format!("frame {} of {total}, light at {} deg", f.index, f.light_deg),
-        )];
-        let exr = stage_exr_layers(
-            &dir.join(format!("{stem}.exr")),
-            w,
-            h,
-            &layers,
-            compression,
-            &meta,
-        )?;
-        let png = stage_png_linear(&dir.join(format!("{stem}.png")), w, h, &f.beauty, exposure)?;
-        let mut rec = FrameRecord::measure(f.index, total, f.light_deg, (w, h), &f.beauty, regions);
-        rec.sweep = settings.clone();
-        unmark_frame(dir, f.index)?;
-        commit(exr)?;
-        commit(png)?;
-        write_record(dir, &rec)?;
-        Ok(())
-    })
+    render
+        .frames
+        .par_iter()
+        .zip(range)
+        .try_for_each(|(f, index)| {
+            let light_deg = path.light_deg(index);
+            let stem = frame_stem(index);
+            let layers = [
+                beauty_rgba(&f.beauty, &render.aov),
+                ExrLayer {
+                    name: "std_error",
+                    channels: &["Y"],
+                    data: f.std_error.clone(),
+                },
+            ];
+            // One attribute: the exr crate writes its extra attributes in hash-map order, which
+            // differs run to run, and frames must be byte-stable (tests/robustness.rs).
+            let meta = [(
+                "sweep_frame",
+                format!("frame {index} of {total}, light at {light_deg} deg"),
+            )];
+            let exr = stage_exr_layers(
+                &dir.join(format!("{stem}.exr")),
+                w,
+                h,
+                &layers,
+                compression,
+                &meta,
+            )?;
+            let png =
+                stage_png_linear(&dir.join(format!("{stem}.png")), w, h, &f.beauty, exposure)?;
+            let mut rec = FrameRecord::measure(index, total, light_deg, (w, h), &f.beauty, regions);
+            rec.sweep = settings.clone();
+            unmark_frame(dir, index)?;
+            commit(exr)?;
+            commit(png)?;
+            write_record(dir, &rec)?;
+            Ok(())
+        })
 }
 
 /// Runs a sweep job on a loaded scene. A whole sweep holds its output folder alone, clears what
@@ -200,6 +212,8 @@ pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepE
     write_frames(
         &job.out,
         &r,
+        &path,
+        range.clone(),
         total,
         loaded.exposure,
         &scene_regions(loaded),

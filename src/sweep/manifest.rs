@@ -4,7 +4,7 @@
 //! direction, intensity). `xylem sweep` writes it for every sweep; a photographed sweep supplies
 //! its own (fields in notes/fit.md "Capture format").
 
-use super::cache::SweepPath;
+use super::path::SweepPath;
 use crate::render::{Light, Projection};
 use crate::scene::LoadedScene;
 use glam::Vec3;

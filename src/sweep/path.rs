@@ -6,6 +6,8 @@
 //! through the object's zenith.
 
 use crate::math::Vec3;
+use crate::render::{Light, LightFrames};
+use crate::scene::{LoadedScene, MAX_ARCS};
 use std::ops::Range;
 
 /// Errors in a light path or frame selection; each message names the value and the allowed range.
@@ -251,5 +253,232 @@ mod tests {
                 "{bad}"
             );
         }
+    }
+}
+
+/// Where the moving light goes: the arc's angles, its plane, and for lights with a position the
+/// pivot and distance. The light runs the arc once per azimuth (`azimuths[..arcs]`, degrees
+/// about the zenith from `plane`): frame k is angle `k % arc.frames` of arc `k / arc.frames`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SweepPath {
+    pub arc: LightArc,
+    pub plane: ArcPlane,
+    pub pivot: Vec3,
+    pub radius: f32,
+    pub azimuths: [f32; MAX_ARCS],
+    pub arcs: usize,
+}
+
+/// Why a scene's sweep cannot be set up; each names the scene and the `[sweep]` field.
+#[derive(Debug, thiserror::Error)]
+pub enum SetupError {
+    #[error(
+        "scene `{scene}` has no [sweep] table (it needs at least `light`, `arc_deg` and `radius`)"
+    )]
+    NoTable { scene: String },
+    #[error(
+        "scene `{scene}`: [sweep] light = \"{light}\" names no light; lights with names: {names}"
+    )]
+    NoLight {
+        scene: String,
+        light: String,
+        names: String,
+    },
+    #[error("scene `{scene}`: [sweep] light = \"{light}\" is an area or environment light; a sweep moves a point, spot, sphere or distant light")]
+    Immovable { scene: String, light: String },
+    #[error("scene `{scene}`: [sweep] {field}: {message}")]
+    Field {
+        scene: String,
+        field: &'static str,
+        message: String,
+    },
+    #[error("scene `{scene}`: {source}")]
+    Path { scene: String, source: PathError },
+}
+
+impl SweepPath {
+    /// The sweep of a loaded scene's `[sweep]` table, with `frames` and `arc` (degrees) overriding
+    /// the table's; returns the path and the index of the light that moves.
+    pub fn from_scene(
+        loaded: &LoadedScene,
+        frames: Option<usize>,
+        arc: Option<(f32, f32)>,
+    ) -> Result<(SweepPath, usize), SetupError> {
+        let scene = loaded.name.clone();
+        let t = loaded.sweep.as_ref().ok_or_else(|| SetupError::NoTable {
+            scene: scene.clone(),
+        })?;
+        let moving = loaded
+            .light_names
+            .iter()
+            .position(|n| n.as_deref() == Some(t.light.as_str()))
+            .ok_or_else(|| SetupError::NoLight {
+                scene: scene.clone(),
+                light: t.light.clone(),
+                names: loaded
+                    .light_names
+                    .iter()
+                    .flatten()
+                    .map(|n| format!("\"{n}\""))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            })?;
+        if matches!(
+            loaded.scene.lights[moving],
+            Light::Rect { .. } | Light::Environment(_)
+        ) {
+            return Err(SetupError::Immovable {
+                scene,
+                light: t.light.clone(),
+            });
+        }
+        let field = |field, message: &str| SetupError::Field {
+            scene: scene.clone(),
+            field,
+            message: message.to_string(),
+        };
+        let radius = t.radius;
+        if !(radius.is_finite() && radius > 0.0) {
+            return Err(field(
+                "radius",
+                &format!("{radius} must be a positive distance (mm)"),
+            ));
+        }
+        let pivot = Vec3::from_array(t.pivot);
+        if !pivot.is_finite() {
+            return Err(field("pivot", "every component must be finite"));
+        }
+        let plane = ArcPlane::from_axis(Vec3::Z, Vec3::from_array(t.axis)).ok_or_else(|| {
+            field(
+                "axis",
+                "must be a non-zero direction not parallel to +z (the zenith)",
+            )
+        })?;
+        let (from, to) = arc.unwrap_or((t.arc_deg[0], t.arc_deg[1]));
+        let arc =
+            LightArc::new(from, to, frames.unwrap_or(t.frames as usize)).map_err(|source| {
+                SetupError::Path {
+                    scene: scene.clone(),
+                    source,
+                }
+            })?;
+        let arcs = t.azimuths_deg.len();
+        if arcs == 0 || arcs > MAX_ARCS {
+            return Err(field(
+                "azimuths_deg",
+                &format!("{arcs} azimuths (allowed 1 to {MAX_ARCS})"),
+            ));
+        }
+        if arc.frames * arcs > MAX_FRAMES {
+            return Err(SetupError::Path {
+                scene,
+                source: PathError::Frames(arc.frames * arcs),
+            });
+        }
+        let path = SweepPath::with_arcs(arc, plane, pivot, radius, &t.azimuths_deg);
+        Ok((path, moving))
+    }
+
+    /// A path of one arc per entry of `azimuths_deg` (at most [`MAX_ARCS`]; extra ones are
+    /// dropped).
+    pub fn with_arcs(
+        arc: LightArc,
+        plane: ArcPlane,
+        pivot: Vec3,
+        radius: f32,
+        azimuths_deg: &[f32],
+    ) -> SweepPath {
+        let given = azimuths_deg.len().min(MAX_ARCS);
+        let mut azimuths = [0.0; MAX_ARCS];
+        azimuths[..given].copy_from_slice(&azimuths_deg[..given]);
+        let arcs = given.max(1);
+        SweepPath {
+            arc,
+            plane,
+            pivot,
+            radius,
+            azimuths,
+            arcs,
+        }
+    }
+
+    /// Frames of the whole sweep: every arc's.
+    pub fn frames(&self) -> usize {
+        self.arc.frames * self.arcs
+    }
+
+    /// The light angle (degrees from the zenith along its arc) of frame `frame`.
+    pub fn light_deg(&self, frame: usize) -> f32 {
+        self.arc.angle_deg(frame % self.arc.frames)
+    }
+
+    /// The azimuth (degrees about the zenith) of the arc frame `frame` lies on.
+    pub fn azimuth_deg(&self, frame: usize) -> f32 {
+        self.azimuths[(frame / self.arc.frames).min(self.arcs - 1)]
+    }
+
+    /// The plane of the arc frame `frame` lies on: `plane` turned about its zenith by the arc's
+    /// azimuth (Rodrigues' rotation of `toward`, which is perpendicular to the zenith).
+    pub fn frame_plane(&self, frame: usize) -> ArcPlane {
+        let (s, c) = self.azimuth_deg(frame).to_radians().sin_cos();
+        let (z, a) = (self.plane.zenith, self.plane.toward);
+        ArcPlane {
+            zenith: z,
+            toward: (c * a + s * z.cross(a)).normalize(),
+        }
+    }
+
+    /// The unit direction from the pivot towards the light of frame `frame`.
+    pub fn direction(&self, frame: usize) -> Vec3 {
+        self.frame_plane(frame).direction(self.light_deg(frame))
+    }
+
+    /// `light` moved to frame `frame`: point and sphere lights move to the arc point, spot
+    /// lights move there and aim at the pivot, distant lights shine from the arc direction.
+    /// Other lights (area, environment) have no position on an arc and are returned unchanged.
+    pub fn place(&self, light: &Light, frame: usize) -> Light {
+        let dir = self.direction(frame);
+        let at = self.pivot + self.radius * dir;
+        match light.clone() {
+            Light::Point { intensity, .. } => Light::Point {
+                position: at,
+                intensity,
+            },
+            Light::Spot {
+                intensity,
+                cos_inner,
+                cos_outer,
+                ..
+            } => Light::Spot {
+                position: at,
+                direction: -dir,
+                intensity,
+                cos_inner,
+                cos_outer,
+            },
+            Light::Sphere {
+                radius, radiance, ..
+            } => Light::Sphere {
+                center: at,
+                radius,
+                radiance,
+            },
+            Light::Distant { irradiance, .. } => Light::Distant {
+                direction: dir,
+                irradiance,
+            },
+            other => other,
+        }
+    }
+
+    /// The scene's lights over frames `frames` of this path, light `moving` placed on the arc.
+    pub fn light_frames(
+        &self,
+        lights: &[Light],
+        moving: usize,
+        frames: Range<usize>,
+    ) -> LightFrames {
+        let places = frames.map(|f| self.place(&lights[moving], f)).collect();
+        LightFrames::moving(lights, moving, places)
     }
 }

@@ -3,11 +3,11 @@
 //! such frames — rendered here or farmed out with `--frames-range` — into the contact sheet, the
 //! animated PNG, the CSV and the `index.html` viewer. One code path serves both cases.
 
-use super::contact::{contact_sheet, Rgb8};
 use super::path::MAX_FRAMES;
 use super::viewer::viewer_html;
 use crate::math::{luminance, Vec3};
 use crate::output::{remove_if_present, write_atomic, Staged};
+use crate::picture::contact::{contact_sheet, Rgb8};
 use crate::render::image_io::{write_png_linear, write_png_rgb8, ImageError};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};

@@ -7,12 +7,12 @@
 
 use crate::material::{MeasuredBoard, Placement};
 use crate::math::luminance;
+use crate::picture::contact::{contact_sheet_rows, Rgb8};
+use crate::picture::plot::{line_plot, PlotOptions, Series, PALETTE};
 use crate::render::image_io::{to_srgb8, write_png_rgb8};
 use crate::render::{render, RunOptions};
 use crate::scene;
-use crate::sweep::cache::{render_sweep, SweepPath};
-use crate::sweep::contact::{contact_sheet_rows, Rgb8};
-use crate::sweep::plot::{line_plot, PlotOptions, Series, PALETTE};
+use crate::sweep::{render_sweep, SweepPath};
 use crate::validate::report::markdown_table;
 use crate::wood::{Needs, WoodVolume};
 use glam::Vec3;
@@ -583,7 +583,7 @@ axis = {axis}
         Ok(SweepLuminance {
             width: r.width,
             height: r.height,
-            angles: r.frames.iter().map(|f| f.light_deg).collect(),
+            angles: (0..r.frames.len()).map(|k| path.light_deg(k)).collect(),
             frames: r.frames.iter().map(|f| f.beauty.clone()).collect(),
         })
     }

@@ -1186,7 +1186,7 @@ pub fn to_markdown(v: &BsdfValidation, plots: &[(String, String)]) -> String {
 /// Writes the polar plot of `spec` (f·cos θi in the incidence plane at θo = 0°, 30°, 60°, 80°,
 /// each curve normalised to its own maximum, so lobe shapes compare across angles) as a PNG.
 pub fn write_polar_plot(spec: &CaseSpec, path: &Path) -> anyhow::Result<()> {
-    use crate::sweep::plot::{line_plot, PlotOptions, Series, PALETTE};
+    use crate::picture::plot::{line_plot, PlotOptions, Series, PALETTE};
     let b = spec.bsdf()?;
     let curves: Vec<Vec<(f64, f64)>> = [0.0f32, 30.0, 60.0, 80.0]
         .iter()

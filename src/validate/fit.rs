@@ -455,10 +455,10 @@ pub const FULL_WELL: f32 = 4000.0;
 fn plot_png(
     dir: &Path,
     name: &str,
-    series: &[crate::sweep::plot::Series],
+    series: &[crate::picture::plot::Series],
     log_x: bool,
 ) -> Result<(), String> {
-    use crate::sweep::plot::{line_plot, PlotOptions};
+    use crate::picture::plot::{line_plot, PlotOptions};
     let img = line_plot(
         series,
         &PlotOptions {
@@ -472,8 +472,8 @@ fn plot_png(
 }
 
 /// Fitted and true maps side by side (diffuse, fibre colour, axis as colour), 2× enlarged.
-fn side_by_side(truth: &MeasuredBoard, fitted: &FittedMaps) -> crate::sweep::contact::Rgb8 {
-    use crate::sweep::contact::{contact_sheet_rows, Rgb8};
+fn side_by_side(truth: &MeasuredBoard, fitted: &FittedMaps) -> crate::picture::contact::Rgb8 {
+    use crate::picture::contact::{contact_sheet_rows, Rgb8};
     let n = truth.width;
     let img = |v: &[Vec3], f: &dyn Fn(Vec3) -> Vec3| Rgb8 {
         width: n,
@@ -522,7 +522,7 @@ pub fn run_report(
     spec: &SweepSpec,
     progress: &dyn Fn(&str),
 ) -> Result<(String, bool), String> {
-    use crate::sweep::plot::{Series, PALETTE};
+    use crate::picture::plot::{Series, PALETTE};
     use crate::validate::report::markdown_table;
     let plots = dir.join("plots");
     std::fs::create_dir_all(&plots).map_err(|e| format!("{}: {e}", plots.display()))?;
@@ -704,7 +704,7 @@ pub fn run_report(
 /// the grain), its fitted maps (diffuse, fibre colour ×3, fibre axis), and the fitted maps
 /// re-rendered through the `measured` material under the same light.
 pub fn readme_figure(base: &Path, work: &Path, spec: &SweepSpec) -> Result<(), String> {
-    use crate::sweep::contact::{contact_sheet_rows, Rgb8};
+    use crate::picture::contact::{contact_sheet_rows, Rgb8};
     let w = work.join("readme");
     let source = Source::Measured {
         dir: "data/marschner2005/maple".into(),

@@ -15,10 +15,12 @@ pub mod appearance;
 pub mod bsdf;
 pub mod fit;
 pub mod gltf;
+pub mod highlight;
 pub mod layered_reference;
 pub mod report;
 pub mod rough_finish;
 pub mod scenes;
 pub mod sweep;
+pub mod tradeoff;
 
 pub use report::update_report_section;

@@ -3,7 +3,7 @@
 //! 1. **Highlight tracking** — a flat finished board with uniform fibres dipping α = 0°, 15°, 30°
 //!    into the surface, orthographic camera, distant light on an arc: each pixel's brightest
 //!    frame lies within one frame step of the light angle predicted from the model (refraction
-//!    into the finish and ψh = 0; `sweep::highlight`, derivation in notes/sweep.md).
+//!    into the finish and ψh = 0; `validate::highlight`, derivation in notes/sweep.md).
 //! 2. **Renderer against the BSDF** — the same setup: every pixel of every frame equals
 //!    `eval(wo, wi) · cos θi · E` computed directly from [`WoodBsdf`] (relative error ≤ 1e-3).
 //! 3. **Figure signatures** — African mahogany (interlocked grain): the two families of stripes
@@ -18,11 +18,12 @@
 
 use crate::bsdf::{Bsdf, WoodBsdf, WoodBsdfParams};
 use crate::math::{luminance, Vec3};
+use crate::picture::plot::{line_plot, PlotOptions, Series, PALETTE};
+use crate::render::Frames;
 use crate::render::RunOptions;
 use crate::scene::{from_str, LoadedScene};
-use crate::sweep::cache::{render_sweep, SweepPath, SweepRender};
-use crate::sweep::highlight::{inclined_fibre, peak_in_arc_deg};
-use crate::sweep::plot::{line_plot, PlotOptions, Series, PALETTE};
+use crate::sweep::{render_sweep, SweepPath};
+use crate::validate::highlight::{inclined_fibre, peak_in_arc_deg};
 use crate::validate::report::markdown_table;
 use serde::Serialize;
 use std::path::Path;
@@ -182,7 +183,7 @@ fn load(name: &str, text: &str) -> Result<LoadedScene, SweepCheckError> {
 fn sweep_all(
     loaded: &LoadedScene,
     run: &RunOptions,
-) -> Result<(SweepRender, SweepPath), SweepCheckError> {
+) -> Result<(Frames, SweepPath), SweepCheckError> {
     let err = |message: String| SweepCheckError::Scene {
         name: loaded.name.clone(),
         message,
@@ -202,7 +203,7 @@ fn sweep_all(
 }
 
 /// Luminance of pixel `i` in every frame.
-fn pixel_series(r: &SweepRender, i: usize) -> Vec<f32> {
+fn pixel_series(r: &Frames, i: usize) -> Vec<f32> {
     r.frames.iter().map(|f| luminance(f.beauty[i])).collect()
 }
 
@@ -353,8 +354,8 @@ pub fn renderer_vs_bsdf(run: &RunOptions) -> Result<CheckOutcome, SweepCheckErro
     let wo = Vec3::new(s, 0.0, c);
     let mut worst = 0.0f64;
     let mut compared = 0usize;
-    for f in &r.frames {
-        let wi = path.plane.direction(f.light_deg);
+    for (k, f) in r.frames.iter().enumerate() {
+        let wi = path.plane.direction(path.light_deg(k));
         // E = 1 on a surface facing the light; cos θi = wi·n with n = +z.
         let expected = bsdf.eval(wo, wi) * wi.z;
         for px in &f.beauty {
@@ -383,7 +384,7 @@ pub fn renderer_vs_bsdf(run: &RunOptions) -> Result<CheckOutcome, SweepCheckErro
 /// The diffuse term's dependence on the light, g(θi) = luminance(f_diffuse(wo, wi)) · cos θi, for
 /// the orthographic view straight down (wo = +z) and each frame's light direction, from [`WoodBsdf`]
 /// with the fibre lobe switched off (k_f = 0); the substrate albedo only scales it.
-fn diffuse_shape(path: &SweepPath, r: &SweepRender) -> Result<Vec<f64>, SweepCheckError> {
+fn diffuse_shape(path: &SweepPath, r: &Frames) -> Result<Vec<f64>, SweepCheckError> {
     let bsdf = WoodBsdf::new(WoodBsdfParams {
         diffuse: Vec3::splat(0.5),
         fiber_color: Vec3::ZERO,
@@ -394,10 +395,9 @@ fn diffuse_shape(path: &SweepPath, r: &SweepRender) -> Result<Vec<f64>, SweepChe
         name: "mahogany_stripes".into(),
         message: e.to_string(),
     })?;
-    Ok(r.frames
-        .iter()
-        .map(|f| {
-            let wi = path.plane.direction(f.light_deg);
+    Ok((0..r.frames.len())
+        .map(|k| {
+            let wi = path.plane.direction(path.light_deg(k));
             (luminance(bsdf.eval(Vec3::Z, wi)) * wi.z.max(0.0)) as f64
         })
         .collect())

@@ -1,7 +1,7 @@
 //! `xylem bench trace`: BVH build time and closest-hit / any-hit rays per second per core on a
 //! ~1M-triangle mesh, for coherent (camera) and incoherent (random) rays.
 
-use crate::render::bench::{build_params, run_trace_benchmark, TraceFigures, BUILD_PRESETS};
+use crate::bench::trace::{build_params, run_trace_benchmark, TraceFigures, BUILD_PRESETS};
 use anyhow::{bail, Context};
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -3,9 +3,9 @@
 //! time and closest-hit / any-hit rays per second on one core, for xylem's wide BVH and, on the
 //! same mesh and rays, obvhs's CWBVH traversal (and Embree 3 with the feature `embree-anchor`).
 
-use super::geometry::{Accel, Instance, Ray, Transform, TriMesh};
 use crate::material::Placement;
 use crate::math::{uniform_sphere, Pcg32, PI};
+use crate::render::geometry::{Accel, Instance, Ray, Transform, TriMesh};
 use glam::{Vec2, Vec3};
 use obvhs::cwbvh::{builder::build_cwbvh_from_tris, CwBvh};
 use obvhs::ray::{Ray as BvhRay, RayHit};

@@ -3,7 +3,7 @@
 //! Declarations follow embree3/rtcore_*.h (Embree 3.13, RTC_MAX_INSTANCE_LEVEL_COUNT = 1,
 //! RTC_MIN_WIDTH = 0).
 
-use super::geometry::{Ray, TriMesh};
+use crate::render::geometry::{Ray, TriMesh};
 use std::ffi::c_void;
 use std::time::{Duration, Instant};
 
@@ -195,28 +195,28 @@ impl Drop for EmbreeScene {
     }
 }
 
-/// Times Embree on the same rays as [`super::bench::time_rays`].
-pub fn time_rays(scene: &EmbreeScene, rays: &[Ray], coherent: bool) -> super::bench::TraceFigures {
-    let t0 = super::bench::ThreadTimer::start();
+/// Times Embree on the same rays as [`super::trace::time_rays`].
+pub fn time_rays(scene: &EmbreeScene, rays: &[Ray], coherent: bool) -> super::trace::TraceFigures {
+    let t0 = super::trace::ThreadTimer::start();
     let hits = rays
         .iter()
         .filter(|r| scene.intersect(r, coherent).is_some())
         .count();
     let closest = t0.elapsed();
-    let t1 = super::bench::ThreadTimer::start();
+    let t1 = super::trace::ThreadTimer::start();
     let free = rays
         .iter()
         .filter(|r| scene.unoccluded(r, f32::INFINITY, coherent))
         .count();
     let any = t1.elapsed();
     debug_assert_eq!(free + hits, rays.len());
-    super::bench::figures(rays.len(), hits, closest, any)
+    super::trace::figures(rays.len(), hits, closest, any)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::bench::{bumpy_sphere, coherent_rays, incoherent_rays};
+    use crate::bench::trace::{bumpy_sphere, coherent_rays, incoherent_rays};
     use crate::render::{Accel, Instance, Transform};
     use std::sync::Arc;
 
