@@ -36,11 +36,17 @@ fn table(node: usize, v: usize) -> f32 {
 /// from |t| = 1.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct TransmittedPart {
+    /// Fraction of the transmitted energy in this part.
     pub share: f32,
+    /// E[t_x].
     pub mean_x: f32,
+    /// E[t_z].
     pub mean_z: f32,
+    /// Var(t_x).
     pub cov_xx: f32,
+    /// Var(t_y).
     pub cov_yy: f32,
+    /// Cov(t_x, t_z).
     pub cov_xz: f32,
 }
 
