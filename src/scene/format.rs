@@ -265,7 +265,8 @@ pub enum LightTable {
         #[serde(default = "white")]
         #[serde(deserialize_with = "exact")]
         color: [f32; 3],
-        /// Optional lat-long EXR (z up, u = φ/2π from +x, v = θ/π from +z), relative to the scene file.
+        /// Optional lat-long EXR map (z up, u = φ/2π from +x, v = θ/π from +z); path relative
+        /// to the scene file.
         map: Option<String>,
         /// Turn of the map about z (degrees, −360–360, default 0).
         #[serde(default)]
@@ -351,7 +352,8 @@ pub enum MaterialTable {
         diffuse: String,
         /// Fibre colour map (8-bit PNG, same size as `diffuse`).
         fiber_color: String,
-        /// Fibre axis map (8-bit PNG; axis = 2v/255 − 1 in x = columns, y = up the image, z = normal).
+        /// Fibre axis map (8-bit PNG; axis = 2v/255 − 1 in the frame x = columns,
+        /// y = towards the top row, z = the normal).
         fiber_axis: String,
         /// Optional β map (β = 90° · v/255); else `highlight_width_deg` everywhere.
         highlight_width: Option<String>,
@@ -521,11 +523,13 @@ pub struct TreeTable {
     /// Selects which boards / slices (cut = "veneer" / "boards").
     #[serde(default)]
     pub seed: u64,
-    /// solid: tree point (mm) where the object's origin lies; its distance from z is the distance from the pith (default [0, 0, 0]).
+    /// solid: tree point (mm) where the object's origin lies; its distance from the z axis is
+    /// the distance from the pith (default [0, 0, 0]).
     #[serde(default)]
     #[serde(deserialize_with = "exact")]
     pub origin: [f32; 3],
-    /// solid: the object direction the fibres run along, mapped to the pith direction (default [0, 0, 1]).
+    /// solid: the object direction the fibres run along, mapped to the pith direction
+    /// (default [0, 0, 1]).
     #[serde(default = "default_axis")]
     #[serde(deserialize_with = "exact")]
     pub axis: [f32; 3],
