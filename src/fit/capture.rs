@@ -220,7 +220,7 @@ pub struct Capture {
 /// a two-fold ambiguity of the fibre's in-plane angle whenever the highlights of both arcs peak
 /// at the same half-vector (an in-plane fibre seen from above; notes/fit.md §3).
 pub const MIN_ARCS: usize = 3;
-/// See [`MIN_ARCS`].
+/// How far apart (degrees, mod 180°) every pair of arcs must be; see [`MIN_ARCS`].
 pub const MIN_ARC_SEPARATION_DEG: f32 = 20.0;
 
 fn vec3(a: [f32; 3]) -> Vec3 {
