@@ -79,10 +79,22 @@ pub struct FolderLock {
 /// Why a folder lock was not taken.
 #[derive(Debug, thiserror::Error)]
 pub enum LockError {
+    /// Another run holds the lock.
     #[error("output folder {path} is in use by another xylem run ({what}); wait for it to finish or choose another --out")]
-    Busy { path: String, what: &'static str },
+    Busy {
+        /// The folder.
+        path: String,
+        /// What kind of run holds it (as far as the requested mode tells).
+        what: &'static str,
+    },
+    /// The folder could not be opened or locked.
     #[error("cannot lock output folder {path}: {source}")]
-    Io { path: String, source: io::Error },
+    Io {
+        /// The folder.
+        path: String,
+        /// The I/O error.
+        source: io::Error,
+    },
 }
 
 /// How a run uses an output folder.

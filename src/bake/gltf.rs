@@ -50,23 +50,38 @@ pub fn gltf_roughness(beta: f32) -> f32 {
 /// Errors while exporting a board to glTF, naming the file.
 #[derive(Debug, thiserror::Error)]
 pub enum GltfError {
+    /// The file could not be written.
     #[error("cannot write glTF {path}: {source}")]
     Io {
+        /// The `.glb` file.
         path: String,
+        /// The I/O error.
         source: std::io::Error,
     },
+    /// A texture could not be PNG-encoded.
     #[error("cannot encode a texture of {path}: {source}")]
     Png {
+        /// The `.glb` file.
         path: String,
+        /// The encoder's error.
         source: png::EncodingError,
     },
+    /// The glTF JSON could not be serialised.
     #[error("cannot serialise the glTF document of {path}: {source}")]
     Json {
+        /// The `.glb` file.
         path: String,
+        /// serde_json's error.
         source: serde_json::Error,
     },
+    /// The maps and board do not fit together (map sizes, non-positive board size).
     #[error("glTF {path}: {message}")]
-    Invalid { path: String, message: String },
+    Invalid {
+        /// The `.glb` file.
+        path: String,
+        /// What does not fit.
+        message: String,
+    },
 }
 
 /// Writes `maps` (baked over `board`'s top face) as a `.glb` at `path`, whole or not at all

@@ -57,8 +57,11 @@ impl std::fmt::Display for BakeCut {
 /// sits `radius` mm from the pith; the baked face is the one `T/2` out along the face normal.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BoardCut {
+    /// [length W, width H, thickness T] (mm).
     pub size: [f32; 3],
+    /// Which face of the log the board shows.
     pub cut: BakeCut,
+    /// Distance of the board's centre from the pith (mm).
     pub radius: f32,
 }
 

@@ -172,6 +172,7 @@ impl FiberAxis {
         }
     }
 
+    /// The unit fibre axis u.
     #[inline]
     pub fn axis(&self) -> Vec3 {
         self.frame.n

@@ -9,6 +9,7 @@ use glam::{Vec2, Vec3};
 /// GGX distribution with width α (α → 0 is a mirror).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ggx {
+    /// Width α (the GGX roughness, 0 = mirror).
     pub alpha: f32,
 }
 

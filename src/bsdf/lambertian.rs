@@ -7,6 +7,7 @@ use glam::{Vec2, Vec3};
 /// Ideal diffuse reflection with albedo `albedo` (each channel in [0, 1]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lambertian {
+    /// Albedo per channel, linear RGB 0–1.
     pub albedo: Vec3,
 }
 

@@ -29,27 +29,39 @@ use glam::{Vec2, Vec3};
 /// probability and `f / pdf · |cos θi|` is the path weight.
 #[derive(Clone, Copy, Debug)]
 pub struct BsdfSample {
+    /// Sampled incident direction (unit, shading frame).
     pub wi: Vec3,
+    /// BSDF value f(wo, wi), without the cosine.
     pub f: Vec3,
+    /// Solid-angle density of `wi`, or the lobe-selection probability for a delta lobe.
     pub pdf: f32,
+    /// True when `wi` came from a delta lobe (`eval` and `pdf` do not see it).
     pub is_delta: bool,
 }
 
 /// A BSDF: `eval` is f(wo, wi) without the cosine and without delta lobes; `pdf` is the density
 /// per unit solid angle that `sample` draws its non-delta directions from (0 for delta lobes).
 pub trait Bsdf {
+    /// f(wo, wi) without the cosine factor and without delta lobes (shading frame, z = normal).
     fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3;
+    /// Density per unit solid angle with which `sample` draws `wi` given `wo` (0 for delta lobes).
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32;
+    /// Draws `wi` for `wo` from the lobe chosen by `uc` and the 2D sample `u` (each in [0, 1));
+    /// `None` when no direction is produced (e.g. `wo` below the surface).
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample>;
 }
 
 /// A BSDF parameter outside its allowed range (or not finite).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum BsdfError {
+    /// A parameter is not finite or outside its range.
     #[error("WoodBsdfParams.{field} = {value}: must be {range}")]
     OutOfRange {
+        /// The parameter's field name in [`WoodBsdfParams`].
         field: &'static str,
+        /// The value given.
         value: String,
+        /// The allowed range, in words.
         range: &'static str,
     },
 }

@@ -82,6 +82,7 @@ pub(crate) fn locate(t: f32, n: usize) -> (usize, f32) {
 /// interpolated from the table once at construction.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RoughFinish {
+    /// The finish's microfacet distribution (α = the finish roughness).
     pub ggx: Ggx,
     eta: f32,
     reflectance: [f32; MU_NODES],

@@ -32,15 +32,21 @@ fn table(node: usize, v: usize) -> f32 {
 /// One part (single or multiple scattering) of the transmitted light for an exterior direction
 /// whose azimuth is +x: its share of the transmitted energy, and the mean and covariance of the
 /// interior direction t (pointing up, away from the substrate, as interior directions do in
-/// `bsdf`). By symmetry about the plane of incidence E[t_y] = cov_xy = cov_yz = 0; cov_zz follows
+/// `bsdf`). By symmetry about the plane of incidence E(t_y) = cov_xy = cov_yz = 0; cov_zz follows
 /// from |t| = 1.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct TransmittedPart {
+    /// Fraction of the transmitted energy in this part.
     pub share: f32,
+    /// Mean of t_x.
     pub mean_x: f32,
+    /// Mean of t_z.
     pub mean_z: f32,
+    /// Var(t_x).
     pub cov_xx: f32,
+    /// Var(t_y).
     pub cov_yy: f32,
+    /// Cov(t_x, t_z).
     pub cov_xz: f32,
 }
 

@@ -8,6 +8,7 @@ use glam::{Vec2, Vec3};
 /// A perfect mirror with reflectance `reflectance` per channel (two-sided).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Mirror {
+    /// Reflectance per channel, linear RGB 0–1.
     pub reflectance: Vec3,
 }
 
@@ -40,11 +41,14 @@ impl Bsdf for Mirror {
 /// of refraction (Veach 1997, §5.2; pbrt-v4 §9.5.2, radiance transport).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Glass {
+    /// Refractive index inside (relative to outside).
     pub eta: f32,
+    /// Transmission tint per channel, linear RGB 0–1.
     pub tint: Vec3,
 }
 
 impl Glass {
+    /// Clear glass of index `eta` (tint 1).
     pub fn new(eta: f32) -> Self {
         Glass {
             eta,

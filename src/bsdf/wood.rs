@@ -269,6 +269,7 @@ impl WoodBsdf {
         self
     }
 
+    /// How the finish's internal reflections are counted (see [`FinishModel`]).
     pub fn finish(&self) -> FinishModel {
         self.finish
     }
@@ -289,10 +290,12 @@ impl WoodBsdf {
         }
     }
 
+    /// The parameters the BSDF was built from.
     pub fn params(&self) -> &WoodBsdfParams {
         &self.params
     }
 
+    /// The fibre lobe's normalisation.
     pub fn normalization(&self) -> FiberNormalization {
         self.norm
     }

@@ -10,8 +10,11 @@ pub const PITH_EPSILON: f32 = 1e-6;
 /// Cylindrical coordinates of a tree-space point: radius r (mm), angle θ in (−π, π], height z (mm).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Cylindrical {
+    /// Distance from the pith (mm).
     pub r: f32,
+    /// Angle about the pith (radians, in (−π, π]).
     pub theta: f32,
+    /// Height along the pith (mm).
     pub z: f32,
 }
 

@@ -8,6 +8,7 @@ use glam::{Mat3, Vec3};
 
 /// A scalar magnitude field m(p) with its gradient ∇m(p) (mm and mm/mm).
 pub trait Magnitude {
+    /// The magnitude m(p) and its gradient ∇m(p).
     fn eval(&self, p: Vec3) -> (f32, Vec3);
 }
 
@@ -21,8 +22,11 @@ impl<F: Fn(Vec3) -> (f32, Vec3)> Magnitude for F {
 /// One displacement term: a unit direction `dir`, magnitude `m` and its gradient `grad_m` at p.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Displacement {
+    /// Unit displacement direction aᵢ(p) (r̂, θ̂ or ẑ).
     pub dir: Vec3,
+    /// Magnitude mᵢ(p) (mm).
     pub m: f32,
+    /// Gradient ∇mᵢ(p).
     pub grad_m: Vec3,
 }
 

@@ -11,21 +11,42 @@ use std::path::{Path, PathBuf};
 /// Why a capture cannot be fitted; every message names the file and the field.
 #[derive(Debug, thiserror::Error)]
 pub enum CaptureError {
+    /// A file (manifest or frame) could not be read.
     #[error("{path}: cannot read it: {cause}")]
-    Read { path: String, cause: String },
+    Read {
+        /// The file.
+        path: String,
+        /// The I/O or decoding error.
+        cause: String,
+    },
+    /// The manifest is not valid JSON for the format.
     #[error("{path}: {cause} (the manifest format is described in notes/fit.md)")]
-    Parse { path: String, cause: String },
+    Parse {
+        /// The manifest.
+        path: String,
+        /// serde's message.
+        cause: String,
+    },
+    /// A manifest field is missing, out of range or inconsistent.
     #[error("{path}: field `{field}`: {message}")]
     Field {
+        /// The manifest.
         path: String,
+        /// The field at fault.
         field: String,
+        /// What is allowed.
         message: String,
     },
+    /// A frame image is unreadable or does not match the manifest (size, channels).
     #[error("{path}: frame image {image} ({field}): {message}")]
     Frame {
+        /// The manifest.
         path: String,
+        /// The manifest field naming the image.
         field: String,
+        /// The image file.
         image: String,
+        /// What is wrong with it.
         message: String,
     },
 }
@@ -33,8 +54,11 @@ pub enum CaptureError {
 /// The camera of a capture, able to project world points to film coordinates (pixels).
 #[derive(Clone, Copy, Debug)]
 pub struct FilmCamera {
+    /// Film width (pixels).
     pub width: u32,
+    /// Film height (pixels).
     pub height: u32,
+    /// Camera position (world mm).
     pub eye: Vec3,
     right: Vec3,
     up: Vec3,
@@ -80,11 +104,17 @@ impl FilmCamera {
 /// z = x × y out of the face), size and finish index.
 #[derive(Clone, Copy, Debug)]
 pub struct BoardPlane {
+    /// Centre of the face (world mm).
     pub origin: Vec3,
+    /// Unit axis along the map's columns.
     pub x: Vec3,
+    /// Unit axis towards the map's top row.
     pub y: Vec3,
+    /// Unit normal out of the face, x × y.
     pub z: Vec3,
+    /// [width, height] of the face (mm).
     pub size: [f32; 2],
+    /// Refractive index of the finish.
     pub eta: f32,
 }
 
@@ -105,17 +135,32 @@ impl BoardPlane {
 /// A frame's light: a point (position) or a distant light (unit direction towards it).
 #[derive(Clone, Copy, Debug)]
 pub enum FrameLight {
-    Point { position: Vec3, radius: f32 },
-    Distant { direction: Vec3 },
+    /// A point light, or a sphere light of `radius` mm (0 = point) whose mirror glint is masked.
+    Point {
+        /// Light position (world mm).
+        position: Vec3,
+        /// Sphere radius (mm, 0 = a point).
+        radius: f32,
+    },
+    /// A distant light.
+    Distant {
+        /// Unit direction towards the light.
+        direction: Vec3,
+    },
 }
 
 /// One frame of the capture.
 #[derive(Clone, Debug)]
 pub struct CaptureFrame {
+    /// The frame's image file.
     pub image: PathBuf,
+    /// Where the light was for this frame.
     pub light: FrameLight,
+    /// Radiant intensity (W/sr, point) or irradiance (distant) per channel, linear RGB.
     pub intensity: Vec3,
+    /// Which arc of the sweep (0-based).
     pub arc: usize,
+    /// That arc's azimuth about +z (degrees).
     pub azimuth_deg: f32,
 }
 
@@ -153,12 +198,19 @@ impl CaptureFrame {
 /// A read and checked manifest: camera, board, frames, and how pixel values decode.
 #[derive(Clone, Debug)]
 pub struct Capture {
+    /// The capture folder; frame paths are relative to it.
     pub dir: PathBuf,
+    /// The manifest file read.
     pub manifest_path: PathBuf,
+    /// The camera the frames were taken with.
     pub camera: FilmCamera,
+    /// The board face to fit.
     pub board: BoardPlane,
+    /// The frames, in manifest order.
     pub frames: Vec<CaptureFrame>,
+    /// Photographs stored as sRGB (decoded to linear), else linear values.
     pub srgb: bool,
+    /// A frame taken with the light off, subtracted from every frame.
     pub black_frame: Option<PathBuf>,
     /// Linear value at or above which a photograph's pixel counts as clipped.
     pub clip: Option<f32>,
@@ -168,6 +220,7 @@ pub struct Capture {
 /// a two-fold ambiguity of the fibre's in-plane angle whenever the highlights of both arcs peak
 /// at the same half-vector (an in-plane fibre seen from above; notes/fit.md §3).
 pub const MIN_ARCS: usize = 3;
+/// How far apart (degrees, mod 180°) every pair of arcs must be; see [`MIN_ARCS`].
 pub const MIN_ARC_SEPARATION_DEG: f32 = 20.0;
 
 fn vec3(a: [f32; 3]) -> Vec3 {

@@ -19,21 +19,35 @@ use std::path::Path;
 /// Why the maps could not be written.
 #[derive(Debug, thiserror::Error)]
 pub enum MapsError {
+    /// A map image could not be written.
     #[error(transparent)]
     Image(#[from] ImageError),
+    /// The output folder's lock could not be taken.
     #[error(transparent)]
     Lock(#[from] LockError),
+    /// A file of the output could not be written.
     #[error("{path}: {cause}")]
-    Io { path: String, cause: std::io::Error },
+    Io {
+        /// The file.
+        path: String,
+        /// The I/O error.
+        cause: std::io::Error,
+    },
 }
 
 /// Per-texel fitted parameters, row-major, top row first (the `measured` layout).
 #[derive(Clone, Debug, PartialEq)]
 pub struct FittedMaps {
+    /// Map width (texels).
     pub width: usize,
+    /// Map height (texels).
     pub height: usize,
+    /// Substrate albedo ρ' per texel, linear RGB.
     pub diffuse: Vec<Vec3>,
+    /// Fibre highlight colour k_f per texel, linear RGB.
     pub fiber_color: Vec<Vec3>,
+    /// Unit fibre axis per texel in the board frame (x = columns, y = towards the top row, z = out
+    /// of the face).
     pub fiber_axis: Vec<Vec3>,
     /// β, radians.
     pub beta: Vec<f32>,

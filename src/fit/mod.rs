@@ -24,24 +24,48 @@ use std::time::{Duration, Instant};
 /// Anything that stops a fit.
 #[derive(Debug, thiserror::Error)]
 pub enum FitError {
+    /// The capture could not be read or is inconsistent.
     #[error(transparent)]
     Capture(#[from] CaptureError),
+    /// A texel of the board lies outside the frames.
     #[error("{path}: field `board`: texel (column {col}, row {row}) of the {w}x{h} map projects to film point ({x:.1}, {y:.1}), outside the {fw}x{fh} frames (allowed: the whole board in view)")]
     OutOfView {
+        /// The manifest.
         path: String,
+        /// The texel's column.
         col: usize,
+        /// The texel's row.
         row: usize,
+        /// Map width (texels).
         w: usize,
+        /// Map height (texels).
         h: usize,
+        /// Film x of the texel's centre (pixels).
         x: f32,
+        /// Film y of the texel's centre (pixels).
         y: f32,
+        /// Frame width (pixels).
         fw: u32,
+        /// Frame height (pixels).
         fh: u32,
     },
+    /// The requested map size is outside 1–8192 texels per side.
     #[error("--texels {w}x{h}: allowed 1 to 8192 each")]
-    Texels { w: usize, h: usize },
+    Texels {
+        /// Requested width (texels).
+        w: usize,
+        /// Requested height (texels).
+        h: usize,
+    },
+    /// The worker thread pool could not be started.
     #[error("cannot start {threads} worker threads: {cause}")]
-    Threads { threads: usize, cause: String },
+    Threads {
+        /// Threads requested.
+        threads: usize,
+        /// rayon's error.
+        cause: String,
+    },
+    /// The maps could not be written.
     #[error(transparent)]
     Output(#[from] maps::MapsError),
 }
@@ -54,6 +78,7 @@ pub struct FitOptions {
     pub texels: Option<(usize, usize)>,
     /// Worker threads; 0 = all cores.
     pub threads: usize,
+    /// Show a progress bar on stderr.
     pub progress: bool,
 }
 
@@ -94,9 +119,13 @@ fn bilinear(img: &[Vec3], w: u32, h: u32, x: f32, y: f32) -> Vec3 {
 /// What [`fit`] measured besides the maps.
 #[derive(Clone, Debug)]
 pub struct FitStats {
+    /// Time spent reading and projecting the frames.
     pub read_time: Duration,
+    /// Time spent fitting the texels.
     pub fit_time: Duration,
+    /// Frames in the capture.
     pub frames: usize,
+    /// Texels with fewer than 8 usable frames, left unfitted (residual 1).
     pub texels_failed: usize,
 }
 

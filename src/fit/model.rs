@@ -18,9 +18,13 @@ use glam::{Mat3, Vec3};
 /// frame), the normalised radiance z (radiance / irradiance factor) and a weight (0: rejected).
 #[derive(Clone, Debug, Default)]
 pub struct TexelData {
+    /// View direction (unit, board frame).
     pub wo: Vec3,
+    /// Light direction per frame (unit, board frame).
     pub wi: Vec<Vec3>,
+    /// Normalised radiance per frame: pixel radiance / irradiance factor, linear RGB.
     pub z: Vec<Vec3>,
+    /// Weight per frame: 1 kept, 0 rejected (clipped, grazing or glint).
     pub w: Vec<f32>,
 }
 

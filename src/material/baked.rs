@@ -20,7 +20,9 @@ use std::sync::Arc;
 /// Baked maps, row-major, top row first; texel (0, 0) is the top-left corner (glTF).
 #[derive(Clone, Debug)]
 pub struct BakedMaps {
+    /// Width in texels.
     pub width: u32,
+    /// Height in texels.
     pub height: u32,
     /// Diffuse colour (linear RGB).
     pub base_color: Vec<Vec3>,
@@ -29,6 +31,7 @@ pub struct BakedMaps {
     pub anisotropy: Vec<Vec3>,
     /// Fibre highlight width β (radians).
     pub highlight_width: Vec<f32>,
+    /// Ray-cell fraction (0–1).
     pub ray_mask: Vec<f32>,
     /// Tangent-space normal (unit), stored as 0.5 + 0.5·n in the PNG.
     pub normal: Vec<Vec3>,
@@ -50,10 +53,13 @@ pub enum BakedFibers {
 /// Everything one bilinear lookup of the maps returns.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BakedTexel {
+    /// Diffuse colour (linear RGB).
     pub base_color: Vec3,
     /// Encoded anisotropy (as stored).
     pub anisotropy: Vec3,
+    /// Fibre highlight width β (radians).
     pub highlight_width: f32,
+    /// Ray-cell fraction (0–1).
     pub ray_mask: f32,
     /// Tangent-space normal (renormalised).
     pub normal: Vec3,
@@ -122,6 +128,7 @@ pub fn fiber_from_anisotropy(a: Vec3) -> Vec3 {
 /// Wood from baked maps over one flat face of an object (object space), seen through a finish.
 #[derive(Clone, Debug)]
 pub struct BakedWoodMaterial {
+    /// The maps, shared between objects.
     pub maps: Arc<BakedMaps>,
     /// The face the maps cover, in object space.
     pub face: FaceRect,
@@ -129,10 +136,13 @@ pub struct BakedWoodMaterial {
     pub fiber_saturation: Vec3,
     /// Where the fibre direction comes from.
     pub fibers: BakedFibers,
-    /// Refractive index and GGX roughness of the finish, and the normal-map strength (0 = off).
+    /// Refractive index of the finish (1–4).
     pub eta: f32,
+    /// GGX roughness of the finish (0–1).
     pub roughness: f32,
+    /// Normal-map strength (0 = off).
     pub bump: f32,
+    /// Speed/accuracy switches (`xylem tradeoff`).
     pub switches: ShadingSwitches,
 }
 

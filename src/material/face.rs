@@ -12,9 +12,13 @@ use glam::{Vec2, Vec3};
 /// size along them. Lengths in the units of the space it lives in.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FaceRect {
+    /// Corner of texel (0, 0) (the top-left one).
     pub corner: Vec3,
+    /// Unit axis of +u (along the image columns).
     pub right: Vec3,
+    /// Unit axis of +v (down the image rows).
     pub down: Vec3,
+    /// Extent along `right` and `down`.
     pub size: Vec2,
 }
 

@@ -40,8 +40,11 @@ impl ColorSpace {
 /// The image files of one board. Paths as given (the scene resolves them against its file).
 #[derive(Clone, Debug, PartialEq)]
 pub struct MeasuredFiles {
+    /// Diffuse colour map (8-bit PNG).
     pub diffuse: PathBuf,
+    /// Fibre highlight colour map (8-bit PNG).
     pub fiber_color: PathBuf,
+    /// Fibre axis map (8-bit PNG, axis = 2v/255 − 1).
     pub fiber_axis: PathBuf,
     /// Optional β map: β = 90° · v/255 from the first channel.
     pub highlight_width: Option<PathBuf>,
@@ -66,25 +69,41 @@ pub enum MeasuredError {
     #[error(
         "{field} map {path}: cannot read it: {cause} (allowed: an 8-bit RGB, RGBA or grey PNG)"
     )]
+    /// A map could not be read or decoded as an 8-bit PNG.
     Read {
+        /// The map's scene field (`diffuse`, `fiber_axis`, ...).
         field: &'static str,
+        /// The image file.
         path: String,
+        /// The decoder's error.
         cause: String,
     },
+    /// A map's size differs from the diffuse map's.
     #[error("{field} map {path} is {got}, but the diffuse map is {want} (allowed: every map the same size)")]
     Size {
+        /// The map's scene field.
         field: &'static str,
+        /// The image file.
         path: String,
+        /// Its size, "W×H".
         got: String,
+        /// The diffuse map's size.
         want: String,
     },
+    /// A texel's value is out of range (e.g. a fibre axis far from unit length).
     #[error("{field} map {path}: texel (column {x}, row {y}) {what} (allowed {allowed})")]
     Value {
+        /// The map's scene field.
         field: &'static str,
+        /// The image file.
         path: String,
+        /// The texel's column.
         x: u32,
+        /// The texel's row.
         y: u32,
+        /// What is wrong with the value.
         what: String,
+        /// The allowed range.
         allowed: &'static str,
     },
 }
@@ -105,7 +124,9 @@ impl MeasuredError {
 /// face (right-handed; notes/measured.md "y sign").
 #[derive(Clone, Debug, PartialEq)]
 pub struct MeasuredBoard {
+    /// Width in texels (image columns).
     pub width: u32,
+    /// Height in texels (image rows).
     pub height: u32,
     /// Diffuse colour ρ_d, linear RGB.
     pub diffuse: Vec<Vec3>,
@@ -261,12 +282,18 @@ pub fn energy_bounded_fiber_color(published: Vec3) -> Vec3 {
 /// that face with its top row towards `up`: +z (up +y), −z (up −y), ±x and ±y (up +z).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum BoardFace {
+    /// +z, image top towards +y (the default).
     #[default]
     PosZ,
+    /// −z, image top towards −y.
     NegZ,
+    /// +x, image top towards +z.
     PosX,
+    /// −x, image top towards +z.
     NegX,
+    /// +y, image top towards +z.
     PosY,
+    /// −y, image top towards +z.
     NegY,
 }
 
@@ -310,6 +337,7 @@ impl BoardFace {
 /// (`clamped` counts them; notes/measured.md "Highlight scale").
 #[derive(Clone, Debug)]
 pub struct MeasuredMaterial {
+    /// The decoded maps, shared between objects that use the same files.
     pub board: Arc<MeasuredBoard>,
     /// The face the board covers (object space, mm); outside it the edge texels repeat.
     pub face: FaceRect,
@@ -319,7 +347,9 @@ pub struct MeasuredMaterial {
     pub clamped: usize,
     /// β (radians) where the board has no β map.
     pub highlight_width: f32,
+    /// Refractive index of the finish (1–4).
     pub eta: f32,
+    /// GGX roughness of the finish (0–1, 0 = smooth).
     pub roughness: f32,
 }
 

@@ -61,6 +61,7 @@ pub struct SurfaceAov {
     pub albedo: Vec3,
     /// Fibre direction (world, unit) or zero where the material has no fibres.
     pub fiber: Vec3,
+    /// Ray-cell fraction at the hit (0–1), zero where the material has none.
     pub ray_mask: f32,
     /// Growth time (years from the pith) for wood; zero otherwise.
     pub growth_time: f32,
@@ -70,9 +71,13 @@ pub struct SurfaceAov {
 /// it per pixel sample.
 #[derive(Clone, Copy, Debug)]
 pub enum SurfaceBsdf {
+    /// Ideal diffuse reflection.
     Lambertian(Lambertian),
+    /// The finished-wood BSDF (Marschner et al. 2005 fibre lobe under a dielectric finish).
     Wood(WoodBsdf),
+    /// Perfect specular reflection (a delta lobe).
     Mirror(Mirror),
+    /// Smooth dielectric reflection and refraction (delta lobes).
     Glass(Glass),
 }
 
@@ -121,8 +126,11 @@ impl Bsdf for SurfaceBsdf {
 /// bump-mapped shading normal) and the AOV values.
 #[derive(Clone, Copy, Debug)]
 pub struct Shading {
+    /// The BSDF at the hit.
     pub bsdf: SurfaceBsdf,
+    /// The world shading frame the BSDF lives in.
     pub frame: Frame,
+    /// First-hit values for the AOV layers.
     pub aov: SurfaceAov,
 }
 
@@ -131,11 +139,13 @@ pub struct Shading {
 pub enum Material {
     /// Ideal diffuse reflector.
     Lambertian {
+        /// Reflectance, linear RGB 0–1.
         albedo: Vec3,
     },
     /// The finished-wood BSDF with the same parameters everywhere; `fiber_dir` and `ray_dir` are
     /// in object space (for validation scenes).
     Fiber {
+        /// The BSDF's parameters (directions in object space).
         params: WoodBsdfParams,
     },
     /// The procedural wood volume seen through a finish.
@@ -146,11 +156,16 @@ pub enum Material {
     /// A board measured by Marschner et al. 2005: per-texel BSDF parameters from image maps on
     /// one flat face.
     Measured(Box<MeasuredMaterial>),
+    /// Perfect mirror.
     Mirror {
+        /// Reflectance, linear RGB 0–1.
         reflectance: Vec3,
     },
+    /// Smooth dielectric (glass).
     Glass {
+        /// Refractive index.
         eta: f32,
+        /// Transmission tint, linear RGB 0–1.
         tint: Vec3,
     },
     /// A classic solid texture (marble, stone, …) as the albedo of a Lambertian surface, looked
@@ -161,7 +176,9 @@ pub enum Material {
 /// A solid texture shared between hits.
 #[derive(Clone)]
 pub struct TextureMaterial {
+    /// The texture's name (for messages and `Debug`).
     pub name: String,
+    /// The texture, evaluated at the placement point (mm).
     pub texture: Arc<dyn crate::texture::SolidTexture>,
 }
 
@@ -174,6 +191,7 @@ impl std::fmt::Debug for TextureMaterial {
 /// Solid wood: the volume, the finish over it, and the bump-mapping strength.
 #[derive(Clone, Debug)]
 pub struct WoodMaterial {
+    /// The procedural wood volume (colours, fibres, pores) of a preset and tree.
     pub volume: Arc<WoodVolume>,
     /// Refractive index of the finish (1 = unfinished).
     pub eta: f32,

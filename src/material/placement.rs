@@ -11,11 +11,19 @@ pub enum Cutting {
     /// Carved from one block: `p_tree = origin + scale · Rz(rotation) · A · p`.
     Solid,
     /// Each face (by its dominant normal axis) is its own flat-sawn slice from `region`.
-    Veneer { region: TreeRegion, seed: u64 },
+    Veneer {
+        /// Where the slices are cut from.
+        region: TreeRegion,
+        /// Selects each face's slice.
+        seed: u64,
+    },
     /// The xy plane is divided into boards by `layout`; each board is hashed into `region`.
     Boards {
+        /// How the floor is divided into boards.
         layout: BoardLayout,
+        /// Where the boards are cut from.
         region: TreeRegion,
+        /// Selects each board's place in `region`.
         seed: u64,
     },
 }
@@ -28,13 +36,17 @@ pub enum Cutting {
 /// Veneer and board cuttings use only `scale` and `world_space` of these.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Placement {
+    /// Tree-space point (mm from the pith) of the object's origin.
     pub origin: Vec3,
+    /// Object direction the fibres run along (mapped to +z).
     pub axis: Vec3,
     /// Radians.
     pub rotation: f32,
     /// Tree millimetres per object unit (> 0).
     pub scale: f32,
+    /// Solid block, veneer or boards.
     pub cutting: Cutting,
+    /// Read world points instead of object points (several objects share one block).
     pub world_space: bool,
 }
 

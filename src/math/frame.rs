@@ -5,8 +5,11 @@ use glam::{Mat3, Vec3};
 /// An orthonormal basis `(s, t, n)`; `to_local` maps world vectors into coordinates where `n` is +z.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Frame {
+    /// First tangent (local +x).
     pub s: Vec3,
+    /// Second tangent (local +y), n × s.
     pub t: Vec3,
+    /// Normal (local +z).
     pub n: Vec3,
 }
 
@@ -39,11 +42,13 @@ impl Frame {
         }
     }
 
+    /// World vector `v` in frame coordinates (n = +z).
     #[inline]
     pub fn to_local(&self, v: Vec3) -> Vec3 {
         Vec3::new(v.dot(self.s), v.dot(self.t), v.dot(self.n))
     }
 
+    /// Frame coordinates `v` back in world space (the inverse of [`Frame::to_local`]).
     #[inline]
     pub fn to_world(&self, v: Vec3) -> Vec3 {
         self.s * v.x + self.t * v.y + self.n * v.z

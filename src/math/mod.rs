@@ -12,7 +12,9 @@ pub use glam::{Mat3, Vec2, Vec3};
 pub use rng::Pcg32;
 pub use sampling::*;
 
+/// π.
 pub const PI: f32 = std::f32::consts::PI;
+/// 1/π.
 pub const INV_PI: f32 = std::f32::consts::FRAC_1_PI;
 
 /// `sqrt(max(x, 0))`: rounding can push a mathematically non-negative argument below 0.

@@ -14,6 +14,8 @@ pub struct Pcg32 {
 const MULT: u64 = 6364136223846793005;
 
 impl Pcg32 {
+    /// The generator of sequence `stream` from `seed` (pcg32_srandom_r of the reference
+    /// implementation).
     pub fn new(seed: u64, stream: u64) -> Self {
         let mut r = Pcg32 {
             state: 0,
@@ -25,6 +27,7 @@ impl Pcg32 {
         r
     }
 
+    /// The next 32 random bits (XSH-RR output of the 64-bit LCG state).
     #[inline]
     pub fn next_u32(&mut self) -> u32 {
         let old = self.state;
@@ -40,6 +43,7 @@ impl Pcg32 {
         (self.next_u32() >> 8) as f32 * (1.0 / 16_777_216.0)
     }
 
+    /// Two independent uniforms in [0, 1).
     #[inline]
     pub fn next_vec2(&mut self) -> Vec2 {
         Vec2::new(self.next_f32(), self.next_f32())

@@ -24,6 +24,8 @@ pub fn cosine_hemisphere(u: Vec2) -> Vec3 {
     Vec3::new(d.x, d.y, z)
 }
 
+/// The density of [`cosine_hemisphere`] at a direction with cosine `cos_theta` (0 below the
+/// horizon).
 #[inline]
 pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
     cos_theta.max(0.0) * INV_PI
@@ -37,6 +39,7 @@ pub fn uniform_sphere(u: Vec2) -> Vec3 {
     Vec3::new(r * phi.cos(), r * phi.sin(), z)
 }
 
+/// The density of [`uniform_sphere`].
 pub const UNIFORM_SPHERE_PDF: f32 = 1.0 / (4.0 * PI);
 
 /// Uniform direction in the cone of half-angle `acos(cos_max)` about +z; density `1 / (2π(1 − cos_max))`.

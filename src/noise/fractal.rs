@@ -20,7 +20,9 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Basis {
+    /// Perlin's improved gradient noise (Perlin 2002).
     Gradient,
+    /// Lattice value noise.
     Value,
 }
 
@@ -40,8 +42,11 @@ pub enum FractalKind {
 /// A fractal sum of octaves of a basis noise.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Fractal {
+    /// How the octaves combine.
     pub kind: FractalKind,
+    /// The noise each octave sums.
     pub basis: Basis,
+    /// Number of octaves summed.
     pub octaves: u32,
     /// Frequency ratio between octaves (typically 2).
     pub lacunarity: f32,
@@ -82,6 +87,7 @@ impl Fractal {
         (0..self.octaves).map(|i| self.gain.powi(i as i32)).sum()
     }
 
+    /// The fractal sum at `p` for `seed`.
     #[inline]
     pub fn eval(&self, p: Vec3, seed: u32) -> f32 {
         match (self.basis, self.kind) {

@@ -72,7 +72,9 @@ pub fn seed_offsets(seed: u32) -> [u32; 3] {
 
 /// Teschner et al. 2003 constants (large primes) for the per-axis multiply of [`lattice`].
 pub const PRIME_X: u32 = 73_856_093;
+/// Teschner et al. 2003's prime for y.
 pub const PRIME_Y: u32 = 19_349_663;
+/// Teschner et al. 2003's prime for z.
 pub const PRIME_Z: u32 = 83_492_791;
 /// Knuth's multiplicative-hash constant ⌊2^32/φ⌋ (odd).
 pub const KNUTH: u32 = 0x9e37_79b1;

@@ -108,7 +108,9 @@ use glam::Vec3;
 
 /// A 3D scalar noise with its analytic gradient; a pure function of point and seed.
 pub trait Noise3: Send + Sync {
+    /// The noise value at `p` for `seed`.
     fn eval(&self, p: Vec3, seed: u32) -> f32;
+    /// The noise value and its gradient ∇ at `p`.
     fn eval_grad(&self, p: Vec3, seed: u32) -> (f32, Vec3);
 }
 

@@ -23,7 +23,10 @@ pub enum Kernel {
     Wyvill,
     /// Bump kernel `exp(−s r² / (1 − r²))` (Liu 2016 eq. 6): a box as s → 0, a bump for s ≈ 1, a
     /// spike as s → ∞; for discrete features (pores, rays).
-    Bump { sharpness: f32 },
+    Bump {
+        /// Sharpness s ≥ 0.
+        sharpness: f32,
+    },
 }
 
 impl Kernel {
@@ -78,6 +81,7 @@ pub enum Cells {
 /// Lengths in the units of the points (millimetres in the wood model).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SparseConvolution {
+    /// Kernel shape: Wyvill (continuous noise) or bump (discrete features).
     pub kernel: Kernel,
     /// Mean number of kernels overlapping a point (Liu 2016 §6.1.2), for the nominal envelope.
     pub density: f32,
@@ -90,7 +94,9 @@ pub struct SparseConvolution {
     pub cell: Vec3,
     /// Magnitude α of the base band (eq. 7).
     pub magnitude: f32,
+    /// Unit (non-negative, masks) or signed (zero-mean, distortions) impulse weights.
     pub weights: Weights,
+    /// Cartesian or cylindrical (about the pith) cell lattice.
     pub cells: Cells,
     /// Number of bands (≥ 1).
     pub bands: u32,
@@ -120,10 +126,14 @@ impl Default for SparseConvolution {
 /// Invalid noise parameters, naming the field and the allowed range.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum NoiseError {
+    /// A parameter is not finite or outside its range.
     #[error("noise parameter `{field}` = {value} is outside the allowed range {range}")]
     OutOfRange {
+        /// The parameter, e.g. `size_factor`.
         field: &'static str,
+        /// The value given.
         value: f32,
+        /// The allowed range.
         range: &'static str,
     },
 }
@@ -300,6 +310,7 @@ pub struct SeededSparse {
 }
 
 impl SeededSparse {
+    /// Binds `noise` to `seed`, precomputing each band once.
     pub fn new(noise: SparseConvolution, seed: u32) -> Self {
         let bands = (0..noise.bands.max(1))
             .map(|index| noise.band(index, seed))

@@ -33,7 +33,9 @@ impl Default for Warp {
 /// A warped-fractal evaluation with its intermediate fields (textures colour by |q| and r).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WarpSample {
+    /// The warped fractal's value at p + s r.
     pub value: f32,
+    /// The first warp field q(p).
     pub q: Vec3,
     /// Equal to `q` when `levels` is 1.
     pub r: Vec3,
@@ -77,6 +79,7 @@ impl Warp {
         }
     }
 
+    /// The warped fractal's value at `p` (see [`Warp::sample`]).
     pub fn eval(&self, p: Vec3, seed: u32) -> f32 {
         self.sample(p, seed).value
     }

@@ -32,13 +32,18 @@ fn exact_pairs<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Vec<[f32; 2]>>,
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
+    /// `[render]`: image size, sampling, filter (defaults when the table is absent).
     #[serde(default)]
     pub render: RenderTable,
+    /// `[camera]` (required).
     pub camera: CameraTable,
+    /// `[[lights]]`, any number; lights do not cast shadows or block rays.
     #[serde(default)]
     pub lights: Vec<LightTable>,
+    /// `[materials.NAME]`, keyed by the name objects refer to.
     #[serde(default)]
     pub materials: BTreeMap<String, MaterialTable>,
+    /// `[[objects]]`; a scene needs at least one.
     #[serde(default)]
     pub objects: Vec<ObjectTable>,
     /// Light-sweep setup (used by `xylem sweep`).
@@ -49,14 +54,21 @@ pub struct SceneFile {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct RenderTable {
+    /// Image width in pixels, 1–16384 (default 512; `--res` overrides).
     pub width: u32,
+    /// Image height in pixels, 1–16384 (default 512; `--res` overrides).
     pub height: u32,
+    /// Samples per pixel, 1–1000000 (default 16; `--spp` overrides).
     pub spp: u32,
+    /// Direct lighting only (default) or path tracing.
     pub integrator: IntegratorName,
+    /// Path tracing: most bounces, 1–1000 (default 8).
     pub max_depth: u32,
+    /// Random seed (default 0; `--seed` overrides): same seed, same image on any thread count.
     pub seed: u64,
     /// PNG exposure in stops.
     pub exposure: f32,
+    /// Pixel reconstruction filter (default gaussian).
     pub filter: FilterName,
     /// Filter radius in pixels (box: half-width).
     pub filter_radius: Option<f32>,
@@ -78,26 +90,36 @@ impl Default for RenderTable {
     }
 }
 
+/// `[render] integrator`.
 #[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum IntegratorName {
+    /// Direct lighting only.
     Direct,
+    /// Path tracing: next-event estimation + MIS + Russian roulette, up to `max_depth` bounces.
     Path,
 }
 
+/// `[render] filter`: the pixel reconstruction filter.
 #[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum FilterName {
+    /// Box of half-width `filter_radius` (default 0.5 px).
     Box,
+    /// Tent of radius `filter_radius` (default 1 px).
     Tent,
+    /// Gaussian with σ = `filter_radius` / 3 (default radius 1.5 px).
     Gaussian,
 }
 
+/// `[camera] projection`.
 #[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum ProjectionName {
+    /// Pinhole or thin-lens perspective with vertical field of view `fov_deg`.
     #[default]
     Perspective,
+    /// Parallel projection with film `width` (mm).
     Orthographic,
 }
 
@@ -105,19 +127,25 @@ pub enum ProjectionName {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraTable {
+    /// Perspective (default) or orthographic.
     #[serde(default)]
     pub projection: ProjectionName,
+    /// Camera position (mm, finite).
     #[serde(deserialize_with = "exact")]
     pub eye: [f32; 3],
+    /// Point at the image centre (mm, ≠ `eye`).
     #[serde(deserialize_with = "exact")]
     pub target: [f32; 3],
+    /// Image-up direction, not parallel to the view (default [0, 0, 1]).
     #[serde(default = "default_up")]
     #[serde(deserialize_with = "exact")]
     pub up: [f32; 3],
     /// Perspective only (default [`DEFAULT_FOV_DEG`]); `None` when the file does not give it.
     pub fov_deg: Option<f32>,
+    /// Perspective: thin-lens aperture radius (mm, 0–1e6; 0 = pinhole, default).
     #[serde(default)]
     pub lens_radius: f32,
+    /// Perspective: distance of the plane in focus (mm, 0.001–1e9; default |target − eye|).
     pub focus_distance: Option<f32>,
     /// Orthographic film width (mm).
     pub width: Option<f32>,
@@ -140,75 +168,114 @@ fn white() -> [f32; 3] {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum LightTable {
+    /// Point light at `position`.
     Point {
+        /// Unique name (the sweep moves a light by name).
         name: Option<String>,
+        /// Position (mm).
         #[serde(deserialize_with = "exact")]
         position: [f32; 3],
+        /// Radiant intensity (W/sr, 0–1e12).
         intensity: f32,
+        /// Multiplies the strength ([r, g, b], each 0–1000, default [1, 1, 1]).
         #[serde(default = "white")]
         #[serde(deserialize_with = "exact")]
         color: [f32; 3],
     },
+    /// Spot light at `position` pointing at `target`, with a smooth-edged cone.
     Spot {
+        /// Unique name (the sweep moves a light by name).
         name: Option<String>,
+        /// Position (mm).
         #[serde(deserialize_with = "exact")]
         position: [f32; 3],
+        /// The point the cone's axis passes through (mm).
         #[serde(deserialize_with = "exact")]
         target: [f32; 3],
+        /// Radiant intensity on the axis (W/sr, 0–1e12).
         intensity: f32,
+        /// Multiplies the strength ([r, g, b], each 0–1000, default [1, 1, 1]).
         #[serde(default = "white")]
         #[serde(deserialize_with = "exact")]
         color: [f32; 3],
+        /// Half-angle of the cone (degrees, 0.01–180).
         cone_deg: f32,
+        /// Width of the smooth edge inside the cone (degrees, 0–`cone_deg`, default 0).
         #[serde(default)]
         falloff_deg: f32,
     },
+    /// Distant (directional) light, like the sun.
     Distant {
+        /// Unique name.
         name: Option<String>,
+        /// Direction towards the light.
         #[serde(deserialize_with = "exact")]
         direction: [f32; 3],
+        /// Irradiance on a surface facing the light (W/mm², 0–1e12).
         irradiance: f32,
+        /// Multiplies the strength ([r, g, b], each 0–1000, default [1, 1, 1]).
         #[serde(default = "white")]
         #[serde(deserialize_with = "exact")]
         color: [f32; 3],
     },
+    /// Parallelogram area light; emits to the side of `edge_u × edge_v`.
     Rect {
+        /// Unique name.
         name: Option<String>,
+        /// One corner (mm).
         #[serde(deserialize_with = "exact")]
         corner: [f32; 3],
+        /// First edge from `corner` (mm).
         #[serde(deserialize_with = "exact")]
         edge_u: [f32; 3],
+        /// Second edge from `corner` (mm); the edges must span a non-zero area.
         #[serde(deserialize_with = "exact")]
         edge_v: [f32; 3],
+        /// Emitted radiance (W/(sr·mm²)).
         radiance: f32,
+        /// Multiplies the strength ([r, g, b], each 0–1000, default [1, 1, 1]).
         #[serde(default = "white")]
         #[serde(deserialize_with = "exact")]
         color: [f32; 3],
     },
+    /// Spherical area light.
     Sphere {
+        /// Unique name (the sweep moves a light by name).
         name: Option<String>,
+        /// Centre (mm).
         #[serde(deserialize_with = "exact")]
         center: [f32; 3],
+        /// Radius (mm, 1e-4–1e9).
         radius: f32,
+        /// Emitted radiance (W/(sr·mm²)).
         radiance: f32,
+        /// Multiplies the strength ([r, g, b], each 0–1000, default [1, 1, 1]).
         #[serde(default = "white")]
         #[serde(deserialize_with = "exact")]
         color: [f32; 3],
     },
+    /// Light from infinitely far away in every direction, constant or from a lat-long map.
     Environment {
+        /// Unique name.
         name: Option<String>,
+        /// Radiance scale (default 1).
         #[serde(default = "one")]
         radiance: f32,
+        /// Multiplies the strength ([r, g, b], each 0–1000, default [1, 1, 1]).
         #[serde(default = "white")]
         #[serde(deserialize_with = "exact")]
         color: [f32; 3],
+        /// Optional lat-long EXR map (z up, u = φ/2π from +x, v = θ/π from +z); path relative
+        /// to the scene file.
         map: Option<String>,
+        /// Turn of the map about z (degrees, −360–360, default 0).
         #[serde(default)]
         rotate_deg: f32,
     },
 }
 
 impl LightTable {
+    /// The light's `name`, if it has one.
     pub fn name(&self) -> Option<&str> {
         match self {
             LightTable::Point { name, .. }
@@ -225,27 +292,37 @@ impl LightTable {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum MaterialTable {
+    /// Lambertian diffuse surface.
     Lambertian {
+        /// Reflectance ([r, g, b], each 0–1).
         #[serde(deserialize_with = "exact")]
         albedo: [f32; 3],
     },
     /// The finished-wood BSDF with constant parameters; directions in object space.
     Fiber {
+        /// Diffuse colour ([r, g, b], each 0–1).
         #[serde(deserialize_with = "exact")]
         diffuse: [f32; 3],
+        /// Fibre highlight colour ([r, g, b], each 0–1).
         #[serde(deserialize_with = "exact")]
         fiber_color: [f32; 3],
+        /// Fibre direction (object space).
         #[serde(deserialize_with = "exact")]
         fiber_dir: [f32; 3],
+        /// Ray-cell direction (object space, default [0, 0, 1]).
         #[serde(default = "default_ray_dir")]
         #[serde(deserialize_with = "exact")]
         ray_dir: [f32; 3],
+        /// How much of the surface is ray cells (0–1, default 0).
         #[serde(default)]
         ray_mask: f32,
+        /// Fibre highlight width β (degrees, 0.06–90, default 8).
         #[serde(default = "default_highlight")]
         highlight_width_deg: f32,
+        /// Refractive index of the finish (1–4, default 1.5).
         #[serde(default = "default_eta")]
         eta: f32,
+        /// GGX roughness of the finish (0–1, default 0 = smooth).
         #[serde(default)]
         roughness: f32,
     },
@@ -258,8 +335,10 @@ pub enum MaterialTable {
         /// Selects the tree.
         #[serde(default)]
         seed: u64,
+        /// Refractive index of the finish (1–4, default 1.5).
         #[serde(default = "default_eta")]
         eta: f32,
+        /// GGX roughness of the finish (0–1, default 0 = smooth).
         #[serde(default)]
         roughness: f32,
         /// Pore bump strength (0 = off).
@@ -269,11 +348,16 @@ pub enum MaterialTable {
     /// A board measured by Marschner et al. 2005: per-texel BSDF parameters from image maps (in
     /// the encoding of data/marschner2005/) on one face of the object. Paths relative to the scene.
     Measured {
+        /// Diffuse colour map (8-bit PNG, relative to the scene file).
         diffuse: String,
+        /// Fibre colour map (8-bit PNG, same size as `diffuse`).
         fiber_color: String,
+        /// Fibre axis map (8-bit PNG; axis = 2v/255 − 1 in the frame x = columns,
+        /// y = towards the top row, z = the normal).
         fiber_axis: String,
         /// Optional β map (β = 90° · v/255); else `highlight_width_deg` everywhere.
         highlight_width: Option<String>,
+        /// Highlight width β everywhere (degrees, 0.06–90, default 10) when there is no β map.
         highlight_width_deg: Option<f32>,
         /// The published lobe's k_f per stored unit (notes/measured.md).
         #[serde(default = "default_fiber_color_scale")]
@@ -285,8 +369,10 @@ pub enum MaterialTable {
         size_mm: [f32; 2],
         /// "+z" (default), "-z", "+x", "-x", "+y" or "-y".
         face: Option<String>,
+        /// Refractive index of the finish (1–4, default 1.5).
         #[serde(default = "default_eta")]
         eta: f32,
+        /// GGX roughness of the finish (0–1, default 0 = smooth).
         #[serde(default)]
         roughness: f32,
     },
@@ -299,14 +385,19 @@ pub enum MaterialTable {
         #[serde(default)]
         params: BTreeMap<String, f32>,
     },
+    /// Perfect mirror.
     Mirror {
+        /// Reflectance ([r, g, b], each 0–1, default 0.95).
         #[serde(default = "default_reflectance")]
         #[serde(deserialize_with = "exact")]
         reflectance: [f32; 3],
     },
+    /// Smooth dielectric (refracting) surface.
     Glass {
+        /// Refractive index (1–4, default 1.5).
         #[serde(default = "default_eta")]
         eta: f32,
+        /// Transmission tint ([r, g, b], each 0–1, default 1).
         #[serde(default = "white")]
         #[serde(deserialize_with = "exact")]
         tint: [f32; 3],
@@ -333,7 +424,9 @@ fn default_reflectance() -> [f32; 3] {
 #[derive(Debug, Clone, Copy, Deserialize)]
 #[serde(untagged)]
 pub enum Scale {
+    /// The same factor on every axis.
     Uniform(f32),
+    /// Per-axis [x, y, z] factors.
     Axes(#[serde(deserialize_with = "exact")] [f32; 3]),
 }
 
@@ -349,13 +442,19 @@ impl Default for Scale {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ObjectTable {
+    /// Optional label.
     pub name: Option<String>,
+    /// Which shape: box, quad, sphere, cylinder, lathe, teapot or mesh.
     pub shape: ShapeKind,
+    /// A name from `[materials]` (must exist).
     pub material: String,
     /// box: [x, y, z]; quad: [x, y] (mm).
     pub size: Option<Vec<f32>>,
+    /// sphere (about the origin), cylinder: radius (mm, 1e-6–1e9).
     pub radius: Option<f32>,
+    /// cylinder: height along z from 0 (mm, 1e-6–1e9).
     pub height: Option<f32>,
+    /// sphere, cylinder, lathe: divisions around z (3–4096, default 64).
     pub segments: Option<u32>,
     /// lathe: (radius, z) points (mm).
     #[serde(default, deserialize_with = "exact_pairs")]
@@ -364,17 +463,21 @@ pub struct ObjectTable {
     pub resolution: Option<u32>,
     /// mesh: OBJ or PLY path, relative to the scene file.
     pub file: Option<String>,
+    /// Translation (mm, default [0, 0, 0]).
     #[serde(default)]
     #[serde(deserialize_with = "exact")]
     pub translate: [f32; 3],
+    /// Rotation (degrees) about x, then y, then z (default [0, 0, 0]).
     #[serde(default)]
     #[serde(deserialize_with = "exact")]
     pub rotate_deg: [f32; 3],
+    /// A number or [x, y, z] (non-zero, default 1).
     #[serde(default)]
     pub scale: Scale,
     /// Use smooth (interpolated) normals where the shape or mesh has them.
     #[serde(default = "yes")]
     pub smooth: bool,
+    /// Where the object sits in the tree (default: carved at the pith, fibres along z).
     pub tree: Option<TreeTable>,
 }
 
@@ -420,32 +523,45 @@ pub struct TreeTable {
     /// Selects which boards / slices (cut = "veneer" / "boards").
     #[serde(default)]
     pub seed: u64,
+    /// solid: tree point (mm) where the object's origin lies; its distance from the z axis is
+    /// the distance from the pith (default [0, 0, 0]).
     #[serde(default)]
     #[serde(deserialize_with = "exact")]
     pub origin: [f32; 3],
+    /// solid: the object direction the fibres run along, mapped to the pith direction
+    /// (default [0, 0, 1]).
     #[serde(default = "default_axis")]
     #[serde(deserialize_with = "exact")]
     pub axis: [f32; 3],
+    /// solid: turn about the pith (degrees, default 0): flat- vs quarter-sawn.
     #[serde(default)]
     pub rotation_deg: f32,
+    /// Tree mm per object unit (0.000001–1e6, default 1).
     #[serde(default = "one")]
     pub scale: f32,
 }
 
+/// `tree.cut`: how the object was made from the tree.
 #[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum CutName {
+    /// Carved from one block.
     #[default]
     Solid,
+    /// One flat-sawn slice per face (Liu 2016 Fig. 18).
     Veneer,
+    /// A floor `layout` of boards, each cut from its own place.
     Boards,
 }
 
+/// `tree.space`: the space placement points are read in.
 #[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum SpaceName {
+    /// Object space, before `translate/rotate/scale`: the wood moves with the object.
     #[default]
     Object,
+    /// World space: several objects share one block.
     World,
 }
 
@@ -459,6 +575,7 @@ fn default_axis() -> [f32; 3] {
 #[derive(Debug, Clone, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct SweepTable {
+    /// Number of frames per arc (1–100000, default 48).
     #[serde(default = "default_frames")]
     pub frames: u32,
     /// Arc from / to, degrees from the zenith, each in [-90, 90].
@@ -466,11 +583,13 @@ pub struct SweepTable {
     pub arc_deg: [f32; 2],
     /// Name of the light that moves (a point, spot or sphere light).
     pub light: String,
+    /// Centre of the arc (mm, default [0, 0, 0]).
     #[serde(default)]
     #[serde(deserialize_with = "exact")]
     pub pivot: [f32; 3],
     /// Distance from the pivot to the light (mm).
     pub radius: f32,
+    /// The arc turns about this axis through the pivot, right-hand rule (default [0, 1, 0]).
     #[serde(default = "default_sweep_axis")]
     #[serde(deserialize_with = "exact")]
     pub axis: [f32; 3],
@@ -492,16 +611,21 @@ pub struct SweepTable {
 #[derive(Debug, Clone, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct SweepBoard {
+    /// Centre of the face (world mm).
     #[serde(deserialize_with = "exact")]
     pub origin: [f32; 3],
+    /// Direction of the image columns (default [1, 0, 0]).
     #[serde(default = "default_board_x")]
     #[serde(deserialize_with = "exact")]
     pub x_axis: [f32; 3],
+    /// Direction towards the image's top row (default [0, 1, 0]), ⟂ `x_axis`.
     #[serde(default = "default_board_y")]
     #[serde(deserialize_with = "exact")]
     pub y_axis: [f32; 3],
+    /// [width, height] of the face (mm).
     #[serde(deserialize_with = "exact")]
     pub size_mm: [f32; 2],
+    /// Refractive index of the finish (1–4, default 1.5); must match the board's material.
     #[serde(default = "default_eta")]
     pub eta: f32,
 }
@@ -530,9 +654,14 @@ fn default_sweep_axis() -> [f32; 3] {
 #[derive(Debug, Clone, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct SweepRegion {
+    /// Region name used in the report.
     pub name: String,
+    /// Left edge (pixels, inclusive).
     pub x0: u32,
+    /// Top edge (pixels, inclusive; top-left origin).
     pub y0: u32,
+    /// Right edge (pixels, exclusive; x0 < x1 ≤ width).
     pub x1: u32,
+    /// Bottom edge (pixels, exclusive; y0 < y1 ≤ height).
     pub y1: u32,
 }

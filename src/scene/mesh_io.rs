@@ -10,10 +10,20 @@ use std::path::Path;
 /// A mesh file that could not be read, naming the file and what is wrong.
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
+    /// The file is unreadable, malformed or holds no usable triangles.
     #[error("mesh {path}: {message}")]
-    Bad { path: String, message: String },
+    Bad {
+        /// The mesh file.
+        path: String,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// The file is neither `.obj` nor `.ply`.
     #[error("mesh {path}: unsupported extension (allowed: .obj, .ply)")]
-    Extension { path: String },
+    Extension {
+        /// The mesh file.
+        path: String,
+    },
 }
 
 fn bad(path: &Path, message: impl Into<String>) -> MeshError {

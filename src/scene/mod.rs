@@ -29,30 +29,53 @@ use std::sync::Arc;
 /// Why a scene could not be loaded.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
+    /// The scene file could not be read.
     #[error("cannot read scene {path}: {source}")]
     Io {
+        /// The scene file.
         path: String,
+        /// The I/O error.
         source: std::io::Error,
     },
+    /// The file is not UTF-8 or not valid TOML for the format (unknown field, wrong type...).
     #[error("scene {path}: {message}")]
-    Parse { path: String, message: String },
-    #[error("cannot read scene {0}")]
-    Input(crate::render::resources::ResourceError),
-    #[error("scene {path}: {source}")]
-    Resources {
+    Parse {
+        /// The scene file.
         path: String,
-        source: crate::render::resources::ResourceError,
-    },
-    #[error("scene {path}: field `{field}`: {message}")]
-    Invalid {
-        path: String,
-        field: String,
+        /// toml's or serde's message.
         message: String,
     },
+    /// The scene file itself is missing, not a regular file or larger than
+    /// [`MAX_SCENE_BYTES`](crate::render::resources::MAX_SCENE_BYTES).
+    #[error("cannot read scene {0}")]
+    Input(crate::render::resources::ResourceError),
+    /// The geometry's BVH build would need more memory than the machine has (estimated before
+    /// it starts; `--ignore-limits` skips the check).
+    #[error("scene {path}: {source}")]
+    Resources {
+        /// The scene file.
+        path: String,
+        /// The estimate and what is available.
+        source: crate::render::resources::ResourceError,
+    },
+    /// A field's value is out of range or inconsistent with the rest of the scene.
+    #[error("scene {path}: field `{field}`: {message}")]
+    Invalid {
+        /// The scene file.
+        path: String,
+        /// The field at fault (e.g. `objects[2].radius`).
+        field: String,
+        /// What is allowed.
+        message: String,
+    },
+    /// An object's mesh file could not be loaded.
     #[error("scene {path}: field `{field}`: {source}")]
     Mesh {
+        /// The scene file.
         path: String,
+        /// The field naming the mesh (e.g. `objects[0].file`).
         field: String,
+        /// Why the mesh could not be loaded.
         source: mesh_io::MeshError,
     },
 }
@@ -65,12 +88,15 @@ pub const MAX_EXTENT_MM: f32 = 1e6;
 pub struct LoadedScene {
     /// The file stem (`sweep_board` for scenes/sweep_board.toml).
     pub name: String,
+    /// The built geometry, materials, lights and camera.
     pub scene: render::Scene,
+    /// Image size, sampling, integrator and filter from `[render]`, before command-line overrides.
     pub settings: RenderSettings,
     /// PNG exposure in stops.
     pub exposure: f32,
     /// Name of each light in `scene.lights` (None where the file gave none).
     pub light_names: Vec<Option<String>>,
+    /// The `[sweep]` table, if the scene has one.
     pub sweep: Option<SweepTable>,
     /// Non-fatal problems (e.g. degenerate triangles dropped), for the CLI to print.
     pub warnings: Vec<String>,

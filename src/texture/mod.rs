@@ -37,6 +37,7 @@ use std::collections::BTreeMap;
 
 /// A solid texture: linear RGB colour at a point (mm).
 pub trait SolidTexture: Send + Sync {
+    /// Linear RGB colour at point `p` (mm).
     fn eval(&self, p: Vec3) -> Vec3;
 
     /// [`SolidTexture::eval`] at every point of `points`, written to `out` (same length).

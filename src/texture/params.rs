@@ -7,9 +7,13 @@ use std::collections::BTreeMap;
 /// One parameter a texture accepts.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ParamSpec {
+    /// The name in `params = { name = value }`.
     pub name: &'static str,
+    /// Value when the user gives none.
     pub default: f32,
+    /// Smallest allowed value.
     pub min: f32,
+    /// Largest allowed value.
     pub max: f32,
     /// One line: what it does and its unit.
     pub doc: &'static str,
@@ -35,25 +39,44 @@ pub(crate) const fn p(
 /// Errors of [`super::by_name`].
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum TextureError {
+    /// No texture of this name.
     #[error("unknown texture `{name}`; valid names: {valid}")]
-    UnknownTexture { name: String, valid: String },
+    UnknownTexture {
+        /// The name given.
+        name: String,
+        /// The valid names.
+        valid: String,
+    },
+    /// The texture has no parameter of this name.
     #[error("texture `{texture}` has no parameter `{param}`; allowed: {allowed}")]
     UnknownParam {
+        /// The texture.
         texture: String,
+        /// The parameter given.
         param: String,
+        /// The texture's parameter names.
         allowed: String,
     },
+    /// A parameter value outside its declared range (or not finite).
     #[error("texture `{texture}`: parameter `{param}` = {value} is outside [{min}, {max}]")]
     OutOfRange {
+        /// The texture.
         texture: String,
+        /// The parameter.
         param: String,
+        /// The value given.
         value: f32,
+        /// Smallest allowed value.
         min: f32,
+        /// Largest allowed value.
         max: f32,
     },
+    /// The texture's noise basis rejected its parameters.
     #[error("texture `{texture}`: {source}")]
     Noise {
+        /// The texture.
         texture: String,
+        /// The noise error.
         source: crate::noise::NoiseError,
     },
 }

@@ -13,16 +13,20 @@ pub fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
 /// A multi-stop colour ramp: stops `(t, colour)` with increasing t; clamps outside.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Ramp {
+    /// `(t, colour)` stops, t increasing, colour linear RGB; at least one.
     pub stops: Vec<(f32, Vec3)>,
 }
 
 impl Ramp {
+    /// A ramp through `stops`; they must be non-empty with increasing t.
     pub fn new(stops: &[(f32, Vec3)]) -> Self {
         Ramp {
             stops: stops.to_vec(),
         }
     }
 
+    /// The colour at `t`: linear between the neighbouring stops, the end colours outside
+    /// (non-finite t reads as 0).
     pub fn eval(&self, t: f32) -> Vec3 {
         let t = if t.is_finite() { t } else { 0.0 };
         let s = &self.stops;

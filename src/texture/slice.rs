@@ -9,8 +9,11 @@ use std::str::FromStr;
 /// The slicing plane; the image's right and up directions are the first and second axis.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Plane {
+    /// Image right = +x, up = +y; normal z.
     Xy,
+    /// Image right = +x, up = +z; normal y.
     Xz,
+    /// Image right = +y, up = +z; normal x.
     Yz,
 }
 
@@ -41,9 +44,13 @@ impl std::fmt::Display for Plane {
 /// the plane at `offset` (mm) along its normal.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Slice {
+    /// Which plane.
     pub plane: Plane,
+    /// Position of the plane along its normal (mm).
     pub offset: f32,
+    /// Side of the square (mm).
     pub size: f32,
+    /// Pixels along each side.
     pub res: u32,
 }
 

@@ -61,6 +61,7 @@ tree = {{ origin = [0.0, 120.0, 0.0], axis = [1.0, 0.0, 0.0], rotation_deg = 0.0
 /// How a preset's board renders under uniform white light, against its diffuse albedo.
 #[derive(Clone, Debug, PartialEq)]
 pub struct WhiteLightOrder {
+    /// The preset's name.
     pub preset: String,
     /// Pearson correlation, over the board's pixels, of rendered luminance with the luminance of
     /// the preset's diffuse albedo (the albedo AOV).
@@ -68,6 +69,7 @@ pub struct WhiteLightOrder {
     /// Mean rendered luminance of the palest third of the pixels by albedo (earlywood in most
     /// species) and of the darkest third (latewood).
     pub pale_third: f64,
+    /// Mean rendered luminance of the darkest third by albedo (latewood in most species).
     pub dark_third: f64,
 }
 
@@ -115,6 +117,7 @@ pub fn pearson(pairs: &[(f64, f64)]) -> f64 {
 /// columns, y towards the top row, z out of the face), and which way its grain runs.
 #[derive(Clone, Debug)]
 pub struct BoardMaps {
+    /// The face's maps.
     pub board: MeasuredBoard,
     /// Which image axis the grain runs along: true for columns (x), false for rows (y).
     pub grain_along_x: bool,
@@ -370,9 +373,13 @@ pub fn board_statistics(maps: &BoardMaps, across: std::ops::Range<usize>) -> Vec
 /// quarter-pair correlations).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Comparison {
+    /// The statistic's name (one of [`BOARD_STATISTICS`], or a chatoyance figure).
     pub name: String,
+    /// The preset's whole-board value.
     pub preset: f64,
+    /// The measured board's whole-board value.
     pub measured: f64,
+    /// The measured 10 % and 90 % quantiles over the strips.
     pub band: (f64, f64),
 }
 
@@ -421,12 +428,18 @@ pub fn compare_boards(preset: &BoardMaps, measured: &BoardMaps) -> Vec<Compariso
 pub enum Subject {
     /// A preset by name: built in, or `dir/NAME.toml` when `dir` is given (for calibration).
     Preset {
+        /// Preset name.
         name: String,
+        /// Selects the tree.
         seed: u64,
+        /// Folder of preset files to read instead of the built-in presets.
         dir: Option<PathBuf>,
     },
+    /// A measured board's maps, from a folder of data/marschner2005/ (relative to the repository).
     Measured {
+        /// The board's folder, e.g. `data/marschner2005/maple`.
         dir: String,
+        /// Which image axis the grain runs along: true for columns (x), false for rows (y).
         grain_along_x: bool,
     },
 }
@@ -592,9 +605,13 @@ axis = {axis}
 /// The frames of a top-down sweep (linear RGB, row-major) and their light angles.
 #[derive(Clone, Debug)]
 pub struct SweepLuminance {
+    /// Image width (pixels).
     pub width: u32,
+    /// Image height (pixels).
     pub height: u32,
+    /// Light angle of each frame (degrees from the zenith).
     pub angles: Vec<f32>,
+    /// Each frame's pixels (linear RGB, row-major, top row first).
     pub frames: Vec<Vec<Vec3>>,
 }
 
@@ -623,8 +640,12 @@ impl SweepLuminance {
 /// A calibrated preset and the measured board it is checked against.
 #[derive(Clone, Debug)]
 pub struct Pair {
+    /// The preset's name.
     pub preset: &'static str,
+    /// Its measured board's folder, relative to the repository.
     pub measured_dir: &'static str,
+    /// Which image axis the measured board's grain runs along: true for columns (x), false for rows
+    /// (y).
     pub grain_along_x: bool,
 }
 
@@ -646,12 +667,16 @@ pub const PAIRS: [Pair; 2] = [
 /// Sweep sampling of the chatoyance comparison: frames over ±60°, pixels across the board, spp.
 #[derive(Clone, Copy, Debug)]
 pub struct SweepSettings {
+    /// Frames over the ±60° sweep.
     pub frames: usize,
+    /// Pixels across the board (square image).
     pub res: u32,
+    /// Samples per pixel.
     pub spp: u32,
 }
 
 impl SweepSettings {
+    /// The sampling of `xylem validate appearance`.
     pub const FULL: SweepSettings = SweepSettings {
         frames: 25,
         res: 130,
@@ -681,15 +706,22 @@ fn chatoyance_statistics(s: &SweepLuminance, grain_along_x: bool) -> ([f64; 2], 
 
 /// The comparison of one pair: board statistics, chatoyance, and the rendered sweeps.
 pub struct PairReport {
+    /// The calibrated preset and its measured board.
     pub pair: Pair,
+    /// Board statistics and chatoyance figures, preset against measured.
     pub rows: Vec<Comparison>,
+    /// The preset's board face.
     pub preset_maps: BoardMaps,
+    /// The measured board's maps.
     pub measured_maps: BoardMaps,
+    /// The preset board's rendered sweep.
     pub preset_sweep: SweepLuminance,
+    /// The measured board's rendered sweep.
     pub measured_sweep: SweepLuminance,
 }
 
 impl PairReport {
+    /// True when every row [`passes`](Comparison::passes).
     pub fn passes(&self) -> bool {
         self.rows.iter().all(Comparison::passes)
     }
@@ -750,15 +782,20 @@ pub fn compare_pair(
 /// properties and site": luminance differs more than dominant wavelength or purity).
 #[derive(Clone, Debug, PartialEq)]
 pub struct WalnutCharacter {
+    /// Chromaticity (r, g, b) / (r + g + b) of the board's diffuse colour (the first three
+    /// [`BOARD_STATISTICS`]).
     pub chromaticity: [f64; 3],
     /// Mean diffuse luminance of walnut over that of the curly maple preset.
     pub luminance_vs_maple: f64,
     /// Coefficients of variation over the board of luminance and of chromaticity r.
     pub luminance_cv: f64,
+    /// Coefficient of variation of chromaticity r.
     pub hue_cv: f64,
 }
 
 impl WalnutCharacter {
+    /// The published character: r > g > b, under half of maple's luminance, and luminance varying
+    /// more than hue.
     pub fn passes(&self) -> bool {
         let c = self.chromaticity;
         c[0] > c[1]

@@ -30,32 +30,50 @@ use std::path::{Path, PathBuf};
 /// Errors while loading the case file.
 #[derive(Debug, thiserror::Error)]
 pub enum CasesError {
+    /// The case file could not be read.
     #[error("cannot read {path}: {source}")]
     Io {
+        /// The case file.
         path: PathBuf,
+        /// The I/O error.
         source: std::io::Error,
     },
+    /// The case file is not valid TOML for [`CasesFile`].
     #[error("{path}: {source}")]
     Toml {
+        /// The case file.
         path: PathBuf,
+        /// toml's error (names the field).
         source: toml::de::Error,
     },
+    /// A case's parameters are out of range for [`WoodBsdf`].
     #[error("{path}: case `{case}`: {source}")]
     Params {
+        /// The case file.
         path: PathBuf,
+        /// The case's name.
         case: String,
+        /// Which parameter is out of range.
         source: BsdfError,
     },
+    /// A setting is out of range (the message names it and the allowed range).
     #[error("{path}: {message}")]
-    Invalid { path: PathBuf, message: String },
+    Invalid {
+        /// The case file.
+        path: PathBuf,
+        /// The setting and its allowed range.
+        message: String,
+    },
 }
 
 /// Fibre-lobe normalisation as written in the case file.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Normalization {
+    /// [`FiberNormalization::EnergyBounded`]: directional albedo ≤ 1 at every angle.
     #[default]
     EnergyBounded,
+    /// [`FiberNormalization::Published`]: Marschner et al. 2005 eq. 3, not normalised.
     Published,
 }
 
@@ -65,16 +83,27 @@ pub enum Normalization {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct CaseSpec {
+    /// Case name in the report (grid cases are named from their parameters).
     pub name: String,
+    /// Diffuse (subsurface) colour, linear RGB 0–1.
     pub diffuse: [f32; 3],
+    /// Fibre highlight colour, linear RGB 0–1.
     pub fiber_color: [f32; 3],
+    /// Fibre highlight width β (degrees).
     pub highlight_width_deg: f32,
+    /// Refractive index of the finish.
     pub eta: f32,
+    /// Dip of the fibre axis below the surface plane (degrees).
     pub fiber_dip_deg: f32,
+    /// Azimuth of the fibre axis in the surface plane (degrees).
     pub fiber_azimuth_deg: f32,
+    /// Fraction of ray cells, 0–1.
     pub ray_mask: f32,
+    /// Dip of the ray axis below the surface plane (degrees).
     pub ray_dip_deg: f32,
+    /// GGX roughness of the finish, 0–1 (0 = smooth).
     pub roughness: f32,
+    /// Fibre-lobe normalisation (default energy-bounded).
     pub normalization: Normalization,
     /// A white non-absorbing substrate: its albedo must reach `white_min_albedo`.
     pub white: bool,
@@ -112,6 +141,7 @@ pub fn dipping_axis(dip_deg: f32, azimuth_deg: f32) -> Vec3 {
 }
 
 impl CaseSpec {
+    /// The [`WoodBsdfParams`] of this case (angles converted to radians and axes).
     pub fn params(&self) -> WoodBsdfParams {
         WoodBsdfParams {
             diffuse: Vec3::from(self.diffuse),
@@ -125,6 +155,7 @@ impl CaseSpec {
         }
     }
 
+    /// The BSDF of this case; an error where a parameter is out of range.
     pub fn bsdf(&self) -> Result<WoodBsdf, BsdfError> {
         let norm = match self.normalization {
             Normalization::EnergyBounded => FiberNormalization::EnergyBounded,
@@ -138,11 +169,17 @@ impl CaseSpec {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Grid {
+    /// β values of the grid (degrees).
     pub highlight_width_deg: Vec<f32>,
+    /// η values of the grid.
     pub eta: Vec<f32>,
+    /// Fibre dips of the grid (degrees).
     pub fiber_dip_deg: Vec<f32>,
+    /// Ray-mask values of the grid.
     pub ray_mask: Vec<f32>,
+    /// Finish roughness values of the grid.
     pub roughness: Vec<f32>,
+    /// Every field the grid does not vary.
     #[serde(default)]
     pub base: CaseSpec,
 }
@@ -151,27 +188,44 @@ pub struct Grid {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Settings {
+    /// Seed of every random stream of the run.
     pub seed: u64,
     /// View zenith angles of the furnace check, degrees.
     pub theta_o_deg: Vec<f32>,
+    /// Monte Carlo samples per furnace albedo.
     pub furnace_samples: u32,
     /// Largest quadrature step, degrees (the step is also at most β/2).
     pub quadrature_step_deg: f32,
     /// Agreement of MC and quadrature: |mc − quad| ≤ furnace_sigmas·σ + furnace_abs_tol.
     pub furnace_sigmas: f64,
+    /// Absolute slack of the furnace agreement (see `furnace_sigmas`).
     pub furnace_abs_tol: f64,
+    /// Least albedo of a white case (quadrature, and MC + 3σ).
     pub white_min_albedo: f64,
+    /// The white-case bound applies at view zenith angles up to this (degrees).
     pub white_max_theta_deg: f32,
+    /// Samples per chi-square test.
     pub chi2_samples: u32,
+    /// View zenith angles of the chi-square test (degrees).
     pub chi2_theta_o_deg: Vec<f32>,
+    /// Histogram bins in θ for the chi-square test (≥ 2).
     pub chi2_theta_bins: u32,
+    /// Histogram bins in φ for the chi-square test (≥ 2).
     pub chi2_phi_bins: u32,
+    /// Bins whose expected count is below this are pooled.
     pub chi2_min_expected: f64,
+    /// Family-wise significance level α of the chi-square tests, in (0, 1) (Šidák-corrected per
+    /// test).
     pub significance: f64,
+    /// Relative tolerance of ∫pdf dω against the fraction of non-delta samples (or 5σ).
     pub pdf_tolerance: f64,
+    /// Random direction pairs of the reciprocity check.
     pub reciprocity_pairs: u32,
+    /// Largest allowed relative reciprocity error.
     pub reciprocity_tolerance: f64,
+    /// Largest allowed relative error of a sample's f and pdf against `eval` and `pdf`.
     pub weight_tolerance: f64,
+    /// Random samples per degenerate configuration of the extremes check.
     pub extreme_samples: u32,
 }
 
@@ -179,8 +233,11 @@ pub struct Settings {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CasesFile {
+    /// Sample counts and thresholds.
     pub settings: Settings,
+    /// The grid of cases.
     pub grid: Grid,
+    /// Named cases beside the grid.
     #[serde(default)]
     pub cases: Vec<CaseSpec>,
     /// Parameter sets of the extremes check.
@@ -194,9 +251,13 @@ pub struct CasesFile {
 /// A loaded, checked suite: the expanded case list.
 #[derive(Clone, Debug)]
 pub struct Suite {
+    /// Sample counts and thresholds.
     pub settings: Settings,
+    /// Grid cases, then named cases.
     pub cases: Vec<CaseSpec>,
+    /// Parameter sets of the extremes check.
     pub extremes: Vec<CaseSpec>,
+    /// The rough-finish rows, if the file has them.
     pub rough: Option<RoughSettings>,
 }
 
@@ -347,8 +408,11 @@ pub fn reciprocity_error(b: &(impl Bsdf + ?Sized), pairs: u32, rng: &mut Pcg32) 
 /// Result of one chi-square test of `sample` against `pdf` for one `wo`.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Chi2Outcome {
+    /// The chi-square statistic over the pooled bins.
     pub statistic: f64,
+    /// Degrees of freedom (pooled bins − 1).
     pub dof: u32,
+    /// Probability of a statistic this large if `sample` follows `pdf`.
     pub p_value: f64,
     /// ∫ pdf dω over the hemisphere (sum of expected counts / N).
     pub pdf_integral: f64,
@@ -550,15 +614,20 @@ pub fn extreme_violations(b: &WoodBsdf, samples: u32, rng: &mut Pcg32) -> u64 {
 /// Furnace result for one view direction.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct FurnacePoint {
+    /// View zenith angle (degrees).
     pub theta_o_deg: f32,
+    /// View azimuth (degrees).
     pub phi_o_deg: f32,
     /// Max channel of the Monte Carlo albedo, its standard error, and the quadrature albedo
     /// (plus the delta reflectance F(θo) of a smooth finish) of the same channel.
     pub mc: f64,
+    /// Standard error of `mc`.
     pub sigma: f64,
+    /// Quadrature albedo of the same channel (plus F(θo) of a smooth finish).
     pub quadrature: f64,
     /// Largest |mc − quad| over the channels, and that difference in standard errors.
     pub worst_diff: f64,
+    /// `worst_diff` in standard errors.
     pub worst_z: f64,
     /// Every channel within furnace_sigmas·σ + furnace_abs_tol.
     pub agrees: bool,
@@ -567,9 +636,13 @@ pub struct FurnacePoint {
 /// Everything measured for one case.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct CaseResult {
+    /// The case.
     pub spec: CaseSpec,
+    /// Furnace results per view direction.
     pub furnace: Vec<FurnacePoint>,
+    /// Reciprocity error (max relative).
     pub reciprocity: f64,
+    /// Chi-square outcome per view zenith angle (degrees).
     pub chi2: Vec<(f32, Chi2Outcome)>,
 }
 
@@ -657,14 +730,19 @@ pub fn run_case(spec: &CaseSpec, index: usize, s: &Settings) -> CaseResult {
 /// One line of the summary table.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct CheckSummary {
+    /// The check's name.
     pub check: String,
+    /// Whether every case met the criterion.
     pub passed: bool,
     /// A figure reported without a pass/fail criterion (its criterion reads "reported …"):
     /// shown as "reported", never as "pass", and it cannot fail the run.
     #[serde(default)]
     pub reported: bool,
+    /// The worst figure over the cases.
     pub worst: f64,
+    /// The case that gave `worst`.
     pub case: String,
+    /// The criterion, in words.
     pub criterion: String,
 }
 
@@ -682,19 +760,26 @@ impl CheckSummary {
 /// The whole run: per-check summary, per-case results and the settings used.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct BsdfValidation {
+    /// One summary line per check.
     pub checks: Vec<CheckSummary>,
+    /// Per-case results.
     pub cases: Vec<CaseResult>,
+    /// Each extremes case with its count of NaN / Inf / negative values (0 when clean).
     pub extreme_violations: Vec<(String, u64)>,
+    /// The settings used.
     pub settings: Settings,
     /// Largest albedo of the published (unnormalised) lobe cases, for notes/bsdf.md.
     pub published_max_albedo: Option<(f64, String)>,
+    /// The rough-finish rows against the layered reference.
     #[serde(default)]
     pub rough_rows: Vec<RoughRow>,
+    /// The rough-finish settings used.
     #[serde(default)]
     pub rough_settings: Option<RoughSettings>,
 }
 
 impl BsdfValidation {
+    /// True when every check passed ("reported" figures cannot fail).
     pub fn passed(&self) -> bool {
         self.checks.iter().all(|c| c.passed)
     }

@@ -33,9 +33,17 @@ const BETA_DEG: f32 = crate::material::DEFAULT_HIGHLIGHT_WIDTH_DEG;
 #[derive(Clone, Debug)]
 pub enum Source {
     /// A crop of a measured board (folder with diffuse/fiber_color/fiber_axis PNGs).
-    Measured { dir: PathBuf },
+    Measured {
+        /// The board's folder.
+        dir: PathBuf,
+    },
     /// A preset's quartersawn face (tree placement of scenes/sweep_board.toml).
-    Preset { name: String, seed: u64 },
+    Preset {
+        /// Preset name.
+        name: String,
+        /// Selects the tree.
+        seed: u64,
+    },
 }
 
 /// The sweep a round trip renders.
@@ -45,9 +53,13 @@ pub struct SweepSpec {
     pub texels: usize,
     /// Pixels per texel along each side (odd, so texel centres fall on pixel centres).
     pub px_per_texel: usize,
+    /// Frames per arc.
     pub frames_per_arc: usize,
+    /// Azimuth of each arc about +z (degrees).
     pub azimuths_deg: Vec<f32>,
+    /// Each arc runs from −`arc_deg` to +`arc_deg` (degrees from the zenith).
     pub arc_deg: f32,
+    /// Samples per pixel.
     pub spp: u32,
     /// Radius of the sphere light (mm) at 500 mm: its solid angle gives the renderer's noise.
     pub light_radius_mm: f32,
@@ -192,6 +204,7 @@ eta = 1.5
 pub struct FitErrors {
     /// Angle between fitted and true fibre axes (lines), degrees: median, 90th percentile.
     pub axis_median_deg: f64,
+    /// 90th percentile of the axis angle (degrees).
     pub axis_p90_deg: f64,
     /// |ρ_fit − ρ|/|ρ| (RGB norms), median.
     pub diffuse_median: f64,
@@ -212,6 +225,7 @@ pub const GOALS: FitErrors = FitErrors {
 };
 
 impl FitErrors {
+    /// True when every error is at or below `goal`'s.
     pub fn meets(&self, goal: &FitErrors) -> bool {
         self.axis_median_deg <= goal.axis_median_deg
             && self.axis_p90_deg <= goal.axis_p90_deg
@@ -280,9 +294,13 @@ pub fn compare(fitted: &FittedMaps, truth: &MeasuredBoard) -> FitErrors {
 
 /// A rendered round-trip capture: its folder, the truth, and the fit options that match it.
 pub struct RoundTrip {
+    /// The rendered sweep's folder (frames and `manifest.json`).
     pub sweep_dir: PathBuf,
+    /// The maps the board was rendered from.
     pub truth: MeasuredBoard,
+    /// Texels along each side of the (square) board.
     pub texels: usize,
+    /// Wall-clock seconds of the render.
     pub render_seconds: f64,
 }
 

@@ -74,7 +74,9 @@ fn fwhm(row: &[f32]) -> f32 {
 /// (across it), through the brightest pixel.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Widths {
+    /// Full width at half maximum along image x (the fibre).
     pub along: f32,
+    /// Full width at half maximum along image y (across the fibre).
     pub across: f32,
 }
 
@@ -92,6 +94,7 @@ fn widths(img: &[f32], w: usize) -> Widths {
 /// One comparison at fibre width β.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Approximation {
+    /// The fibre highlight width β (degrees).
     pub beta_deg: f32,
     /// xylem's fibre lobe (`WoodBsdf::eval`, k_f = 1, no diffuse; the finish's mirror
     /// reflection of the light, a delta, is not part of `eval`).

@@ -21,8 +21,11 @@ pub enum Substrate {
     Lambertian(f64),
     /// The energy-bounded fibre lobe with colour k_f and Gaussian width β (radians).
     Fiber {
+        /// The fibre axis in the surface frame.
         axis: FiberAxis,
+        /// Highlight width β (radians).
         beta: f32,
+        /// Fibre colour k_f.
         k_f: f64,
     },
 }
@@ -30,8 +33,11 @@ pub enum Substrate {
 /// A rough dielectric interface (GGX α, relative index η over the substrate) over a substrate.
 #[derive(Clone, Copy, Debug)]
 pub struct LayeredReference {
+    /// GGX roughness α of the interface.
     pub alpha: f64,
+    /// Relative refractive index η of the finish over the outside.
     pub eta: f64,
+    /// What lies under the finish.
     pub substrate: Substrate,
 }
 
@@ -50,17 +56,23 @@ pub enum PathKind {
 /// direction (`BINS_MU` bins in cos θi × 2 half-planes: the mirror side first).
 #[derive(Clone, Debug, Default)]
 pub struct ReferenceAlbedo {
+    /// Albedo of paths that never entered the finish.
     pub interface: f64,
+    /// Albedo of paths that reached the substrate once.
     pub single_pass: f64,
+    /// Albedo of paths that reached the substrate two or more times.
     pub multiple_pass: f64,
     /// Standard error of the total.
     pub sigma: f64,
+    /// Reflected light per exit-direction bin (`2 · BINS_MU` bins, mirror side first), fraction of
+    /// the incident light.
     pub bins: Vec<f64>,
     /// Paths cut at the event cap (should be 0).
     pub truncated: u64,
 }
 
 impl ReferenceAlbedo {
+    /// The whole albedo: interface + single pass + multiple pass.
     pub fn total(&self) -> f64 {
         self.interface + self.single_pass + self.multiple_pass
     }

@@ -14,9 +14,13 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RoughSettings {
+    /// Seed of the random walks.
     pub seed: u64,
+    /// View zenith angles (degrees).
     pub theta_o_deg: Vec<f32>,
+    /// GGX roughness values α of the finish.
     pub roughness: Vec<f32>,
+    /// Refractive indices η of the finish.
     pub eta: Vec<f32>,
     /// Albedos of the Lambertian substrates (1 is the white one).
     pub diffuse: Vec<f32>,
@@ -26,10 +30,13 @@ pub struct RoughSettings {
     pub paths: u32,
     /// Quadrature points per axis of the analytic albedo.
     pub quadrature_n: u32,
+    /// Least albedo of a white row (the bound of issue 12).
     pub white_min_albedo: f64,
     /// Required where the reference itself reaches it.
     pub white_strict_albedo: f64,
+    /// The white bound applies at view zenith angles up to this (degrees).
     pub white_max_theta_deg: f32,
+    /// ... and at finish roughness up to this.
     pub white_max_roughness: f32,
     /// |model − reference| ≤ tolerance · reference + 3σ for the total.
     pub tolerance: f64,
@@ -38,38 +45,50 @@ pub struct RoughSettings {
 /// One (substrate, α, η, θo) row.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct RoughRow {
+    /// "ρ 0.5" (Lambertian of that albedo) or "fibre β ..." (the fibre lobe).
     pub substrate: String,
+    /// GGX roughness α of the finish.
     pub roughness: f32,
+    /// Refractive index η of the finish.
     pub eta: f32,
+    /// View zenith angle (degrees).
     pub theta_o_deg: f32,
     /// The analytic albedo (quadrature of `eval`), its interface reflection alone, and the rest.
     pub model: f64,
+    /// The model's interface reflection alone.
     pub model_interface: f64,
     /// The reference's albedo comparable with the model: interface + substrate, where for the
     /// fibre only the single pass (the model drops the fibre light reflected back down).
     pub reference: f64,
+    /// Standard error of `reference`.
     pub sigma: f64,
+    /// The reference's interface reflection alone.
     pub reference_interface: f64,
     /// Fibre light after internal reflections (not in the model), 0 for Lambertian rows.
     pub reference_dropped: f64,
     /// Largest |Δ| over the direction bins, as a fraction of the incident light.
     pub max_bin_diff: f64,
+    /// Reference paths cut at the event cap (should be 0).
     pub truncated: u64,
 }
 
 impl RoughRow {
+    /// The relative difference |model − reference| / reference (reference floored at 10⁻³).
     pub fn rel_diff(&self) -> f64 {
         (self.model - self.reference).abs() / self.reference.max(1e-3)
     }
 
+    /// The row's criterion: |model − reference| ≤ tolerance · reference + 3σ.
     pub fn agrees(&self, s: &RoughSettings) -> bool {
         (self.model - self.reference).abs() <= s.tolerance * self.reference + 3.0 * self.sigma
     }
 
+    /// True for a fibre-substrate row.
     pub fn is_fiber(&self) -> bool {
         self.substrate.starts_with("fibre")
     }
 
+    /// A short row label: substrate, α, η and θo.
     pub fn label(&self) -> String {
         format!(
             "{} α {} η {} θo {}°",

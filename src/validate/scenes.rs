@@ -20,10 +20,15 @@ use glam::{Vec2, Vec3};
 /// What the ray through a pixel's centre meets first.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum PixelHit {
+    /// The ray leaves the scene (background).
     Nothing,
+    /// The ray meets a light before any surface.
     Light,
+    /// The ray meets a surface.
     Surface {
+        /// The instance index in the scene's acceleration structure.
         object: u32,
+        /// The triangle index within that instance's mesh.
         triangle: u32,
         /// Geometric normal (world, unit, as the mesh winds it).
         normal: Vec3,
@@ -108,9 +113,13 @@ pub fn firefly_ratio(img: &Image, keep: &[bool]) -> (f64, usize) {
 /// Two pixel sets' mean luminances compared.
 #[derive(Clone, Copy, Debug)]
 pub struct Contrast {
+    /// Mean luminance of set a.
     pub mean_a: f64,
+    /// Mean luminance of set b.
     pub mean_b: f64,
+    /// Pixels in set a.
     pub pixels_a: usize,
+    /// Pixels in set b.
     pub pixels_b: usize,
     /// |a − b| / max(a, b).
     pub weber: f64,
@@ -247,19 +256,25 @@ pub fn median_srgb(img: &Image, set: &[bool], exposure: f32) -> f64 {
 /// One measured number of a scene, with its limit.
 #[derive(Clone, Debug)]
 pub struct Measure {
+    /// What was measured, in words.
     pub what: String,
+    /// The measured value.
     pub value: f64,
     /// Pass when `value >= min` (or `value <= max` for an upper limit).
     pub limit: Limit,
 }
 
+/// A measure's pass limit.
 #[derive(Clone, Copy, Debug)]
 pub enum Limit {
+    /// Pass when the value is at least this.
     AtLeast(f64),
+    /// Pass when the value is at most this.
     AtMost(f64),
 }
 
 impl Measure {
+    /// True when `value` is within its limit.
     pub fn pass(&self) -> bool {
         match self.limit {
             Limit::AtLeast(m) => self.value >= m,

@@ -31,16 +31,30 @@ use std::path::Path;
 /// Errors that stop the sweep checks (a failed check is a result, not an error).
 #[derive(Debug, thiserror::Error)]
 pub enum SweepCheckError {
+    /// A validation scene could not be built or rendered.
     #[error("validation scene `{name}`: {message}")]
-    Scene { name: String, message: String },
+    Scene {
+        /// The scene's name.
+        name: String,
+        /// What went wrong.
+        message: String,
+    },
+    /// A plot could not be written.
     #[error("writing plot {path}: {message}")]
-    Plot { path: String, message: String },
+    Plot {
+        /// The plot file.
+        path: String,
+        /// What went wrong.
+        message: String,
+    },
 }
 
 /// One check's outcome.
 #[derive(Clone, Debug, Serialize)]
 pub struct CheckOutcome {
+    /// The check's name.
     pub check: String,
+    /// Whether its criterion held.
     pub passed: bool,
     /// The measured figure, in words and numbers.
     pub figure: String,

@@ -14,14 +14,22 @@ pub enum BoardLayout {
     /// Parallel planks `width` across, `length` along u (the grain); each row is shifted along u by
     /// `stagger` × length (a running bond).
     Planks {
+        /// Plank width across the grain (mm).
         width: f32,
+        /// Plank length along the grain (mm).
         length: f32,
+        /// Shift of each row along u, as a fraction of `length` (0–1).
         stagger: f32,
     },
     /// Nested-square parquet (the Sponza floor of Fig. 14): square tiles of side `tile`, each made
     /// of concentric square frames of width `strip`; every frame has four strips whose grain runs
     /// along the frame's side.
-    Parquet { tile: f32, strip: f32 },
+    Parquet {
+        /// Side of a square tile (mm).
+        tile: f32,
+        /// Width of each frame's strips (mm, at most tile/2).
+        strip: f32,
+    },
 }
 
 /// Which face of the log a board shows.
@@ -38,9 +46,13 @@ pub enum Cut {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TreeRegion {
+    /// Smallest distance from the pith a board is cut at (mm, default 60).
     pub r_min: f32,
+    /// Largest distance from the pith (mm, default 200).
     pub r_max: f32,
+    /// Boards start at heights in [0, z_span) along the pith (mm, default 5000).
     pub z_span: f32,
+    /// Flat-sawn or quartersawn (default flat).
     pub cut: Cut,
 }
 
@@ -59,8 +71,11 @@ impl Default for TreeRegion {
 /// `along` the grain and `across` it, mm from the board's corner.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BoardPoint {
+    /// Which board (hashed into the tree by [`board_to_tree`]).
     pub index: [i32; 3],
+    /// Distance along the grain from the board's corner (mm).
     pub along: f32,
+    /// Distance across the grain from the board's corner (mm).
     pub across: f32,
 }
 

@@ -17,6 +17,7 @@ pub struct BeerColor {
 }
 
 impl BeerColor {
+    /// Fits the absorbances to the preset's earlywood and latewood colours.
     pub fn new(p: &ColorParams) -> Self {
         let early = -Vec3::from(p.earlywood).ln();
         let late = -Vec3::from(p.latewood).ln();

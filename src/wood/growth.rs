@@ -110,7 +110,9 @@ pub struct SmoothRectangleWave {
     ends: [f32; 3],
     rise: f32,
     fall: f32,
+    /// Value over the low part of the period.
     pub min: f32,
+    /// Value over the high part of the period.
     pub max: f32,
 }
 

@@ -30,6 +30,7 @@ pub struct Knots {
     death_year: Option<f32>,
     /// Smooth-minimum width, years (live knots only).
     blend: f32,
+    /// Extra absorbance of knot wood (multiples of the latewood path).
     pub darkening: f32,
     seed: u64,
 }
@@ -53,6 +54,7 @@ pub struct KnotSample {
 }
 
 impl Knots {
+    /// The knot layout of `p` in a tree of ring width `ring_width` (mm); `seed` selects the knots.
     pub fn new(p: &KnotParams, ring_width: f32, seed: u64) -> Self {
         let rise = p.rise.to_radians();
         let cone = p.cone.to_radians();

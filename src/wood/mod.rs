@@ -96,16 +96,19 @@ pub struct Needs {
 }
 
 impl Needs {
+    /// Colour only (slices, previews).
     pub const COLOR: Needs = Needs {
         color: true,
         fibers: false,
         bump: false,
     };
+    /// Colour and the fibre lobe's inputs, no bump.
     pub const COLOR_FIBERS: Needs = Needs {
         color: true,
         fibers: true,
         bump: false,
     };
+    /// Everything, for rendering with pore bump.
     pub const ALL: Needs = Needs {
         color: true,
         fibers: true,
@@ -117,7 +120,9 @@ impl Needs {
 /// gradient are in tree space (millimetres, pith along z).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WoodTexel {
+    /// Diffuse colour (Beer's law, linear RGB).
     pub diffuse: Vec3,
+    /// Fibre highlight colour (linear RGB).
     pub fiber_color: Vec3,
     /// Longitudinal fibre direction (unit).
     pub fiber_dir: Vec3,

@@ -12,20 +12,29 @@ use std::path::Path;
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct WoodParams {
+    /// Growth rings: width and the earlywood/latewood profile.
     pub rings: RingParams,
+    /// Slow and fast growth periods; absent: every ring the mean width.
     #[serde(default)]
     pub growth: Option<GrowthParams>,
+    /// Interlocked grain (a helix angle that reverses with r); absent: fibres along the pith.
     #[serde(default)]
     pub interlock: Option<InterlockParams>,
+    /// Distortions of the rings (figure); each direction off when absent.
     #[serde(default)]
     pub distortion: DistortionParams,
+    /// Pores; absent: no pores (and no pore bump).
     #[serde(default)]
     pub pores: Option<PoreParams>,
+    /// Rays; absent: no rays.
     #[serde(default)]
     pub rays: Option<RayParams>,
+    /// Earlywood and latewood colours and the fibre colour's saturation.
     pub color: ColorParams,
+    /// Fibre highlight width between earlywood and latewood.
     #[serde(default)]
     pub highlight: HighlightParams,
+    /// Knots; absent: clear wood.
     #[serde(default)]
     pub knots: Option<KnotParams>,
 }
@@ -108,10 +117,13 @@ pub struct NoiseParams {
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DistortionParams {
+    /// Along r̂: blister, quilted, birdseye figure.
     #[serde(default)]
     pub radial: Option<NoiseParams>,
+    /// Along θ̂: curly and fiddleback figure.
     #[serde(default)]
     pub tangential: Option<NoiseParams>,
+    /// Along ẑ.
     #[serde(default)]
     pub longitudinal: Option<NoiseParams>,
 }
@@ -148,6 +160,7 @@ pub struct RayParams {
     pub length: f32,
     /// Mean number of rays overlapping a point.
     pub density: f32,
+    /// Bump-kernel sharpness s (0 box, 1 bump, large spike).
     #[serde(default = "one")]
     pub sharpness: f32,
     /// Largest ray mask (blend weight of the ray-fibre BSDF), in [0, 1].
