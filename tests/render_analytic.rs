@@ -4,8 +4,8 @@ use glam::{Affine3A, Vec2, Vec3};
 use std::sync::Arc;
 use xylem::material::{Material, Placement};
 use xylem::render::{
-    render, Accel, Camera, Environment, Filter, Instance, Integrator, Light, Projection,
-    RenderSettings, RunOptions, Scene, Transform,
+    render, Accel, Camera, DistantLight, Environment, Filter, Instance, Integrator, Light,
+    PointLight, Projection, RenderSettings, RunOptions, Scene, Transform,
 };
 use xylem::scene::shapes;
 
@@ -40,10 +40,10 @@ fn lambertian_quad_under_point_light_matches_closed_form() {
             0,
         )]),
         materials: vec![Material::Lambertian { albedo: rho }],
-        lights: vec![Light::Point {
+        lights: vec![Light::Point(PointLight {
             position: light,
             intensity: Vec3::splat(intensity),
-        }],
+        })],
         camera,
         filter: Filter::Box { radius: 0.0 },
     };
@@ -192,10 +192,10 @@ fn constant_fibre_board_under_distant_light_matches_bsdf() {
             placement: Placement::default(),
         }]),
         materials: vec![Material::Fiber { params }],
-        lights: vec![Light::Distant {
+        lights: vec![Light::Distant(DistantLight {
             direction: wi,
             irradiance: Vec3::splat(e),
-        }],
+        })],
         camera,
         filter: Filter::Box { radius: 0.5 },
     };

@@ -566,7 +566,9 @@ fn a_far_eye_and_far_tree_origins_are_named_not_blamed_on_other_fields() {
     assert_ne!(key, board);
     let loaded = xylem::scene::from_str(&key, "far.toml", repo(), "far").unwrap();
     let dir = loaded.scene.lights.iter().find_map(|l| match l {
-        xylem::render::Light::Distant { direction, .. } => Some(*direction),
+        xylem::render::Light::Distant(xylem::render::DistantLight { direction, .. }) => {
+            Some(*direction)
+        }
         _ => None,
     });
     let want = xylem::math::Vec3::new(1.0, 0.0, -1.0).normalize();

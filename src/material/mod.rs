@@ -84,12 +84,18 @@ pub enum SurfaceBsdf {
 impl SurfaceBsdf {
     /// True when every lobe is a delta lobe (light sampling is useless there).
     pub fn is_delta(&self) -> bool {
-        matches!(self, SurfaceBsdf::Mirror(_) | SurfaceBsdf::Glass(_))
+        match self {
+            SurfaceBsdf::Mirror(_) | SurfaceBsdf::Glass(_) => true,
+            SurfaceBsdf::Lambertian(_) | SurfaceBsdf::Wood(_) => false,
+        }
     }
 
     /// True when the BSDF transmits (the renderer must not flip the normal towards the viewer).
     pub fn is_transmissive(&self) -> bool {
-        matches!(self, SurfaceBsdf::Glass(_))
+        match self {
+            SurfaceBsdf::Glass(_) => true,
+            SurfaceBsdf::Lambertian(_) | SurfaceBsdf::Wood(_) | SurfaceBsdf::Mirror(_) => false,
+        }
     }
 }
 
@@ -214,6 +220,19 @@ pub struct ShadingSwitches {
 }
 
 impl Material {
+    /// True for a mirror or glass: every lobe of its BSDF is a delta lobe.
+    pub fn is_delta(&self) -> bool {
+        match self {
+            Material::Mirror { .. } | Material::Glass { .. } => true,
+            Material::Lambertian { .. }
+            | Material::Fiber { .. }
+            | Material::Wood(_)
+            | Material::BakedWood(_)
+            | Material::Measured(_)
+            | Material::Texture(_) => false,
+        }
+    }
+
     /// Evaluates the material at a hit.
     pub fn shade(&self, hit: &MaterialHit) -> Shading {
         let geometric_frame = || Frame::from_normal_tangent(hit.ns, hit.tangent);

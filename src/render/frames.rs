@@ -9,7 +9,7 @@
 //! component for sampling all frames in SIMD lanes.
 
 use super::integrator::{nearest_light, segment_misses_box, LightHit};
-use super::light::Light;
+use super::light::{Light, SphereLight};
 use super::Ray;
 use glam::{Vec3, Vec3A};
 
@@ -159,7 +159,7 @@ fn swept_box(frames: &[Vec<Light>], moving: usize) -> Option<(Vec3A, Vec3A)> {
     let swept = frames
         .iter()
         .try_fold(None, |acc: Option<(Vec3, Vec3)>, fl| {
-            let Light::Sphere { center, radius, .. } = fl[moving] else {
+            let Light::Sphere(SphereLight { center, radius, .. }) = fl[moving] else {
                 return if fl[moving].is_delta() {
                     Some(acc)
                 } else {
@@ -187,11 +187,11 @@ impl MovingSphere {
             radiance: Vec3::ZERO,
         };
         for fl in frames {
-            let Light::Sphere {
+            let Light::Sphere(SphereLight {
                 center,
                 radius,
                 radiance,
-            } = fl[moving]
+            }) = fl[moving]
             else {
                 return None;
             };

@@ -226,7 +226,9 @@ impl<'a> BsdfAtWo<'a> {
     pub fn new(sp: &'a ShadingPoint) -> Self {
         match &sp.bsdf {
             SurfaceBsdf::Wood(b) => BsdfAtWo::Wood(b.at_wo(sp.wo)),
-            other => BsdfAtWo::Other(other, sp.wo),
+            other @ (SurfaceBsdf::Lambertian(_)
+            | SurfaceBsdf::Mirror(_)
+            | SurfaceBsdf::Glass(_)) => BsdfAtWo::Other(other, sp.wo),
         }
     }
 

@@ -10,39 +10,81 @@ use crate::math::{uniform_sphere, Frame, PI, UNIFORM_SPHERE_PDF};
 use glam::{Vec2, Vec3};
 use std::sync::Arc;
 
-/// One light of the scene.
+/// One light of the scene. Each kind is a struct of its own, and every `match` on lights names
+/// every kind (no wildcard arm), so a new kind fails to compile wherever it is not handled.
 #[derive(Clone, Debug)]
 pub enum Light {
-    /// Isotropic point light of radiant intensity `intensity`.
-    Point { position: Vec3, intensity: Vec3 },
-    /// Point light limited to a cone about `direction` with a smoothstep falloff between
-    /// `cos_outer` and `cos_inner` (pbrt-v4 §12.2.2).
-    Spot {
-        position: Vec3,
-        direction: Vec3,
-        intensity: Vec3,
-        cos_inner: f32,
-        cos_outer: f32,
-    },
-    /// Light from one direction (`direction` points towards the light), irradiance `irradiance`
-    /// on a surface facing it.
-    Distant { direction: Vec3, irradiance: Vec3 },
-    /// One-sided parallelogram `corner + a·edge_u + b·edge_v`, emitting `radiance` towards
-    /// `edge_u × edge_v`.
-    Rect {
-        corner: Vec3,
-        edge_u: Vec3,
-        edge_v: Vec3,
-        radiance: Vec3,
-    },
-    /// Sphere emitting `radiance` outwards.
-    Sphere {
-        center: Vec3,
-        radius: f32,
-        radiance: Vec3,
-    },
+    /// Isotropic point light.
+    Point(PointLight),
+    /// Point light limited to a cone.
+    Spot(SpotLight),
+    /// Light from one direction.
+    Distant(DistantLight),
+    /// One-sided parallelogram area light.
+    Rect(RectLight),
+    /// Sphere area light.
+    Sphere(SphereLight),
     /// Light from infinitely far away in every direction.
     Environment(Environment),
+}
+
+/// Isotropic point light at `position` of radiant intensity `intensity` (W/sr, per channel).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointLight {
+    /// Position (mm).
+    pub position: Vec3,
+    /// Radiant intensity (W/sr).
+    pub intensity: Vec3,
+}
+
+/// Point light limited to a cone about `direction` with a smoothstep falloff between
+/// `cos_outer` and `cos_inner` (pbrt-v4 §12.2.2).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpotLight {
+    /// Position (mm).
+    pub position: Vec3,
+    /// Unit axis of the cone, pointing away from the light.
+    pub direction: Vec3,
+    /// Radiant intensity on the axis (W/sr).
+    pub intensity: Vec3,
+    /// Cosine of the half-angle inside which the intensity is full.
+    pub cos_inner: f32,
+    /// Cosine of the half-angle outside which there is no light.
+    pub cos_outer: f32,
+}
+
+/// Light from one direction, irradiance `irradiance` on a surface facing it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DistantLight {
+    /// Unit direction towards the light.
+    pub direction: Vec3,
+    /// Irradiance at normal incidence (W/mm²).
+    pub irradiance: Vec3,
+}
+
+/// One-sided parallelogram `corner + a·edge_u + b·edge_v` (a, b in [0, 1]) emitting `radiance`
+/// towards `edge_u × edge_v`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RectLight {
+    /// One corner (mm).
+    pub corner: Vec3,
+    /// First edge from the corner (mm).
+    pub edge_u: Vec3,
+    /// Second edge from the corner (mm).
+    pub edge_v: Vec3,
+    /// Emitted radiance (W/(sr·mm²)).
+    pub radiance: Vec3,
+}
+
+/// Sphere emitting `radiance` outwards.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SphereLight {
+    /// Centre (mm).
+    pub center: Vec3,
+    /// Radius (mm).
+    pub radius: f32,
+    /// Emitted radiance (W/(sr·mm²)).
+    pub radiance: Vec3,
 }
 
 /// A constant environment or a lat-long map (z up; u = φ/2π with φ = atan2(y, x), v = θ/π).
@@ -82,10 +124,10 @@ pub struct LightSample {
 impl Light {
     /// True for lights that a BSDF-sampled ray can never hit (point, spot, distant).
     pub fn is_delta(&self) -> bool {
-        matches!(
-            self,
-            Light::Point { .. } | Light::Spot { .. } | Light::Distant { .. }
-        )
+        match self {
+            Light::Point(_) | Light::Spot(_) | Light::Distant(_) => true,
+            Light::Rect(_) | Light::Sphere(_) | Light::Environment(_) => false,
+        }
     }
 
     /// Samples incident light at `p` with uniform numbers `u`.
@@ -94,38 +136,38 @@ impl Light {
     /// light with the same numbers (a light sweep) makes the [`LightU`] once.
     pub fn sample(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
         match self {
-            Light::Point {
+            Light::Point(PointLight {
                 position,
                 intensity,
-            } => delta_point(p, *position, *intensity),
-            Light::Spot {
+            }) => delta_point(p, *position, *intensity),
+            Light::Spot(SpotLight {
                 position,
                 direction,
                 intensity,
                 cos_inner,
                 cos_outer,
-            } => {
+            }) => {
                 let mut s = delta_point(p, *position, *intensity)?;
                 let cos = (-s.wi).dot(*direction);
                 s.li *= smoothstep(*cos_outer, *cos_inner, cos);
                 Some(s)
             }
-            Light::Distant {
+            Light::Distant(DistantLight {
                 direction,
                 irradiance,
-            } => Some(LightSample {
+            }) => Some(LightSample {
                 wi: *direction,
                 dist: f32::INFINITY,
                 li: *irradiance,
                 pdf: 1.0,
                 is_delta: true,
             }),
-            Light::Rect {
+            Light::Rect(RectLight {
                 corner,
                 edge_u,
                 edge_v,
                 radiance,
-            } => {
+            }) => {
                 let q = *corner + *edge_u * u.x + *edge_v * u.y;
                 let n = edge_u.cross(*edge_v);
                 let area = n.length();
@@ -145,11 +187,11 @@ impl Light {
                     is_delta: false,
                 })
             }
-            Light::Sphere {
+            Light::Sphere(SphereLight {
                 center,
                 radius,
                 radiance,
-            } => sample_sphere(p, *center, *radius, *radiance, u.x, azimuth(u.y)),
+            }) => sample_sphere(p, *center, *radius, *radiance, u.x, azimuth(u.y)),
             Light::Environment(env) => {
                 let (wi, pdf) = match &env.map {
                     None => (uniform_sphere(u), UNIFORM_SPHERE_PDF),
@@ -170,12 +212,16 @@ impl Light {
     /// and cosine come from `u` (identical results; the trigonometry is done once per `u`).
     pub fn sample_at(&self, p: Vec3, u: &LightU) -> Option<LightSample> {
         match self {
-            Light::Sphere {
+            Light::Sphere(SphereLight {
                 center,
                 radius,
                 radiance,
-            } => sample_sphere(p, *center, *radius, *radiance, u.u.x, u.azimuth),
-            _ => self.sample(p, u.u),
+            }) => sample_sphere(p, *center, *radius, *radiance, u.u.x, u.azimuth),
+            Light::Point(_)
+            | Light::Spot(_)
+            | Light::Distant(_)
+            | Light::Rect(_)
+            | Light::Environment(_) => self.sample(p, u.u),
         }
     }
 
@@ -183,12 +229,12 @@ impl Light {
     /// and the solid-angle density `sample` would have chosen that direction with from `ray.o`.
     pub fn hit(&self, ray: &Ray) -> Option<(f32, Vec3, f32)> {
         match self {
-            Light::Rect {
+            Light::Rect(RectLight {
                 corner,
                 edge_u,
                 edge_v,
                 radiance,
-            } => {
+            }) => {
                 let n = edge_u.cross(*edge_v);
                 let area = n.length();
                 let denom = ray.d.dot(n);
@@ -216,11 +262,11 @@ impl Light {
                 let cos_l = -denom / area;
                 Some((t, *radiance, t * t / (cos_l * area)))
             }
-            Light::Sphere {
+            Light::Sphere(SphereLight {
                 center,
                 radius,
                 radiance,
-            } => {
+            }) => {
                 let t = intersect_sphere(ray, *center, *radius)?;
                 let d2 = (*center - ray.o).length_squared();
                 let r2 = radius * radius;
@@ -236,7 +282,8 @@ impl Light {
                 };
                 Some((f32::INFINITY, env.radiance(ray.d), pdf))
             }
-            _ => None,
+            // Delta lights: no ray meets them.
+            Light::Point(_) | Light::Spot(_) | Light::Distant(_) => None,
         }
     }
 }
@@ -690,17 +737,17 @@ mod tests {
     #[test]
     fn sampled_pdf_matches_hit_pdf() {
         let lights = [
-            Light::Rect {
+            Light::Rect(RectLight {
                 corner: Vec3::new(-1.0, -1.0, 5.0),
                 edge_u: Vec3::new(0.0, 2.0, 0.0),
                 edge_v: Vec3::new(3.0, 0.0, 0.0),
                 radiance: Vec3::ONE,
-            },
-            Light::Sphere {
+            }),
+            Light::Sphere(SphereLight {
                 center: Vec3::new(0.5, 0.0, 4.0),
                 radius: 1.0,
                 radiance: Vec3::ONE,
-            },
+            }),
         ];
         let mut rng = Pcg32::new(1, 1);
         for l in &lights {
@@ -740,11 +787,11 @@ mod tests {
                 let u = LightU::new(rng.next_vec2());
                 cones.sample_sphere(p, &cols, radius, Vec3::splat(2.0), &u);
                 for (k, &center) in centers.iter().enumerate() {
-                    let light = Light::Sphere {
+                    let light = Light::Sphere(SphereLight {
                         center,
                         radius,
                         radiance: Vec3::splat(2.0),
-                    };
+                    });
                     let want = light.sample_at(p, &u);
                     let got = cones.get(k);
                     match (want, got) {
@@ -771,13 +818,13 @@ mod tests {
     #[test]
     fn spot_light_is_a_point_light_inside_its_cone_and_dark_outside() {
         let (i, pos) = (Vec3::splat(50.0), Vec3::new(0.0, 0.0, 10.0));
-        let spot = Light::Spot {
+        let spot = Light::Spot(SpotLight {
             position: pos,
             direction: -Vec3::Z,
             intensity: i,
             cos_inner: 20f32.to_radians().cos(),
             cos_outer: 30f32.to_radians().cos(),
-        };
+        });
         // 10° off axis: full intensity, E = I / d² (inverse-square law).
         let p = Vec3::new(10.0 * 10f32.to_radians().tan(), 0.0, 0.0);
         let s = spot.sample(p, Vec2::ZERO).unwrap();

@@ -22,7 +22,9 @@ pub use geometry::{Accel, Instance, Ray, Transform, TriMesh};
 pub use integrator::{
     light_rng, primary_sample, sample_rngs, Integrator, PrimarySample, ShadingPoint,
 };
-pub use light::{EnvMap, Environment, Light};
+pub use light::{
+    DistantLight, EnvMap, Environment, Light, PointLight, RectLight, SphereLight, SpotLight,
+};
 
 use crate::material::Material;
 use glam::{UVec2, Vec3};

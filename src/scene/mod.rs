@@ -16,8 +16,8 @@ use crate::material::{
     Placement, TextureMaterial, WoodMaterial,
 };
 use crate::render::{
-    self, Accel, Camera, EnvMap, Environment, Filter, Instance, Integrator, Light, Projection,
-    RenderSettings, Transform, TriMesh,
+    self, Accel, Camera, DistantLight, EnvMap, Environment, Filter, Instance, Integrator, Light,
+    PointLight, Projection, RectLight, RenderSettings, SphereLight, SpotLight, Transform, TriMesh,
 };
 use crate::wood::BoardLayout;
 use format::*;
@@ -446,11 +446,11 @@ impl Builder<'_> {
                     intensity,
                     color,
                     ..
-                } => Light::Point {
+                } => Light::Point(PointLight {
                     position: self.finite3(&f("position"), *position)?,
                     intensity: self.color(&f("color"), *color, 1e3)?
                         * self.range(&f("intensity"), *intensity, 0.0, 1e12)?,
-                },
+                }),
                 LightTable::Spot {
                     position,
                     target,
@@ -467,25 +467,25 @@ impl Builder<'_> {
                     }
                     let outer = self.range(&f("cone_deg"), *cone_deg, 0.01, 180.0)?;
                     let falloff = self.range(&f("falloff_deg"), *falloff_deg, 0.0, outer)?;
-                    Light::Spot {
+                    Light::Spot(SpotLight {
                         position: p,
                         direction: d.normalize(),
                         intensity: self.color(&f("color"), *color, 1e3)?
                             * self.range(&f("intensity"), *intensity, 0.0, 1e12)?,
                         cos_inner: (outer - falloff).to_radians().cos(),
                         cos_outer: outer.to_radians().cos(),
-                    }
+                    })
                 }
                 LightTable::Distant {
                     direction,
                     irradiance,
                     color,
                     ..
-                } => Light::Distant {
+                } => Light::Distant(DistantLight {
                     direction: self.unit3(&f("direction"), *direction)?,
                     irradiance: self.color(&f("color"), *color, 1e3)?
                         * self.range(&f("irradiance"), *irradiance, 0.0, 1e12)?,
-                },
+                }),
                 LightTable::Rect {
                     corner,
                     edge_u,
@@ -501,13 +501,13 @@ impl Builder<'_> {
                     if u.cross(v).length_squared() < 1e-12 {
                         return Err(self.invalid(f("edge_v"), "edges must span a non-zero area"));
                     }
-                    Light::Rect {
+                    Light::Rect(RectLight {
                         corner: self.finite3(&f("corner"), *corner)?,
                         edge_u: u,
                         edge_v: v,
                         radiance: self.color(&f("color"), *color, 1e3)?
                             * self.range(&f("radiance"), *radiance, 0.0, 1e12)?,
-                    }
+                    })
                 }
                 LightTable::Sphere {
                     center,
@@ -515,12 +515,12 @@ impl Builder<'_> {
                     radiance,
                     color,
                     ..
-                } => Light::Sphere {
+                } => Light::Sphere(SphereLight {
                     center: self.finite3(&f("center"), *center)?,
                     radius: self.range(&f("radius"), *radius, 1e-4, 1e9)?,
                     radiance: self.color(&f("color"), *color, 1e3)?
                         * self.range(&f("radiance"), *radiance, 0.0, 1e12)?,
-                },
+                }),
                 LightTable::Environment {
                     radiance,
                     color,

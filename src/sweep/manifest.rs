@@ -5,7 +5,7 @@
 //! its own (fields in notes/fit.md "Capture format").
 
 use super::path::SweepPath;
-use crate::render::{Light, Projection};
+use crate::render::{DistantLight, Light, PointLight, Projection, SphereLight, SpotLight};
 use crate::scene::LoadedScene;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
@@ -128,33 +128,33 @@ impl Manifest {
             .map(|k| {
                 let light = path.place(&loaded.scene.lights[moving], k);
                 let (kind, position, direction, radius, intensity) = match light {
-                    Light::Point {
+                    Light::Point(PointLight {
                         position,
                         intensity,
-                    }
-                    | Light::Spot {
+                    })
+                    | Light::Spot(SpotLight {
                         position,
                         intensity,
                         ..
-                    } => ("point", Some(position), None, 0.0, intensity),
+                    }) => ("point", Some(position), None, 0.0, intensity),
                     // A uniform sphere of radiance L and radius r has intensity L π r² in every
                     // direction (its projected area is π r²).
-                    Light::Sphere {
+                    Light::Sphere(SphereLight {
                         center,
                         radius,
                         radiance,
-                    } => (
+                    }) => (
                         "point",
                         Some(center),
                         None,
                         radius,
                         radiance * std::f32::consts::PI * radius * radius,
                     ),
-                    Light::Distant {
+                    Light::Distant(DistantLight {
                         direction,
                         irradiance,
-                    } => ("distant", None, Some(direction), 0.0, irradiance),
-                    _ => ("none", None, None, 0.0, Vec3::ZERO),
+                    }) => ("distant", None, Some(direction), 0.0, irradiance),
+                    Light::Rect(_) | Light::Environment(_) => ("none", None, None, 0.0, Vec3::ZERO),
                 };
                 FrameManifest {
                     image: format!("{}.exr", super::sequence::frame_stem(k)),

@@ -6,7 +6,7 @@
 //! through the object's zenith.
 
 use crate::math::Vec3;
-use crate::render::{Light, LightFrames};
+use crate::render::{DistantLight, Light, LightFrames, PointLight, SphereLight, SpotLight};
 use crate::scene::{LoadedScene, MAX_ARCS};
 use std::ops::Range;
 
@@ -323,10 +323,11 @@ impl SweepPath {
                     .collect::<Vec<_>>()
                     .join(", "),
             })?;
-        if matches!(
-            loaded.scene.lights[moving],
-            Light::Rect { .. } | Light::Environment(_)
-        ) {
+        let movable = match &loaded.scene.lights[moving] {
+            Light::Point(_) | Light::Spot(_) | Light::Sphere(_) | Light::Distant(_) => true,
+            Light::Rect(_) | Light::Environment(_) => false,
+        };
+        if !movable {
             return Err(SetupError::Immovable {
                 scene,
                 light: t.light.clone(),
@@ -440,34 +441,18 @@ impl SweepPath {
         let dir = self.direction(frame);
         let at = self.pivot + self.radius * dir;
         match light.clone() {
-            Light::Point { intensity, .. } => Light::Point {
-                position: at,
-                intensity,
-            },
-            Light::Spot {
-                intensity,
-                cos_inner,
-                cos_outer,
-                ..
-            } => Light::Spot {
+            Light::Point(l) => Light::Point(PointLight { position: at, ..l }),
+            Light::Spot(l) => Light::Spot(SpotLight {
                 position: at,
                 direction: -dir,
-                intensity,
-                cos_inner,
-                cos_outer,
-            },
-            Light::Sphere {
-                radius, radiance, ..
-            } => Light::Sphere {
-                center: at,
-                radius,
-                radiance,
-            },
-            Light::Distant { irradiance, .. } => Light::Distant {
+                ..l
+            }),
+            Light::Sphere(l) => Light::Sphere(SphereLight { center: at, ..l }),
+            Light::Distant(l) => Light::Distant(DistantLight {
                 direction: dir,
-                irradiance,
-            },
-            other => other,
+                ..l
+            }),
+            other @ (Light::Rect(_) | Light::Environment(_)) => other,
         }
     }
 

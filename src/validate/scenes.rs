@@ -59,11 +59,7 @@ pub fn pixel_hits(scene: &Scene) -> Vec<PixelHit> {
                 Some(hit) => {
                     let s = scene.accel.surface(&ray, &hit);
                     let inst = &scene.accel.instances[hit.instance as usize];
-                    let delta = matches!(
-                        scene.materials[inst.material as usize],
-                        crate::material::Material::Mirror { .. }
-                            | crate::material::Material::Glass { .. }
-                    );
+                    let delta = scene.materials[inst.material as usize].is_delta();
                     PixelHit::Surface {
                         object: hit.instance,
                         triangle: hit.triangle,
