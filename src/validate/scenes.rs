@@ -230,6 +230,48 @@ pub fn edge_jump(img: &Image, hits: &[PixelHit], object: u32) -> f64 {
     (across / na as f64) / (within / nw as f64).max(1e-12)
 }
 
+/// The largest relative deviation, over the channels, of the mean beauty of the pixels that see
+/// only the light (their whole 3×3 neighbourhood labelled `Light`) from its radiance `expected`.
+/// Infinite when no pixel sees only the light.
+pub fn light_error(img: &Image, hits: &[PixelHit], expected: Vec3) -> f64 {
+    let (w, h) = (img.width as usize, img.height as usize);
+    let (mut sum, mut n) = (glam::DVec3::ZERO, 0usize);
+    for y in 1..h.saturating_sub(1) {
+        for x in 1..w.saturating_sub(1) {
+            if (0..9).all(|k| hits[(y + k / 3 - 1) * w + x + k % 3 - 1] == PixelHit::Light) {
+                sum += img.beauty[y * w + x].as_dvec3();
+                n += 1;
+            }
+        }
+    }
+    if n == 0 {
+        return f64::INFINITY;
+    }
+    let ratio = sum / n as f64 / expected.as_dvec3();
+    (ratio - glam::DVec3::ONE).abs().max_element()
+}
+
+/// (R/G of the mean of the `set` pixels in the image's left third) over (the same in its right
+/// third): above 1 where the left (red) wall tints the surfaces near it and the right (green)
+/// wall those near it. 0 when either third has fewer than [`MIN_PIXELS`].
+pub fn bleed_ratio(img: &Image, set: &[bool]) -> f64 {
+    let w = img.width as usize;
+    let third = |keep: &dyn Fn(usize) -> bool| {
+        let (mut sum, mut n) = (glam::DVec3::ZERO, 0usize);
+        for (i, c) in img.beauty.iter().enumerate() {
+            if set[i] && keep(i % w) {
+                sum += c.as_dvec3();
+                n += 1;
+            }
+        }
+        (n >= MIN_PIXELS).then(|| sum.x / sum.y.max(1e-300))
+    };
+    match (third(&|x| 3 * x < w), third(&|x| 3 * x >= 2 * w)) {
+        (Some(l), Some(r)) => l / r.max(1e-300),
+        _ => 0.0,
+    }
+}
+
 /// Median of the sRGB-encoded luminance of a pixel set (0–1): how bright it looks in the PNG.
 pub fn median_srgb(img: &Image, set: &[bool], exposure: f32) -> f64 {
     let k = 2f32.powf(exposure);
@@ -292,6 +334,12 @@ pub const VISIBLE_FIGURE: f64 = 0.05;
 /// order of magnitude (two carved cubes differ by up to 2×, since a 3-pixel step across an edge
 /// spans more wood than one along a face; a seam jumps by whole growth rings).
 pub const MIN_SEAM_RATIO: f64 = 10.0;
+/// A light seen directly is its emitted radiance exactly (the camera ray's emission has MIS
+/// weight 1); 1e-3 leaves room for f32 sums over the pixel's samples.
+pub const MAX_LIGHT_ERROR: f64 = 1e-3;
+/// Colour bleeding is visible when the red wall's side of the white surfaces is at least 10 %
+/// redder (R/G) than the green wall's side (the Weber step of [`VISIBLE_WEBER`], in hue).
+pub const MIN_BLEED_RATIO: f64 = 1.1;
 /// Median sRGB level (0–1) of an object that is lit well enough to compare by eye.
 pub const LIT_SRGB: f64 = 0.25;
 
@@ -369,6 +417,33 @@ pub fn measure(
         limit: Limit::AtLeast(LIT_SRGB),
     };
     match name {
+        "cornell_box" => {
+            let white = mask(
+                &hits,
+                &objects(
+                    names,
+                    &["floor", "ceiling", "back", "short_box", "tall_box"],
+                ),
+                None,
+            );
+            let expected = scene.lights.iter().find_map(|l| match l {
+                crate::render::Light::Rect { radiance, .. } => Some(*radiance),
+                _ => None,
+            });
+            vec![
+                Measure {
+                    what: "light seen directly, largest |mean / (radiance × color) − 1|".into(),
+                    value: expected.map_or(f64::INFINITY, |e| light_error(img, &hits, e)),
+                    limit: Limit::AtMost(MAX_LIGHT_ERROR),
+                },
+                Measure {
+                    what: "colour bleeding: R/G of white surfaces, left third over right third"
+                        .into(),
+                    value: bleed_ratio(img, &white),
+                    limit: Limit::AtLeast(MIN_BLEED_RATIO),
+                },
+            ]
+        }
         n if n.starts_with("cornell") => {
             let keep: Vec<bool> = (hits.iter())
                 .map(|h| matches!(h, PixelHit::Surface { delta: false, .. }))
