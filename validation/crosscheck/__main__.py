@@ -128,6 +128,11 @@ def markdown(rows, controls, mode, args, wall):
         "- Geometry: every surface one OBJ mesh written once, flat-shaded in both "
         "(xylem `smooth = false`, Mitsuba `face_normals`); spheres are 48 × 24 UV meshes; "
         "rect lights have a black box behind them in both, since xylem's lights block no rays.",
+        "- A plane cannot light itself, so the plane cases give the same image at every depth "
+        "(same seeds, so their rows repeat); they test the lights and the camera, the Cornell "
+        "boxes the transport.",
+        "- Mitsuba's `max_depth` 1 (emitters only) has no xylem equivalent: xylem's `max_depth` "
+        "is at least 1.",
         "",
     ]
     for name in dict.fromkeys(r["case"] for r in rows):

@@ -26,7 +26,7 @@ DEPTH = 8
 def add_arguments(ap):
     g = ap.add_argument_group("timing")
     g.add_argument("--spp", type=int, default=64, help="spp of the timed render (64)")
-    g.add_argument("--reference-spp", type=int, default=4096)
+    g.add_argument("--reference-spp", type=int, default=2048)
     g.add_argument("--xylem-image", default=None, help="a xylem EXR of the scene to score")
     g.add_argument("--xylem-seconds", type=float, default=None,
                    help="its render time (s), for samples/s and RMSE at equal time")
@@ -46,7 +46,7 @@ def reference(mi, folder, meshes, spp):
         acc += np.array(mi.render(scene, seed=100_000 + k, spp=chunk), dtype=np.float64)[..., :3]
     img = acc / (spp // chunk)
     bmp = mi.Bitmap(img.astype(np.float32), mi.Bitmap.PixelFormat.RGB)
-    tmp = path + ".partial"
+    tmp = path[: -len(".exr")] + ".partial.exr"
     bmp.write(tmp)
     os.replace(tmp, path)
     return img, path
