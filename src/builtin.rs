@@ -15,9 +15,10 @@ macro_rules! embed {
 }
 
 /// (path relative to the repository root, contents).
-const FILES: [(&str, &[u8]); 21] = embed![
+const FILES: [(&str, &[u8]); 22] = embed![
     "scenes/box_joint.toml",
     "scenes/carved_bunny.toml",
+    "scenes/cornell_box.toml",
     "scenes/cornell_bunny.toml",
     "scenes/cornell_bunny_black.toml",
     "scenes/cornell_wood_marble.toml",

@@ -14,6 +14,9 @@
 //! Python is `python3` or `$XYLEM_PYTHON`; Mitsuba's LLVM variant needs libLLVM (Debian's
 //! libllvm19), found in the usual places or given as `$DRJIT_LIBLLVM_PATH`.
 
+mod common;
+
+use common::python::{libllvm, venv};
 use glam::{Vec2, Vec3};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
@@ -212,56 +215,6 @@ fn render_case() -> Value {
     })
 }
 
-fn run(cmd: &mut Command, what: &str, hint: &str) {
-    let out = cmd
-        .output()
-        .unwrap_or_else(|e| panic!("{what}: cannot run {cmd:?}: {e}. {hint}"));
-    if !out.status.success() {
-        panic!(
-            "{what} failed ({}): {cmd:?}\n--- stdout\n{}\n--- stderr\n{}\n{hint}",
-            out.status,
-            String::from_utf8_lossy(&out.stdout),
-            String::from_utf8_lossy(&out.stderr)
-        );
-    }
-}
-
-/// The virtual environment with the pinned test requirements, made once and reused while the
-/// requirements file is unchanged.
-fn venv() -> PathBuf {
-    let venv = root().join("target/python-venv");
-    let python = venv.join("bin/python");
-    if !python.exists() {
-        let base = std::env::var("XYLEM_PYTHON").unwrap_or_else(|_| "python3".into());
-        run(
-            Command::new(&base).args(["-m", "venv"]).arg(&venv),
-            "creating target/python-venv",
-            "Python 3.11+ with venv is needed (Debian: apt-get install python3 python3-venv; or set XYLEM_PYTHON)",
-        );
-    }
-    let req = root().join("python/requirements-test.txt");
-    let wanted = std::fs::read_to_string(&req).expect("python/requirements-test.txt");
-    let stamp = venv.join("xylem-requirements.txt");
-    if std::fs::read_to_string(&stamp).ok().as_deref() != Some(wanted.as_str()) {
-        run(
-            Command::new(&python)
-                .args([
-                    "-m",
-                    "pip",
-                    "install",
-                    "--quiet",
-                    "--disable-pip-version-check",
-                    "-r",
-                ])
-                .arg(&req),
-            "installing python/requirements-test.txt",
-            "pip needs the package index (PyPI) to install numpy, pytest and mitsuba",
-        );
-        std::fs::write(&stamp, wanted).unwrap();
-    }
-    venv
-}
-
 /// The package as pip would install it: python/xylem/*.py and the extension module that this
 /// `cargo test` built (the `_xylem` example, from python/src/lib.rs) in target/python-test/site.
 fn stage_package(dir: &Path) -> PathBuf {
@@ -288,22 +241,6 @@ fn stage_package(dir: &Path) -> PathBuf {
     }
     std::fs::copy(&ext, pkg.join("_xylem.abi3.so")).unwrap();
     site
-}
-
-/// libLLVM for Dr.Jit's LLVM backend (Mitsuba's llvm_* variants).
-fn libllvm() -> Option<PathBuf> {
-    if let Ok(p) = std::env::var("DRJIT_LIBLLVM_PATH") {
-        return Some(PathBuf::from(p));
-    }
-    let dirs = [
-        "/usr/lib/x86_64-linux-gnu",
-        "/usr/lib/aarch64-linux-gnu",
-        "/usr/lib/llvm-19/lib",
-    ];
-    let names = ["libLLVM-19.so", "libLLVM.so.19.1", "libLLVM.so"];
-    dirs.iter()
-        .flat_map(|d| names.iter().map(move |n| Path::new(d).join(n)))
-        .find(|p| p.exists())
 }
 
 #[test]

@@ -11,7 +11,8 @@ use xylem::validate::scenes::measure;
 /// Cornell boxes keep their own spp: the firefly criterion is per pixel and does not get easier
 /// at a smaller size (fewer pixels only means fewer chances to fail; the default size is checked
 /// by `xylem gallery`).
-const CASES: [(&str, u32, Option<u32>); 10] = [
+const CASES: [(&str, u32, Option<u32>); 11] = [
+    ("cornell_box", 2, None),
     ("sweep_board", 4, Some(8)),
     ("parquet_floor", 1, Some(4)),
     ("box_joint", 2, Some(8)),
@@ -90,6 +91,39 @@ fn subject_checks_fail_on_a_broken_scene() {
         .image;
     let m = measure("cornell_wood_marble", &s.scene, &names, &img, 0.0);
     assert!(m.iter().any(|m| !m.pass()), "{m:?}");
+}
+
+/// The Cornell box's bleeding check needs the coloured walls: with the red wall white, the
+/// white surfaces are no redder on its side than in the middle (R/G ratio below 1.1).
+#[test]
+fn cornell_box_bleed_check_fails_without_the_red_wall() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let text = std::fs::read_to_string(dir.join("cornell_box.toml")).unwrap();
+    let red_wall =
+        "translate = [-275.0, 275.0, 275.0]\nrotate_deg = [0.0, 90.0, 0.0]\nmaterial = \"red\"";
+    assert!(text.contains(red_wall));
+    let broken = text.replace(
+        red_wall,
+        &red_wall.replace("material = \"red\"", "material = \"white\""),
+    );
+    let names: Vec<Option<String>> = xylem::scene::parse(&broken, "cb")
+        .unwrap()
+        .objects
+        .into_iter()
+        .map(|o| o.name)
+        .collect();
+    let mut s = xylem::scene::from_str(&broken, "cb.toml", &dir, "cb").unwrap();
+    s.scene.camera = s.scene.camera.with_resolution(64, 64);
+    s.settings.spp = 16;
+    let img = render(&s.scene, &s.settings, &RunOptions::default())
+        .unwrap()
+        .image;
+    let m = measure("cornell_box", &s.scene, &names, &img, s.exposure);
+    let bleed = m
+        .iter()
+        .find(|m| m.what.starts_with("red bleeding"))
+        .unwrap();
+    assert!(!bleed.pass(), "{bleed}");
 }
 
 /// The cube check needs the veneer's seams: with the "veneered" cube carved from a block too,

@@ -235,6 +235,58 @@ pub fn edge_jump(img: &Image, hits: &[PixelHit], object: u32) -> f64 {
     (across / na as f64) / (within / nw as f64).max(1e-12)
 }
 
+/// The largest relative deviation, over the channels, of the mean beauty of the pixels that see
+/// only the light (the rays through their centre and four corners all meet it first; the light
+/// is a convex quad, so then the whole pixel does) from its radiance `expected`. Infinite when
+/// no pixel sees only the light.
+pub fn light_error(scene: &Scene, img: &Image, hits: &[PixelHit], expected: Vec3) -> f64 {
+    let w = img.width as usize;
+    let sees_light = |film: Vec2| {
+        let ray = scene.camera.ray(film, Vec2::splat(0.5));
+        let t_hit = scene
+            .accel
+            .intersect(&ray, f32::INFINITY)
+            .map_or(f32::INFINITY, |h| h.t);
+        nearest_light(&scene.lights, &ray, t_hit).is_some_and(|(_, t, _, _)| t < t_hit)
+    };
+    let (mut sum, mut n) = (glam::DVec3::ZERO, 0usize);
+    for (i, h) in hits.iter().enumerate() {
+        let p = Vec2::new((i % w) as f32, (i / w) as f32);
+        let corners = [Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::ONE];
+        if *h == PixelHit::Light && corners.iter().all(|&c| sees_light(p + c)) {
+            sum += img.beauty[i].as_dvec3();
+            n += 1;
+        }
+    }
+    if n == 0 {
+        return f64::INFINITY;
+    }
+    let ratio = sum / n as f64 / expected.as_dvec3();
+    (ratio - glam::DVec3::ONE).abs().max_element()
+}
+
+/// Colour bleeding from one side wall: (channel `a` / channel `b` of the mean of the `set`
+/// pixels in the image's `third`, 0 = left, 2 = right) over the same in the middle third. Above
+/// 1 where the wall on that side tints the white surfaces near it. 0 when either third has
+/// fewer than [`MIN_PIXELS`].
+pub fn bleed_ratio(img: &Image, set: &[bool], third: usize, a: usize, b: usize) -> f64 {
+    let w = img.width as usize;
+    let ratio = |t: usize| {
+        let (mut sum, mut n) = (glam::DVec3::ZERO, 0usize);
+        for (i, c) in img.beauty.iter().enumerate() {
+            if set[i] && 3 * (i % w) / w == t {
+                sum += c.as_dvec3();
+                n += 1;
+            }
+        }
+        (n >= MIN_PIXELS).then(|| sum[a] / sum[b].max(1e-300))
+    };
+    match (ratio(third), ratio(1)) {
+        (Some(side), Some(middle)) => side / middle.max(1e-300),
+        _ => 0.0,
+    }
+}
+
 /// Median of the sRGB-encoded luminance of a pixel set (0–1): how bright it looks in the PNG.
 pub fn median_srgb(img: &Image, set: &[bool], exposure: f32) -> f64 {
     let k = 2f32.powf(exposure);
@@ -303,6 +355,13 @@ pub const VISIBLE_FIGURE: f64 = 0.05;
 /// order of magnitude (two carved cubes differ by up to 2×, since a 3-pixel step across an edge
 /// spans more wood than one along a face; a seam jumps by whole growth rings).
 pub const MIN_SEAM_RATIO: f64 = 10.0;
+/// A light seen directly is its emitted radiance exactly (the camera ray's emission has MIS
+/// weight 1); 1e-3 leaves room for f32 sums over the pixel's samples.
+pub const MAX_LIGHT_ERROR: f64 = 1e-3;
+/// Colour bleeding is visible when the white surfaces on a coloured wall's side are at least
+/// 10 % redder (R/G; greener, G/R) than in the middle (the Weber step of [`VISIBLE_WEBER`], in
+/// hue).
+pub const MIN_BLEED_RATIO: f64 = 1.1;
 /// Median sRGB level (0–1) of an object that is lit well enough to compare by eye.
 pub const LIT_SRGB: f64 = 0.25;
 
@@ -380,6 +439,37 @@ pub fn measure(
         limit: Limit::AtLeast(LIT_SRGB),
     };
     match name {
+        "cornell_box" => {
+            let white = mask(
+                &hits,
+                &objects(
+                    names,
+                    &["floor", "ceiling", "back", "short_box", "tall_box"],
+                ),
+                None,
+            );
+            let expected = scene.lights.iter().find_map(|l| match l {
+                crate::render::Light::Rect { radiance, .. } => Some(*radiance),
+                _ => None,
+            });
+            vec![
+                Measure {
+                    what: "light seen directly, largest |mean / (radiance × color) − 1|".into(),
+                    value: expected.map_or(f64::INFINITY, |e| light_error(scene, img, &hits, e)),
+                    limit: Limit::AtMost(MAX_LIGHT_ERROR),
+                },
+                Measure {
+                    what: "red bleeding: R/G of white surfaces, left third over middle".into(),
+                    value: bleed_ratio(img, &white, 0, 0, 1),
+                    limit: Limit::AtLeast(MIN_BLEED_RATIO),
+                },
+                Measure {
+                    what: "green bleeding: G/R of white surfaces, right third over middle".into(),
+                    value: bleed_ratio(img, &white, 2, 1, 0),
+                    limit: Limit::AtLeast(MIN_BLEED_RATIO),
+                },
+            ]
+        }
         n if n.starts_with("cornell") => {
             let keep: Vec<bool> = (hits.iter())
                 .map(|h| matches!(h, PixelHit::Surface { delta: false, .. }))

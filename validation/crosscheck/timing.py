@@ -1,0 +1,120 @@
+"""Timing mode: Mitsuba 3 rendering the Lambertian Cornell box (scenes/cornell_box.toml's scene,
+256 × 256, xylem depth 8 = Mitsuba depth 9, box filter), its samples/s and its RMSE against a
+high-spp reference, and the same figures for a xylem image of the scene if one is given
+(`xylem bench render` passes its own).
+
+samples/s = width · height · spp / seconds of the render itself: the scene is loaded and rendered
+once (Dr.Jit compiles its kernels then), and the second render of the same scene and seed, which
+reuses the compiled kernels, is timed. The reference is one Mitsuba render of `--reference-spp`
+samples per pixel in chunks of 256 spp, cached in target/crosscheck/; RMSE is over all pixels and
+channels. RMSE at equal time is RMSE · sqrt(seconds / Mitsuba's seconds): Monte Carlo error falls
+as 1/sqrt(samples), so it is the error each renderer would reach in Mitsuba's time.
+"""
+
+import math
+import os
+import time
+
+import numpy as np
+
+from . import render, scenes
+
+RES = (256, 256)
+DEPTH = 8
+
+
+def add_arguments(ap):
+    g = ap.add_argument_group("timing")
+    g.add_argument("--spp", type=int, default=64, help="spp of the timed render (64)")
+    g.add_argument("--reference-spp", type=int, default=2048)
+    g.add_argument("--xylem-image", default=None, help="a xylem EXR of the scene to score")
+    g.add_argument("--xylem-seconds", type=float, default=None,
+                   help="its render time (s), for samples/s and RMSE at equal time")
+    g.add_argument("--xylem-spp", type=int, default=None, help="its spp (default --spp)")
+
+
+def reference(mi, folder, meshes, spp):
+    """The cached high-spp Mitsuba image (H, W, 3)."""
+    path = os.path.join(folder, f"reference_cornell_box_{RES[0]}x{RES[1]}_d{DEPTH}_{spp}spp.exr")
+    if os.path.exists(path):
+        return render.read_exr_rgb(mi, path), path
+    chunk = min(256, spp)
+    scene = mi.load_dict(scenes.mitsuba_dict(mi, scenes.cornell_lambertian(), meshes, DEPTH,
+                                             chunk, 0, RES))
+    acc = np.zeros((RES[1], RES[0], 3))
+    for k in range(spp // chunk):
+        acc += np.array(mi.render(scene, seed=100_000 + k, spp=chunk), dtype=np.float64)[..., :3]
+    img = acc / (spp // chunk)
+    bmp = mi.Bitmap(img.astype(np.float32), mi.Bitmap.PixelFormat.RGB)
+    tmp = path[: -len(".exr")] + ".partial.exr"
+    bmp.write(tmp)
+    os.replace(tmp, path)
+    return img, path
+
+
+def rmse(a, b):
+    return float(np.sqrt(np.mean((a - b) ** 2)))
+
+
+def run(mi, args):
+    import drjit as dr
+
+    os.makedirs(args.work, exist_ok=True)
+    meshes = scenes.write_meshes(scenes.cornell_lambertian(), os.path.join(args.work, "meshes"))
+    ref, ref_path = reference(mi, args.work, meshes, args.reference_spp)
+    t0 = time.perf_counter()
+    scene = mi.load_dict(scenes.mitsuba_dict(mi, scenes.cornell_lambertian(), meshes, DEPTH,
+                                             args.spp, 1, RES))
+    load_s = time.perf_counter() - t0
+    times = []
+    for _ in range(2):
+        t0 = time.perf_counter()
+        img = mi.render(scene, seed=1, spp=args.spp)
+        dr.eval(img)
+        dr.sync_thread()
+        times.append(time.perf_counter() - t0)
+    img = np.array(img, dtype=np.float64)[..., :3]
+    samples = RES[0] * RES[1] * args.spp
+    m = {"renderer": f"Mitsuba {mi.__version__} {mi.variant()}", "threads": args.threads,
+         "spp": args.spp, "seconds": times[1], "first_render_s": times[0], "load_s": load_s,
+         "samples_per_s": samples / times[1], "rmse": rmse(img, ref)}
+    m["rmse_equal_time"] = m["rmse"]
+    out = {"res": list(RES), "xylem_depth": DEPTH, "mitsuba_depth": DEPTH + 1,
+           "reference": os.path.relpath(ref_path), "reference_spp": args.reference_spp,
+           "reference_mean": ref.mean(axis=(0, 1)).tolist(), "mitsuba": m,
+           "load_average": list(os.getloadavg())}
+    if args.xylem_image:
+        x = render.read_exr_rgb(mi, args.xylem_image)
+        xs = {"renderer": "xylem", "image": args.xylem_image, "rmse": rmse(x, ref),
+              "spp": args.xylem_spp or args.spp}
+        if args.xylem_seconds:
+            xs["seconds"] = args.xylem_seconds
+            xs["samples_per_s"] = RES[0] * RES[1] * xs["spp"] / args.xylem_seconds
+            xs["rmse_equal_time"] = xs["rmse"] * math.sqrt(args.xylem_seconds / m["seconds"])
+        out["xylem"] = xs
+    return out
+
+
+def table(out):
+    lines = [f"Cornell box {out['res'][0]}x{out['res'][1]}, xylem depth {out['xylem_depth']} "
+             f"(Mitsuba {out['mitsuba_depth']}), reference {out['reference']} "
+             f"({out['reference_spp']} spp Mitsuba)",
+             f"{'renderer':<28} {'spp':>5} {'seconds':>8} {'Msamples/s':>11} {'RMSE':>9} "
+             f"{'RMSE@equal time':>16}"]
+    rows = [out["mitsuba"]] + ([out["xylem"]] if "xylem" in out else [])
+    for r in rows:
+        sec = f"{r['seconds']:.3f}" if "seconds" in r else "-"
+        sps = f"{r['samples_per_s'] / 1e6:.3f}" if "samples_per_s" in r else "-"
+        eq = f"{r['rmse_equal_time']:.5f}" if "rmse_equal_time" in r else "-"
+        lines.append(f"{r['renderer']:<28} {r['spp']:>5} {sec:>8} {sps:>11} {r['rmse']:>9.5f} "
+                     f"{eq:>16}")
+    m = out["mitsuba"]
+    lines.append(f"Mitsuba: first render (with JIT compilation) {m['first_render_s']:.2f} s, "
+                 f"scene load {m['load_s']:.2f} s")
+    x = out.get("xylem")
+    if x and "samples_per_s" in x:
+        lines.append(f"xylem / Mitsuba: samples/s {x['samples_per_s'] / m['samples_per_s']:.3f}, "
+                     f"RMSE {x['rmse'] / m['rmse']:.3f}, RMSE at equal time "
+                     f"{x['rmse_equal_time'] / m['rmse_equal_time']:.3f}")
+    lines.append(f"load average {out['load_average'][0]:.2f}")
+    return "\n".join(lines)
