@@ -409,14 +409,16 @@ pub fn curl_flip(
         band_pattern(a, set, film, along, across),
         band_pattern(b, set, film, along, across),
     );
-    let pairs: Vec<((f64, f64), (f64, f64))> = (ha.into_iter().zip(hb))
+    /// (h, its noise variance) in each render.
+    type Pair = ((f64, f64), (f64, f64));
+    let pairs: Vec<Pair> = (ha.into_iter().zip(hb))
         .filter(|(x, y)| x.0.is_finite() && y.0.is_finite())
         .collect();
     if pairs.len() < MIN_PIXELS {
         return none;
     }
     let n = pairs.len() as f64;
-    let mean = |f: &dyn Fn(&((f64, f64), (f64, f64))) -> f64| pairs.iter().map(f).sum::<f64>() / n;
+    let mean = |f: &dyn Fn(&Pair) -> f64| pairs.iter().map(f).sum::<f64>() / n;
     let (mx, my) = (mean(&|p| p.0 .0), mean(&|p| p.1 .0));
     let sxx = mean(&|p| (p.0 .0 - mx).powi(2));
     let syy = mean(&|p| (p.1 .0 - my).powi(2));
@@ -901,14 +903,14 @@ mod tests {
         // of the centre's value and 24 of the other, so rel = 49 v / (25 v + 24 o) and the Weber
         // contrast is 1 − (0.4 · 24.6) / (0.6 · 24.4) = 0.327869 (by hand).
         let img = textured(20, 20, |x, y| if (x + y) % 2 == 0 { 0.6 } else { 0.4 });
-        let c = ring_contrast(&img, &vec![true; 400]);
+        let c = ring_contrast(&img, &[true; 400]);
         assert!((c.weber - 0.327869).abs() < 1e-5, "{c:?}");
         // The same pattern in the lighting only (a flat albedo): no rings to find.
         let mut flat = img.clone();
         flat.aov
             .iter_mut()
             .for_each(|a| a.albedo = Vec3::splat(0.5));
-        assert_eq!(ring_contrast(&flat, &vec![true; 400]).weber, 0.0);
+        assert_eq!(ring_contrast(&flat, &[true; 400]).weber, 0.0);
     }
 
     #[test]
