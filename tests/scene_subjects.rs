@@ -5,48 +5,66 @@
 
 use std::path::Path;
 use xylem::render::{render, RunOptions};
-use xylem::validate::scenes::measure;
+use xylem::validate::scenes::{measure, measure_rendered, Measure};
 
-/// (scene, divisor of the default width and height, spp or None for the scene's own).
-/// Cornell boxes keep their own spp: the firefly criterion is per pixel and does not get easier
-/// at a smaller size (fewer pixels only means fewer chances to fail; the default size is checked
-/// by `xylem gallery`).
-const CASES: [(&str, u32, Option<u32>); 11] = [
-    ("cornell_box", 2, None),
-    ("sweep_board", 4, Some(8)),
-    ("parquet_floor", 1, Some(4)),
-    ("box_joint", 2, Some(8)),
-    ("cube_carved_vs_veneer", 2, Some(8)),
-    ("turned_bowl", 2, Some(16)),
-    ("teapot", 4, Some(16)),
-    ("cornell_wood_marble", 4, None),
-    ("cornell_bunny", 4, None),
-    ("dovetail", 2, Some(8)),
-    ("carved_bunny", 2, Some(16)),
+/// (scene, divisor of the default width and height, spp or None for the scene's own, the
+/// measures checked at that size: those whose name contains one of these, all when empty).
+/// Cornell boxes keep their own spp for the firefly criterion: it is per pixel and does not get
+/// easier at a smaller size (fewer pixels only means fewer chances to fail; the default size is
+/// checked by `xylem gallery`). Their rings are checked at half size and 16 spp: the rings are a
+/// few pixels wide at the default size and sub-pixel at a quarter, and noise, being independent
+/// of the ring a pixel is on, does not move the ring contrast's means.
+/// Measured but not yet asserted (open, notes/scenes.md "Open"): the bowl's band-pattern
+/// correlation (0.02 here, needs ≤ −0.1), `cornell_wood_marble`'s rings (Weber 0.07–0.08 on its
+/// three wooden surfaces) and the blue variant's cooler light on the wood.
+#[allow(clippy::type_complexity)]
+const CASES: [(&str, u32, Option<u32>, &[&str]); 14] = [
+    ("cornell_box", 2, None, &[]),
+    ("sweep_board", 4, Some(8), &[]),
+    ("parquet_floor", 1, Some(4), &[]),
+    ("box_joint", 2, Some(8), &[]),
+    ("cube_carved_vs_veneer", 2, Some(8), &[]),
+    ("turned_bowl", 2, Some(16), &["median", "curl bands"]),
+    ("teapot", 4, Some(16), &[]),
+    ("cornell_wood_marble", 4, None, &["firefly"]),
+    ("cornell_bunny", 4, None, &["firefly"]),
+    ("cornell_bunny", 2, Some(16), &["rings"]),
+    ("cornell_bunny_black", 4, None, &["firefly"]),
+    ("cornell_bunny_black", 2, Some(16), &["rings", "light on"]),
+    ("dovetail", 2, Some(8), &[]),
+    ("carved_bunny", 2, Some(16), &[]),
 ];
 
-fn check(name: &str, div: u32, spp: Option<u32>) -> Vec<String> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("scenes")
-        .join(format!("{name}.toml"));
-    let text = std::fs::read_to_string(&path).unwrap();
-    let names: Vec<Option<String>> = xylem::scene::parse(&text, name)
+fn object_names(text: &str) -> Vec<Option<String>> {
+    xylem::scene::parse(text, "scene")
         .unwrap()
         .objects
         .into_iter()
         .map(|o| o.name)
-        .collect();
-    let mut s = xylem::scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        .collect()
+}
+
+/// Scene `name` (its text possibly edited by `edit`) at 1/`div` of its size, measured.
+fn measured(
+    name: &str,
+    div: u32,
+    spp: Option<u32>,
+    edit: impl Fn(String) -> String,
+) -> Vec<Measure> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let text = edit(std::fs::read_to_string(dir.join(format!("{name}.toml"))).unwrap());
+    let names = object_names(&text);
+    let mut s = xylem::scene::from_str(&text, &format!("{name}.toml"), &dir, name)
+        .unwrap_or_else(|e| panic!("{e}"));
     let (w, h) = (s.scene.camera.width, s.scene.camera.height);
     s.scene.camera = s.scene.camera.with_resolution(w / div, h / div);
     if let Some(spp) = spp {
         s.settings.spp = spp;
     }
-    let img = render(&s.scene, &s.settings, &RunOptions::default())
-        .unwrap()
-        .image;
-    let m = measure(name, &s.scene, &names, &img, s.exposure);
-    assert!(!m.is_empty(), "{name} has no subject check");
+    let run = RunOptions::default();
+    let img = render(&s.scene, &s.settings, &run).unwrap().image;
+    let (m, _) =
+        measure_rendered(name, &s.scene, &s.settings, &run, &names, &img, s.exposure).unwrap();
     for m in &m {
         println!(
             "{name} ({}x{}, {} spp): {m}",
@@ -55,6 +73,15 @@ fn check(name: &str, div: u32, spp: Option<u32>) -> Vec<String> {
             s.settings.spp
         );
     }
+    m
+}
+
+fn check(name: &str, div: u32, spp: Option<u32>, only: &[&str]) -> Vec<String> {
+    let m: Vec<Measure> = measured(name, div, spp, |t| t)
+        .into_iter()
+        .filter(|m| only.is_empty() || only.iter().any(|o| m.what.contains(o)))
+        .collect();
+    assert!(!m.is_empty(), "{name} has no subject check {only:?}");
     m.iter()
         .filter(|m| !m.pass())
         .map(|m| format!("{name}: {m}"))
@@ -65,7 +92,7 @@ fn check(name: &str, div: u32, spp: Option<u32>) -> Vec<String> {
 fn every_builtin_scene_shows_its_subject() {
     let failures: Vec<String> = CASES
         .iter()
-        .flat_map(|&(n, d, spp)| check(n, d, spp))
+        .flat_map(|&(n, d, spp, only)| check(n, d, spp, only))
         .collect();
     assert!(failures.is_empty(), "{failures:#?}");
 }
@@ -79,18 +106,13 @@ fn subject_checks_fail_on_a_broken_scene() {
     let mut s = xylem::scene::load(&path).unwrap();
     s.scene.camera = s.scene.camera.with_resolution(100, 100);
     s.settings.spp = 1;
-    let text = std::fs::read_to_string(&path).unwrap();
-    let names: Vec<Option<String>> = xylem::scene::parse(&text, "c")
-        .unwrap()
-        .objects
-        .into_iter()
-        .map(|o| o.name)
-        .collect();
+    let names = object_names(&std::fs::read_to_string(&path).unwrap());
     let img = render(&s.scene, &s.settings, &RunOptions::default())
         .unwrap()
         .image;
-    let m = measure("cornell_wood_marble", &s.scene, &names, &img, 0.0);
-    assert!(m.iter().any(|m| !m.pass()), "{m:?}");
+    let m = measure("cornell_wood_marble", &s.scene, &names, &img, None, 0.0);
+    let firefly = m.iter().find(|m| m.what.starts_with("firefly")).unwrap();
+    assert!(!firefly.pass(), "{firefly}");
 }
 
 /// The Cornell box's bleeding check needs the coloured walls: with the red wall white, the
@@ -118,7 +140,7 @@ fn cornell_box_bleed_check_fails_without_the_red_wall() {
     let img = render(&s.scene, &s.settings, &RunOptions::default())
         .unwrap()
         .image;
-    let m = measure("cornell_box", &s.scene, &names, &img, s.exposure);
+    let m = measure("cornell_box", &s.scene, &names, &img, None, s.exposure);
     let bleed = m
         .iter()
         .find(|m| m.what.starts_with("red bleeding"))
@@ -130,28 +152,40 @@ fn cornell_box_bleed_check_fails_without_the_red_wall() {
 /// its rings run on around its edges and the edge-jump ratio falls below 2.
 #[test]
 fn cube_check_fails_without_the_veneer() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
-    let text = std::fs::read_to_string(dir.join("cube_carved_vs_veneer.toml")).unwrap();
     let veneer = "tree = { cut = \"veneer\", region = { r_min = 60.0, r_max = 200.0, z_span = 3000.0, cut = \"flat\" }, seed = 5 }";
-    assert!(text.contains(veneer));
-    let solid = text.replace(
-        veneer,
-        "tree = { cut = \"solid\", origin = [0.0, 90.0, 0.0], axis = [0.2, 1.0, 0.1] }",
-    );
-    let names: Vec<Option<String>> = xylem::scene::parse(&solid, "cube")
-        .unwrap()
-        .objects
-        .into_iter()
-        .map(|o| o.name)
-        .collect();
-    let mut s = xylem::scene::from_str(&solid, "cube.toml", &dir, "cube").unwrap();
-    s.scene.camera = s.scene.camera.with_resolution(240, 150);
-    s.settings.spp = 4;
-    let img = render(&s.scene, &s.settings, &RunOptions::default())
-        .unwrap()
-        .image;
-    let m = measure("cube_carved_vs_veneer", &s.scene, &names, &img, s.exposure);
-    println!("{m:#?}");
+    let m = measured("cube_carved_vs_veneer", 2, Some(4), |text| {
+        assert!(text.contains(veneer));
+        text.replace(
+            veneer,
+            "tree = { cut = \"solid\", origin = [0.0, 90.0, 0.0], axis = [0.2, 1.0, 0.1] }",
+        )
+    });
     let edge = m.iter().find(|m| m.what.starts_with("edge jump")).unwrap();
     assert!(!edge.pass(), "{edge}");
+}
+
+/// The bowl's curl check needs the curl: the same bowl of the curly_maple preset with its curl
+/// (the tangential distortion's magnitude) set to 0 keeps its rings, pores and in-plane wander,
+/// and fails the flipping-band contrast. Open: measured 0.156 without the curl against 0.193 with
+/// it (both ≥ 0.1), so the check does not yet tell them apart.
+#[test]
+#[ignore = "open: the curl-free bowl passes the band contrast too (notes/scenes.md, Open)"]
+fn bowl_check_fails_without_the_curl() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let preset = std::fs::read_to_string(dir.join("presets/curly_maple.toml")).unwrap();
+    let curl = "[distortion.tangential]\nmagnitude = 0.32\n";
+    assert!(preset.contains(curl));
+    let flat = preset.replace(curl, "[distortion.tangential]\nmagnitude = 0.0\n");
+    let file = std::env::temp_dir().join(format!("xylem_no_curl_{}.toml", std::process::id()));
+    std::fs::write(&file, flat).unwrap();
+    let m = measured("turned_bowl", 2, Some(16), |text| {
+        assert!(text.contains("preset = \"curly_maple\""));
+        text.replace(
+            "preset = \"curly_maple\"",
+            &format!("preset_file = {:?}", file.display().to_string()),
+        )
+    });
+    std::fs::remove_file(&file).ok();
+    let bands = m.iter().find(|m| m.what.starts_with("curl bands")).unwrap();
+    assert!(!bands.pass(), "{bands}");
 }

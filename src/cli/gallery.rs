@@ -121,8 +121,24 @@ fn scenes(out: &Path, only: &[String]) -> anyhow::Result<bool> {
         )?;
         let png = out.join(format!("{name}.png"));
         write_png_rgb8(&png, w, h, &to_srgb8(&r.image.beauty, s.exposure))?;
-        let measures =
-            crate::validate::scenes::measure(name, &s.scene, &objects, &r.image, s.exposure);
+        let run = RunOptions {
+            threads: 0,
+            progress: true,
+        };
+        let (measures, companion) = crate::validate::scenes::measure_rendered(
+            name,
+            &s.scene,
+            &s.settings,
+            &run,
+            &objects,
+            &r.image,
+            s.exposure,
+        )?;
+        if let Some(c) = companion {
+            // The check's second render (turned_bowl: the key light mirrored along the fibre).
+            let png = out.join(format!("{name}_light_mirrored.png"));
+            write_png_rgb8(&png, w, h, &to_srgb8(&c.beauty, s.exposure))?;
+        }
         let secs = r.elapsed.as_secs_f64();
         println!("{name}: {secs:.1} s");
         for m in &measures {

@@ -8,13 +8,23 @@
 //!   (issue 17's firefly criterion), on diffuse and glossy surfaces (a mirror's or glass's image
 //!   of the light is a real feature, not a firefly);
 //! - a figure (curl, rings) is visible when the beauty's local contrast (pixel against its 5×5
-//!   mean) exceeds 0.05 after the pixels' own noise is taken out.
+//!   mean) exceeds 0.05 after the pixels' own noise is taken out;
+//! - growth rings are readable when the beauty's pixels on the light rings (by the albedo AOV)
+//!   are brighter than those on the dark rings, relative to their neighbourhood, by the Weber
+//!   threshold above;
+//! - a curly figure is there when its bands along the fibre flip between bright and dark as the
+//!   light moves to the other side along the fibre (chatoyance), with the Weber threshold's
+//!   contrast: an albedo pattern (rings, scratches) stays put.
 //!
 //! Pixels are labelled by what the camera ray through their centre hits first (object, triangle,
 //! face normal), independently of the shading.
 
-use crate::math::luminance;
-use crate::render::{integrator::nearest_light, Image, Scene};
+use crate::material::Material;
+use crate::math::{luminance, Frame};
+use crate::render::{
+    integrator::nearest_light, render_frames, Image, Light, LightFrames, PointLight, RenderError,
+    RenderSettings, RunOptions, Scene, SphereLight, SpotLight,
+};
 use glam::{Vec2, Vec3};
 
 /// What the ray through a pixel's centre meets first.
@@ -32,6 +42,8 @@ pub enum PixelHit {
         triangle: u32,
         /// Geometric normal (world, unit, as the mesh winds it).
         normal: Vec3,
+        /// Where the ray hits (world, mm).
+        point: Vec3,
         /// True for a mirror or glass (every lobe a delta).
         delta: bool,
     },
@@ -64,6 +76,7 @@ pub fn pixel_hits(scene: &Scene) -> Vec<PixelHit> {
                         object: hit.instance,
                         triangle: hit.triangle,
                         normal: s.ng,
+                        point: ray.o + ray.d * hit.t,
                         delta,
                     }
                 }
@@ -129,10 +142,16 @@ pub const MIN_PIXELS: usize = 20;
 
 /// Mean luminance of the pixels in `a` against those in `b`.
 pub fn contrast(img: &Image, a: &[bool], b: &[bool]) -> Contrast {
+    let lum: Vec<f64> = img.beauty.iter().map(|c| luminance(*c) as f64).collect();
+    contrast_of(&lum, a, b)
+}
+
+/// Mean of `values` over the set `a` against the set `b` (the statistics of [`contrast`]).
+pub fn contrast_of(values: &[f64], a: &[bool], b: &[bool]) -> Contrast {
     let stats = |set: &[bool]| {
-        let v: Vec<f64> = (img.beauty.iter().zip(set))
+        let v: Vec<f64> = (values.iter().zip(set))
             .filter(|(_, &s)| s)
-            .map(|(c, _)| luminance(*c) as f64)
+            .map(|(x, _)| *x)
             .collect();
         let n = v.len().max(1) as f64;
         let m = v.iter().sum::<f64>() / n;
@@ -154,6 +173,52 @@ pub fn contrast(img: &Image, a: &[bool], b: &[bool]) -> Contrast {
         weber: d / ma.max(mb).max(1e-12),
         z: d / (sa + sb).sqrt().max(1e-300),
     }
+}
+
+/// Half-width of the window [`ring_contrast`] compares each pixel with (7×7 pixels).
+const RING_WINDOW: usize = 3;
+
+/// Growth-ring contrast of the beauty on the pixels of `set`: each pixel's luminance over the
+/// mean of its 7×7 neighbourhood (in `set`), compared between the pixels whose albedo AOV is
+/// lighter than its own neighbourhood's mean (earlywood, light rings) and those darker (latewood).
+/// The labels come from the albedo, the numbers from the beauty, so this is the rings' contrast
+/// as rendered; the lighting's slow change across a wall divides out, and Monte Carlo noise
+/// (independent of the label) averages out of both means and only lowers `z`.
+pub fn ring_contrast(img: &Image, set: &[bool]) -> Contrast {
+    let (w, h) = (img.width as usize, img.height as usize);
+    let lum: Vec<f64> = img.beauty.iter().map(|c| luminance(*c) as f64).collect();
+    let alb: Vec<f64> = img.aov.iter().map(|a| luminance(a.albedo) as f64).collect();
+    let k = RING_WINDOW;
+    let mut rel = vec![0.0; w * h];
+    let (mut light, mut dark) = (vec![false; w * h], vec![false; w * h]);
+    for y in k..h.saturating_sub(k) {
+        for x in k..w.saturating_sub(k) {
+            let i = y * w + x;
+            if !set[i] {
+                continue;
+            }
+            let (mut sl, mut sa, mut n) = (0.0, 0.0, 0usize);
+            for yy in y - k..=y + k {
+                for xx in x - k..=x + k {
+                    let j = yy * w + xx;
+                    if set[j] {
+                        sl += lum[j];
+                        sa += alb[j];
+                        n += 1;
+                    }
+                }
+            }
+            // At least half the window on the surface, so edges do not judge.
+            if 2 * n < (2 * k + 1).pow(2) || sl <= 0.0 {
+                continue;
+            }
+            rel[i] = lum[i] * n as f64 / sl;
+            let a = alb[i] * n as f64 / sa.max(1e-12);
+            light[i] = a > 1.0;
+            dark[i] = a < 1.0;
+        }
+    }
+    contrast_of(&rel, &light, &dark)
 }
 
 /// Local contrast of the pixels in `set` whose 5×5 neighbourhood lies in `set`: the RMS of each
@@ -187,6 +252,243 @@ pub fn figure_contrast(img: &Image, set: &[bool]) -> f64 {
         return 0.0;
     }
     ((r2 - noise2).max(0.0) / n as f64).sqrt() / (sum / n as f64).max(1e-12)
+}
+
+/// Half-angle (degrees) within which a surface's normal is taken to be the half vector between
+/// the camera and a small light: there the finish mirrors the light, a highlight of the coat and
+/// not of the wood (the sphere light's 2.5° plus the 0.05-roughness finish's spread, doubled).
+const FINISH_GLINT_DEG: f32 = 8.0;
+
+/// The pixels of `set` where the finish does not mirror one of `lights` (point, spot or sphere):
+/// the half vector between the view and the light is more than [`FINISH_GLINT_DEG`] from the
+/// geometric normal. Geometric, so the two renders of [`curl_flip`] are judged on one set.
+pub fn without_glints(
+    scene: &Scene,
+    hits: &[PixelHit],
+    set: &[bool],
+    lights: &[Light],
+) -> Vec<bool> {
+    let cos_max = FINISH_GLINT_DEG.to_radians().cos();
+    let centres: Vec<Vec3> = (lights.iter())
+        .filter_map(|l| match l {
+            Light::Point(PointLight { position, .. }) | Light::Spot(SpotLight { position, .. }) => {
+                Some(*position)
+            }
+            Light::Sphere(s) => Some(s.center),
+            Light::Distant(_) | Light::Rect(_) | Light::Environment(_) => None,
+        })
+        .collect();
+    (hits.iter().zip(set))
+        .map(|(h, &s)| match *h {
+            PixelHit::Surface { normal, point, .. } if s => {
+                let v = (scene.camera.eye - point).normalize();
+                let n = if normal.dot(v) < 0.0 { -normal } else { normal };
+                centres
+                    .iter()
+                    .all(|c| (v + (*c - point).normalize()).normalize().dot(n) < cos_max)
+            }
+            _ => false,
+        })
+        .collect()
+}
+
+/// A curly figure's bands as one render and its companion (the light mirrored along the fibre)
+/// show them: the band contrast and the correlation of the two band patterns.
+#[derive(Clone, Copy, Debug)]
+pub struct CurlFlip {
+    /// Weber contrast 2a / (1 + a) of a sinusoidal band of relative amplitude a = √2 · RMS of the
+    /// flipping part (h₁ − h₂) / 2 of the two band patterns, Monte Carlo noise taken out.
+    pub weber: f64,
+    /// Correlation of the two band patterns h₁, h₂: near +1 for a pattern in the albedo (rings,
+    /// scratches), negative for figure that swaps bright and dark with the light.
+    pub correlation: f64,
+    /// Pixels judged.
+    pub pixels: usize,
+}
+
+/// The band pattern of the curl in `img` on the pixels of `set`: each pixel's luminance averaged
+/// across the fibre over ± `across` pixels, over the mean of that along the fibre over ± `along`
+/// pixels, minus 1 (a band-pass that keeps bands across the fibre and removes the shading's slow
+/// change); with its Monte Carlo variance. The fibre's image direction is the fiber AOV projected
+/// on the camera's film. NaN unless both windows lie wholly in `set`.
+fn band_pattern(
+    img: &Image,
+    set: &[bool],
+    film: &Frame,
+    along: i32,
+    across: i32,
+) -> Vec<(f64, f64)> {
+    let (w, h) = (img.width as i32, img.height as i32);
+    let lum: Vec<f64> = img.beauty.iter().map(|c| luminance(*c) as f64).collect();
+    let dir = |i: usize| {
+        let f = img.aov[i].fiber;
+        // Film x = camera s, film y (down) = −t.
+        let d = Vec2::new(f.dot(film.s), -f.dot(film.t));
+        (d.length() > 1e-3).then(|| d.normalize())
+    };
+    let at = |x: i32, y: i32, d: Vec2, k: i32| {
+        let (qx, qy) = (
+            (x as f32 + d.x * k as f32).round() as i32,
+            (y as f32 + d.y * k as f32).round() as i32,
+        );
+        (qx >= 0 && qy >= 0 && qx < w && qy < h)
+            .then(|| (qy * w + qx) as usize)
+            .filter(|&j| set[j])
+    };
+    // Across the fibre: mean and its variance of the mean.
+    let mut c = vec![(f64::NAN, 0.0); lum.len()];
+    for y in 0..h {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            let Some(d) = dir(i).filter(|_| set[i]) else {
+                continue;
+            };
+            let p = Vec2::new(-d.y, d.x);
+            let js: Vec<usize> = (-across..=across).filter_map(|k| at(x, y, p, k)).collect();
+            if js.len() as i32 == 2 * across + 1 {
+                let n = js.len() as f64;
+                let m = js.iter().map(|&j| lum[j]).sum::<f64>() / n;
+                let var = js
+                    .iter()
+                    .map(|&j| (img.std_error[j] as f64).powi(2))
+                    .sum::<f64>()
+                    / (n * n);
+                c[i] = (m, var);
+            }
+        }
+    }
+    let mut out = vec![(f64::NAN, 0.0); lum.len()];
+    for y in 0..h {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            let Some(d) = dir(i).filter(|_| c[i].0.is_finite()) else {
+                continue;
+            };
+            let js: Vec<usize> = (-along..=along)
+                .filter_map(|k| at(x, y, d, k))
+                .filter(|&j| c[j].0.is_finite())
+                .collect();
+            let mean = js.iter().map(|&j| c[j].0).sum::<f64>() / js.len().max(1) as f64;
+            if js.len() as i32 == 2 * along + 1 && mean > 0.0 {
+                out[i] = (c[i].0 / mean - 1.0, c[i].1 / (mean * mean));
+            }
+        }
+    }
+    out
+}
+
+/// The curl's chatoyance: `a` and `b` are one scene rendered with the light on either side
+/// along the fibre; `band_mm` is the curl kernel's extent along the fibre (the tangential
+/// distortion's z semi-axis S_z, tree mm = world mm). Windows: across the fibre ± S_z / 2 (the
+/// bands are 25–60 mm long that way, so this only averages noise), along it ± 2 S_z, i.e. twice
+/// a band pair: one kernel's slope ∂m/∂z, which tilts the fibre, is one bright and one dark band
+/// over its 2 S_z (Liu et al. 2016 §5.1, eq. 15), so the window keeps the bands and removes the
+/// shading's slower change. Pixel pitch: the median world distance between horizontally
+/// neighbouring pixels of `set`.
+pub fn curl_flip(
+    a: &Image,
+    b: &Image,
+    hits: &[PixelHit],
+    set: &[bool],
+    film: &Frame,
+    band_mm: f64,
+) -> CurlFlip {
+    let w = a.width as usize;
+    let point = |i: usize| match hits[i] {
+        PixelHit::Surface { point, .. } => Some(point),
+        _ => None,
+    };
+    let mut pitch: Vec<f32> = (0..hits.len().saturating_sub(1))
+        .filter(|&i| (i + 1) % w != 0 && set[i] && set[i + 1])
+        .filter_map(|i| Some(point(i)?.distance(point(i + 1)?)))
+        .collect();
+    pitch.sort_by(f32::total_cmp);
+    let none = CurlFlip {
+        weber: 0.0,
+        correlation: f64::NAN,
+        pixels: 0,
+    };
+    let Some(&mm) = pitch.get(pitch.len() / 2) else {
+        return none;
+    };
+    let px = |mm_len: f64| ((mm_len / mm as f64).round() as i32).max(1);
+    let (along, across) = (px(2.0 * band_mm), px(0.5 * band_mm));
+    let (ha, hb) = (
+        band_pattern(a, set, film, along, across),
+        band_pattern(b, set, film, along, across),
+    );
+    /// (h, its noise variance) in each render.
+    type Pair = ((f64, f64), (f64, f64));
+    let pairs: Vec<Pair> = (ha.into_iter().zip(hb))
+        .filter(|(x, y)| x.0.is_finite() && y.0.is_finite())
+        .collect();
+    if pairs.len() < MIN_PIXELS {
+        return none;
+    }
+    let n = pairs.len() as f64;
+    let mean = |f: &dyn Fn(&Pair) -> f64| pairs.iter().map(f).sum::<f64>() / n;
+    let (mx, my) = (mean(&|p| p.0 .0), mean(&|p| p.1 .0));
+    let sxx = mean(&|p| (p.0 .0 - mx).powi(2));
+    let syy = mean(&|p| (p.1 .0 - my).powi(2));
+    let sxy = mean(&|p| (p.0 .0 - mx) * (p.1 .0 - my));
+    // Var((h₁ − h₂)/2) = (sxx + syy − 2 sxy) / 4, less the noise (var₁ + var₂) / 4.
+    let noise = mean(&|p| p.0 .1 + p.1 .1) / 4.0;
+    let rms = ((sxx + syy - 2.0 * sxy) / 4.0 - noise).max(0.0).sqrt();
+    let amp = std::f64::consts::SQRT_2 * rms;
+    CurlFlip {
+        weber: 2.0 * amp / (1.0 + amp),
+        correlation: sxy / (sxx * syy).sqrt().max(1e-300),
+        pixels: pairs.len(),
+    }
+}
+
+/// The mirror image of `lights` through the plane x = 0 (world): the companion render of a scene
+/// whose check compares the light on either side along a fibre that runs along x.
+pub fn mirrored_x(lights: &[Light]) -> Vec<Light> {
+    let m = |p: Vec3| Vec3::new(-p.x, p.y, p.z);
+    (lights.iter())
+        .map(|l| match l.clone() {
+            Light::Point(p) => Light::Point(PointLight {
+                position: m(p.position),
+                ..p
+            }),
+            Light::Sphere(s) => Light::Sphere(SphereLight {
+                center: m(s.center),
+                ..s
+            }),
+            other @ (Light::Spot(_)
+            | Light::Distant(_)
+            | Light::Rect(_)
+            | Light::Environment(_)) => other,
+        })
+        .collect()
+}
+
+/// The lights of the second render a scene's check needs (the curl's chatoyance: the key light
+/// on the other side along the fibre), or None when one render is enough.
+pub fn companion_lights(name: &str, scene: &Scene) -> Option<Vec<Light>> {
+    (name == "turned_bowl").then(|| mirrored_x(&scene.lights))
+}
+
+/// [`measure`] with the companion render it needs (if any) made here at `settings`; returns the
+/// measures and the companion image.
+pub fn measure_rendered(
+    name: &str,
+    scene: &Scene,
+    settings: &RenderSettings,
+    run: &RunOptions,
+    names: &[Option<String>],
+    img: &Image,
+    exposure: f32,
+) -> Result<(Vec<Measure>, Option<Image>), RenderError> {
+    let companion = match companion_lights(name, scene) {
+        Some(lights) => {
+            Some(render_frames(scene, &LightFrames::fixed(&lights), settings, run)?.image(0))
+        }
+        None => None,
+    };
+    let m = measure(name, scene, names, img, companion.as_ref(), exposure);
+    Ok((m, companion))
 }
 
 /// How much a solid-texture coordinate jumps across a face edge: the mean |Δ growth time|
@@ -364,6 +666,10 @@ pub const MAX_LIGHT_ERROR: f64 = 1e-3;
 pub const MIN_BLEED_RATIO: f64 = 1.1;
 /// Median sRGB level (0–1) of an object that is lit well enough to compare by eye.
 pub const LIT_SRGB: f64 = 0.25;
+/// The largest correlation of a curly figure's band patterns under the light on either side
+/// along the fibre: below zero by more than its ≈ 0.05–0.1 sampling spread (a few hundred
+/// independent bands' worth of pixels), so the bands do swap. An albedo pattern gives ≈ +1.
+pub const MAX_CURL_CORRELATION: f64 = -0.1;
 
 /// The objects of the scene file whose names start with one of `prefixes`.
 fn objects(names: &[Option<String>], prefixes: &[&str]) -> Vec<u32> {
@@ -403,6 +709,11 @@ fn step(
         &mask(hits, &objects(names, a), face),
         &mask(hits, &objects(names, b), face),
     );
+    visible(what, &c)
+}
+
+/// A contrast as the two measures of a visible step (Weber, z).
+fn visible(what: &str, c: &Contrast) -> Vec<Measure> {
     vec![
         Measure {
             what: format!("{what} Weber contrast"),
@@ -417,6 +728,44 @@ fn step(
     ]
 }
 
+/// The colour of the light falling on `set`, blue over red: Σ beauty / Σ albedo AOV per channel
+/// (a diffuse surface's beauty is its albedo times its irradiance / π). Against the ceiling
+/// (rect) light's own blue over red: Jørgensen's report (Fig. 1) lights its box by the ceiling and
+/// the background, so the blue background's variant is cooler than the ceiling light alone and
+/// the black one no cooler (its only other light is the warm walls' and wood's interreflection).
+fn light_colour(scene: &Scene, img: &Image, set: &[bool], black: bool) -> Measure {
+    let (mut b, mut a) = (Vec3::ZERO, Vec3::ZERO);
+    for ((c, aov), _) in (img.beauty.iter().zip(&img.aov).zip(set)).filter(|(_, &s)| s) {
+        b += *c;
+        a += aov.albedo;
+    }
+    let e = b / a.max(Vec3::splat(1e-12));
+    let key = (scene.lights.iter())
+        .find_map(|l| match l {
+            Light::Rect(r) => Some((r.radiance.z / r.radiance.x) as f64),
+            Light::Point(_)
+            | Light::Spot(_)
+            | Light::Distant(_)
+            | Light::Sphere(_)
+            | Light::Environment(_) => None,
+        })
+        .unwrap_or(f64::NAN);
+    let value = (e.z / e.x.max(1e-12)) as f64;
+    if black {
+        Measure {
+            what: format!("light on the wood, blue over red (ceiling light {key:.3}): no cooler"),
+            value,
+            limit: Limit::AtMost(key),
+        }
+    } else {
+        Measure {
+            what: format!("light on the wood, blue over red (ceiling light {key:.3}): cooler"),
+            value,
+            limit: Limit::AtLeast(key),
+        }
+    }
+}
+
 /// The numbers that say whether scene `name` (a file stem of scenes/) shows its subject in
 /// `img`, rendered from `scene`; `names` are its objects' names in file order. Empty for a
 /// scene without a check.
@@ -425,18 +774,25 @@ pub fn measure(
     scene: &Scene,
     names: &[Option<String>],
     img: &Image,
+    companion: Option<&Image>,
     exposure: f32,
 ) -> Vec<Measure> {
     let hits = pixel_hits(scene);
+    let on = |objs: &[&str]| mask(&hits, &objects(names, objs), None);
     let fig = |what: &str, objs: &[&str]| Measure {
         what: format!("{what} local contrast"),
-        value: figure_contrast(img, &mask(&hits, &objects(names, objs), None)),
+        value: figure_contrast(img, &on(objs)),
         limit: Limit::AtLeast(VISIBLE_FIGURE),
     };
     let lit = |what: &str, objs: &[&str]| Measure {
         what: format!("{what} median sRGB"),
-        value: median_srgb(img, &mask(&hits, &objects(names, objs), None), exposure),
+        value: median_srgb(img, &on(objs), exposure),
         limit: Limit::AtLeast(LIT_SRGB),
+    };
+    let rings = |objs: &[&str]| -> Vec<Measure> {
+        (objs.iter())
+            .flat_map(|o| visible(&format!("{o} rings"), &ring_contrast(img, &on(&[o]))))
+            .collect()
     };
     match name {
         "cornell_box" => {
@@ -449,8 +805,12 @@ pub fn measure(
                 None,
             );
             let expected = scene.lights.iter().find_map(|l| match l {
-                crate::render::Light::Rect { radiance, .. } => Some(*radiance),
-                _ => None,
+                Light::Rect(r) => Some(r.radiance),
+                Light::Point(_)
+                | Light::Spot(_)
+                | Light::Distant(_)
+                | Light::Sphere(_)
+                | Light::Environment(_) => None,
             });
             vec![
                 Measure {
@@ -474,11 +834,62 @@ pub fn measure(
             let keep: Vec<bool> = (hits.iter())
                 .map(|h| matches!(h, PixelHit::Surface { delta: false, .. }))
                 .collect();
-            vec![Measure {
+            let mut m = vec![Measure {
                 what: "firefly ratio (pixel / 3×3 median)".into(),
                 value: firefly_ratio(img, &keep).0,
                 limit: Limit::AtMost(MAX_FIREFLY_RATIO),
-            }]
+            }];
+            if n == "cornell_wood_marble" {
+                m.extend(rings(&["floor", "left", "right"]));
+            } else {
+                m.extend(rings(&["floor", "back"]));
+                m.push(light_colour(
+                    scene,
+                    img,
+                    &on(&["floor", "back"]),
+                    n.ends_with("_black"),
+                ));
+            }
+            m
+        }
+        "turned_bowl" => {
+            let bowl = objects(names, &["bowl"]);
+            // The curl's extent along the fibre: the tangential distortion's z semi-axis.
+            let band_mm = bowl.first().and_then(|&o| {
+                let material =
+                    &scene.materials[scene.accel.instances[o as usize].material as usize];
+                let Material::Wood(w) = material else {
+                    return None;
+                };
+                Some(w.volume.params().distortion.tangential.as_ref()?.size[2])
+            });
+            let flip = match (companion, band_mm) {
+                (Some(b), Some(mm)) => {
+                    let lights: Vec<Light> = (scene.lights.iter().cloned())
+                        .chain(mirrored_x(&scene.lights))
+                        .collect();
+                    let set = without_glints(scene, &hits, &on(&["bowl"]), &lights);
+                    curl_flip(img, b, &hits, &set, &scene.camera.frame, mm as f64)
+                }
+                _ => CurlFlip {
+                    weber: 0.0,
+                    correlation: f64::NAN,
+                    pixels: 0,
+                },
+            };
+            vec![
+                lit("bowl", &["bowl"]),
+                Measure {
+                    what: "curl bands flipping with the light, Weber contrast".into(),
+                    value: flip.weber,
+                    limit: Limit::AtLeast(VISIBLE_WEBER),
+                },
+                Measure {
+                    what: "curl band patterns, light on either side, correlation".into(),
+                    value: flip.correlation,
+                    limit: Limit::AtMost(MAX_CURL_CORRELATION),
+                },
+            ]
         }
         "parquet_floor" => step(
             img,
@@ -533,10 +944,6 @@ pub fn measure(
                 },
             ]
         }
-        "turned_bowl" => vec![
-            lit("bowl", &["bowl"]),
-            fig("bowl grain and figure", &["bowl"]),
-        ],
         "carved_bunny" => vec![lit("bunny", &["bunny"]), fig("bunny rings", &["bunny"])],
         // Walnut is dark by nature (median sRGB ≈ 0.16 here): only its grain is checked.
         "teapot" => vec![fig("teapot grain", &["teapot"])],
@@ -587,6 +994,69 @@ mod tests {
         assert!(c.z > 1e6);
         // An empty set shows nothing.
         assert_eq!(contrast(&img, &left, &vec![false; 100]).weber, 0.0);
+    }
+
+    /// An image whose albedo AOV equals its beauty and whose fibre runs along +x.
+    fn textured(w: u32, h: u32, lum: impl Fn(u32, u32) -> f32) -> Image {
+        let mut img = image(w, h, lum);
+        for (a, c) in img.aov.iter_mut().zip(&img.beauty) {
+            a.albedo = *c;
+            a.fiber = Vec3::X;
+        }
+        img
+    }
+
+    #[test]
+    fn ring_contrast_of_a_checkerboard() {
+        // One-pixel checkerboard of 0.6 and 0.4 in both beauty and albedo: a 7×7 window holds 25
+        // of the centre's value and 24 of the other, so rel = 49 v / (25 v + 24 o) and the Weber
+        // contrast is 1 − (0.4 · 24.6) / (0.6 · 24.4) = 0.327869 (by hand).
+        let img = textured(20, 20, |x, y| if (x + y) % 2 == 0 { 0.6 } else { 0.4 });
+        let c = ring_contrast(&img, &[true; 400]);
+        assert!((c.weber - 0.327869).abs() < 1e-5, "{c:?}");
+        // The same pattern in the lighting only (a flat albedo): no rings to find.
+        let mut flat = img.clone();
+        flat.aov
+            .iter_mut()
+            .for_each(|a| a.albedo = Vec3::splat(0.5));
+        assert_eq!(ring_contrast(&flat, &[true; 400]).weber, 0.0);
+    }
+
+    #[test]
+    fn curl_flip_of_swapping_bands() {
+        // Bands across a fibre along x, period 7 px = 7 mm (pitch 1 mm): 1 ± 0.2 sin(2π x / 7).
+        // band_mm 5 gives windows ±10 px along (21 = 3 periods, so the mean is exactly 1) and ±3
+        // across: h = ±0.2 sin, amplitude 0.2, Weber 2 · 0.2 / 1.2 = 1/3; correlation −1 when the
+        // bands swap, +1 (and no flipping part) when they stay.
+        // 62 columns: the judged ones (x = 10–51) are 6 whole periods, so their RMS is a/√2.
+        let (w, h) = (62u32, 30u32);
+        let band = |sign: f32| {
+            move |x: u32, _| 1.0 + sign * 0.2 * (std::f32::consts::TAU * x as f32 / 7.0).sin()
+        };
+        let (a, b) = (textured(w, h, band(1.0)), textured(w, h, band(-1.0)));
+        let hits: Vec<PixelHit> = (0..w * h)
+            .map(|i| PixelHit::Surface {
+                object: 0,
+                triangle: 0,
+                normal: Vec3::Z,
+                point: Vec3::new((i % w) as f32, -((i / w) as f32), 0.0),
+                delta: false,
+            })
+            .collect();
+        let film = Frame {
+            s: Vec3::X,
+            t: Vec3::Y,
+            n: -Vec3::Z,
+        };
+        let set = vec![true; (w * h) as usize];
+        let f = curl_flip(&a, &b, &hits, &set, &film, 5.0);
+        assert!((f.weber - 1.0 / 3.0).abs() < 1e-4, "{f:?}");
+        assert!((f.correlation + 1.0).abs() < 1e-4, "{f:?}");
+        let same = curl_flip(&a, &a, &hits, &set, &film, 5.0);
+        assert!(
+            same.weber < 1e-6 && (same.correlation - 1.0).abs() < 1e-6,
+            "{same:?}"
+        );
     }
 
     #[test]
