@@ -17,6 +17,7 @@ pub mod noise;
 pub mod output;
 pub mod render;
 pub mod scene;
+pub mod simd;
 pub mod sweep;
 pub mod texture;
 pub mod validate;
