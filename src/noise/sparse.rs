@@ -741,19 +741,27 @@ impl Band {
     /// The cell search of a prepared query (see [`Band::cartesian`]).
     #[inline(always)]
     fn cartesian_search<const GRAD: bool>(&self, q: &CartesianQuery) -> (f32, Vec3) {
-        self.cartesian_search_on::<GRAD>(Simd::best(), q)
+        // SAFETY: the level `Simd::best` allows.
+        unsafe { self.cartesian_search_on::<GRAD>(Simd::best(), q) }
     }
 
-    /// [`Band::cartesian_search`] at the level `simd`, which must be no wider than
-    /// [`Simd::best`] (tests run every level).
+    /// [`Band::cartesian_search`] at the level `simd` (tests run every level).
+    ///
+    /// # Safety
+    /// `simd` must be no wider than [`Simd::best`]. (A precondition rather than a check: this
+    /// runs once per noise query.)
     #[inline(always)]
-    fn cartesian_search_on<const GRAD: bool>(&self, simd: Simd, q: &CartesianQuery) -> (f32, Vec3) {
-        assert!(simd <= Simd::best(), "{simd:?} not available");
+    unsafe fn cartesian_search_on<const GRAD: bool>(
+        &self,
+        simd: Simd,
+        q: &CartesianQuery,
+    ) -> (f32, Vec3) {
         #[cfg(target_arch = "x86_64")]
         if q.in_block() {
             let upright = q.map.axes.as_ref().is_some_and(is_upright);
             match simd {
-                // SAFETY: `simd` is no wider than `Simd::best()`, which detected its features.
+                // SAFETY: `simd` is no wider than `Simd::best()` (the caller's promise), which
+                // detected its features.
                 Simd::Avx512 => return unsafe { self.cartesian_avx512::<GRAD>(q, upright) },
                 Simd::Avx2 => return unsafe { self.cartesian_avx2::<GRAD>(q, upright) },
                 Simd::Sse2 | Simd::Scalar => {}
@@ -1309,10 +1317,13 @@ mod tests {
                     b.cartesian::<false>(p, frame, 1.0).0,
                 )];
                 for simd in Simd::ALL.into_iter().filter(|&s| s <= Simd::best()) {
-                    searches.push((
-                        b.cartesian_search_on::<true>(simd, &q),
-                        b.cartesian_search_on::<false>(simd, &q).0,
-                    ));
+                    // SAFETY: no wider than `Simd::best()`.
+                    searches.push(unsafe {
+                        (
+                            b.cartesian_search_on::<true>(simd, &q),
+                            b.cartesian_search_on::<false>(simd, &q).0,
+                        )
+                    });
                 }
                 for (fast, fast_value) in searches {
                     assert_eq!(
