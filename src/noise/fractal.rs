@@ -352,6 +352,18 @@ simd_level! { Avx512
     }
 }
 
+simd_level! { Avx2
+    unsafe fn many_avx2(f: &Fractal, points: &[Vec3], seed: u32, out: &mut [f32]) -> usize {
+        f.many::<std::arch::x86_64::__m256>(points, seed, out)
+    }
+}
+
+simd_level! { Avx512
+    unsafe fn many_avx512(f: &Fractal, points: &[Vec3], seed: u32, out: &mut [f32]) -> usize {
+        f.many::<std::arch::x86_64::__m512>(points, seed, out)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -426,17 +438,5 @@ mod tests {
                 }
             }
         }
-    }
-}
-
-simd_level! { Avx2
-    unsafe fn many_avx2(f: &Fractal, points: &[Vec3], seed: u32, out: &mut [f32]) -> usize {
-        f.many::<std::arch::x86_64::__m256>(points, seed, out)
-    }
-}
-
-simd_level! { Avx512
-    unsafe fn many_avx512(f: &Fractal, points: &[Vec3], seed: u32, out: &mut [f32]) -> usize {
-        f.many::<std::arch::x86_64::__m512>(points, seed, out)
     }
 }
