@@ -19,6 +19,7 @@ pub mod output;
 pub mod picture;
 pub mod render;
 pub mod scene;
+pub mod simd;
 pub mod sweep;
 pub mod texture;
 pub mod validate;

@@ -3,7 +3,7 @@
 //! at the pith and far out where the growth wave leaves its fast range.
 
 use glam::Vec3;
-use xylem::noise::Simd;
+use xylem::simd::Simd;
 use xylem::wood::{self, Needs, WoodTexel, WoodVolume};
 
 fn bits(t: &WoodTexel) -> Vec<u32> {
@@ -51,7 +51,7 @@ fn eval_many_is_eval_bit_for_bit() {
         for needs in [Needs::COLOR, Needs::COLOR_FIBERS, Needs::ALL] {
             let one: Vec<WoodTexel> = pts.iter().map(|&p| volume.eval(p, needs)).collect();
             // Every instruction set this CPU has (the lane stages are compiled for each).
-            for simd in [Simd::Scalar, Simd::Sse2, Simd::Avx2, Simd::Avx512] {
+            for simd in Simd::ALL {
                 if simd > Simd::best() {
                     continue;
                 }

@@ -54,6 +54,11 @@ enum Command {
 /// Entry point of the binary: runs the subcommand and turns an error into a message and exit code 1.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
+    // A forced SIMD level with an unknown name is refused here, before any work.
+    if let Err(e) = crate::simd::Simd::from_env() {
+        eprintln!("error: {e}");
+        return ExitCode::FAILURE;
+    }
     let result = match cli.command {
         Command::Render(a) => render::run(a),
         Command::Sweep(a) => sweep::run(a),

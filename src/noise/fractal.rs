@@ -11,8 +11,8 @@ use super::gradient::{gradient3_grad_s, gradient3_s};
 use super::hash::mix32;
 #[cfg(target_arch = "x86_64")]
 use super::lanes::Lanes;
-use super::lanes::Simd;
 use super::value::value3_grad_s;
+use crate::simd::{simd_level, Simd};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
@@ -346,16 +346,28 @@ impl Octaves {
     }
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn octaves_avx2(o: &mut Octaves, p: Vec3, fold: &impl Fn(f32) -> f32) {
-    o.lanes::<std::arch::x86_64::__m256>(p, fold)
+simd_level! { Avx2
+    unsafe fn octaves_avx2(o: &mut Octaves, p: Vec3, fold: &impl Fn(f32) -> f32) {
+        o.lanes::<std::arch::x86_64::__m256>(p, fold)
+    }
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-unsafe fn octaves_avx512(o: &mut Octaves, p: Vec3, fold: &impl Fn(f32) -> f32) {
-    o.lanes::<std::arch::x86_64::__m512>(p, fold)
+simd_level! { Avx512
+    unsafe fn octaves_avx512(o: &mut Octaves, p: Vec3, fold: &impl Fn(f32) -> f32) {
+        o.lanes::<std::arch::x86_64::__m512>(p, fold)
+    }
+}
+
+simd_level! { Avx2
+    unsafe fn many_avx2(f: &Fractal, points: &[Vec3], seed: u32, out: &mut [f32]) -> usize {
+        f.many::<std::arch::x86_64::__m256>(points, seed, out)
+    }
+}
+
+simd_level! { Avx512
+    unsafe fn many_avx512(f: &Fractal, points: &[Vec3], seed: u32, out: &mut [f32]) -> usize {
+        f.many::<std::arch::x86_64::__m512>(points, seed, out)
+    }
 }
 
 #[cfg(test)]
@@ -387,7 +399,7 @@ mod tests {
                         lacunarity: 2.1,
                         gain: 0.45,
                     };
-                    for simd in [Simd::Scalar, Simd::Sse2, Simd::Avx2, Simd::Avx512] {
+                    for simd in Simd::ALL {
                         let mut out = vec![f32::NAN; pts.len()];
                         fr.eval_many_with(simd, &pts, 77, &mut out);
                         for (p, v) in pts.iter().zip(out) {
@@ -423,7 +435,7 @@ mod tests {
                     let want = fr
                         .sum::<false, _>(p, seed, |q, s| (gradient3_s(q, s), Vec3::ZERO))
                         .0;
-                    for simd in [Simd::Scalar, Simd::Sse2, Simd::Avx2, Simd::Avx512] {
+                    for simd in Simd::ALL {
                         if simd <= Simd::best() {
                             let got = fr.gradient_lanes_with(simd, p, seed, fold);
                             assert_eq!(got, want, "{simd:?} {kind:?} {octaves} octaves at {p}");
@@ -433,16 +445,4 @@ mod tests {
             }
         }
     }
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn many_avx2(f: &Fractal, points: &[Vec3], seed: u32, out: &mut [f32]) -> usize {
-    f.many::<std::arch::x86_64::__m256>(points, seed, out)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-unsafe fn many_avx512(f: &Fractal, points: &[Vec3], seed: u32, out: &mut [f32]) -> usize {
-    f.many::<std::arch::x86_64::__m512>(points, seed, out)
 }

@@ -10,8 +10,8 @@ use super::hash::{mix32, saturating_i32};
 use super::hash::{KNUTH, PRIME_X, PRIME_Y, PRIME_Z};
 #[cfg(target_arch = "x86_64")]
 use super::lanes::Lanes;
-use super::lanes::Simd;
 use super::lattice::{corner_hashes, end_values, trilinear, trilinear_grad};
+use crate::simd::{simd_level, Simd};
 use glam::Vec3;
 
 /// Perlin 2002 quintic fade.
@@ -202,7 +202,7 @@ pub fn gradient3_many_with(simd: Simd, points: &[Vec3], seed: u32, out: &mut [f3
     let s = mix32(seed);
     let done = match simd.min(Simd::best()) {
         Simd::Scalar => 0,
-        // SAFETY: each arm runs only where `Simd::best` detected its instruction set.
+        // SAFETY: each arm runs only where `Simd::best` detected its level's features.
         #[cfg(target_arch = "x86_64")]
         Simd::Sse2 => unsafe { many_sse2(points, s, out) },
         #[cfg(target_arch = "x86_64")]
@@ -222,16 +222,16 @@ unsafe fn many_sse2(points: &[Vec3], s: u32, out: &mut [f32]) -> usize {
     many::<std::arch::x86_64::__m128>(points, s, out)
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn many_avx2(points: &[Vec3], s: u32, out: &mut [f32]) -> usize {
-    many::<std::arch::x86_64::__m256>(points, s, out)
+simd_level! { Avx2
+    unsafe fn many_avx2(points: &[Vec3], s: u32, out: &mut [f32]) -> usize {
+        many::<std::arch::x86_64::__m256>(points, s, out)
+    }
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-unsafe fn many_avx512(points: &[Vec3], s: u32, out: &mut [f32]) -> usize {
-    many::<std::arch::x86_64::__m512>(points, s, out)
+simd_level! { Avx512
+    unsafe fn many_avx512(points: &[Vec3], s: u32, out: &mut [f32]) -> usize {
+        many::<std::arch::x86_64::__m512>(points, s, out)
+    }
 }
 
 /// The lane kernel over whole groups of `L::N` points; returns how many points it wrote.
@@ -359,7 +359,7 @@ mod tests {
         // Same operations in the same order, so the same numbers (a zero's sign may differ: the
         // lane kernel masks a dropped axis to +0 where the scalar one multiplies by 0). Lengths
         // that are not multiples of the lane count exercise the scalar tail.
-        for simd in [Simd::Scalar, Simd::Sse2, Simd::Avx2, Simd::Avx512] {
+        for simd in Simd::ALL {
             if simd > Simd::best() {
                 eprintln!("{simd:?} not on this CPU: not tested here");
                 continue;

@@ -2,8 +2,8 @@
 //! (gradient.rs) serves SSE2 (4 lanes, the x86-64 baseline), AVX2 (8) and AVX-512 (16).
 //!
 //! Every method is `#[inline(always)]`: it compiles into the `#[target_feature]` function that
-//! calls it, with that function's instructions. Callers must only use a lane type whose feature
-//! the CPU has (`is_x86_feature_detected!`); that is what makes the methods `unsafe`.
+//! calls it, with that function's instructions. Callers must only use a lane type whose level
+//! the CPU has ([`crate::simd::Simd::best`]); that is what makes the methods `unsafe`.
 //! Every operation is lane-wise and exact in the same way as its scalar counterpart (IEEE f32
 //! add / sub / mul without contraction, wrapping u32 arithmetic), so kernels built from them
 //! give the scalar kernel's values.
@@ -12,59 +12,6 @@
 use glam::Vec3;
 #[cfg(target_arch = "x86_64")]
 use std::arch::x86_64::*;
-
-/// The instruction sets the lane kernels run on, in increasing width.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
-pub enum Simd {
-    /// One point at a time (every target).
-    Scalar,
-    /// 4 lanes; part of the x86-64 baseline.
-    Sse2,
-    /// 8 lanes (with `vpmulld` for the hash multiply).
-    Avx2,
-    /// 16 lanes (AVX-512 F).
-    Avx512,
-}
-
-impl Simd {
-    /// The widest one this CPU has (detected at run time; the result is cached by std).
-    pub fn best() -> Simd {
-        #[cfg(target_arch = "x86_64")]
-        {
-            if is_x86_feature_detected!("avx512f") {
-                Simd::Avx512
-            } else if is_x86_feature_detected!("avx2") {
-                Simd::Avx2
-            } else {
-                Simd::Sse2
-            }
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        {
-            Simd::Scalar
-        }
-    }
-
-    /// Its name as in the CPU flags (for benchmark tables).
-    pub fn name(self) -> &'static str {
-        match self {
-            Simd::Scalar => "scalar",
-            Simd::Sse2 => "sse2",
-            Simd::Avx2 => "avx2",
-            Simd::Avx512 => "avx512f",
-        }
-    }
-
-    /// Points per kernel call.
-    pub fn lanes(self) -> usize {
-        match self {
-            Simd::Scalar => 1,
-            Simd::Sse2 => 4,
-            Simd::Avx2 => 8,
-            Simd::Avx512 => 16,
-        }
-    }
-}
 
 /// A vector of `N` f32 lanes with a matching vector `I` of u32 lanes.
 #[cfg(target_arch = "x86_64")]

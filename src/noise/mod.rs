@@ -15,8 +15,9 @@
 //! | [`value1`], [`value1_grad`] | 1D value noise | [−1, 1) |
 //!
 //! Many points at once: [`gradient3_many`]`(&points, seed, &mut out)` runs the kernel on 16 / 8 /
-//! 4 points per call (AVX-512 / AVX2 / SSE2, detected at run time — [`Simd::best`]; scalar
-//! elsewhere), with the values of [`gradient3`]; [`Fractal::eval_many`] likewise.
+//! 4 points per call (AVX-512 / AVX2 / SSE2, detected at run time —
+//! [`crate::simd::Simd::best`]; scalar elsewhere), with the values of [`gradient3`];
+//! [`Fractal::eval_many`] likewise.
 //!
 //! `*_grad` returns `(value, ∇value)` with the analytic gradient. The [`Noise3`] trait wraps
 //! them ([`Gradient`], [`Value`]) and [`SparseConvolution`] for code generic over the noise.
@@ -96,7 +97,6 @@ pub use gradient::{
     fade, fade_d, gradient1, gradient1_grad, gradient3, gradient3_grad, gradient3_many,
     gradient3_many_with,
 };
-pub use lanes::Simd;
 pub use sparse::{
     band_cells, Cells, Kernel, NoiseError, SeededSparse, SparseConvolution, SparseConvolution1,
     Weights, MAX_IMPULSES_PER_CELL,

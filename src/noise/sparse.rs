@@ -10,6 +10,7 @@
 
 use super::hash::{cell3, cell3_offset, floor_i32, mix32, pcg3d, seed_offsets, unit_f32};
 use crate::math::Frame;
+use crate::simd::{simd_level, Simd};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 use std::f32::consts::PI;
@@ -648,32 +649,6 @@ fn layer_shrink(oz: i32, fz: f32, cells_per_semi_axis: f32) -> f32 {
     ((1.0 - gap * gap).max(0.0).sqrt() + LAYER_SLACK).min(1.0)
 }
 
-/// The instruction set the Cartesian block search runs on, if any: AVX-512 (F, DQ, VL: 32 lanes
-/// in two registers) or AVX2 (four); std caches the detection. Without AVX2 the cells are
-/// searched one at a time.
-#[cfg(target_arch = "x86_64")]
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum BlockSearch {
-    Avx512,
-    Avx2,
-    None,
-}
-
-#[cfg(target_arch = "x86_64")]
-#[inline]
-fn block_search() -> BlockSearch {
-    if is_x86_feature_detected!("avx512f")
-        && is_x86_feature_detected!("avx512dq")
-        && is_x86_feature_detected!("avx512vl")
-    {
-        BlockSearch::Avx512
-    } else if is_x86_feature_detected!("avx2") {
-        BlockSearch::Avx2
-    } else {
-        BlockSearch::None
-    }
-}
-
 /// The indices of the set bits of `mask`, ascending.
 #[inline(always)]
 fn lanes(mut mask: u32) -> impl Iterator<Item = usize> {
@@ -760,9 +735,10 @@ impl Band {
         }
     }
 
-    /// Cartesian cells: on CPUs with AVX-512 or AVX2 the 3 × 3 × 3 block of cells is searched in
-    /// SIMD lanes ([`Band::cartesian_block`]), else (and for windows wider than the block, which
-    /// only rounding can make) one cell at a time. All give the same value, bit for bit.
+    /// Cartesian cells: at the AVX-512 or AVX2 level ([`Simd::best`]) the 3 × 3 × 3 block of
+    /// cells is searched in SIMD lanes ([`Band::cartesian_block`]: 32 lanes, two AVX-512 or four
+    /// AVX2 registers), else (and for windows wider than the block, which only rounding can
+    /// make) one cell at a time. All give the same value, bit for bit.
     fn cartesian<const GRAD: bool>(
         &self,
         p: Vec3,
@@ -776,14 +752,30 @@ impl Band {
     /// The cell search of a prepared query (see [`Band::cartesian`]).
     #[inline(always)]
     fn cartesian_search<const GRAD: bool>(&self, q: &CartesianQuery) -> (f32, Vec3) {
+        // SAFETY: the level `Simd::best` allows.
+        unsafe { self.cartesian_search_on::<GRAD>(Simd::best(), q) }
+    }
+
+    /// [`Band::cartesian_search`] at the level `simd` (tests run every level).
+    ///
+    /// # Safety
+    /// `simd` must be no wider than [`Simd::best`]. (A precondition rather than a check: this
+    /// runs once per noise query.)
+    #[inline(always)]
+    unsafe fn cartesian_search_on<const GRAD: bool>(
+        &self,
+        simd: Simd,
+        q: &CartesianQuery,
+    ) -> (f32, Vec3) {
         #[cfg(target_arch = "x86_64")]
         if q.in_block() {
             let upright = q.map.axes.as_ref().is_some_and(is_upright);
-            match block_search() {
-                // SAFETY: `block_search` detected the instruction sets.
-                BlockSearch::Avx512 => return unsafe { self.cartesian_avx512::<GRAD>(q, upright) },
-                BlockSearch::Avx2 => return unsafe { self.cartesian_avx2::<GRAD>(q, upright) },
-                BlockSearch::None => {}
+            match simd {
+                // SAFETY: `simd` is no wider than `Simd::best()` (the caller's promise), which
+                // detected its features.
+                Simd::Avx512 => return unsafe { self.cartesian_avx512::<GRAD>(q, upright) },
+                Simd::Avx2 => return unsafe { self.cartesian_avx2::<GRAD>(q, upright) },
+                Simd::Sse2 | Simd::Scalar => {}
             }
         }
         self.cartesian_cells::<GRAD>(q)
@@ -846,24 +838,24 @@ impl Band {
         acc
     }
 
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn cartesian_avx2<const GRAD: bool>(
-        &self,
-        q: &CartesianQuery,
-        upright: bool,
-    ) -> (f32, Vec3) {
-        self.cartesian_block::<GRAD>(q, upright)
+    simd_level! { Avx2
+        unsafe fn cartesian_avx2<const GRAD: bool>(
+            &self,
+            q: &CartesianQuery,
+            upright: bool,
+        ) -> (f32, Vec3) {
+            self.cartesian_block::<GRAD>(q, upright)
+        }
     }
 
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f,avx512dq,avx512vl")]
-    unsafe fn cartesian_avx512<const GRAD: bool>(
-        &self,
-        q: &CartesianQuery,
-        upright: bool,
-    ) -> (f32, Vec3) {
-        self.cartesian_block::<GRAD>(q, upright)
+    simd_level! { Avx512
+        unsafe fn cartesian_avx512<const GRAD: bool>(
+            &self,
+            q: &CartesianQuery,
+            upright: bool,
+        ) -> (f32, Vec3) {
+            self.cartesian_block::<GRAD>(q, upright)
+        }
     }
 
     /// The window searched in lanes, one lane per cell of the 3 × 3 × 3 block (in the order of
@@ -1330,20 +1322,17 @@ mod tests {
                 let q = b.cartesian_query(p, frame, 1.0);
                 let reference = b.cartesian_cells::<true>(&q);
                 let value = b.cartesian_cells::<false>(&q).0;
-                // The dispatched search (the widest the CPU has) and, where the CPU has AVX2,
-                // the AVX2 block search itself.
+                // The dispatched search and the search at every level this CPU has.
                 let mut searches = vec![(
                     b.cartesian::<true>(p, frame, 1.0),
                     b.cartesian::<false>(p, frame, 1.0).0,
                 )];
-                #[cfg(target_arch = "x86_64")]
-                if q.in_block() && is_x86_feature_detected!("avx2") {
-                    let upright = frame.is_some_and(is_upright);
-                    // SAFETY: AVX2 detected.
+                for simd in Simd::ALL.into_iter().filter(|&s| s <= Simd::best()) {
+                    // SAFETY: no wider than `Simd::best()`.
                     searches.push(unsafe {
                         (
-                            b.cartesian_avx2::<true>(&q, upright),
-                            b.cartesian_avx2::<false>(&q, upright).0,
+                            b.cartesian_search_on::<true>(simd, &q),
+                            b.cartesian_search_on::<false>(simd, &q).0,
                         )
                     });
                 }

@@ -18,6 +18,7 @@
 //! the same IEEE operations in the same order (Rust never contracts to FMA), so they return
 //! identical hits (tested).
 
+use crate::simd::{simd_level, Simd};
 use glam::{Vec2, Vec3};
 use obvhs::bvh2::Bvh2;
 
@@ -234,8 +235,8 @@ struct Avx2;
 impl Kernel for Avx2 {
     #[inline(always)]
     fn node(node: &Node, r: &RayData, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]) {
-        // SAFETY: `Avx2` is only used by the `#[target_feature(enable = "avx2")]` traversals,
-        // which run only when the CPU reports AVX2.
+        // SAFETY: `Avx2` is only used by the traversals compiled for the AVX2 level
+        // (`simd_level!`), which run only when `Simd::best` allows that level.
         unsafe { intersect_node_avx2(node, r, t_min, t_max) }
     }
 
@@ -246,113 +247,115 @@ impl Kernel for Avx2 {
     }
 }
 
-/// [`intersect_node`] with AVX2 intrinsics: `vmaxps(a, b)` is `a > b ? a : b` and `vminps(a, b)`
-/// is `a < b ? a : b`, the portable code's `max` and `min` exactly.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-#[inline]
-unsafe fn intersect_node_avx2(
-    node: &Node,
-    r: &RayData,
-    t_min: f32,
-    t_max: f32,
-) -> (u32, [f32; WIDTH]) {
-    use std::arch::x86_64::*;
-    let slab = |plane: &[f32; WIDTH], o: f32, inv: f32| {
-        _mm256_mul_ps(
-            _mm256_sub_ps(_mm256_loadu_ps(plane.as_ptr()), _mm256_set1_ps(o)),
-            _mm256_set1_ps(inv),
-        )
-    };
-    let [nx, ny, nz] = r.near;
-    let [ox, oy, oz] = r.o;
-    let [ix, iy, iz] = r.inv;
-    let t_near = _mm256_max_ps(
-        _mm256_max_ps(
-            slab(&node.bounds[nx][0], ox, ix),
-            slab(&node.bounds[ny][1], oy, iy),
-        ),
-        _mm256_max_ps(slab(&node.bounds[nz][2], oz, iz), _mm256_set1_ps(t_min)),
-    );
-    let t_far = _mm256_min_ps(
-        _mm256_min_ps(
-            slab(&node.bounds[1 - nx][0], ox, ix),
-            slab(&node.bounds[1 - ny][1], oy, iy),
-        ),
-        _mm256_min_ps(slab(&node.bounds[1 - nz][2], oz, iz), _mm256_set1_ps(t_max)),
-    );
-    let hit = _mm256_cmp_ps::<_CMP_LE_OQ>(t_near, _mm256_mul_ps(t_far, _mm256_set1_ps(ROBUST_FAR)));
-    let mut out = [0.0; WIDTH];
-    _mm256_storeu_ps(out.as_mut_ptr(), t_near);
-    (_mm256_movemask_ps(hit) as u32, out)
+simd_level! { Avx2
+    /// [`intersect_node`] with AVX2 intrinsics: `vmaxps(a, b)` is `a > b ? a : b` and
+    /// `vminps(a, b)` is `a < b ? a : b`, the portable code's `max` and `min` exactly.
+    #[inline]
+    unsafe fn intersect_node_avx2(
+        node: &Node,
+        r: &RayData,
+        t_min: f32,
+        t_max: f32,
+    ) -> (u32, [f32; WIDTH]) {
+        use std::arch::x86_64::*;
+        let slab = |plane: &[f32; WIDTH], o: f32, inv: f32| {
+            _mm256_mul_ps(
+                _mm256_sub_ps(_mm256_loadu_ps(plane.as_ptr()), _mm256_set1_ps(o)),
+                _mm256_set1_ps(inv),
+            )
+        };
+        let [nx, ny, nz] = r.near;
+        let [ox, oy, oz] = r.o;
+        let [ix, iy, iz] = r.inv;
+        let t_near = _mm256_max_ps(
+            _mm256_max_ps(
+                slab(&node.bounds[nx][0], ox, ix),
+                slab(&node.bounds[ny][1], oy, iy),
+            ),
+            _mm256_max_ps(slab(&node.bounds[nz][2], oz, iz), _mm256_set1_ps(t_min)),
+        );
+        let t_far = _mm256_min_ps(
+            _mm256_min_ps(
+                slab(&node.bounds[1 - nx][0], ox, ix),
+                slab(&node.bounds[1 - ny][1], oy, iy),
+            ),
+            _mm256_min_ps(slab(&node.bounds[1 - nz][2], oz, iz), _mm256_set1_ps(t_max)),
+        );
+        let far = _mm256_mul_ps(t_far, _mm256_set1_ps(ROBUST_FAR));
+        let hit = _mm256_cmp_ps::<_CMP_LE_OQ>(t_near, far);
+        let mut out = [0.0; WIDTH];
+        _mm256_storeu_ps(out.as_mut_ptr(), t_near);
+        (_mm256_movemask_ps(hit) as u32, out)
+    }
 }
 
-/// [`intersect_packet`] with AVX2 intrinsics on the eight lanes of a packet: the same operations
-/// in the same order (`_CMP_NEQ_UQ` is Rust's `!=`, the ordered compares its `>=` and `<`), then
-/// the first lane holding the minimum t, as the portable scan picks it.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-#[inline]
-unsafe fn intersect_packet_avx2(
-    p: &Packet,
-    r: &RayData,
-    t_min: f32,
-    t_max: f32,
-) -> Option<LaneHit> {
-    use std::arch::x86_64::*;
-    let load = |a: &[f32; PACKET]| _mm256_loadu_ps(a.as_ptr());
-    let (mul, sub, add) = (_mm256_mul_ps, _mm256_sub_ps, _mm256_add_ps);
-    let dot = |a: [__m256; 3], b: [__m256; 3]| {
-        add(add(mul(a[0], b[0]), mul(a[1], b[1])), mul(a[2], b[2]))
-    };
-    let [dx, dy, dz] = r.d.map(|x| _mm256_set1_ps(x));
-    let [ox, oy, oz] = r.o.map(|x| _mm256_set1_ps(x));
-    let c = [
-        sub(load(&p.v0[0]), ox),
-        sub(load(&p.v0[1]), oy),
-        sub(load(&p.v0[2]), oz),
-    ];
-    let rv = [
-        sub(mul(dy, c[2]), mul(dz, c[1])),
-        sub(mul(dz, c[0]), mul(dx, c[2])),
-        sub(mul(dx, c[1]), mul(dy, c[0])),
-    ];
-    let [e1, e2] = [&p.e1, &p.e2].map(|a| [load(&a[0]), load(&a[1]), load(&a[2])]);
-    let ng = [
-        sub(mul(e1[1], e2[2]), mul(e2[1], e1[2])),
-        sub(mul(e1[2], e2[0]), mul(e2[2], e1[0])),
-        sub(mul(e1[0], e2[1]), mul(e2[0], e1[1])),
-    ];
-    let det = dot(ng, [dx, dy, dz]);
-    let inv_det = _mm256_div_ps(_mm256_set1_ps(1.0), det);
-    let u = mul(dot(rv, e2), inv_det);
-    let v = mul(dot(rv, e1), inv_det);
-    let w = sub(sub(_mm256_set1_ps(1.0), u), v);
-    let t = mul(dot(ng, c), inv_det);
-    let signs = _mm256_castps_si256(_mm256_or_ps(_mm256_or_ps(u, v), w));
-    let ok = _mm256_and_ps(
-        _mm256_and_ps(
-            _mm256_cmp_ps::<_CMP_NEQ_UQ>(det, _mm256_setzero_ps()),
-            _mm256_castsi256_ps(_mm256_cmpgt_epi32(signs, _mm256_set1_epi32(-1))),
-        ),
-        _mm256_and_ps(
-            _mm256_cmp_ps::<_CMP_GE_OQ>(t, _mm256_set1_ps(t_min)),
-            _mm256_cmp_ps::<_CMP_LT_OQ>(t, _mm256_set1_ps(t_max)),
-        ),
-    );
-    let t = _mm256_blendv_ps(_mm256_set1_ps(f32::INFINITY), t, ok);
-    // Horizontal minimum: halves, then pairs, then neighbours.
-    let m = _mm256_min_ps(t, _mm256_permute2f128_ps::<1>(t, t));
-    let m = _mm256_min_ps(m, _mm256_permute_ps::<0b01_00_11_10>(m));
-    let m = _mm256_min_ps(m, _mm256_permute_ps::<0b10_11_00_01>(m));
-    let t_best = _mm256_cvtss_f32(m);
-    (t_best < t_max).then(|| {
-        let lane = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(t, m)).trailing_zeros() as usize;
-        let (mut us, mut vs) = ([0.0; PACKET], [0.0; PACKET]);
-        _mm256_storeu_ps(us.as_mut_ptr(), u);
-        _mm256_storeu_ps(vs.as_mut_ptr(), v);
-        (lane, t_best, us[lane], vs[lane])
-    })
+simd_level! { Avx2
+    /// [`intersect_packet`] with AVX2 intrinsics on the eight lanes of a packet: the same
+    /// operations in the same order (`_CMP_NEQ_UQ` is Rust's `!=`, the ordered compares its `>=`
+    /// and `<`), then the first lane holding the minimum t, as the portable scan picks it.
+    #[inline]
+    unsafe fn intersect_packet_avx2(
+        p: &Packet,
+        r: &RayData,
+        t_min: f32,
+        t_max: f32,
+    ) -> Option<LaneHit> {
+        use std::arch::x86_64::*;
+        let load = |a: &[f32; PACKET]| _mm256_loadu_ps(a.as_ptr());
+        let (mul, sub, add) = (_mm256_mul_ps, _mm256_sub_ps, _mm256_add_ps);
+        let dot = |a: [__m256; 3], b: [__m256; 3]| {
+            add(add(mul(a[0], b[0]), mul(a[1], b[1])), mul(a[2], b[2]))
+        };
+        let [dx, dy, dz] = r.d.map(|x| _mm256_set1_ps(x));
+        let [ox, oy, oz] = r.o.map(|x| _mm256_set1_ps(x));
+        let c = [
+            sub(load(&p.v0[0]), ox),
+            sub(load(&p.v0[1]), oy),
+            sub(load(&p.v0[2]), oz),
+        ];
+        let rv = [
+            sub(mul(dy, c[2]), mul(dz, c[1])),
+            sub(mul(dz, c[0]), mul(dx, c[2])),
+            sub(mul(dx, c[1]), mul(dy, c[0])),
+        ];
+        let [e1, e2] = [&p.e1, &p.e2].map(|a| [load(&a[0]), load(&a[1]), load(&a[2])]);
+        let ng = [
+            sub(mul(e1[1], e2[2]), mul(e2[1], e1[2])),
+            sub(mul(e1[2], e2[0]), mul(e2[2], e1[0])),
+            sub(mul(e1[0], e2[1]), mul(e2[0], e1[1])),
+        ];
+        let det = dot(ng, [dx, dy, dz]);
+        let inv_det = _mm256_div_ps(_mm256_set1_ps(1.0), det);
+        let u = mul(dot(rv, e2), inv_det);
+        let v = mul(dot(rv, e1), inv_det);
+        let w = sub(sub(_mm256_set1_ps(1.0), u), v);
+        let t = mul(dot(ng, c), inv_det);
+        let signs = _mm256_castps_si256(_mm256_or_ps(_mm256_or_ps(u, v), w));
+        let ok = _mm256_and_ps(
+            _mm256_and_ps(
+                _mm256_cmp_ps::<_CMP_NEQ_UQ>(det, _mm256_setzero_ps()),
+                _mm256_castsi256_ps(_mm256_cmpgt_epi32(signs, _mm256_set1_epi32(-1))),
+            ),
+            _mm256_and_ps(
+                _mm256_cmp_ps::<_CMP_GE_OQ>(t, _mm256_set1_ps(t_min)),
+                _mm256_cmp_ps::<_CMP_LT_OQ>(t, _mm256_set1_ps(t_max)),
+            ),
+        );
+        let t = _mm256_blendv_ps(_mm256_set1_ps(f32::INFINITY), t, ok);
+        // Horizontal minimum: halves, then pairs, then neighbours.
+        let m = _mm256_min_ps(t, _mm256_permute2f128_ps::<1>(t, t));
+        let m = _mm256_min_ps(m, _mm256_permute_ps::<0b01_00_11_10>(m));
+        let m = _mm256_min_ps(m, _mm256_permute_ps::<0b10_11_00_01>(m));
+        let t_best = _mm256_cvtss_f32(m);
+        (t_best < t_max).then(|| {
+            let lane =
+                _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(t, m)).trailing_zeros() as usize;
+            let (mut us, mut vs) = ([0.0; PACKET], [0.0; PACKET]);
+            _mm256_storeu_ps(us.as_mut_ptr(), u);
+            _mm256_storeu_ps(vs.as_mut_ptr(), v);
+            (lane, t_best, us[lane], vs[lane])
+        })
+    }
 }
 
 /// Möller–Trumbore ray/triangle test on eight triangles at once (Möller & Trumbore 1997, in the
@@ -524,16 +527,14 @@ impl WideBvh {
         self.with_stack(|s| self.unoccluded_in::<Portable>(o, d, t_max, s))
     }
 
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn closest_avx2(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<WideHit> {
-        self.with_stack(|s| self.closest_in::<Avx2>(o, d, t_max, s))
-    }
+    simd_level! { Avx2
+        unsafe fn closest_avx2(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<WideHit> {
+            self.with_stack(|s| self.closest_in::<Avx2>(o, d, t_max, s))
+        }
 
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn unoccluded_avx2(&self, o: Vec3, d: Vec3, t_max: f32) -> bool {
-        self.with_stack(|s| self.unoccluded_in::<Avx2>(o, d, t_max, s))
+        unsafe fn unoccluded_avx2(&self, o: Vec3, d: Vec3, t_max: f32) -> bool {
+            self.with_stack(|s| self.unoccluded_in::<Avx2>(o, d, t_max, s))
+        }
     }
 
     /// Runs `f` with a traversal stack large enough for this tree: a per-thread buffer that
@@ -822,16 +823,9 @@ impl CollapsePlan {
     }
 }
 
-/// Whether the AVX2 compilation of the traversal can run here.
+/// Whether the AVX2 compilation of the traversal may run here ([`Simd::best`]).
 fn avx2_available() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx2")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
+    Simd::best() >= Simd::Avx2
 }
 
 /// Moves `v` into a fresh allocation that the kernel is asked to back with transparent huge

@@ -14,6 +14,7 @@ use crate::field::{
 };
 use crate::math::Frame;
 use crate::noise::SparseConvolution1;
+use crate::simd::{simd_level, Simd};
 use glam::Vec3;
 
 /// A wood volume ready to evaluate: parameters turned into precomputed waves, colours and noise.
@@ -408,21 +409,15 @@ impl WoodVolume {
     /// rings, interlock, Beer's law) in SIMD lanes. Anything else, and a last partial block, goes
     /// point by point.
     pub fn eval_many(&self, points: &[Vec3], needs: Needs, out: &mut [WoodTexel]) {
-        self.eval_many_on(crate::noise::Simd::best(), points, needs, out);
+        self.eval_many_on(Simd::best(), points, needs, out);
     }
 
     /// [`WoodVolume::eval_many`] with the lane stages compiled for `simd` (which the CPU must
     /// have; tests run every level).
     #[doc(hidden)]
-    pub fn eval_many_on(
-        &self,
-        simd: crate::noise::Simd,
-        points: &[Vec3],
-        needs: Needs,
-        out: &mut [WoodTexel],
-    ) {
+    pub fn eval_many_on(&self, simd: Simd, points: &[Vec3], needs: Needs, out: &mut [WoodTexel]) {
         assert_eq!(points.len(), out.len(), "eval_many: one texel per point");
-        assert!(simd <= crate::noise::Simd::best(), "{simd:?} not available");
+        assert!(simd <= Simd::best(), "{simd:?} not available");
         let mut done = 0;
         if needs == Needs::COLOR && self.knots.is_none() {
             for (p, o) in points.chunks_exact(BATCH).zip(out.chunks_exact_mut(BATCH)) {
@@ -443,16 +438,10 @@ impl WoodVolume {
 
     /// [`WoodVolume::color_block`] compiled for `simd`.
     #[inline]
-    fn color_block_on(
-        &self,
-        simd: crate::noise::Simd,
-        p: &[Vec3; BATCH],
-        out: &mut [WoodTexel; BATCH],
-    ) -> bool {
-        use crate::noise::Simd;
+    fn color_block_on(&self, simd: Simd, p: &[Vec3; BATCH], out: &mut [WoodTexel; BATCH]) -> bool {
         #[cfg(target_arch = "x86_64")]
         match simd {
-            // SAFETY: `Simd::best` detected the instruction set.
+            // SAFETY: the caller checked `simd <= Simd::best()`, which detected its features.
             Simd::Avx512 => return unsafe { self.color_block_avx512(p, out) },
             Simd::Avx2 => return unsafe { self.color_block_avx2(p, out) },
             _ => {}
@@ -461,16 +450,20 @@ impl WoodVolume {
         self.color_block(p, out)
     }
 
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl")]
-    unsafe fn color_block_avx512(&self, p: &[Vec3; BATCH], out: &mut [WoodTexel; BATCH]) -> bool {
-        self.color_block(p, out)
+    simd_level! { Avx512
+        unsafe fn color_block_avx512(
+            &self,
+            p: &[Vec3; BATCH],
+            out: &mut [WoodTexel; BATCH],
+        ) -> bool {
+            self.color_block(p, out)
+        }
     }
 
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn color_block_avx2(&self, p: &[Vec3; BATCH], out: &mut [WoodTexel; BATCH]) -> bool {
-        self.color_block(p, out)
+    simd_level! { Avx2
+        unsafe fn color_block_avx2(&self, p: &[Vec3; BATCH], out: &mut [WoodTexel; BATCH]) -> bool {
+            self.color_block(p, out)
+        }
     }
 
     /// One block of colour-only texels (see [`WoodVolume::eval_many`]): the operations of

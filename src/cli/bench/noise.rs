@@ -7,8 +7,9 @@
 use crate::math::{Frame, Pcg32};
 use crate::noise::{
     cellular3, gradient3, gradient3_grad, gradient3_many_with, value3, Cells, Fractal, FractalKind,
-    Kernel, Simd, SparseConvolution, Warp, Weights,
+    Kernel, SparseConvolution, Warp, Weights,
 };
+use crate::simd::Simd;
 use glam::Vec3;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -91,8 +92,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let frame = Frame::from_normal(Vec3::new(0.2, 0.1, 1.0).normalize());
     // The batch calls on every instruction set this CPU has, widest first (the first row of each
     // is what `gradient3_many` / `Fractal::eval_many` use).
-    let isas: Vec<Simd> = [Simd::Avx512, Simd::Avx2, Simd::Sse2, Simd::Scalar]
+    let isas: Vec<Simd> = Simd::ALL
         .into_iter()
+        .rev()
         .filter(|&s| s <= Simd::best())
         .collect();
     let mut rows: Vec<(String, f64)> = Vec::new();
