@@ -646,12 +646,12 @@ pub(crate) fn radiance_frames(
                 }
             }
         });
-        let Some(sp) = sp_opt else { break };
+        let Some(sp) = &sp_opt else { break };
         if depth >= max_depth || !scratch.alive.contains(&true) {
             break;
         }
         if !sp.bsdf.is_delta() {
-            next_event_frames(lights, shadow, &sp, rng, scratch, rays);
+            next_event_frames(lights, shadow, sp, rng, scratch, rays);
             for k in (0..n).filter(|&k| scratch.alive[k]) {
                 out[k] += beta * scratch.nee[k];
             }
@@ -685,7 +685,7 @@ pub(crate) fn radiance_frames(
         }
         let d = sp.frame.to_world(bs.wi);
         ray = Ray {
-            o: offset_origin(&sp, d),
+            o: offset_origin(sp, d),
             d,
         };
         rays.0 += 1;
@@ -723,12 +723,12 @@ fn next_event_frames(
     let mut moving_u = None;
     terms.clear();
     for (j, light) in lights.first().iter().enumerate() {
-        let u = LightU::new(rng.next_vec2());
+        let u = rng.next_vec2();
         terms.push(if Some(j) == moving {
-            moving_u = Some(u);
+            moving_u = Some(LightU::new(u));
             Vec3::ZERO
         } else {
-            light_term(shadow, sp, &bsdf, light.sample_at(sp.p, &u), rays)
+            light_term(shadow, sp, &bsdf, light.sample(sp.p, u), rays)
         });
     }
     nee.clear();
