@@ -224,12 +224,15 @@ pub(crate) fn offset_origin(sp: &ShadingPoint, dir: Vec3) -> Vec3 {
 /// with its `wo`-only terms worked out once (`WoodBsdf::at_wo`), any other BSDF as it is.
 /// Values identical to `eval` and `pdf`.
 #[derive(Clone, Copy, Debug)]
-pub(crate) enum BsdfAtWo<'a> {
+pub enum BsdfAtWo<'a> {
+    /// The wood BSDF with its `wo`-only terms worked out.
     Wood(WoodAtWo<'a>),
+    /// Any other BSDF, with `wo` (local frame).
     Other(&'a SurfaceBsdf, Vec3),
 }
 
 impl<'a> BsdfAtWo<'a> {
+    /// The BSDF of `sp` with its `wo` fixed.
     pub fn new(sp: &'a ShadingPoint) -> Self {
         match &sp.bsdf {
             SurfaceBsdf::Wood(b) => BsdfAtWo::Wood(b.at_wo(sp.wo)),
@@ -447,7 +450,7 @@ fn slab_misses(o: [f32; 3], inv: [f32; 3], t_max: f32, lo: [f32; 3], hi: [f32; 3
 /// the light is unoccluded, w the power heuristic against BSDF sampling (1 for delta lights);
 /// zero when the sample failed, the BSDF vanishes or the light is occluded.
 #[inline]
-pub(crate) fn light_term(
+pub fn light_term(
     shadow: &ShadowTest,
     sp: &ShadingPoint,
     bsdf: &BsdfAtWo,
@@ -525,7 +528,7 @@ pub struct TermScratch {
 /// stage is a loop without dependencies from one sample to the next. The same functions as
 /// [`light_term`] on the same values, so the same bits (tested by the sweep's equality test).
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn light_terms(
+pub fn light_terms(
     shadow: &ShadowTest,
     sp: &ShadingPoint,
     bsdf: &BsdfAtWo,
