@@ -1,6 +1,6 @@
 //! The SIMD level: which instruction set the hot loops compiled more than once (noise lane
 //! kernels, the wood colour blocks, the sparse-noise block search, the wide-BVH traversal) run
-//! on. The features of each level are listed once, in [`simd_level!`]: the same list gives the
+//! on. The features of each level are listed once, in `simd_level!`: the same list gives the
 //! `#[target_feature]` of every function compiled for the level and the run-time check that
 //! lets it run, so the two cannot drift apart. [`Simd::best`] is the one place that decides.
 //!

@@ -84,22 +84,30 @@ pub fn incoherent_rays(count: usize, seed: u64) -> Vec<Ray> {
 /// One row of the benchmark report.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct TraceFigures {
+    /// Rays traced.
     pub rays: usize,
+    /// Rays that hit the mesh.
     pub closest_hits: usize,
+    /// Closest-hit speed (million rays per second of thread CPU time).
     pub closest_mrays_per_s: f64,
+    /// Any-hit (occlusion) speed (million rays per second of thread CPU time).
     pub any_hit_mrays_per_s: f64,
 }
 
 /// The whole benchmark report (serialised with `--json`).
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct TraceReport {
+    /// Triangles of the mesh.
     pub triangles: usize,
+    /// Name of the obvhs build parameters.
     pub build_params: String,
     /// obvhs core build (PLOC + reinsertion + CWBVH conversion), seconds.
     pub build_core_s: f64,
     /// Everything from the mesh to a ready `Accel` (world transform, AABBs, reordering), seconds.
     pub build_total_s: f64,
+    /// xylem's wide BVH on the coherent (pinhole camera) rays.
     pub coherent: TraceFigures,
+    /// xylem's wide BVH on the incoherent (random) rays.
     pub incoherent: TraceFigures,
     /// The same mesh, build parameters and rays through obvhs's own CWBVH build and traversal
     /// (what the renderer used before the wide BVH), for comparison.
@@ -111,14 +119,17 @@ pub struct TraceReport {
 /// obvhs CWBVH figures: core build time and both ray sets.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct CwBvhFigures {
+    /// obvhs's CWBVH build time, seconds.
     pub build_core_s: f64,
+    /// Traversal of the coherent rays.
     pub coherent: TraceFigures,
+    /// Traversal of the incoherent rays.
     pub incoherent: TraceFigures,
 }
 
 /// obvhs's own CWBVH build and traversal of a mesh (object space = world space), with
 /// `RtTriangle`s in BVH primitive order: the renderer's tracer before the wide BVH.
-pub struct ObvhsCwBvh {
+pub(crate) struct ObvhsCwBvh {
     bvh: CwBvh,
     tris: Vec<RtTriangle>,
     pub build_time: Duration,
@@ -186,10 +197,15 @@ pub fn figures(rays: usize, hits: usize, closest: Duration, any: Duration) -> Tr
 /// Embree's figures on the same mesh and rays, and xylem's closest-hit speed as a fraction of it.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct EmbreeFigures {
+    /// Embree's build time, seconds.
     pub build_s: f64,
+    /// Embree on the coherent rays.
     pub coherent: TraceFigures,
+    /// Embree on the incoherent rays.
     pub incoherent: TraceFigures,
+    /// xylem's closest-hit speed over Embree's, coherent rays.
     pub closest_ratio_coherent: f64,
+    /// xylem's closest-hit speed over Embree's, incoherent rays.
     pub closest_ratio_incoherent: f64,
 }
 
@@ -197,13 +213,15 @@ pub struct EmbreeFigures {
 /// elsewhere): on a shared machine the time the tracing thread waits descheduled is not counted,
 /// for xylem and Embree alike.
 #[derive(Clone, Copy)]
-pub struct ThreadTimer(Duration);
+pub(crate) struct ThreadTimer(Duration);
 
 impl ThreadTimer {
+    /// Starts the stopwatch.
     pub fn start() -> Self {
         ThreadTimer(thread_time())
     }
 
+    /// CPU time of the calling thread since [`ThreadTimer::start`].
     pub fn elapsed(&self) -> Duration {
         thread_time().saturating_sub(self.0)
     }

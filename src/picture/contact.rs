@@ -4,8 +4,11 @@
 /// An 8-bit sRGB image (RGB, row-major, top row first), as read back from a frame's PNG.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Rgb8 {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
+    /// RGB bytes, 3 per pixel.
     pub data: Vec<u8>,
 }
 

@@ -7,7 +7,9 @@ use super::contact::{draw_label, Rgb8};
 /// One curve of a plot.
 #[derive(Clone, Debug)]
 pub struct Series {
+    /// The (x, y) points, joined in order.
     pub points: Vec<(f64, f64)>,
+    /// Line colour (8-bit sRGB).
     pub color: [u8; 3],
     /// Draw a small square on every point (for measurements, not sampled curves).
     pub markers: bool,
@@ -16,9 +18,13 @@ pub struct Series {
 /// Plot size and axis scaling.
 #[derive(Clone, Copy, Debug)]
 pub struct PlotOptions {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
+    /// Logarithmic x axis (points with x ≤ 0 are left out).
     pub log_x: bool,
+    /// Logarithmic y axis (points with y ≤ 0 are left out).
     pub log_y: bool,
 }
 

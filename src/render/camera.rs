@@ -11,22 +11,32 @@ pub enum Projection {
     /// Pinhole or thin lens (pbrt-v4 §5.2.3): `fov_y` vertical field of view (radians),
     /// `lens_radius` (mm, 0 = pinhole) and `focus_distance` (mm, along the view axis).
     Perspective {
+        /// Vertical field of view (radians).
         fov_y: f32,
+        /// Thin-lens aperture radius (mm); 0 = pinhole.
         lens_radius: f32,
+        /// Distance of the plane in focus, along the view axis (mm).
         focus_distance: f32,
     },
     /// Parallel rays; `width` is the film width in world millimetres.
-    Orthographic { width: f32 },
+    Orthographic {
+        /// Film width (world mm).
+        width: f32,
+    },
 }
 
 /// A camera at `eye` looking along `frame.n` with `frame.t` the image-up direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
+    /// Eye position (world, mm).
     pub eye: Vec3,
     /// s = image right, t = image up, n = view direction.
     pub frame: Frame,
+    /// How film points become rays.
     pub projection: Projection,
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
 }
 

@@ -10,11 +10,22 @@ use glam::{Vec2, Vec3};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Filter {
     /// Uniform over the square of half-width `radius` (0.5 = the pixel itself).
-    Box { radius: f32 },
+    Box {
+        /// Half-width (pixels).
+        radius: f32,
+    },
     /// Separable triangle filter.
-    Tent { radius: f32 },
+    Tent {
+        /// Half-width where the tent reaches zero (pixels).
+        radius: f32,
+    },
     /// Separable Gaussian of standard deviation `sigma`, truncated at `radius`.
-    Gaussian { sigma: f32, radius: f32 },
+    Gaussian {
+        /// Standard deviation (pixels).
+        sigma: f32,
+        /// Truncation radius (pixels).
+        radius: f32,
+    },
 }
 
 impl Default for Filter {
@@ -65,6 +76,7 @@ fn sample_tent(u: f32) -> f32 {
 /// First-hit values averaged per pixel.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Aov {
+    /// Diffuse albedo of the first hit (linear RGB).
     pub albedo: Vec3,
     /// Shading normal (world).
     pub normal: Vec3,
@@ -72,8 +84,11 @@ pub struct Aov {
     /// while accumulating, their mean once averaged, +∞ where no sample hit (the OpenEXR
     /// convention for "nothing there": a compositor's depth test keeps anything in front).
     pub depth: f32,
+    /// Fibre direction at the first hit (world, unit; zero where the material has no fibres).
     pub fiber: Vec3,
+    /// Ray-cell fraction at the first hit (0–1; zero where the material has none).
     pub ray_mask: f32,
+    /// Growth time at the first hit (years from the pith) for wood; zero otherwise.
     pub growth_time: f32,
     /// Coverage: 1 for a sample whose camera ray hit something, 0 for a miss; once averaged, the
     /// fraction of the pixel's samples that hit (the EXR's alpha, unpremultiplied radiance of
@@ -117,6 +132,7 @@ pub struct PixelSum {
     aov: Aov,
     /// Samples taken (finite or not).
     count: u32,
+    /// Samples whose radiance was NaN or infinite (dropped).
     pub nonfinite: u32,
 }
 
@@ -144,12 +160,15 @@ impl PixelSum {
 /// A finished image with its AOV layers.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Image {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// Linear RGB radiance, row-major, top row first.
     pub beauty: Vec<Vec3>,
     /// Standard error of each pixel's luminance estimate.
     pub std_error: Vec<f32>,
+    /// First-hit AOVs per pixel (row-major, top row first), averaged over the pixel's samples.
     pub aov: Vec<Aov>,
     /// Samples dropped because their radiance was NaN or infinite.
     pub nonfinite: u64,

@@ -23,9 +23,12 @@ use std::time::{Duration, Instant};
 /// An indexed triangle mesh in object space (millimetres).
 #[derive(Clone, Debug, Default)]
 pub struct TriMesh {
+    /// Vertex positions (object space, mm).
     pub positions: Vec<Vec3>,
     /// Per-vertex shading normals (same length as `positions`), if the mesh has them.
     pub normals: Option<Vec<Vec3>>,
+    /// Triangles as indices into `positions`; the winding gives the geometric normal
+    /// (v1 − v0) × (v2 − v0).
     pub indices: Vec<[u32; 3]>,
 }
 
@@ -81,13 +84,16 @@ impl TriMesh {
 /// (inverse transpose of the linear part) precomputed.
 #[derive(Clone, Copy, Debug)]
 pub struct Transform {
+    /// Object → world map.
     pub to_world: Affine3A,
+    /// World → object map (the inverse of `to_world`).
     pub to_object: Affine3A,
     /// Transforms normals and gradients (covectors) from object to world.
     pub normal_to_world: Mat3,
 }
 
 impl Transform {
+    /// The placement `to_world` with its inverse and normal matrix worked out.
     pub fn new(to_world: Affine3A) -> Self {
         let to_object = to_world.inverse();
         Transform {
@@ -97,6 +103,7 @@ impl Transform {
         }
     }
 
+    /// The placement that leaves the mesh where it is.
     pub fn identity() -> Self {
         Transform::new(Affine3A::IDENTITY)
     }
@@ -107,21 +114,25 @@ impl Transform {
         d.is_finite() && d.abs() > 1e-12 && self.to_object.is_finite()
     }
 
+    /// A point (object space) in world space.
     #[inline]
     pub fn point_to_world(&self, p: Vec3) -> Vec3 {
         self.to_world.transform_point3(p)
     }
 
+    /// A point (world space) in object space.
     #[inline]
     pub fn point_to_object(&self, p: Vec3) -> Vec3 {
         self.to_object.transform_point3(p)
     }
 
+    /// A direction (object space) in world space, not renormalised.
     #[inline]
     pub fn vector_to_world(&self, v: Vec3) -> Vec3 {
         self.to_world.transform_vector3(v)
     }
 
+    /// A normal (object space) in world space by the inverse transpose, not renormalised.
     #[inline]
     pub fn normal_to_world(&self, n: Vec3) -> Vec3 {
         self.normal_to_world * n
@@ -131,8 +142,11 @@ impl Transform {
 /// One placed mesh: which mesh, where, and which material (index into the scene's materials).
 #[derive(Clone, Debug)]
 pub struct Instance {
+    /// The mesh; instances that share one `Arc` share one object-space BVH.
     pub mesh: Arc<TriMesh>,
+    /// Where the mesh is placed.
     pub transform: Transform,
+    /// Index into the scene's materials.
     pub material: u32,
     /// Where the object sits in the tree (solid-texture space).
     pub placement: Placement,
@@ -141,11 +155,14 @@ pub struct Instance {
 /// A ray in world space; `d` need not be unit length for intersection, but the renderer keeps it unit.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ray {
+    /// Origin (world, mm).
     pub o: Vec3,
+    /// Direction (world).
     pub d: Vec3,
 }
 
 impl Ray {
+    /// The point at parameter `t` (`o + t·d`).
     #[inline]
     pub fn at(&self, t: f32) -> Vec3 {
         self.o + self.d * t
@@ -156,9 +173,13 @@ impl Ray {
 /// barycentrics (p = (1 − u − v)·v0 + u·v1 + v·v2).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
+    /// Ray parameter of the hit (mm along a unit-length ray).
     pub t: f32,
+    /// Index into [`Accel::instances`].
     pub instance: u32,
+    /// Index into the instance mesh's `indices`.
     pub triangle: u32,
+    /// Barycentrics (u, v) of the hit in that triangle.
     pub uv: Vec2,
 }
 
@@ -166,14 +187,20 @@ pub struct Hit {
 /// flipped towards the viewer), object-space position.
 #[derive(Clone, Copy, Debug)]
 pub struct SurfaceHit {
+    /// Hit point (world, mm), from the ray equation.
     pub p: Vec3,
+    /// Hit point in the instance's object space (mm), from the barycentrics.
     pub p_object: Vec3,
     /// Geometric normal in object space (unit).
     pub n_object: Vec3,
+    /// Geometric normal (world, unit).
     pub ng: Vec3,
+    /// Shading normal (world, unit): the interpolated vertex normals, or `ng` where the mesh has
+    /// none.
     pub ns: Vec3,
     /// A tangent along the triangle's first edge (world), for a stable shading frame.
     pub tangent: Vec3,
+    /// Index into [`Accel::instances`].
     pub instance: u32,
 }
 
@@ -199,6 +226,7 @@ pub struct Accel {
     instanced: Vec<bool>,
     /// The top-level BVH over the widened world boxes of `placed` (None when nothing is shared).
     top: Option<Bvh2>,
+    /// The placed meshes, indexed by [`Hit::instance`].
     pub instances: Vec<Instance>,
     /// Time spent building: obvhs's BVH2s (PLOC, reinsertion) and their collapse to wide BVHs.
     pub build_time: Duration,
@@ -270,10 +298,13 @@ fn used_vertices(mesh: &TriMesh) -> Vec<u32> {
 }
 
 impl Accel {
+    /// Builds the acceleration structure over `instances` with [`BUILD_PARAMS`].
     pub fn new(instances: Vec<Instance>) -> Self {
         Self::with_params(instances, BUILD_PARAMS)
     }
 
+    /// Builds the acceleration structure with other obvhs BVH2 build parameters (for the BVH
+    /// builder comparison of `xylem bench trace`).
     pub fn with_params(instances: Vec<Instance>, params: BvhBuildParams) -> Self {
         let start = Instant::now();
         // Distinct meshes by identity, in first-use order (deterministic), with their users.

@@ -9,26 +9,50 @@ use std::path::Path;
 /// Errors while writing an image, naming the file.
 #[derive(Debug, thiserror::Error)]
 pub enum ImageError {
+    /// The file could not be created or written.
     #[error("cannot write image {path}: {source}")]
     Io {
+        /// The file.
         path: String,
+        /// Why.
         source: std::io::Error,
     },
+    /// The PNG encoder failed.
     #[error("cannot encode PNG {path}: {source}")]
     Png {
+        /// The file.
         path: String,
+        /// Why.
         source: png::EncodingError,
     },
+    /// The exr crate could not write the file.
     #[error("cannot write EXR {path}: {message}")]
-    ExrWrite { path: String, message: String },
+    ExrWrite {
+        /// The file.
+        path: String,
+        /// The exr crate's message.
+        message: String,
+    },
+    /// The exr crate could not read the file.
     #[error("cannot read EXR {path}: {message}")]
-    ExrRead { path: String, message: String },
+    ExrRead {
+        /// The file.
+        path: String,
+        /// The exr crate's message.
+        message: String,
+    },
+    /// A pixel buffer whose length does not match the image size.
     #[error("image {path}: buffer holds {got} pixels, {width}x{height} needs {want}")]
     Size {
+        /// The file.
         path: String,
+        /// Image width in pixels.
         width: u32,
+        /// Image height in pixels.
         height: u32,
+        /// Pixels the buffer holds.
         got: usize,
+        /// Pixels the size needs (width × height).
         want: usize,
     },
 }
@@ -88,7 +112,9 @@ pub fn commit(staged: Staged) -> Result<(), ImageError> {
 /// not the file, says how the samples are meant.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PngTag {
+    /// A colour image: sRGB-encoded samples, with an `sRGB` chunk.
     Srgb,
+    /// A data map: no colour-space chunk.
     Untagged,
 }
 
@@ -198,7 +224,9 @@ pub fn stage_png_linear(
 pub struct ExrLayer<'a> {
     /// Layer name; empty for the beauty layer (plain `R`, `G`, `B` channels).
     pub name: &'a str,
+    /// Channel suffixes, e.g. `["R", "G", "B"]`.
     pub channels: &'a [&'a str],
+    /// Row-major values, `channels.len()` per pixel, top row first.
     pub data: Vec<f32>,
 }
 

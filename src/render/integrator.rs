@@ -57,6 +57,7 @@ impl std::fmt::Display for Integrator {
 /// the local frame and the material's BSDF. `Copy`, so sweeps can cache one per pixel sample.
 #[derive(Clone, Copy, Debug)]
 pub struct ShadingPoint {
+    /// Hit point (world, mm).
     pub p: Vec3,
     /// Geometric normal (world), on the side of `wo` unless the BSDF transmits.
     pub ng: Vec3,
@@ -64,6 +65,7 @@ pub struct ShadingPoint {
     pub frame: Frame,
     /// Direction towards the viewer, in the local frame.
     pub wo: Vec3,
+    /// The material's BSDF at the hit, in the local shading frame.
     pub bsdf: SurfaceBsdf,
     /// Ray-origin offset length for rays leaving this point (mm).
     pub eps: f32,
@@ -72,10 +74,13 @@ pub struct ShadingPoint {
 /// The light-independent part of one pixel sample.
 #[derive(Clone, Copy, Debug)]
 pub struct PrimarySample {
+    /// The camera ray (world, unit direction).
     pub ray: Ray,
     /// Distance to the first surface (infinite on a miss).
     pub t_hit: f32,
+    /// The first hit, ready to be lit; `None` on a miss.
     pub point: Option<ShadingPoint>,
+    /// The first-hit AOVs of this sample (coverage 0 on a miss).
     pub aov: Aov,
 }
 
@@ -208,7 +213,9 @@ pub fn nearest_light(lights: &[Light], ray: &Ray, t_max: f32) -> Option<LightHit
     best
 }
 
-pub fn offset_origin(sp: &ShadingPoint, dir: Vec3) -> Vec3 {
+/// Origin of a ray leaving `sp` along `dir`: the hit point moved `eps` along the geometric
+/// normal, to the side `dir` points to, so the ray does not hit the surface it starts on.
+pub(crate) fn offset_origin(sp: &ShadingPoint, dir: Vec3) -> Vec3 {
     let side = if sp.ng.dot(dir) >= 0.0 { 1.0 } else { -1.0 };
     sp.p + sp.ng * (side * sp.eps)
 }
@@ -218,11 +225,14 @@ pub fn offset_origin(sp: &ShadingPoint, dir: Vec3) -> Vec3 {
 /// Values identical to `eval` and `pdf`.
 #[derive(Clone, Copy, Debug)]
 pub enum BsdfAtWo<'a> {
+    /// The wood BSDF with its `wo`-only terms worked out.
     Wood(WoodAtWo<'a>),
+    /// Any other BSDF, with `wo` (local frame).
     Other(&'a SurfaceBsdf, Vec3),
 }
 
 impl<'a> BsdfAtWo<'a> {
+    /// The BSDF of `sp` with its `wo` fixed.
     pub fn new(sp: &'a ShadingPoint) -> Self {
         match &sp.bsdf {
             SurfaceBsdf::Wood(b) => BsdfAtWo::Wood(b.at_wo(sp.wo)),

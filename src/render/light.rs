@@ -90,15 +90,21 @@ pub struct SphereLight {
 /// A constant environment or a lat-long map (z up; u = φ/2π with φ = atan2(y, x), v = θ/π).
 #[derive(Clone, Debug)]
 pub struct Environment {
+    /// Radiance (W/(sr·mm²), linear RGB) of the constant environment, or the factor the map's
+    /// texels are scaled by.
     pub scale: Vec3,
+    /// The lat-long map; `None` for a constant environment.
     pub map: Option<Arc<EnvMap>>,
 }
 
 /// A lat-long radiance map with its sampling distribution.
 #[derive(Debug)]
 pub struct EnvMap {
+    /// Texels per row (φ from 0 to 2π).
     pub width: usize,
+    /// Rows (θ from 0 at +z to π).
     pub height: usize,
+    /// Radiance texels (linear RGB), row-major, top row = +z.
     pub texels: Vec<Vec3>,
     dist: Distribution2D,
     /// (cos, sin) of the map's rotation about z: a texel at azimuth φ is seen at φ + angle. Applied
@@ -118,6 +124,8 @@ pub struct LightSample {
     pub li: Vec3,
     /// Solid-angle density; 1 for delta lights.
     pub pdf: f32,
+    /// True for a delta light (point, spot, distant): a BSDF-sampled ray can never hit it, so
+    /// the sample takes no MIS weight.
     pub is_delta: bool,
 }
 
@@ -292,11 +300,13 @@ impl Light {
 /// (sin, cos) of the azimuth φ = 2π u.y of a sphere light's cone sample.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightU {
+    /// The two uniform numbers in [0, 1)².
     pub u: Vec2,
     azimuth: (f32, f32),
 }
 
 impl LightU {
+    /// The light-sample numbers `u` with the azimuth they give worked out.
     pub fn new(u: Vec2) -> Self {
         LightU {
             u,
@@ -394,19 +404,23 @@ impl ConeSample {
 pub struct LightSamples {
     /// Unit directions towards the light (world), by component.
     pub wi: [Vec<f32>; 3],
+    /// Distance to each light sample (infinite for distant and environment lights).
     pub dist: Vec<f32>,
     /// Solid-angle density (1 for delta lights); 0 where there is no sample.
     pub pdf: Vec<f32>,
+    /// Incident radiance of each sample (irradiance at normal incidence for delta lights).
     pub li: Vec<Vec3>,
     /// Whether the light is a delta light (the same in every place).
     pub is_delta: bool,
 }
 
 impl LightSamples {
+    /// Number of samples.
     pub fn len(&self) -> usize {
         self.pdf.len()
     }
 
+    /// True when there are no samples.
     pub fn is_empty(&self) -> bool {
         self.pdf.is_empty()
     }
@@ -601,6 +615,8 @@ impl EnvMap {
         )
     }
 
+    /// The texel (nearest, no filtering) seen looking along the world direction `d`, the map's
+    /// rotation applied.
     pub fn lookup(&self, d: Vec3) -> Vec3 {
         let uv = Self::uv(self.turn(d, true));
         let x = ((uv.x * self.width as f32) as usize).min(self.width - 1);

@@ -36,18 +36,27 @@ use std::time::{Duration, Instant};
 
 /// Everything a render needs to know about the world.
 pub struct Scene {
+    /// The geometry: placed meshes in their BVHs.
     pub accel: Accel,
+    /// Materials, indexed by [`Instance::material`].
     pub materials: Vec<Material>,
+    /// The lights [`render`] renders with ([`render_frames`] takes each frame's lights from a
+    /// [`LightFrames`] instead).
     pub lights: Vec<Light>,
+    /// The camera: pose, projection and image size.
     pub camera: Camera,
+    /// Pixel reconstruction filter.
     pub filter: Filter,
 }
 
 /// Sampling settings of one render.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderSettings {
+    /// Samples per pixel (1–1000000).
     pub spp: u32,
+    /// Direct lighting only, or path tracing.
     pub integrator: Integrator,
+    /// Random seed: the same seed gives the same image on any thread count.
     pub seed: u64,
 }
 
@@ -109,18 +118,33 @@ pub struct RunOptions {
 /// A finished render with its statistics.
 #[derive(Clone, Debug)]
 pub struct RenderOutput {
+    /// The image with its AOV layers.
     pub image: Image,
+    /// Wall time of the render.
     pub elapsed: Duration,
     /// Rays traced (camera, shadow and bounce rays).
     pub rays: u64,
 }
 
+/// Why a render could not start.
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
+    /// The rayon thread pool could not be built.
     #[error("cannot start {threads} render threads: {message}")]
-    Threads { threads: usize, message: String },
+    Threads {
+        /// The thread count asked for.
+        threads: usize,
+        /// rayon's message.
+        message: String,
+    },
+    /// An image with no pixels.
     #[error("image size {width}x{height} is empty")]
-    EmptyImage { width: u32, height: u32 },
+    EmptyImage {
+        /// Image width in pixels.
+        width: u32,
+        /// Image height in pixels.
+        height: u32,
+    },
 }
 
 /// Side length of the square tiles handed to worker threads.

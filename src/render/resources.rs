@@ -18,17 +18,34 @@ pub const MAX_MESH_BYTES: u64 = 4 << 30;
 /// A limit a run would exceed, with the flag that overrides it where one does.
 #[derive(Debug, thiserror::Error)]
 pub enum ResourceError {
+    /// An estimate above what the machine has.
     #[error("{what} needs about {need} of {kind} but {have} is available; lower the resolution or the frame count, or pass --ignore-limits to try anyway")]
     TooLarge {
+        /// What needs it (a render, a sweep, a scene).
         what: String,
+        /// `"memory"` or `"disk space"`.
         kind: &'static str,
+        /// The estimate.
         need: Bytes,
+        /// What is available.
         have: Bytes,
     },
+    /// A `--threads` value above the allowed maximum.
     #[error("--threads {threads}: out of range (allowed 0 = all cores, up to {max} = {MAX_THREADS_PER_CORE} per core)")]
-    Threads { threads: usize, max: usize },
+    Threads {
+        /// The value asked for.
+        threads: usize,
+        /// The largest allowed.
+        max: usize,
+    },
+    /// An input file that is not a regular file or is too large to read.
     #[error("{path}: {message}")]
-    Input { path: String, message: String },
+    Input {
+        /// The file.
+        path: String,
+        /// What is wrong with it.
+        message: String,
+    },
 }
 
 /// A byte count printed in binary units.
@@ -49,8 +66,11 @@ impl std::fmt::Display for Bytes {
 /// Memory and disk a run needs (estimates from the sizes of the buffers it allocates).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Resources {
+    /// What the run is (a render, a sweep), for messages.
     pub what: String,
+    /// Peak memory estimate (bytes).
     pub memory: u64,
+    /// Disk estimate of the files written (bytes).
     pub disk: u64,
 }
 

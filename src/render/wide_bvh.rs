@@ -97,8 +97,11 @@ impl Packet {
 /// (p = (1 − u − v)·v0 + u·v1 + v·v2).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WideHit {
+    /// Ray parameter of the hit.
     pub t: f32,
+    /// Triangle id, as given to the builder.
     pub triangle: u32,
+    /// Barycentrics (u, v) of the hit.
     pub uv: Vec2,
 }
 

@@ -27,20 +27,33 @@ use std::time::Duration;
 /// Anything that stops a sweep job.
 #[derive(Debug, thiserror::Error)]
 pub enum SweepError {
+    /// The scene's `[sweep]` table does not describe a path.
     #[error(transparent)]
     Setup(#[from] SetupError),
+    /// A bad `--frames`, `--arc` or `--frames-range` value.
     #[error(transparent)]
     Path(#[from] PathError),
+    /// The renderer could not start.
     #[error(transparent)]
     Render(#[from] RenderError),
+    /// A frame record or an assembled output could not be written or read.
     #[error(transparent)]
     Sequence(#[from] SequenceError),
+    /// A frame's EXR or PNG could not be written.
     #[error(transparent)]
     Image(#[from] ImageError),
+    /// The output folder could not be created.
     #[error("cannot create output folder {path}: {cause}")]
-    OutDir { path: String, cause: std::io::Error },
+    OutDir {
+        /// The folder.
+        path: String,
+        /// Why.
+        cause: std::io::Error,
+    },
+    /// Another job holds the output folder.
     #[error(transparent)]
     Lock(#[from] LockError),
+    /// The sweep would need more memory or disk than the machine has.
     #[error(transparent)]
     Resources(#[from] ResourceError),
 }
@@ -54,9 +67,11 @@ pub struct SweepJob {
     pub arc: Option<(f32, f32)>,
     /// `--frames-range` text; `None` renders every frame.
     pub range: Option<String>,
+    /// Output folder of the frames, records and assembled sequence.
     pub out: PathBuf,
     /// Render every frame from scratch instead of caching (for timing and checking the cache).
     pub naive: bool,
+    /// Threads and progress bar (never change a pixel).
     pub run: RunOptions,
     /// Compression of each frame's EXR (the shared AOV file is always ZIP).
     pub exr: ExrCompression,
@@ -70,8 +85,11 @@ pub struct SweepJob {
 /// What a job did.
 #[derive(Debug)]
 pub struct JobReport {
+    /// The frames this job rendered (indices into the whole sweep).
     pub rendered: Range<usize>,
+    /// Frames of the whole sweep.
     pub total: usize,
+    /// Wall time of the rendering (without writing the files).
     pub render_time: Duration,
     /// Set when every frame was present and the sequence outputs were written.
     pub assembled: Option<Assembled>,

@@ -24,11 +24,17 @@ pub const FORMAT: &str = "xylem-sweep-manifest/1";
 pub struct CameraManifest {
     /// `"perspective"` (pinhole) or `"orthographic"`.
     pub projection: String,
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
+    /// Camera position (world, mm).
     pub eye: [f32; 3],
+    /// Image-right direction (world, unit).
     pub right: [f32; 3],
+    /// Image-up direction (world, unit).
     pub up: [f32; 3],
+    /// View direction (world, unit).
     pub forward: [f32; 3],
     /// Vertical field of view (perspective), degrees.
     #[serde(default)]
@@ -43,10 +49,15 @@ pub struct CameraManifest {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BoardManifest {
+    /// Centre of the face (world, mm).
     pub origin: [f32; 3],
+    /// Unit direction of the maps' image columns (world).
     pub x_axis: [f32; 3],
+    /// Unit direction towards the maps' top row (world), perpendicular to `x_axis`.
     pub y_axis: [f32; 3],
+    /// [width, height] of the face along `x_axis` and `y_axis` (mm).
     pub size_mm: [f32; 2],
+    /// Refractive index of the smooth finish (1–4).
     pub eta: f32,
 }
 
@@ -54,12 +65,15 @@ pub struct BoardManifest {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FrameManifest {
+    /// The frame's image, relative to the folder (`.exr` or `.png`).
     pub image: String,
     /// `"point"` (position, intensity in W/sr-like units: radiance of a pixel seeing a white
     /// Lambertian at distance d is I cos θ/(π d²)) or `"distant"` (direction, irradiance).
     pub light: String,
+    /// Light position (world, mm), for a `"point"` light.
     #[serde(default)]
     pub position: Option<[f32; 3]>,
+    /// Unit direction towards the light (world), for a `"distant"` light.
     #[serde(default)]
     pub direction: Option<[f32; 3]>,
     /// Radius of a sphere light (mm; 0 for a point), used to reject the finish's mirror glint.
@@ -67,8 +81,11 @@ pub struct FrameManifest {
     pub radius: f32,
     /// Intensity (point) or irradiance (distant), linear RGB.
     pub intensity: [f32; 3],
+    /// Index of the arc the frame lies on (0-based).
     pub arc: usize,
+    /// Azimuth of that arc about the zenith (degrees).
     pub azimuth_deg: f32,
+    /// Light angle from the zenith along the arc (degrees).
     pub light_deg: f32,
 }
 
@@ -76,7 +93,9 @@ pub struct FrameManifest {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Manifest {
+    /// The format tag, [`FORMAT`].
     pub format: String,
+    /// The camera, the same for every frame.
     pub camera: CameraManifest,
     /// `None` when the scene's `[sweep]` has no `[sweep.board]` (a fit then refuses the folder).
     pub board: Option<BoardManifest>,
@@ -88,6 +107,7 @@ pub struct Manifest {
     /// Pixel value at or above which a photograph is clipped (`None`: never clipped).
     #[serde(default)]
     pub clip: Option<f32>,
+    /// The frames, in sweep order.
     pub frames: Vec<FrameManifest>,
 }
 

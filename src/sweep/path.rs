@@ -13,20 +13,37 @@ use std::ops::Range;
 /// Errors in a light path or frame selection; each message names the value and the allowed range.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum PathError {
+    /// An `--arc` value that is not `FROM..TO`.
     #[error("arc `{0}`: expected FROM..TO in degrees, e.g. `-60..60`")]
     ArcSyntax(String),
+    /// An arc end outside [−90°, 90°] (below the horizon) or not finite.
     #[error("arc {from}..{to} deg: both ends must lie in [-90, 90] (above the horizon)")]
-    ArcRange { from: f32, to: f32 },
+    ArcRange {
+        /// First end (degrees).
+        from: f32,
+        /// Last end (degrees).
+        to: f32,
+    },
+    /// A `--frames-range` value that is not `A..B` or `A..=B`.
     #[error("frames-range `{0}`: expected A..B (frames A to B-1) or A..=B, with whole numbers")]
     RangeSyntax(String),
+    /// A `--frames-range` that selects no frame.
     #[error("frames-range `{text}`: selects no frame (needs A < B, or A <= B with ..=)")]
-    RangeEmpty { text: String },
+    RangeEmpty {
+        /// The range as given.
+        text: String,
+    },
+    /// A `--frames-range` that ends past the last frame.
     #[error("frames-range `{text}`: frame {end} is past the last frame of a {frames}-frame sweep (allowed 0..{frames})")]
     RangePastEnd {
+        /// The range as given.
         text: String,
+        /// The first frame past the range.
         end: usize,
+        /// Frames of the sweep.
         frames: usize,
     },
+    /// A frame count outside 1 to [`MAX_FRAMES`].
     #[error("frames = {0}: out of range (allowed 1 to {MAX_FRAMES})")]
     Frames(usize),
 }
@@ -38,8 +55,11 @@ pub const MAX_FRAMES: usize = 100_000;
 /// (inclusive), measured from the zenith towards the arc direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightArc {
+    /// Light angle of the first frame (degrees from the zenith, −90–90).
     pub from_deg: f32,
+    /// Light angle of the last frame (degrees from the zenith, −90–90).
     pub to_deg: f32,
+    /// Frames along the arc (1 to [`MAX_FRAMES`]).
     pub frames: usize,
 }
 
@@ -91,7 +111,9 @@ impl LightArc {
 /// direction at +90°. Both are unit vectors and orthogonal (the constructor makes them so).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ArcPlane {
+    /// Unit direction towards the light at angle 0.
     pub zenith: Vec3,
+    /// Unit direction towards the light at +90°, perpendicular to `zenith`.
     pub toward: Vec3,
 }
 
@@ -261,11 +283,17 @@ mod tests {
 /// about the zenith from `plane`): frame k is angle `k % arc.frames` of arc `k / arc.frames`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SweepPath {
+    /// The light angles of one arc.
     pub arc: LightArc,
+    /// The plane of the arc at azimuth 0.
     pub plane: ArcPlane,
+    /// Centre of the arc (world, mm).
     pub pivot: Vec3,
+    /// Distance of a positioned light from the pivot (mm, > 0).
     pub radius: f32,
+    /// Azimuth of each arc about the zenith (degrees); the first `arcs` are used.
     pub azimuths: [f32; MAX_ARCS],
+    /// Arcs the light runs (1 to [`MAX_ARCS`]).
     pub arcs: usize,
 }
 
@@ -275,25 +303,49 @@ pub enum SetupError {
     #[error(
         "scene `{scene}` has no [sweep] table (it needs at least `light`, `arc_deg` and `radius`)"
     )]
-    NoTable { scene: String },
+    /// The scene has no `[sweep]` table.
+    NoTable {
+        /// The scene's name.
+        scene: String,
+    },
     #[error(
         "scene `{scene}`: [sweep] light = \"{light}\" names no light; lights with names: {names}"
     )]
+    /// The `[sweep] light` names no light of the scene.
     NoLight {
+        /// The scene's name.
         scene: String,
+        /// The name given.
         light: String,
+        /// The names the scene's lights have, for the message.
         names: String,
     },
+    /// The named light is an area or environment light, which a sweep cannot move.
     #[error("scene `{scene}`: [sweep] light = \"{light}\" is an area or environment light; a sweep moves a point, spot, sphere or distant light")]
-    Immovable { scene: String, light: String },
+    Immovable {
+        /// The scene's name.
+        scene: String,
+        /// The light's name.
+        light: String,
+    },
+    /// A `[sweep]` field out of range.
     #[error("scene `{scene}`: [sweep] {field}: {message}")]
     Field {
+        /// The scene's name.
         scene: String,
+        /// The field.
         field: &'static str,
+        /// What is wrong and what is allowed.
         message: String,
     },
+    /// The arc or frame count of the table (or its overrides) is invalid.
     #[error("scene `{scene}`: {source}")]
-    Path { scene: String, source: PathError },
+    Path {
+        /// The scene's name.
+        scene: String,
+        /// What is wrong with the arc or frame count.
+        source: PathError,
+    },
 }
 
 impl SweepPath {

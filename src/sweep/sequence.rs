@@ -27,46 +27,82 @@ pub const VIEWER: &str = "index.html";
 /// Errors while writing or assembling a sequence; each names the file concerned.
 #[derive(Debug, thiserror::Error)]
 pub enum SequenceError {
+    /// A file or folder could not be read, written or listed.
     #[error("{path}: {cause}")]
-    Io { path: String, cause: std::io::Error },
+    Io {
+        /// The file or folder.
+        path: String,
+        /// Why.
+        cause: std::io::Error,
+    },
+    /// A frame record could not be encoded or parsed.
     #[error("frame record {path}: {cause}")]
     Json {
+        /// The record file.
         path: String,
+        /// serde_json's message.
         cause: serde_json::Error,
     },
+    /// A frame's PNG could not be decoded.
     #[error("cannot read PNG {path}: {cause}")]
     Decode {
+        /// The PNG file.
         path: String,
+        /// The png crate's message.
         cause: png::DecodingError,
     },
+    /// The animated PNG could not be encoded.
     #[error("cannot encode animated PNG {path}: {cause}")]
     Encode {
+        /// The animation file.
         path: String,
+        /// The png crate's message.
         cause: png::EncodingError,
     },
+    /// A frame's PNG or the contact sheet could not be written.
     #[error(transparent)]
     Image(#[from] ImageError),
+    /// The folder holds no frame records.
     #[error("{dir}: no frame records (frame_NNNN.json) to assemble; render frames first")]
-    Empty { dir: String },
+    Empty {
+        /// The folder.
+        dir: String,
+    },
+    /// Frames of the sweep are missing from the folder.
     #[error("{dir}: a {frames}-frame sweep lacks frames {missing}; render them (e.g. --frames-range {hint}) and assemble again")]
     Missing {
+        /// The folder.
         dir: String,
+        /// Frames of the whole sweep.
         frames: usize,
+        /// The missing frame indices, as ranges.
         missing: String,
+        /// A `--frames-range` that renders the first missing ones.
         hint: String,
     },
+    /// A frame that disagrees with the others or with its record (size, settings, colour type).
     #[error("{path}: {what}")]
-    Mismatch { path: String, what: String },
+    Mismatch {
+        /// The file.
+        path: String,
+        /// How it disagrees.
+        what: String,
+    },
 }
 
 /// A named rectangle of the image whose mean radiance the CSV follows: pixel columns `x0..x1`
 /// and rows `y0..y1` (half-open, top-left origin), as the scene's `[[sweep.regions]]` give them.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Region {
+    /// Name in the CSV header and the viewer.
     pub name: String,
+    /// First pixel column.
     pub x0: u32,
+    /// First pixel row (from the top).
     pub y0: u32,
+    /// Column past the last.
     pub x1: u32,
+    /// Row past the last.
     pub y1: u32,
 }
 
@@ -100,7 +136,9 @@ impl Region {
 /// Mean luminance of one named region in one frame.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RegionMean {
+    /// The region's name.
     pub name: String,
+    /// Mean luminance of the region (linear).
     pub luminance: f32,
 }
 
@@ -112,7 +150,9 @@ pub struct SweepSettings {
     pub scene: String,
     /// The arc's ends in degrees.
     pub arc_deg: [f32; 2],
+    /// Samples per pixel.
     pub spp: u32,
+    /// Random seed.
     pub seed: u64,
     /// What else the run was given: the scene file's CRC-32 and the `--quality` preset.
     pub provenance: String,
@@ -146,16 +186,24 @@ impl SweepSettings {
 /// What a frame leaves beside its images: enough to assemble the sequence without the scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FrameRecord {
+    /// Index of the frame in the whole sweep.
     pub index: usize,
+    /// Frames of the whole sweep.
     pub frames: usize,
     /// The settings of the sweep the frame belongs to (empty in records of older versions).
     #[serde(default)]
     pub sweep: SweepSettings,
+    /// Light angle from the zenith along the arc (degrees).
     pub light_deg: f32,
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
+    /// Mean radiance over the image (linear RGB).
     pub mean_rgb: [f32; 3],
+    /// Luminance of `mean_rgb`.
     pub mean_luminance: f32,
+    /// Mean luminance of each of the scene's regions, in their order.
     pub regions: Vec<RegionMean>,
 }
 
@@ -506,7 +554,9 @@ fn csv_name(name: &str) -> String {
 /// The files [`assemble`] wrote.
 #[derive(Clone, Debug)]
 pub struct Assembled {
+    /// Frames assembled.
     pub frames: usize,
+    /// The files written: contact sheet, animated PNG, CSV and viewer.
     pub files: Vec<PathBuf>,
 }
 

@@ -260,7 +260,7 @@ pub fn figure_contrast(img: &Image, set: &[bool]) -> f64 {
 const FINISH_GLINT_DEG: f32 = 8.0;
 
 /// The pixels of `set` where the finish does not mirror one of `lights` (point, spot or sphere):
-/// the half vector between the view and the light is more than [`FINISH_GLINT_DEG`] from the
+/// the half vector between the view and the light is more than `FINISH_GLINT_DEG` (8°) from the
 /// geometric normal. Geometric, so the two renders of [`curl_flip`] are judged on one set.
 pub fn without_glints(
     scene: &Scene,
