@@ -9,6 +9,7 @@ pub mod bake;
 pub mod bench;
 pub mod bsdf;
 pub mod builtin;
+#[cfg(feature = "cli")]
 pub mod cli;
 pub mod field;
 pub mod fit;
@@ -17,6 +18,7 @@ pub mod math;
 pub mod noise;
 pub mod output;
 pub mod picture;
+pub mod progress;
 pub mod render;
 pub mod scene;
 pub mod simd;
