@@ -10,6 +10,7 @@ pub mod bake;
 pub mod bench;
 pub mod bsdf;
 pub mod builtin;
+#[cfg(feature = "cli")]
 pub mod cli;
 pub mod field;
 pub mod fit;
@@ -18,6 +19,7 @@ pub mod math;
 pub mod noise;
 pub mod output;
 pub mod picture;
+pub mod progress;
 pub mod render;
 pub mod scene;
 pub mod simd;

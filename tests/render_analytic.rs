@@ -135,7 +135,7 @@ fn one_and_two_threads_are_bit_identical() {
             &loaded.settings,
             &RunOptions {
                 threads,
-                progress: false,
+                ..Default::default()
             },
         )
         .unwrap()

@@ -120,7 +120,7 @@ fn check_scene(text: &str, what: &str) -> bool {
         loaded.settings.spp = 1;
         let run = RunOptions {
             threads: 1,
-            progress: false,
+            ..Default::default()
         };
         let out = render(&loaded.scene, &loaded.settings, &run)?;
         Ok::<_, Box<dyn std::error::Error>>(out.image)

@@ -146,7 +146,7 @@ fn check_scene(loaded: &LoadedScene, integrator: Integrator, frames: std::ops::R
         SweepPath::from_scene(&loaded, None, None).expect("the scene's [sweep] table");
     let run = RunOptions {
         threads: 1,
-        progress: false,
+        ..Default::default()
     };
     let sweep = render_sweep(
         &loaded.scene,
@@ -202,7 +202,7 @@ fn cached_wood_under_a_sphere_light_between_fixed_lights_equals_naive_frames() {
     let (path, moving) = SweepPath::from_scene(&loaded, None, None).unwrap();
     let run = RunOptions {
         threads: 1,
-        progress: false,
+        ..Default::default()
     };
     let s = render_sweep(&loaded.scene, &loaded.settings, &path, moving, 0..9, &run).unwrap();
     let brightest = s

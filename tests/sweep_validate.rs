@@ -5,10 +5,10 @@
 use xylem::render::RunOptions;
 use xylem::validate::sweep::{highlight_tracking, renderer_vs_bsdf};
 
-fn run() -> RunOptions {
+fn run() -> RunOptions<'static> {
     RunOptions {
         threads: 1,
-        progress: false,
+        ..Default::default()
     }
 }
 

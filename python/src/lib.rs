@@ -773,7 +773,7 @@ fn render<'py>(
     let loaded = load_scene(scene, spp, res, seed)?;
     let run = xylem::render::RunOptions {
         threads,
-        progress: false,
+        ..Default::default()
     };
     let out = py
         .allow_threads(|| xylem::render::render(&loaded.scene, &loaded.settings, &run))
@@ -819,7 +819,7 @@ fn sweep<'py>(
         xylem::sweep::SweepPath::from_scene(&loaded, frames, arc).map_err(value_error)?;
     let run = xylem::render::RunOptions {
         threads,
-        progress: false,
+        ..Default::default()
     };
     let total = path.arc.frames;
     let r = py

@@ -45,10 +45,11 @@ fn parse_texels(s: &str) -> Result<(usize, usize), String> {
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let capture = Capture::open(&args.sweep)?;
+    let bar = super::progress::Bar::new(!args.quiet);
     let opts = FitOptions {
         texels: args.texels,
         threads: args.threads,
-        progress: !args.quiet,
+        progress: &bar,
     };
     let (maps, stats) = fit(&capture, &opts)?;
     let mut res: Vec<f32> = maps.residual.clone();

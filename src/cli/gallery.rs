@@ -98,6 +98,7 @@ fn scenes(out: &Path, only: &[String]) -> anyhow::Result<bool> {
         "| scene | size, spp | render time | subject check |\n| --- | --- | --- | --- |\n",
     );
     let mut ok = true;
+    let bar = super::progress::Bar::new(true);
     for name in names {
         let path = PathBuf::from(format!("scenes/{name}.toml"));
         let text = std::fs::read_to_string(&path).with_context(|| {
@@ -116,14 +117,14 @@ fn scenes(out: &Path, only: &[String]) -> anyhow::Result<bool> {
             &s.settings,
             &RunOptions {
                 threads: 0,
-                progress: true,
+                progress: &bar,
             },
         )?;
         let png = out.join(format!("{name}.png"));
         write_png_rgb8(&png, w, h, &to_srgb8(&r.image.beauty, s.exposure))?;
         let run = RunOptions {
             threads: 0,
-            progress: true,
+            progress: &bar,
         };
         let (measures, companion) = crate::validate::scenes::measure_rendered(
             name,
@@ -163,6 +164,7 @@ fn scenes(out: &Path, only: &[String]) -> anyhow::Result<bool> {
 fn sweeps(out: &Path, frames: usize) -> anyhow::Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let board = super::preset::board_table()?;
+    let bar = super::progress::Bar::new(true);
     for name in FIGURED {
         let loaded =
             super::preset::preset_board(&board, name, (160, 120), 16, CLOSE_EYE, CLOSE_FOV_DEG)?;
@@ -176,7 +178,7 @@ fn sweeps(out: &Path, frames: usize) -> anyhow::Result<()> {
             0..frames,
             &RunOptions {
                 threads: 0,
-                progress: true,
+                progress: &bar,
             },
         )?;
         let (w, h) = (loaded.scene.camera.width, loaded.scene.camera.height);

@@ -9,6 +9,7 @@ mod bench;
 mod fit;
 mod gallery;
 mod preset;
+mod progress;
 mod render;
 mod sweep;
 mod texture;

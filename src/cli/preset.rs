@@ -216,6 +216,7 @@ pub(super) fn gallery(
     use crate::picture::contact::{contact_sheet_rows, Rgb8};
     use crate::render::image_io::{to_srgb8, write_png_rgb8};
     use crate::sweep::{render_sweep, SweepPath};
+    let bar = super::progress::Bar::new(true);
     if angles.is_empty() || angles.iter().any(|a| !(-89.0..=89.0).contains(a)) {
         anyhow::bail!("--angles: each light angle must lie in [-89, 89] degrees");
     }
@@ -250,7 +251,7 @@ pub(super) fn gallery(
                 0..1,
                 &crate::render::RunOptions {
                     threads: 0,
-                    progress: true,
+                    progress: &bar,
                 },
             )?;
             let exposure = loaded.exposure;

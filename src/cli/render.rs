@@ -69,9 +69,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if let Some((w, h)) = args.res {
         loaded.scene.camera = loaded.scene.camera.with_resolution(w, h);
     }
+    let bar = super::progress::Bar::new(!args.quiet);
     let run = crate::render::RunOptions {
         threads: args.threads,
-        progress: !args.quiet,
+        progress: &bar,
     };
     let cam = &loaded.scene.camera;
     eprintln!(

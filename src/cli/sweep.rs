@@ -84,6 +84,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .map(parse_arc)
         .transpose()
         .context("--arc")?;
+    let bar = super::progress::Bar::new(!args.quiet);
     let job = SweepJob {
         frames: args.frames,
         arc,
@@ -95,7 +96,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         naive: args.naive,
         run: crate::render::RunOptions {
             threads: args.threads,
-            progress: !args.quiet,
+            progress: &bar,
         },
         exr: args.exr_compression,
         ignore_limits: args.ignore_limits,

@@ -75,7 +75,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     let run = crate::render::RunOptions {
         threads: args.threads,
-        progress: false,
+        ..Default::default()
     };
     let all = settings();
     let bar = indicatif::ProgressBar::new(all.len() as u64 + 1).with_style(

@@ -16,9 +16,10 @@ pub use capture::{Capture, CaptureError};
 pub use maps::{write_maps, FittedMaps};
 pub use model::{fit_texel, Scratch, TexelData, TexelFit};
 
+use crate::progress::{NoProgress, Progress};
 use glam::Vec3;
-use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 /// Anything that stops a fit.
@@ -71,15 +72,25 @@ pub enum FitError {
 }
 
 /// How to fit.
-#[derive(Clone, Debug, Default)]
-pub struct FitOptions {
+#[derive(Clone, Debug)]
+pub struct FitOptions<'a> {
     /// Map size in texels; default: the board's size in pixels along each axis (about one texel
     /// per pixel).
     pub texels: Option<(usize, usize)>,
     /// Worker threads; 0 = all cores.
     pub threads: usize,
-    /// Show a progress bar on stderr.
-    pub progress: bool,
+    /// Told of the texels fitted so far (the CLI draws a bar on stderr).
+    pub progress: &'a dyn Progress,
+}
+
+impl Default for FitOptions<'_> {
+    fn default() -> Self {
+        FitOptions {
+            texels: None,
+            threads: 0,
+            progress: &NoProgress,
+        }
+    }
 }
 
 /// Texels the board covers in the frames: its edges' lengths in pixels, rounded.
@@ -196,7 +207,8 @@ fn fit_in_pool(
     // The first bad frame in frame order is the one reported, whatever the threads did.
     let samples: Vec<Vec<Vec3>> = read.into_iter().collect::<Result<_, CaptureError>>()?;
     let read_time = start.elapsed();
-    let bar = progress_bar(opts.progress, n as u64);
+    opts.progress.start(n as u64, "texels");
+    let done = AtomicU64::new(0);
     let start = Instant::now();
     let eta = board.eta;
     let fits: Vec<Option<TexelFit>> = (0..n)
@@ -224,13 +236,15 @@ fn fit_in_pool(
                     d.w.push(if ok { 1.0 } else { 0.0 });
                 }
                 if i % 256 == 0 {
-                    bar.inc(256.min((n - i) as u64));
+                    let step = 256.min((n - i) as u64);
+                    let d = done.fetch_add(step, Ordering::Relaxed) + step;
+                    opts.progress.update(d, n as u64, "");
                 }
                 fit_texel(d, eta, scratch)
             },
         )
         .collect();
-    bar.finish_and_clear();
+    opts.progress.finish();
     let failed = fits.iter().filter(|f| f.is_none()).count();
     let maps = FittedMaps::from_fits(w, h, &fits);
     Ok((
@@ -242,18 +256,4 @@ fn fit_in_pool(
             texels_failed: failed,
         },
     ))
-}
-
-fn progress_bar(show: bool, n: u64) -> ProgressBar {
-    if !show {
-        return ProgressBar::hidden();
-    }
-    let b = ProgressBar::new(n);
-    b.set_style(
-        ProgressStyle::with_template(
-            "{spinner} [{elapsed_precise}] {wide_bar} {pos}/{len} texels, eta {eta}",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    b
 }

@@ -235,7 +235,8 @@ pub struct ExrLayer<'a> {
 /// Measured on a 512×384 sweep frame (RGB + standard error, 32-bit float, path-traced noise):
 /// ZIP 2.31 MB, RLE 2.89 MB, none 3.15 MB; writing 48 such frames costs ≈ 2.5 s of CPU with ZIP
 /// and ≈ 0.3 s with RLE (notes/sweep.md). Noisy float data leaves deflate little to find.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum ExrCompression {
     /// Deflate in blocks of 16 scan lines: the smallest files, the slowest to write.
     #[default]

@@ -27,8 +27,8 @@ pub use light::{
 };
 
 use crate::material::Material;
+use crate::progress::{NoProgress, Progress};
 use glam::{UVec2, Vec3};
-use indicatif::{ProgressBar, ProgressStyle};
 use integrator::{radiance_frames, FramesScratch, RayCount, ShadowTest};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -107,12 +107,24 @@ impl RenderSettings {
 }
 
 /// How to run a render (not part of the image: changing these never changes a pixel).
-#[derive(Clone, Copy, Debug, Default)]
-pub struct RunOptions {
+///
+/// `RunOptions { threads: 2, ..Default::default() }` renders on two threads and reports no
+/// progress.
+#[derive(Clone, Copy, Debug)]
+pub struct RunOptions<'a> {
     /// Worker threads; 0 = all cores.
     pub threads: usize,
-    /// Show an indicatif progress bar on stderr.
-    pub progress: bool,
+    /// Told of every finished tile with the Mrays/s so far (the CLI draws a bar on stderr).
+    pub progress: &'a dyn Progress,
+}
+
+impl Default for RunOptions<'_> {
+    fn default() -> Self {
+        RunOptions {
+            threads: 0,
+            progress: &NoProgress,
+        }
+    }
 }
 
 /// A finished render with its statistics.
@@ -261,7 +273,9 @@ pub fn render_frames(
         .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| UVec2::new(tx, ty) * TILE))
         .collect();
     let shadow = ShadowTest::culled(&scene.accel);
-    let bar = progress_bar(run.progress, tiles.len() as u64, lights.len());
+    let n_tiles = tiles.len() as u64;
+    run.progress.start(n_tiles, &progress_unit(lights.len()));
+    let tiles_done = AtomicU64::new(0);
     let total_rays = AtomicU64::new(0);
     let start = Instant::now();
     let results: Vec<(UVec2, TileFrames)> = pool.install(|| {
@@ -271,13 +285,14 @@ pub fn render_frames(
                 let tile = render_tile(scene, lights, &shadow, settings, origin);
                 let total = total_rays.fetch_add(tile.rays, Ordering::Relaxed) + tile.rays;
                 let secs = start.elapsed().as_secs_f64().max(1e-9);
-                bar.set_message(format!("{:.2} Mrays/s", total as f64 / secs / 1e6));
-                bar.inc(1);
+                let done = tiles_done.fetch_add(1, Ordering::Relaxed) + 1;
+                let rate = format!("{:.2} Mrays/s", total as f64 / secs / 1e6);
+                run.progress.update(done, n_tiles, &rate);
                 (origin, tile)
             })
             .collect()
     });
-    bar.finish_and_clear();
+    run.progress.finish();
     let n = (w * h) as usize;
     let mut frames: Vec<FrameImage> = (0..lights.len())
         .map(|_| FrameImage {
@@ -314,23 +329,13 @@ pub fn render_frames(
     })
 }
 
-fn progress_bar(show: bool, tiles: u64, frames: usize) -> ProgressBar {
-    if !show {
-        return ProgressBar::hidden();
-    }
-    let per = if frames > 1 {
-        format!(" × {frames} frames")
+/// What a render's progress counts: `tiles`, or `tiles × 48 frames` for a sweep.
+fn progress_unit(frames: usize) -> String {
+    if frames > 1 {
+        format!("tiles × {frames} frames")
     } else {
-        String::new()
-    };
-    let b = ProgressBar::new(tiles);
-    b.set_style(
-        ProgressStyle::with_template(&format!(
-            "{{spinner}} [{{elapsed_precise}}] {{wide_bar}} {{pos}}/{{len}} tiles{per}, eta {{eta}} {{msg}}"
-        ))
-        .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    b
+        "tiles".to_string()
+    }
 }
 
 /// One tile's frames (per frame the averaged pixels, an [`Image`] the size of the tile without

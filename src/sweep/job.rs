@@ -60,7 +60,7 @@ pub enum SweepError {
 
 /// What to render and where.
 #[derive(Clone, Debug, Default)]
-pub struct SweepJob {
+pub struct SweepJob<'a> {
     /// Frames along the arc (default: the scene's `[sweep] frames`).
     pub frames: Option<usize>,
     /// Arc ends in degrees (default: the scene's `[sweep] arc_deg`).
@@ -71,8 +71,8 @@ pub struct SweepJob {
     pub out: PathBuf,
     /// Render every frame from scratch instead of caching (for timing and checking the cache).
     pub naive: bool,
-    /// Threads and progress bar (never change a pixel).
-    pub run: RunOptions,
+    /// Threads and progress reporting (never change a pixel).
+    pub run: RunOptions<'a>,
     /// Compression of each frame's EXR (the shared AOV file is always ZIP).
     pub exr: ExrCompression,
     /// Skip the memory and disk estimate (`--ignore-limits`).

@@ -1268,9 +1268,28 @@ pub fn to_markdown(v: &BsdfValidation, plots: &[(String, String)]) -> String {
     md
 }
 
+/// Why a polar plot could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum PolarPlotError {
+    /// The case's parameters are out of range for [`WoodBsdf`].
+    #[error(transparent)]
+    Params(#[from] BsdfError),
+    /// The plot's folder could not be made.
+    #[error("cannot create folder {path}: {source}")]
+    Dir {
+        /// The folder.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// The PNG could not be written.
+    #[error(transparent)]
+    Png(#[from] crate::render::image_io::ImageError),
+}
+
 /// Writes the polar plot of `spec` (f·cos θi in the incidence plane at θo = 0°, 30°, 60°, 80°,
 /// each curve normalised to its own maximum, so lobe shapes compare across angles) as a PNG.
-pub fn write_polar_plot(spec: &CaseSpec, path: &Path) -> anyhow::Result<()> {
+pub fn write_polar_plot(spec: &CaseSpec, path: &Path) -> Result<(), PolarPlotError> {
     use crate::picture::plot::{line_plot, PlotOptions, Series, PALETTE};
     let b = spec.bsdf()?;
     let curves: Vec<Vec<(f64, f64)>> = [0.0f32, 30.0, 60.0, 80.0]
@@ -1308,7 +1327,10 @@ pub fn write_polar_plot(spec: &CaseSpec, path: &Path) -> anyhow::Result<()> {
         },
     );
     if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir)?;
+        std::fs::create_dir_all(dir).map_err(|source| PolarPlotError::Dir {
+            path: dir.to_path_buf(),
+            source,
+        })?;
     }
     crate::render::image_io::write_png_rgb8(path, img.width, img.height, &img.data)?;
     Ok(())

@@ -77,7 +77,8 @@ impl Knobs {
 /// ≤ 16 spp), and 4 / 16 / 64 spp for SSIM ≥ 0.9 / 0.97 / 0.99 on the mahogany board. Noise bands
 /// and impulse density are not reduced: they change the figure itself (≤ 1 band drops curly
 /// maple to SSIM 0.86).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Quality {
     /// 4 spp: SSIM ≥ 0.9 on the mahogany board.
     Draft,
@@ -87,12 +88,14 @@ pub enum Quality {
     Final,
 }
 
-/// The `--quality` name (`draft`), as clap spells it.
+/// The `--quality` name (`draft`): the variant in lower case, as clap's derive spells it.
 impl std::fmt::Display for Quality {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        use clap::ValueEnum;
-        let v = self.to_possible_value().expect("no Quality is skipped");
-        f.write_str(v.get_name())
+        f.write_str(match self {
+            Quality::Draft => "draft",
+            Quality::Default => "default",
+            Quality::Final => "final",
+        })
     }
 }
 
@@ -419,6 +422,18 @@ pub fn render_with(
 mod tests {
     use super::*;
     use glam::Vec3;
+
+    /// The written-out names are the ones `--quality` accepts (clap derives its own).
+    #[cfg(feature = "cli")]
+    #[test]
+    fn quality_names_are_clap_names() {
+        use clap::ValueEnum;
+        for q in Quality::value_variants() {
+            let clap_name = q.to_possible_value().map(|v| v.get_name().to_string());
+            assert_eq!(clap_name.as_deref(), Some(q.to_string().as_str()));
+        }
+        assert_eq!(Quality::value_variants().len(), 3);
+    }
 
     #[test]
     fn identical_images_have_no_error_and_unit_ssim() {

@@ -62,7 +62,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let (w, h) = (loaded.scene.camera.width, loaded.scene.camera.height);
     let opts = RunOptions {
         threads: args.threads,
-        progress: false,
+        ..Default::default()
     };
     render(&loaded.scene, &loaded.settings, &opts)?; // warm-up, untimed
     let out = render(&loaded.scene, &loaded.settings, &opts)?;

@@ -25,10 +25,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .report
         .unwrap_or_else(|| PathBuf::from("validation/REPORT.md"));
     let dir = report.parent().map(|p| p.to_path_buf()).unwrap_or_default();
-    let run = crate::render::RunOptions {
-        threads: 0,
-        progress: false,
-    };
+    let run = crate::render::RunOptions::default();
     let bar = indicatif::ProgressBar::new(6).with_style(
         indicatif::ProgressStyle::with_template("validate sweep {bar:40} {pos}/{len} {msg}")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
