@@ -149,7 +149,7 @@ def test_render_releases_the_gil(root):
     t = threading.Thread(target=tick)
     t.start()
     start = time.perf_counter()
-    out = xylem.render(str(root / "scenes" / "sweep_board.toml"), spp=4, res=(96, 72), threads=1)
+    out = xylem.render(str(root / "scenes" / "sweep_board.toml"), spp=16, res=(96, 72), threads=1)
     end = time.perf_counter()
     done.set()
     t.join()
