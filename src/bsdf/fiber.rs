@@ -290,6 +290,7 @@ impl FiberAxis {
     /// the arithmetic stages are loops LLVM vectorises, the libm calls (asin, exp, cos, acos)
     /// loops of independent calls, instead of one dependent chain per direction.
     #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
     pub fn eval_pdf_many_at(
         &self,
         at: &FiberAtWo,

@@ -586,6 +586,7 @@ impl WoodAtWo<'_> {
     /// `wi`): the same stages, each run over `BATCH` directions at a time ([`FiberAxis::
     /// eval_pdf_many_at`] for the fibre lobes), so that the same values come out (tested) with
     /// the arithmetic in SIMD lanes.
+    #[inline(always)]
     pub fn eval_pdf_many(&self, wi: &[Vec3], with_pdf: bool, f: &mut [Vec3], pdf: &mut [f32]) {
         assert!(f.len() == wi.len() && pdf.len() == wi.len());
         if self.rough.is_some() {

@@ -145,6 +145,7 @@ impl PixelSum {
 
     /// Adds one sample's radiance only (a light sweep keeps the AOVs, the same in every frame,
     /// in one sum of its own).
+    #[inline(always)]
     pub fn add_radiance(&mut self, radiance: Vec3) {
         self.count += 1;
         if radiance.is_finite() {

@@ -9,7 +9,7 @@
 //! component for sampling all frames in SIMD lanes.
 
 use super::integrator::{nearest_light, segment_misses_box, LightHit};
-use super::light::{Light, SphereLight};
+use super::light::{sphere_line_misses, Light, SphereLight};
 use super::Ray;
 use glam::{Vec3, Vec3A};
 
@@ -129,6 +129,7 @@ impl LightFrames {
     /// Calls `f(k, nearest_light(frame k's lights, ray, t_max))` for every frame k. When the ray
     /// surely misses the moving light's box (or nothing moves), the answer is that of the fixed
     /// lights alone, found once.
+    #[inline(always)]
     pub(crate) fn nearest_per_frame(
         &self,
         ray: &Ray,
@@ -144,6 +145,32 @@ impl LightFrames {
             let hit = nearest_light(&self.fixed, ray, t_max);
             for k in 0..self.frames.len() {
                 f(k, hit);
+            }
+        } else if let Some(s) = &self.sphere {
+            // A frame whose sphere the ray's line misses (`sphere_line_misses`, the test that
+            // `intersect_sphere` starts with) has the fixed lights' answer; only the others are
+            // asked in full. The misses are found a block of frames at a time in SIMD lanes.
+            const BLOCK: usize = 16;
+            let fixed = nearest_light(&self.fixed, ray, t_max);
+            let [cx, cy, cz] = &s.centers;
+            for start in (0..self.frames.len()).step_by(BLOCK) {
+                let n = BLOCK.min(self.frames.len() - start);
+                let mut miss = [false; BLOCK];
+                for j in 0..n {
+                    let c = Vec3::new(cx[start + j], cy[start + j], cz[start + j]);
+                    miss[j] = sphere_line_misses(ray, c, s.radius);
+                }
+                for j in 0..n {
+                    let k = start + j;
+                    f(
+                        k,
+                        if miss[j] {
+                            fixed
+                        } else {
+                            nearest_light(&self.frames[k], ray, t_max)
+                        },
+                    );
+                }
             }
         } else {
             for (k, lights) in self.frames.iter().enumerate() {

@@ -253,6 +253,7 @@ impl<'a> BsdfAtWo<'a> {
 
     /// [`BsdfAtWo::eval_pdf`] of every `wi[k]` into `f[k]`, `pdf[k]` (the wood BSDF a batch at
     /// a time, [`WoodAtWo::eval_pdf_many`]; others one by one).
+    #[inline(always)]
     pub fn eval_pdf_many(&self, wi: &[Vec3], with_pdf: bool, f: &mut [Vec3], pdf: &mut [f32]) {
         match self {
             BsdfAtWo::Wood(w) => w.eval_pdf_many(wi, with_pdf, f, pdf),
@@ -365,6 +366,7 @@ impl<'a> ShadowTest<'a> {
     /// it), whether the boxes alone show it unoccluded (`culled[k]`; all false without boxes).
     /// The segments are set up in one loop and tested in one loop per box, so the slab tests
     /// run in SIMD lanes.
+    #[inline(always)]
     pub fn culled_many(
         &self,
         sp: &ShadingPoint,
@@ -528,6 +530,7 @@ pub struct TermScratch {
 /// stage is a loop without dependencies from one sample to the next. The same functions as
 /// [`light_term`] on the same values, so the same bits (tested by the sweep's equality test).
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 pub fn light_terms(
     shadow: &ShadowTest,
     sp: &ShadingPoint,
@@ -617,6 +620,7 @@ pub(crate) struct FramesScratch {
 /// frames in SIMD lanes ([`light_terms`]). Each frame sums its terms in the lights' order, so
 /// it equals the render of that frame alone bit for bit.
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 pub(crate) fn radiance_frames(
     scene: &Scene,
     lights: &LightFrames,
@@ -711,6 +715,7 @@ pub(crate) fn radiance_frames(
 /// Next-event estimation at `sp` in every live frame into `scratch.nee`: one sample of every
 /// light (two numbers per light from `rng`, whatever its place), each weighted against BSDF
 /// sampling by the power heuristic (delta lights take weight 1), summed in the lights' order.
+#[inline(always)]
 fn next_event_frames(
     lights: &LightFrames,
     shadow: &ShadowTest,

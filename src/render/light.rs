@@ -434,6 +434,7 @@ impl LightSamples {
 
     /// Samples the sphere of radius `radius` and radiance `radiance` centred at `centers[k]` (by
     /// component) from `p`, for every k, with numbers `u`.
+    #[inline(always)]
     pub fn sample_sphere(
         &mut self,
         p: Vec3,
@@ -527,18 +528,32 @@ fn smoothstep(a: f32, b: f32, x: f32) -> f32 {
     t * t * (3.0 - 2.0 * t)
 }
 
+/// The discriminant of the ray–sphere quadratic in the numerically stable form of Haines et
+/// al. (Ray Tracing Gems ch. 7): r² minus the squared distance of the centre to the ray's line
+/// (`oc` = origin − centre, `b` = oc·d).
+#[inline(always)]
+fn sphere_discriminant(oc: Vec3, b: f32, d: Vec3, radius: f32) -> f32 {
+    let perp = oc - d * b;
+    radius * radius - perp.length_squared()
+}
+
+/// True when the line of `ray` surely misses the sphere (negative discriminant): the first test
+/// of [`intersect_sphere`], branch-free so that a loop of it over many spheres vectorises.
+#[inline(always)]
+pub fn sphere_line_misses(ray: &Ray, center: Vec3, radius: f32) -> bool {
+    let oc = ray.o - center;
+    sphere_discriminant(oc, oc.dot(ray.d), ray.d, radius) < 0.0
+}
+
 /// Nearest positive distance at which `ray` (unit direction) meets a sphere.
 pub fn intersect_sphere(ray: &Ray, center: Vec3, radius: f32) -> Option<f32> {
+    if sphere_line_misses(ray, center, radius) {
+        return None;
+    }
     let oc = ray.o - center;
     let b = oc.dot(ray.d);
     let c = oc.length_squared() - radius * radius;
-    // Numerically stable form (Haines et al., Ray Tracing Gems ch. 7): discriminant from the
-    // distance of the centre to the ray line.
-    let perp = oc - ray.d * b;
-    let disc = radius * radius - perp.length_squared();
-    if disc < 0.0 {
-        return None;
-    }
+    let disc = sphere_discriminant(oc, b, ray.d, radius);
     let q = -b - b.signum() * disc.sqrt();
     let (t0, t1) = if q != 0.0 { (c / q, q) } else { (-b, -b) };
     let (t0, t1) = (t0.min(t1), t0.max(t1));

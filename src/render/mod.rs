@@ -28,6 +28,7 @@ pub use light::{
 
 use crate::material::Material;
 use crate::progress::{NoProgress, Progress};
+use crate::simd::{simd_level, Simd};
 use glam::{UVec2, Vec3};
 use integrator::{radiance_frames, FramesScratch, RayCount, ShadowTest};
 use rayon::prelude::*;
@@ -349,6 +350,53 @@ struct TileFrames {
 /// One tile for every frame: each (pixel, frame) sums its samples in sample order; the AOVs,
 /// the same in every frame, are summed once.
 fn render_tile(
+    scene: &Scene,
+    lights: &LightFrames,
+    shadow: &ShadowTest,
+    settings: &RenderSettings,
+    origin: UVec2,
+) -> TileFrames {
+    #[cfg(target_arch = "x86_64")]
+    match Simd::best() {
+        // SAFETY: `Simd::best` detected the level's features on this CPU.
+        Simd::Avx512 => {
+            return unsafe { render_tile_avx512(scene, lights, shadow, settings, origin) }
+        }
+        Simd::Avx2 => return unsafe { render_tile_avx2(scene, lights, shadow, settings, origin) },
+        Simd::Sse2 | Simd::Scalar => {}
+    }
+    render_tile_in(scene, lights, shadow, settings, origin)
+}
+
+simd_level! { Avx512
+    unsafe fn render_tile_avx512(
+        scene: &Scene,
+        lights: &LightFrames,
+        shadow: &ShadowTest,
+        settings: &RenderSettings,
+        origin: UVec2,
+    ) -> TileFrames {
+        render_tile_in(scene, lights, shadow, settings, origin)
+    }
+}
+
+simd_level! { Avx2
+    unsafe fn render_tile_avx2(
+        scene: &Scene,
+        lights: &LightFrames,
+        shadow: &ShadowTest,
+        settings: &RenderSettings,
+        origin: UVec2,
+    ) -> TileFrames {
+        render_tile_in(scene, lights, shadow, settings, origin)
+    }
+}
+
+/// The body of [`render_tile`], compiled once per SIMD level (`simd_level!`): the per-frame
+/// loops it inlines (light samples, next-event terms, BSDF batches, sums) run in that level's
+/// lanes. The same IEEE operations at every level, so the same bits (tests/simd_levels.rs).
+#[inline(always)]
+fn render_tile_in(
     scene: &Scene,
     lights: &LightFrames,
     shadow: &ShadowTest,
