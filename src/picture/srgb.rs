@@ -56,15 +56,32 @@ fn code_f64(x: f32) -> u8 {
     (255.0 * encode_f64((x as f64).clamp(0.0, 1.0))).round() as u8
 }
 
-/// An exact and fast 8-bit sRGB encoder: `thresholds[k]` is the smallest f32 whose code
+/// Right shift of an f32's bits that leaves its exponent and the top [`MANTISSA_BITS`] bits of
+/// its mantissa: the bucket of the encoder's table.
+const BUCKET_SHIFT: u32 = 23 - MANTISSA_BITS;
+/// Mantissa bits that pick a bucket: 2⁸ buckets an octave, each at most 2⁻⁸ ≈ 0.0039 of its
+/// start wide, while neighbouring thresholds lie at least ≈ 1/112 ≈ 0.0089 of their value
+/// apart (near x = 1, where d code/dx = 255 · 1.055/2.4 · x^(−1/2.4) ≈ 112; notes/picture.md),
+/// so no bucket holds two thresholds.
+const MANTISSA_BITS: u32 = 8;
+/// The first bucket: everything below 2⁻¹⁴ (all code 0; the first threshold is ≈ 1.5·10⁻⁴ >
+/// 2⁻¹³) falls into it.
+const FIRST_BUCKET: usize = ((127 - 14) << 23 >> BUCKET_SHIFT) as usize;
+/// Buckets from 2⁻¹⁴ up to and including 1.0's.
+const BUCKETS: usize = (127 << 23 >> BUCKET_SHIFT) as usize - FIRST_BUCKET + 1;
+
+/// An exact and fast 8-bit sRGB encoder. `thresholds[k]` is the smallest f32 whose code
 /// (`round(255 · encode(x))`, IEC 61966-2-1 in f64) exceeds `k`, so the code of x is the number
-/// of thresholds at or below x, found by a branch-free binary search (8 comparisons, no `powf`).
-/// The 256th entry is padding (+∞) that keeps every index in bounds.
+/// of thresholds at or below x. The count is looked up, not searched: x's exponent and top
+/// mantissa bits pick a bucket, `base` holds the code at the bucket's start, and since no bucket
+/// holds two thresholds one comparison with `thresholds[base]` finishes it (no `powf`, no
+/// branch). The 256th threshold is padding (+∞) for code 255.
 ///
 /// Non-finite values encode as 0 and the rest are clamped to [0, 1], as [`linear_to_srgb`] does.
 #[derive(Clone, Debug)]
 pub struct Srgb8 {
     thresholds: [f32; 256],
+    base: [u8; BUCKETS],
 }
 
 impl Default for Srgb8 {
@@ -73,10 +90,19 @@ impl Default for Srgb8 {
     }
 }
 
+/// The bucket of a value in [0, 1] (+0.0 for zeros of either sign).
+#[inline]
+fn bucket(x: f32) -> usize {
+    (((x.to_bits() & 0x7fff_ffff) >> BUCKET_SHIFT) as usize)
+        .saturating_sub(FIRST_BUCKET)
+        .min(BUCKETS - 1)
+}
+
 impl Srgb8 {
-    /// Computes the 255 thresholds from the exact formula: a first guess from the inverse curve at
-    /// the code's lower half-step, `decode((k + ½) / 255)`, moved one f32 step at a time to the
-    /// smallest value whose code exceeds `k` (a step or two at most).
+    /// Computes the 255 thresholds from the exact formula — a first guess from the inverse curve
+    /// at the code's lower half-step, `decode((k + ½) / 255)`, moved one f32 step at a time to
+    /// the smallest value whose code exceeds `k` (a step or two at most) — and the code at each
+    /// bucket's start.
     pub fn new() -> Self {
         let mut thresholds = [f32::INFINITY; 256];
         for (k, t) in thresholds.iter_mut().take(255).enumerate() {
@@ -90,7 +116,12 @@ impl Srgb8 {
             }
             *t = x;
         }
-        Srgb8 { thresholds }
+        let mut base = [0u8; BUCKETS];
+        for (i, b) in base.iter_mut().enumerate().skip(1) {
+            let start = f32::from_bits(((FIRST_BUCKET + i) << BUCKET_SHIFT) as u32);
+            *b = thresholds[..255].partition_point(|&t| t <= start) as u8;
+        }
+        Srgb8 { thresholds, base }
     }
 
     /// The linear value where the code first exceeds `k` (k < 255).
@@ -102,15 +133,14 @@ impl Srgb8 {
     /// formula in f64, for every f32.
     #[inline]
     pub fn encode(&self, x: f32) -> u8 {
-        // NaN and ±∞ give 0 (a select, not a branch); negatives fall below every threshold and
-        // values above 1 above every real one.
-        let x = if x.is_finite() { x } else { 0.0 };
-        let t = &self.thresholds;
-        let mut i = 0usize;
-        for step in [128, 64, 32, 16, 8, 4, 2, 1] {
-            i += usize::from(x >= t[(i + step - 1) & 255]) * step;
-        }
-        i as u8
+        // NaN and ±∞ give 0 (a select, not a branch).
+        let x = if x.is_finite() {
+            x.clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let code = self.base[bucket(x)];
+        code + u8::from(x >= self.thresholds[code as usize])
     }
 }
 
@@ -200,6 +230,22 @@ mod tests {
     }
 
     #[test]
+    fn no_bucket_holds_two_thresholds() {
+        let enc = Srgb8::new();
+        for k in 1..255u8 {
+            let (lo, hi) = (enc.threshold(k - 1), enc.threshold(k));
+            assert!(
+                bucket(lo) < bucket(hi),
+                "thresholds {} and {k} share bucket {}",
+                k - 1,
+                bucket(hi)
+            );
+        }
+        assert!(enc.threshold(0) > f32::from_bits(((FIRST_BUCKET + 1) << BUCKET_SHIFT) as u32));
+        assert_eq!(bucket(1.0), BUCKETS - 1);
+    }
+
+    #[test]
     fn random_values_match_the_f64_formula() {
         // A fixed-seed xorshift over [-0.1, 1.2): every value is checked, so no tolerance.
         let enc = Srgb8::new();
@@ -278,6 +324,53 @@ mod tests {
             1.0f32.to_bits() as u64 + 1
         );
         assert_eq!(new_wrong, 0);
+    }
+
+    /// Time to encode a 512×384 frame of fixed-seed noise, old (`powf` per channel) against new
+    /// (threshold table), median of 31 runs each (`cargo test --release --lib srgb_frame_speed
+    /// -- --ignored --nocapture`; notes/picture.md records the figures).
+    #[test]
+    #[ignore]
+    fn srgb_frame_speed() {
+        use std::hint::black_box;
+        use std::time::Instant;
+        let mut s = 99u64;
+        let px: Vec<glam::Vec3> = (0..512 * 384)
+            .map(|_| {
+                let mut v = [0.0f32; 3];
+                for c in &mut v {
+                    s = s
+                        .wrapping_mul(6364136223846793005)
+                        .wrapping_add(1442695040888963407);
+                    *c = -(((s >> 40) as f32 + 0.5) / (1u64 << 24) as f32).ln() * 0.2;
+                }
+                glam::Vec3::from_array(v)
+            })
+            .collect();
+        let old = |px: &[glam::Vec3]| -> Vec<u8> {
+            px.iter().flat_map(|c| c.to_array()).map(previous).collect()
+        };
+        let median = |f: &dyn Fn() -> Vec<u8>| {
+            let mut t: Vec<f64> = (0..31)
+                .map(|_| {
+                    let start = Instant::now();
+                    black_box(f());
+                    start.elapsed().as_secs_f64() * 1e3
+                })
+                .collect();
+            t.sort_by(f64::total_cmp);
+            t[15]
+        };
+        let t_old = median(&|| old(black_box(&px)));
+        let t_new = median(&|| to_srgb8(black_box(&px), 0.0));
+        let t_table = median(&|| {
+            black_box(Srgb8::new());
+            Vec::new()
+        });
+        println!(
+            "512x384 frame: powf {t_old:.3} ms, threshold table {t_new:.3} ms (table build {t_table:.4} ms included), speedup {:.1}x",
+            t_old / t_new
+        );
     }
 
     #[test]
