@@ -65,8 +65,8 @@ impl Rgb8 {
                 for y in ty * f..((ty + 1) * f).min(self.height) {
                     for x in tx * f..((tx + 1) * f).min(self.width) {
                         let i = (y as usize * self.width as usize + x as usize) * 3;
-                        for c in 0..3 {
-                            acc[c] += srgb8_to_linear(self.data[i + c]);
+                        for (a, &v) in acc.iter_mut().zip(&self.data[i..i + 3]) {
+                            *a += srgb8_to_linear(v);
                         }
                         n += 1.0;
                     }
