@@ -17,7 +17,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .settings
         .exr_meta(&loaded.name, file, &loaded.scene.camera);
     image_io::write_image_exr(Path::new("board.exr"), &out.image, &meta)?;
-    image_io::write_png_linear(
+    xylem::picture::png::write_png_linear(
         Path::new("board.png"),
         out.image.width,
         out.image.height,

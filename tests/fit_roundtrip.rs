@@ -140,12 +140,7 @@ fn bad_captures_name_the_file_and_field() {
 
 fn image_of_size(dir: &Path, w: u32, h: u32) -> String {
     let name = "odd_size.png";
-    xylem::render::image_io::write_png_rgb8(
-        &dir.join(name),
-        w,
-        h,
-        &vec![100u8; (w * h * 3) as usize],
-    )
-    .unwrap();
+    xylem::picture::png::write_png_rgb8(&dir.join(name), w, h, &vec![100u8; (w * h * 3) as usize])
+        .unwrap();
     name.into()
 }

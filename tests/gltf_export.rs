@@ -128,7 +128,7 @@ fn anisotropy_runs_across_the_fibre_and_data_maps_are_untagged() {
     // Every embedded image: untagged (glTF says how to read each; no sRGB, gAMA, cHRM, iCCP).
     for name in ["base_color", "normal", "metallic_roughness", "anisotropy"] {
         let (png, _, _) = image(&doc, &bin, name);
-        let c = xylem::render::image_io::png_chunk_types(&png);
+        let c = xylem::picture::png::png_chunk_types(&png);
         for tag in ["sRGB", "gAMA", "cHRM", "iCCP"] {
             assert!(!c.iter().any(|x| x == tag), "{name}: {c:?}");
         }

@@ -138,7 +138,7 @@ fn rendered_texels_equal_the_bsdf_of_the_decoded_parameters() {
     // data/marschner2005/README.md: colours v/255, axis 2v/255 − 1 with y towards the top row.
     let map = |name: &str| {
         let p = root().join("data/marschner2005/maple").join(name);
-        let img = xylem::sweep::sequence::read_png_rgb8(&p).unwrap();
+        let img = xylem::picture::png::read_png_rgb8(&p).unwrap();
         assert_eq!((img.width, img.height), (390, 390));
         move |t: usize| Vec3::from_array([0, 1, 2].map(|c| img.data[3 * t + c] as f32 / 255.0))
     };
@@ -270,7 +270,7 @@ fn beta_maps_are_range_checked() {
     std::fs::create_dir_all(&dir).unwrap();
     let write = |name: &str, v: u8| -> PathBuf {
         let p = dir.join(name);
-        xylem::render::image_io::write_png_rgb8(&p, 390, 390, &vec![v; 390 * 390 * 3]).unwrap();
+        xylem::picture::png::write_png_rgb8(&p, 390, 390, &vec![v; 390 * 390 * 3]).unwrap();
         p
     };
     let (zero, full) = (write("beta0.png", 0), write("beta255.png", 255));

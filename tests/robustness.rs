@@ -6,8 +6,10 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
-use xylem::render::image_io::{read_exr_channels, read_exr_rgb, to_srgb8};
-use xylem::sweep::sequence::{read_png_rgb8, read_records, FrameRecord, CSV, VIEWER};
+use xylem::picture::png::read_png_rgb8;
+use xylem::picture::srgb::to_srgb8;
+use xylem::render::image_io::{read_exr_channels, read_exr_rgb};
+use xylem::sweep::sequence::{read_records, FrameRecord, CSV, VIEWER};
 
 fn xylem() -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_xylem"));

@@ -3,9 +3,10 @@
 
 use glam::Vec3;
 use std::path::PathBuf;
+use xylem::picture::png::read_png_rgb8;
 use xylem::sweep::sequence::{
-    assemble, read_png_rgb8, write_frame, AssembleOptions, FrameRecord, Region, SequenceError,
-    ANIMATION, CONTACT_SHEET, CSV, VIEWER,
+    assemble, write_frame, AssembleOptions, FrameRecord, Region, SequenceError, ANIMATION,
+    CONTACT_SHEET, CSV, VIEWER,
 };
 use xylem::sweep::LightArc;
 

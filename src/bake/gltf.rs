@@ -13,7 +13,8 @@
 //! tangent space has it.
 
 use super::{BakedMaps, BoardCut};
-use crate::render::image_io::{encode_png_rgb8, to_srgb8, PngTag};
+use crate::picture::png::{encode_png_rgb8, PngTag};
+use crate::picture::srgb::to_srgb8;
 use gltf_json as json;
 use json::validation::{Checked::Valid, USize64};
 use json::Index;

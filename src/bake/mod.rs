@@ -11,9 +11,10 @@
 //! image's top, z out of the face. Data maps (anisotropy, normal) are stored linearly, not sRGB.
 
 pub use crate::material::{across_fiber, BakedMaps, FaceRect};
-use crate::render::image_io::{
-    to_srgb8, write_exr_layers, write_png_data8, write_png_rgb8, ExrLayer, ImageError,
-};
+use crate::picture::png::{write_png_data8, write_png_rgb8};
+use crate::picture::srgb::to_srgb8;
+use crate::picture::ImageError;
+use crate::render::image_io::{write_exr_layers, ExrLayer};
 
 pub mod gltf;
 use crate::wood::{Needs, WoodVolume};

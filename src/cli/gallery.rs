@@ -3,9 +3,9 @@
 //! (`xylem preset gallery`), and a light-sweep close-up (APNG) of each figured preset.
 
 use crate::picture::contact::Rgb8;
-use crate::render::image_io::{to_srgb8, write_png_rgb8};
+use crate::picture::png::{write_apng, write_png_rgb8};
+use crate::picture::srgb::to_srgb8;
 use crate::render::{render, RunOptions};
-use crate::sweep::sequence::write_apng;
 use crate::sweep::{render_sweep, SweepPath};
 use anyhow::Context;
 use std::fmt::Write as _;

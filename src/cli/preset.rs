@@ -1,6 +1,6 @@
 //! `xylem preset`: the built-in species presets.
 
-use crate::render::image_io::write_png_linear;
+use crate::picture::png::write_png_linear;
 use crate::texture::{Plane, Slice};
 use crate::wood;
 use crate::wood::{preview_color, Needs};
@@ -214,7 +214,8 @@ pub(super) fn gallery(
     only: &[String],
 ) -> anyhow::Result<()> {
     use crate::picture::contact::{contact_sheet_rows, Rgb8};
-    use crate::render::image_io::{to_srgb8, write_png_rgb8};
+    use crate::picture::png::write_png_rgb8;
+    use crate::picture::srgb::to_srgb8;
     use crate::sweep::{render_sweep, SweepPath};
     let bar = super::progress::Bar::new(true);
     if angles.is_empty() || angles.iter().any(|a| !(-89.0..=89.0).contains(a)) {

@@ -130,7 +130,9 @@ fn write_outputs(
     exposure: f32,
     meta: crate::render::image_io::ExrMeta,
 ) -> anyhow::Result<()> {
-    use crate::render::image_io::{commit, stage_image_exr, stage_png_linear};
+    use crate::picture::file::commit;
+    use crate::picture::png::stage_png_linear;
+    use crate::render::image_io::stage_image_exr;
     let (staged_exr, staged_png) = rayon::join(
         || stage_image_exr(exr, image, meta),
         || stage_png_linear(png, image.width, image.height, &image.beauty, exposure),

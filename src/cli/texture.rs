@@ -4,7 +4,8 @@
 //! The source of the colours is chosen in [`source`]; the slicing and output are shared, so
 //! further sources (wood presets) only add a branch there and their own options.
 
-use crate::render::image_io::{write_exr_layers_with, write_png_linear, ExrCompression, ExrLayer};
+use crate::picture::png::write_png_linear;
+use crate::render::image_io::{write_exr_layers_with, ExrCompression, ExrLayer};
 use crate::texture::{self, first_non_finite, Plane, Slice, SolidTexture};
 use anyhow::{bail, Context};
 use std::collections::BTreeMap;
@@ -186,12 +187,12 @@ fn animate(args: &Args, slice: &Slice, out: &std::path::Path, seconds: f32) -> a
         frames.push(crate::picture::contact::Rgb8 {
             width: slice.res,
             height: slice.res,
-            data: crate::render::image_io::to_srgb8(&pixels, args.exposure),
+            data: crate::picture::srgb::to_srgb8(&pixels, args.exposure),
         });
         bar.inc(1);
     }
     bar.finish_and_clear();
-    crate::sweep::sequence::write_apng(out, &frames, 12)
+    crate::picture::png::write_apng(out, &frames, 12)
         .with_context(|| format!("writing {}", out.display()))?;
     println!(
         "wrote {} ({} frames over {seconds} s)",

@@ -94,7 +94,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 .chars()
                 .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
                 .collect();
-            crate::render::image_io::write_png_linear(
+            crate::picture::png::write_png_linear(
                 &dir.join(format!("{file}.png")),
                 w,
                 h,
@@ -213,7 +213,7 @@ fn write_plot(path: &Path, rows: &[Measurement]) -> anyhow::Result<()> {
     if let Some(p) = path.parent() {
         std::fs::create_dir_all(p)?;
     }
-    crate::render::image_io::write_png_rgb8(path, img.width, img.height, &img.data)?;
+    crate::picture::png::write_png_rgb8(path, img.width, img.height, &img.data)?;
     Ok(())
 }
 

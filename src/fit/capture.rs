@@ -4,7 +4,8 @@
 //! frame the light direction and irradiance — is what the model needs (notes/fit.md §1).
 
 use crate::math::Vec3;
-use crate::render::image_io::{read_exr_rgb, srgb_to_linear};
+use crate::picture::srgb::srgb_to_linear;
+use crate::render::image_io::read_exr_rgb;
 use crate::sweep::manifest::{Manifest, MANIFEST_FILE};
 use std::path::{Path, PathBuf};
 

@@ -10,9 +10,10 @@
 use super::model::TexelFit;
 use crate::material::MeasuredBoard;
 use crate::output::{FolderLock, LockError, LockMode, Staged};
-use crate::render::image_io::{
-    commit, stage_exr_layers, stage_png_rgb8, ExrCompression, ExrLayer, ImageError,
-};
+use crate::picture::file::commit;
+use crate::picture::png::stage_png_rgb8;
+use crate::picture::ImageError;
+use crate::render::image_io::{stage_exr_layers, ExrCompression, ExrLayer};
 use glam::Vec3;
 use std::path::Path;
 

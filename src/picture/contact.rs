@@ -1,6 +1,8 @@
 //! The contact sheet: every frame of a sweep as a thumbnail on one grid, each labelled with its
 //! light angle, so the highlight's travel can be read at a glance.
 
+use super::srgb::{srgb8_to_linear, Srgb8};
+
 /// An 8-bit sRGB image (RGB, row-major, top row first), as read back from a frame's PNG.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Rgb8 {
@@ -55,6 +57,7 @@ impl Rgb8 {
         }
         let (w, h) = ((self.width / f).max(1), (self.height / f).max(1));
         let mut out = Rgb8::filled(w, h, [0, 0, 0]);
+        let enc = Srgb8::new();
         for ty in 0..h {
             for tx in 0..w {
                 let mut acc = [0.0f32; 3];
@@ -62,28 +65,17 @@ impl Rgb8 {
                 for y in ty * f..((ty + 1) * f).min(self.height) {
                     for x in tx * f..((tx + 1) * f).min(self.width) {
                         let i = (y as usize * self.width as usize + x as usize) * 3;
-                        for c in 0..3 {
-                            acc[c] += srgb8_to_linear(self.data[i + c]);
+                        for (a, &v) in acc.iter_mut().zip(&self.data[i..i + 3]) {
+                            *a += srgb8_to_linear(v);
                         }
                         n += 1.0;
                     }
                 }
-                let px = acc
-                    .map(|a| (crate::render::image_io::linear_to_srgb(a / n) * 255.0 + 0.5) as u8);
+                let px = acc.map(|a| enc.encode(a / n));
                 out.put(tx, ty, px);
             }
         }
         out
-    }
-}
-
-/// The inverse sRGB transfer function (IEC 61966-2-1) of an 8-bit code.
-pub fn srgb8_to_linear(v: u8) -> f32 {
-    let x = v as f32 / 255.0;
-    if x <= 0.040_45 {
-        x / 12.92
-    } else {
-        ((x + 0.055) / 1.055).powf(2.4)
     }
 }
 
@@ -218,14 +210,6 @@ mod tests {
         assert_eq!((s.width, s.height), (1, 1));
         assert_eq!(s.data, vec![188, 188, 188]);
         assert_eq!(img.shrink_to_width(5), img);
-    }
-
-    #[test]
-    fn srgb_decoding_inverts_encoding() {
-        for v in 0..=255u8 {
-            let back = crate::render::image_io::linear_to_srgb(srgb8_to_linear(v)) * 255.0;
-            assert!((back - v as f32).abs() < 0.01, "{v}");
-        }
     }
 
     #[test]

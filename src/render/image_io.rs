@@ -1,223 +1,11 @@
-//! Writing images people look at: sRGB PNG previews of linear RGB buffers, and multi-layer
-//! OpenEXR files (beauty plus AOV layers) through the `exr` crate.
+//! Multi-layer OpenEXR files (beauty plus AOV layers) through the `exr` crate, written whole or
+//! not at all ([`crate::picture::file::stage`]) and byte-identical for equal input; PNG files are
+//! [`crate::picture::png`]'s.
 
 use crate::output::Staged;
+use crate::picture::file::{commit, stage, ImageError};
 use glam::Vec3;
-use std::io::BufWriter;
 use std::path::Path;
-
-/// Errors while writing an image, naming the file.
-#[derive(Debug, thiserror::Error)]
-pub enum ImageError {
-    /// The file could not be created or written.
-    #[error("cannot write image {path}: {source}")]
-    Io {
-        /// The file.
-        path: String,
-        /// Why.
-        source: std::io::Error,
-    },
-    /// The PNG encoder failed.
-    #[error("cannot encode PNG {path}: {source}")]
-    Png {
-        /// The file.
-        path: String,
-        /// Why.
-        source: png::EncodingError,
-    },
-    /// The exr crate could not write the file.
-    #[error("cannot write EXR {path}: {message}")]
-    ExrWrite {
-        /// The file.
-        path: String,
-        /// The exr crate's message.
-        message: String,
-    },
-    /// The exr crate could not read the file.
-    #[error("cannot read EXR {path}: {message}")]
-    ExrRead {
-        /// The file.
-        path: String,
-        /// The exr crate's message.
-        message: String,
-    },
-    /// A pixel buffer whose length does not match the image size.
-    #[error("image {path}: buffer holds {got} pixels, {width}x{height} needs {want}")]
-    Size {
-        /// The file.
-        path: String,
-        /// Image width in pixels.
-        width: u32,
-        /// Image height in pixels.
-        height: u32,
-        /// Pixels the buffer holds.
-        got: usize,
-        /// Pixels the size needs (width × height).
-        want: usize,
-    },
-}
-
-/// The sRGB transfer function (IEC 61966-2-1) of a linear value, clamped to [0, 1].
-#[inline]
-pub fn linear_to_srgb(x: f32) -> f32 {
-    let x = if x.is_finite() {
-        x.clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    if x <= 0.003_130_8 {
-        12.92 * x
-    } else {
-        1.055 * x.powf(1.0 / 2.4) - 0.055
-    }
-}
-
-/// The inverse sRGB transfer function (IEC 61966-2-1): the linear value of an encoded x in [0, 1].
-#[inline]
-pub fn srgb_to_linear(x: f32) -> f32 {
-    if x <= 0.040_45 {
-        x / 12.92
-    } else {
-        ((x + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-/// 8-bit sRGB bytes (RGB, row-major, top row first) of a linear buffer scaled by `2^exposure`.
-pub fn to_srgb8(pixels: &[Vec3], exposure: f32) -> Vec<u8> {
-    let scale = exposure.exp2();
-    pixels
-        .iter()
-        .flat_map(|c| (*c * scale).to_array())
-        .map(|v| (linear_to_srgb(v) * 255.0 + 0.5) as u8)
-        .collect()
-}
-
-/// Writes 8-bit RGB bytes as a PNG, whole or not at all ([`crate::output::Staged`]).
-pub fn write_png_rgb8(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<(), ImageError> {
-    let staged = stage_png_rgb8(path, width, height, rgb)?;
-    commit(staged)
-}
-
-/// Renames a staged image over its final name.
-pub fn commit(staged: Staged) -> Result<(), ImageError> {
-    let path = staged.path().display().to_string();
-    staged
-        .commit()
-        .map_err(|source| ImageError::Io { path, source })
-}
-
-/// How a PNG labels its samples: colour images carry an `sRGB` chunk; data maps (normals,
-/// anisotropy, roughness, masks) carry no colour-space chunk at all (no `sRGB`, `gAMA`, `cHRM`
-/// or `iCCP`), as glTF 2.0 §5.22 ("Image") asks of every image a glTF asset embeds: the asset,
-/// not the file, says how the samples are meant.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum PngTag {
-    /// A colour image: sRGB-encoded samples, with an `sRGB` chunk.
-    Srgb,
-    /// A data map: no colour-space chunk.
-    Untagged,
-}
-
-/// Encodes 8-bit RGB bytes (row-major, top row first) as a PNG into `out`.
-pub fn encode_png_rgb8(
-    out: impl std::io::Write,
-    width: u32,
-    height: u32,
-    rgb: &[u8],
-    tag: PngTag,
-) -> Result<(), png::EncodingError> {
-    let mut enc = png::Encoder::new(out, width, height);
-    enc.set_color(png::ColorType::Rgb);
-    enc.set_depth(png::BitDepth::Eight);
-    if tag == PngTag::Srgb {
-        enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
-    }
-    let mut w = enc.write_header()?;
-    w.write_image_data(rgb)?;
-    w.finish()
-}
-
-/// Checks that `rgb` holds `width × height` RGB pixels, naming `path` if not.
-fn check_rgb8(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<(), ImageError> {
-    let want = width as usize * height as usize;
-    if rgb.len() == want * 3 {
-        return Ok(());
-    }
-    Err(ImageError::Size {
-        path: path.display().to_string(),
-        width,
-        height,
-        got: rgb.len() / 3,
-        want,
-    })
-}
-
-/// Encodes an sRGB-tagged PNG into a uniquely named temporary file beside `path`, to
-/// [`commit`] later.
-pub fn stage_png_rgb8(
-    path: &Path,
-    width: u32,
-    height: u32,
-    rgb: &[u8],
-) -> Result<Staged, ImageError> {
-    stage_png_tagged(path, width, height, rgb, PngTag::Srgb)
-}
-
-/// Writes 8-bit codes of a data map (no transfer curve) as an untagged PNG ([`PngTag`]), whole
-/// or not at all.
-pub fn write_png_data8(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<(), ImageError> {
-    commit(stage_png_tagged(
-        path,
-        width,
-        height,
-        rgb,
-        PngTag::Untagged,
-    )?)
-}
-
-fn stage_png_tagged(
-    path: &Path,
-    width: u32,
-    height: u32,
-    rgb: &[u8],
-    tag: PngTag,
-) -> Result<Staged, ImageError> {
-    check_rgb8(path, width, height, rgb)?;
-    let name = path.display().to_string();
-    let mut staged = Staged::new(path).map_err(|source| ImageError::Io {
-        path: name.clone(),
-        source,
-    })?;
-    let mut out = BufWriter::new(staged.file());
-    encode_png_rgb8(&mut out, width, height, rgb, tag).map_err(|source| ImageError::Png {
-        path: name.clone(),
-        source,
-    })?;
-    flush(out, &name)?;
-    Ok(staged)
-}
-
-/// Writes a linear RGB buffer as an sRGB PNG preview with exposure `exposure` stops.
-pub fn write_png_linear(
-    path: &Path,
-    width: u32,
-    height: u32,
-    pixels: &[Vec3],
-    exposure: f32,
-) -> Result<(), ImageError> {
-    write_png_rgb8(path, width, height, &to_srgb8(pixels, exposure))
-}
-
-/// [`write_png_linear`] staged, to [`commit`] later.
-pub fn stage_png_linear(
-    path: &Path,
-    width: u32,
-    height: u32,
-    pixels: &[Vec3],
-    exposure: f32,
-) -> Result<Staged, ImageError> {
-    stage_png_rgb8(path, width, height, &to_srgb8(pixels, exposure))
-}
 
 /// One named layer of a multi-layer EXR: `channels` are the channel suffixes (e.g. `["R","G","B"]`
 /// or `["X","Y","Z"]`), `data` is row-major with `channels.len()` values per pixel.
@@ -248,17 +36,19 @@ pub enum ExrCompression {
 }
 
 impl ExrCompression {
+    /// The exr crate's encoding, always with chunks in increasing order: the crate's parallel
+    /// compressor writes them in the order its threads finish unless a line order is set, so
+    /// equal pixels could give different bytes run to run.
     fn encoding(self) -> exr::prelude::Encoding {
         use exr::prelude::Encoding;
-        match self {
+        let base = match self {
             ExrCompression::Zip => Encoding::SMALL_LOSSLESS,
-            // Chunks in increasing order: the parallel compressor otherwise writes them as they
-            // finish, so equal pixels gave different bytes run to run.
-            ExrCompression::Rle => Encoding {
-                line_order: exr::prelude::LineOrder::Increasing,
-                ..Encoding::FAST_LOSSLESS
-            },
+            ExrCompression::Rle => Encoding::FAST_LOSSLESS,
             ExrCompression::None => Encoding::UNCOMPRESSED,
+        };
+        Encoding {
+            line_order: exr::prelude::LineOrder::Increasing,
+            ..base
         }
     }
 }
@@ -347,20 +137,72 @@ pub fn stage_exr_layers(
         compression.encoding(),
         AnyChannels::sort(SmallVec::from_vec(channels)),
     );
-    let mut staged = Staged::new(path).map_err(|source| ImageError::Io {
-        path: name.clone(),
-        source,
-    })?;
-    let mut out = BufWriter::new(staged.file());
+    let mut bytes = std::io::Cursor::new(Vec::new());
     Image::from_layer(layer)
         .write()
-        .to_buffered(&mut out)
+        .to_buffered(&mut bytes)
         .map_err(|e| ImageError::ExrWrite {
             path: name.clone(),
             message: e.to_string(),
         })?;
-    flush(out, &name)?;
-    Ok(staged)
+    let mut bytes = bytes.into_inner();
+    sort_header_attributes(&mut bytes).map_err(|message| ImageError::ExrWrite {
+        path: name.clone(),
+        message,
+    })?;
+    stage(path, |out| {
+        std::io::Write::write_all(out, &bytes).map_err(|source| ImageError::Io {
+            path: name.clone(),
+            source,
+        })
+    })
+}
+
+/// Sorts the attributes of a single-part EXR's header by name, in place, so that equal input
+/// gives equal bytes: the exr crate keeps the non-standard attributes (our `meta`) in a
+/// `HashMap` and writes them in its per-process random order. OpenEXR's own library writes
+/// them sorted by name too (its header is a `std::map`).
+///
+/// The header (OpenEXR file layout: magic number, 4-byte version and flags, then attributes
+/// `name\0 type\0 size:i32 value` up to a lone `\0`) keeps its length, so the offset table
+/// after it stays valid. Multi-part files (flag bit 12), which xylem does not write, are refused.
+fn sort_header_attributes(bytes: &mut [u8]) -> Result<(), String> {
+    const MAGIC: [u8; 4] = [0x76, 0x2f, 0x31, 0x01];
+    if bytes.len() < 8 || bytes[..4] != MAGIC {
+        return Err("the encoder's output is not an OpenEXR stream".into());
+    }
+    if bytes[4..8].try_into().map(u32::from_le_bytes).unwrap_or(0) & 0x1000 != 0 {
+        return Err("multi-part EXR headers are not sorted".into());
+    }
+    let truncated = || "the encoder's header is truncated".to_string();
+    let nul = |from: usize| -> Result<usize, String> {
+        let rest = bytes.get(from..).ok_or_else(truncated)?;
+        Ok(from + rest.iter().position(|&b| b == 0).ok_or_else(truncated)?)
+    };
+    // (start, end of name, end) of each attribute.
+    let mut attrs = Vec::new();
+    let mut at = 8;
+    while *bytes.get(at).ok_or_else(truncated)? != 0 {
+        let name_end = nul(at)?;
+        let type_end = nul(name_end + 1)?;
+        let size = bytes
+            .get(type_end + 1..type_end + 5)
+            .ok_or_else(truncated)?;
+        let size = i32::from_le_bytes(size.try_into().unwrap());
+        let end = type_end + 5 + usize::try_from(size).map_err(|_| truncated())?;
+        if end > bytes.len() {
+            return Err(truncated());
+        }
+        attrs.push((at, name_end, end));
+        at = end;
+    }
+    attrs.sort_by(|a, b| bytes[a.0..a.1].cmp(&bytes[b.0..b.1]));
+    let sorted: Vec<u8> = attrs
+        .iter()
+        .flat_map(|&(start, _, end)| bytes[start..end].iter().copied())
+        .collect();
+    bytes[8..at].copy_from_slice(&sorted);
+    Ok(())
 }
 
 /// Text attributes of an EXR header, (name, value): e.g. `("spp", "64")`.
@@ -373,14 +215,6 @@ fn exr_text(s: &str) -> exr::prelude::Text {
         .map(|c| if (c as u32) < 256 { c } else { '?' })
         .collect();
     exr::prelude::Text::new_or_panic(latin1)
-}
-
-/// Flushes a buffered writer, naming the file on failure (a dropped `BufWriter` would hide it).
-fn flush(mut out: BufWriter<&mut std::fs::File>, name: &str) -> Result<(), ImageError> {
-    std::io::Write::flush(&mut out).map_err(|source| ImageError::Io {
-        path: name.to_string(),
-        source,
-    })
 }
 
 /// Writes a rendered image as EXR: beauty `R G B A` (alpha = the fraction of the pixel's camera
@@ -543,31 +377,9 @@ pub fn read_exr_text(path: &Path) -> Result<Vec<(String, String)>, ImageError> {
     Ok(out)
 }
 
-/// The chunk types of a PNG byte stream in order (PNG spec §5.3: after the 8-byte signature,
-/// length, type, data, CRC), e.g. to check which colour-space chunks a file carries.
-pub fn png_chunk_types(bytes: &[u8]) -> Vec<String> {
-    let mut at = 8;
-    let mut out = Vec::new();
-    while at + 8 <= bytes.len() {
-        let len = u32::from_be_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
-        out.push(String::from_utf8_lossy(&bytes[at + 4..at + 8]).into_owned());
-        at += 12 + len;
-    }
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn srgb_curve_endpoints_and_continuity() {
-        assert_eq!(linear_to_srgb(0.0), 0.0);
-        assert!((linear_to_srgb(1.0) - 1.0).abs() < 1e-6);
-        assert_eq!(linear_to_srgb(f32::NAN), 0.0);
-        let a = 0.003_130_8_f32;
-        assert!((12.92 * a - (1.055 * a.powf(1.0 / 2.4) - 0.055)).abs() < 1e-4);
-    }
 
     #[test]
     fn rendered_exr_has_alpha_infinite_depth_on_misses_and_header_metadata() {
@@ -608,63 +420,118 @@ mod tests {
         assert_eq!(get("scene"), "board ? ø");
     }
 
-    #[test]
-    fn data_pngs_carry_no_colour_space_chunk() {
-        let rgb = [10u8, 128, 255, 0, 0, 0];
-        let chunks = |tag| {
-            let mut v = Vec::new();
-            encode_png_rgb8(&mut v, 2, 1, &rgb, tag).unwrap();
-            png_chunk_types(&v)
-        };
-        let (srgb, data) = (chunks(PngTag::Srgb), chunks(PngTag::Untagged));
-        assert!(srgb.iter().any(|c| c == "sRGB"), "{srgb:?}");
-        for c in ["sRGB", "gAMA", "cHRM", "iCCP"] {
-            assert!(!data.iter().any(|d| d == c), "{c} in {data:?}");
+    /// Every compression xylem offers; the match fails to compile when one is added and not
+    /// listed here.
+    fn every_compression() -> [ExrCompression; 3] {
+        let all = [
+            ExrCompression::Zip,
+            ExrCompression::Rle,
+            ExrCompression::None,
+        ];
+        for c in all {
+            match c {
+                ExrCompression::Zip | ExrCompression::Rle | ExrCompression::None => {}
+            }
         }
-        assert_eq!(data.first().map(String::as_str), Some("IHDR"));
-        assert_eq!(data.last().map(String::as_str), Some("IEND"));
+        all
     }
 
-    #[test]
-    fn png_round_trip_and_size_check() {
-        let dir = std::env::temp_dir().join(format!("xylem-png-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let p = dir.join("t.png");
-        let px = vec![Vec3::new(1.0, 0.5, 0.0); 6];
-        write_png_linear(&p, 3, 2, &px, 0.0).unwrap();
-        let dec = png::Decoder::new(std::fs::File::open(&p).unwrap());
-        let mut r = dec.read_info().unwrap();
-        let mut buf = vec![0; r.output_buffer_size()];
-        let info = r.next_frame(&mut buf).unwrap();
-        assert_eq!((info.width, info.height), (3, 2));
-        assert_eq!(&buf[..3], &[255, 188, 0]);
-        assert!(write_png_linear(&p, 4, 2, &px, 0.0).is_err());
-        let e = dir.join("t.exr");
-        let layers = [
+    /// A 200×150 image of fixed-seed noise (several ZIP blocks and RLE tiles) and a depth layer.
+    fn noisy_layers() -> (u32, u32, Vec<ExrLayer<'static>>) {
+        let (w, h) = (200u32, 150u32);
+        let mut s = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let n = (w * h) as usize;
+        let rgb: Vec<f32> = (0..3 * n).map(|_| next()).collect();
+        let depth: Vec<f32> = (0..n)
+            .map(|i| if i % 7 == 0 { f32::INFINITY } else { i as f32 })
+            .collect();
+        let layers = vec![
             ExrLayer {
                 name: "",
                 channels: &["R", "G", "B"],
-                data: px.iter().flat_map(|c| c.to_array()).collect(),
+                data: rgb,
             },
             ExrLayer {
                 name: "depth",
                 channels: &["Z"],
-                data: vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0],
+                data: depth,
             },
         ];
-        for c in [
-            ExrCompression::Zip,
-            ExrCompression::Rle,
-            ExrCompression::None,
-        ] {
-            write_exr_layers_with(&e, 3, 2, &layers, c, &[]).unwrap();
-            let (w, h, rgb) = read_exr_rgb(&e).unwrap();
-            assert_eq!((w, h), (3, 2), "{c:?}");
-            assert_eq!(rgb, px, "{c:?}");
+        (w, h, layers)
+    }
+
+    #[test]
+    fn every_compression_reads_back_bit_identically() {
+        let dir = tempfile::tempdir().unwrap();
+        let e = dir.path().join("t.exr");
+        let (w, h, layers) = noisy_layers();
+        for c in every_compression() {
+            write_exr_layers_with(&e, w, h, &layers, c, &[]).unwrap();
+            let (rw, rh, rgb) = read_exr_rgb(&e).unwrap();
+            assert_eq!((rw, rh), (w as usize, h as usize), "{c:?}");
+            let flat: Vec<f32> = rgb.iter().flat_map(|p| p.to_array()).collect();
+            assert!(flat == layers[0].data, "{c:?}: RGB differs");
             let ch = read_exr_channels(&e).unwrap();
             let z = ch.iter().find(|(n, _)| n == "depth.Z").unwrap();
-            assert_eq!(z.1, vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0], "{c:?}");
+            assert!(z.1 == layers[1].data, "{c:?}: depth differs");
         }
-        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn equal_input_gives_equal_bytes_for_every_compression() {
+        let dir = tempfile::tempdir().unwrap();
+        let (w, h, layers) = noisy_layers();
+        // Eight text attributes: in the exr crate's random HashMap order two writes would agree
+        // only by chance (1 in 8! orders).
+        let meta: Vec<(&str, String)> = [
+            "scene", "spp", "seed", "camera", "quality", "light", "crc", "frame",
+        ]
+        .iter()
+        .enumerate()
+        .map(|(i, k)| (*k, format!("value {i}")))
+        .collect();
+        for c in every_compression() {
+            let files: Vec<Vec<u8>> = (0..3)
+                .map(|k| {
+                    let p = dir.path().join(format!("{c:?}_{k}.exr"));
+                    write_exr_layers_with(&p, w, h, &layers, c, &meta).unwrap();
+                    std::fs::read(&p).unwrap()
+                })
+                .collect();
+            for (k, f) in files.iter().enumerate().skip(1) {
+                let differ = f.iter().zip(&files[0]).filter(|(a, b)| a != b).count();
+                assert!(
+                    f.len() == files[0].len() && differ == 0,
+                    "{c:?}: write {k} has {} bytes, {differ} of them differ from write 0 ({} bytes)",
+                    f.len(),
+                    files[0].len()
+                );
+            }
+            let text = read_exr_text(&dir.path().join(format!("{c:?}_0.exr"))).unwrap();
+            assert_eq!(text.len(), 1 + meta.len(), "{c:?}: {text:?}");
+        }
+    }
+
+    #[test]
+    fn header_sorting_refuses_what_is_not_a_single_part_exr() {
+        assert!(sort_header_attributes(&mut [0u8; 4]).is_err());
+        assert!(sort_header_attributes(&mut b"not an exr file at all".to_vec()).is_err());
+        // Magic and version, then an attribute cut short.
+        let mut cut = vec![0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0];
+        cut.extend_from_slice(b"name\0text\0\x10\0\0\0ab");
+        assert!(sort_header_attributes(&mut cut).is_err());
+        let mut multi = vec![0x76, 0x2f, 0x31, 0x01, 2, 0x10, 0, 0, 0];
+        assert!(sort_header_attributes(&mut multi).is_err());
+        // Two attributes out of order are swapped; the lone NUL after them ends the header.
+        let mut two = vec![0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0];
+        two.extend_from_slice(b"zz\0t\0\x01\0\0\0Zaa\0t\0\x02\0\0\0AA\0rest");
+        sort_header_attributes(&mut two).unwrap();
+        assert_eq!(&two[8..], b"aa\0t\0\x02\0\0\0AAzz\0t\0\x01\0\0\0Z\0rest");
     }
 }

@@ -11,9 +11,11 @@ use super::sequence::{
 };
 use super::{render_naive, render_sweep};
 use crate::output::{remove_if_present, FolderLock, LockError, LockMode};
+use crate::picture::file::commit;
+use crate::picture::png::stage_png_linear;
+use crate::picture::ImageError;
 use crate::render::image_io::{
-    aov_layers, beauty_rgba, commit, stage_exr_layers, stage_png_linear, write_exr_layers,
-    ExrCompression, ExrLayer, ImageError,
+    aov_layers, beauty_rgba, stage_exr_layers, write_exr_layers, ExrCompression, ExrLayer,
 };
 use crate::render::resources::{ResourceError, Resources};
 use crate::render::Frames;

@@ -6,12 +6,12 @@
 use super::path::MAX_FRAMES;
 use super::viewer::viewer_html;
 use crate::math::{luminance, Vec3};
-use crate::output::{remove_if_present, write_atomic, Staged};
+use crate::output::{remove_if_present, write_atomic};
 use crate::picture::contact::{contact_sheet, Rgb8};
-use crate::render::image_io::{write_png_linear, write_png_rgb8, ImageError};
+use crate::picture::png::{read_png_rgb8, write_apng, write_png_linear, write_png_rgb8};
+use crate::picture::ImageError;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use std::io::BufWriter;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
@@ -43,23 +43,7 @@ pub enum SequenceError {
         /// serde_json's message.
         cause: serde_json::Error,
     },
-    /// A frame's PNG could not be decoded.
-    #[error("cannot read PNG {path}: {cause}")]
-    Decode {
-        /// The PNG file.
-        path: String,
-        /// The png crate's message.
-        cause: png::DecodingError,
-    },
-    /// The animated PNG could not be encoded.
-    #[error("cannot encode animated PNG {path}: {cause}")]
-    Encode {
-        /// The animation file.
-        path: String,
-        /// The png crate's message.
-        cause: png::EncodingError,
-    },
-    /// A frame's PNG or the contact sheet could not be written.
+    /// A frame's PNG, the contact sheet or the animated PNG could not be read or written.
     #[error(transparent)]
     Image(#[from] ImageError),
     /// The folder holds no frame records.
@@ -438,81 +422,6 @@ fn runs(sorted: &[usize]) -> Vec<Range<usize>> {
         }
     }
     out
-}
-
-/// Reads an 8-bit RGB (or RGBA, alpha dropped) PNG.
-pub fn read_png_rgb8(path: &Path) -> Result<Rgb8, SequenceError> {
-    let name = path.display().to_string();
-    let decode = |cause| SequenceError::Decode {
-        path: name.clone(),
-        cause,
-    };
-    let file = std::fs::File::open(path).map_err(|cause| SequenceError::Io {
-        path: name.clone(),
-        cause,
-    })?;
-    let mut dec = png::Decoder::new(std::io::BufReader::new(file));
-    dec.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
-    let mut reader = dec.read_info().map_err(decode)?;
-    let mut buf = vec![0; reader.output_buffer_size()];
-    let info = reader.next_frame(&mut buf).map_err(decode)?;
-    buf.truncate(info.buffer_size());
-    let data = match info.color_type {
-        png::ColorType::Rgb => buf,
-        png::ColorType::Rgba => buf
-            .chunks_exact(4)
-            .flat_map(|p| [p[0], p[1], p[2]])
-            .collect(),
-        png::ColorType::Grayscale => buf.iter().flat_map(|&g| [g, g, g]).collect(),
-        png::ColorType::GrayscaleAlpha => buf
-            .chunks_exact(2)
-            .flat_map(|p| [p[0], p[0], p[0]])
-            .collect(),
-        png::ColorType::Indexed => {
-            return Err(SequenceError::Mismatch {
-                path: name,
-                what: "indexed colour was not expanded".into(),
-            })
-        }
-    };
-    Ok(Rgb8 {
-        width: info.width,
-        height: info.height,
-        data,
-    })
-}
-
-/// Writes `frames` (all the same size) as a looping animated PNG, `fps` frames per second.
-pub fn write_apng(path: &Path, frames: &[Rgb8], fps: u16) -> Result<(), SequenceError> {
-    let name = path.display().to_string();
-    let first = frames.first().ok_or_else(|| SequenceError::Mismatch {
-        path: name.clone(),
-        what: "an animation needs at least one frame".into(),
-    })?;
-    let io = |cause| SequenceError::Io {
-        path: name.clone(),
-        cause,
-    };
-    let enc_err = |cause| SequenceError::Encode {
-        path: name.clone(),
-        cause,
-    };
-    let mut staged = Staged::new(path).map_err(io)?;
-    let mut out = BufWriter::new(staged.file());
-    let mut enc = png::Encoder::new(&mut out, first.width, first.height);
-    enc.set_color(png::ColorType::Rgb);
-    enc.set_depth(png::BitDepth::Eight);
-    enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
-    enc.set_animated(frames.len() as u32, 0).map_err(enc_err)?;
-    enc.set_frame_delay(1, fps.max(1)).map_err(enc_err)?;
-    let mut w = enc.write_header().map_err(enc_err)?;
-    for f in frames {
-        w.write_image_data(&f.data).map_err(enc_err)?;
-    }
-    w.finish().map_err(enc_err)?;
-    std::io::Write::flush(&mut out).map_err(io)?;
-    drop(out);
-    staged.commit().map_err(io)
 }
 
 /// The CSV of light angle and mean radiance per frame, one column per named region.

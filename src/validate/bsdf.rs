@@ -1284,7 +1284,7 @@ pub enum PolarPlotError {
     },
     /// The PNG could not be written.
     #[error(transparent)]
-    Png(#[from] crate::render::image_io::ImageError),
+    Png(#[from] crate::picture::ImageError),
 }
 
 /// Writes the polar plot of `spec` (f·cos θi in the incidence plane at θo = 0°, 30°, 60°, 80°,
@@ -1332,7 +1332,7 @@ pub fn write_polar_plot(spec: &CaseSpec, path: &Path) -> Result<(), PolarPlotErr
             source,
         })?;
     }
-    crate::render::image_io::write_png_rgb8(path, img.width, img.height, &img.data)?;
+    crate::picture::png::write_png_rgb8(path, img.width, img.height, &img.data)?;
     Ok(())
 }
 

@@ -14,7 +14,10 @@ use crate::fit::maps::stage_board_pngs;
 use crate::fit::{fit, Capture, FitOptions, FittedMaps};
 use crate::material::{MeasuredBoard, MeasuredFiles, Placement};
 use crate::math::Pcg32;
-use crate::render::image_io::{commit, linear_to_srgb, read_exr_rgb, stage_png_rgb8};
+use crate::picture::file::commit;
+use crate::picture::png::stage_png_rgb8;
+use crate::picture::srgb::Srgb8;
+use crate::render::image_io::read_exr_rgb;
 use crate::render::RunOptions;
 use crate::scene;
 use crate::sweep::job::{run_job, SweepJob};
@@ -391,6 +394,7 @@ pub fn to_camera_frames(
         .flat_map(|f| f.2.iter().map(|p| p.max_element()))
         .fold(0.0f32, f32::max);
     let exposure = 0.9 / peak.max(1e-12);
+    let enc = Srgb8::new();
     for (k, (f, (w, h, px))) in m.frames.iter_mut().zip(&frames).enumerate() {
         let mut rng = Pcg32::new(seed, k as u64);
         let bytes: Vec<u8> = px
@@ -407,7 +411,7 @@ pub fn to_camera_frames(
                     }
                     None => v,
                 };
-                (linear_to_srgb(v) * 255.0 + 0.5) as u8
+                enc.encode(v)
             })
             .collect();
         let name = format!("frame_{k:04}.png");
@@ -485,7 +489,7 @@ fn plot_png(
         },
     );
     let path = dir.join(name);
-    crate::render::image_io::write_png_rgb8(&path, img.width, img.height, &img.data)
+    crate::picture::png::write_png_rgb8(&path, img.width, img.height, &img.data)
         .map_err(|e| format!("{}: {e}", path.display()))
 }
 
@@ -574,7 +578,7 @@ pub fn run_report(
         rows.push(row);
         let sheet = side_by_side(&rt.truth, &maps);
         let file = format!("fit_{}.png", name.replace(' ', "_"));
-        crate::render::image_io::write_png_rgb8(
+        crate::picture::png::write_png_rgb8(
             &plots.join(&file),
             sheet.width,
             sheet.height,
@@ -751,22 +755,20 @@ pub fn readme_figure(base: &Path, work: &Path, spec: &SweepSpec) -> Result<(), S
         Ok(Rgb8 {
             width: fw as u32,
             height: fh as u32,
-            data: crate::render::image_io::to_srgb8(&px, 0.0),
+            data: crate::picture::srgb::to_srgb8(&px, 0.0),
         })
     };
     let measured = frame(&w.join("truth"), &w.join("render_truth"))?;
     let refit = frame(&fit_dir, &w.join("render_fit"))?;
     let k = spec.px_per_texel as u32;
+    let enc = Srgb8::new();
     let big = |v: &[Vec3], f: &dyn Fn(Vec3) -> Vec3| {
         let n = maps.width as u32;
         let mut data = Vec::with_capacity((n * k * n * k * 3) as usize);
         for y in 0..n * k {
             for x in 0..n * k {
                 let c = f(v[((y / k) * n + x / k) as usize]);
-                data.extend(
-                    c.to_array()
-                        .map(|x| (linear_to_srgb(x) * 255.0 + 0.5) as u8),
-                );
+                data.extend(c.to_array().map(|x| enc.encode(x)));
             }
         }
         Rgb8 {
@@ -794,6 +796,6 @@ pub fn readme_figure(base: &Path, work: &Path, spec: &SweepSpec) -> Result<(), S
     .collect();
     let sheet = contact_sheet_rows(&thumbs, &labels, 5, 4);
     let path = base.join("notes/images/fit_maple.png");
-    crate::render::image_io::write_png_rgb8(&path, sheet.width, sheet.height, &sheet.data)
+    crate::picture::png::write_png_rgb8(&path, sheet.width, sheet.height, &sheet.data)
         .map_err(|e| format!("{}: {e}", path.display()))
 }

@@ -405,7 +405,7 @@ mod glb_tests {
         let (w, h, px) = render_glb(&glb, 480).unwrap();
         let out =
             std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("notes/images/gltf_board.png");
-        crate::render::image_io::write_png_linear(&out, w, h, &px, 0.0).unwrap();
+        crate::picture::png::write_png_linear(&out, w, h, &px, 0.0).unwrap();
     }
 
     #[test]

@@ -594,7 +594,7 @@ pub fn median_srgb(img: &Image, set: &[bool], exposure: f32) -> f64 {
     let k = 2f32.powf(exposure);
     let mut v: Vec<f32> = (img.beauty.iter().zip(set))
         .filter(|(_, &s)| s)
-        .map(|(c, _)| crate::render::image_io::linear_to_srgb(luminance(*c) * k))
+        .map(|(c, _)| crate::picture::srgb::linear_to_srgb(luminance(*c) * k))
         .collect();
     if v.is_empty() {
         return 0.0;

@@ -267,7 +267,7 @@ fn write_plot(
     if let Some(p) = path.parent() {
         std::fs::create_dir_all(p).map_err(|e| err(e.to_string()))?;
     }
-    crate::render::image_io::write_png_rgb8(&path, img.width, img.height, &img.data)
+    crate::picture::png::write_png_rgb8(&path, img.width, img.height, &img.data)
         .map_err(|e| err(e.to_string()))
 }
 

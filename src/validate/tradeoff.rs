@@ -7,7 +7,7 @@ use crate::bsdf::FinishModel;
 use crate::field::JacobianModel;
 use crate::material::{BakedFibers, BakedWoodMaterial, FaceRect, Material};
 use crate::math::luminance;
-use crate::render::image_io::linear_to_srgb;
+use crate::picture::srgb::linear_to_srgb;
 use crate::render::{render, RunOptions};
 use crate::scene::LoadedScene;
 use crate::wood::{NoiseParams, WoodParams, WoodVolume};

@@ -1,0 +1,305 @@
+//! PNG files: 8-bit RGB images (sRGB-tagged colour or untagged data maps), previews of linear
+//! buffers, looping animated PNGs (APNG), and reading 8-bit PNGs back. Every file is written
+//! whole or not at all through [`super::file::stage`].
+
+use super::contact::Rgb8;
+use super::file::{commit, stage, ImageError};
+use super::srgb::to_srgb8;
+use crate::output::Staged;
+use glam::Vec3;
+use std::path::Path;
+
+/// How a PNG labels its samples: colour images carry an `sRGB` chunk; data maps (normals,
+/// anisotropy, roughness, masks) carry no colour-space chunk at all (no `sRGB`, `gAMA`, `cHRM`
+/// or `iCCP`), as glTF 2.0 §5.22 ("Image") asks of every image a glTF asset embeds: the asset,
+/// not the file, says how the samples are meant.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PngTag {
+    /// A colour image: sRGB-encoded samples, with an `sRGB` chunk.
+    Srgb,
+    /// A data map: no colour-space chunk.
+    Untagged,
+}
+
+/// An 8-bit RGB encoder of `width × height` with the colour-space chunk of `tag`.
+fn encoder<W: std::io::Write>(
+    out: W,
+    width: u32,
+    height: u32,
+    tag: PngTag,
+) -> png::Encoder<'static, W> {
+    let mut enc = png::Encoder::new(out, width, height);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    if tag == PngTag::Srgb {
+        enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+    }
+    enc
+}
+
+/// Encodes 8-bit RGB bytes (row-major, top row first) as a PNG into `out`.
+pub fn encode_png_rgb8(
+    out: impl std::io::Write,
+    width: u32,
+    height: u32,
+    rgb: &[u8],
+    tag: PngTag,
+) -> Result<(), png::EncodingError> {
+    let mut w = encoder(out, width, height, tag).write_header()?;
+    w.write_image_data(rgb)?;
+    w.finish()
+}
+
+/// Checks that `rgb` holds `width × height` RGB pixels, naming `path` if not.
+fn check_rgb8(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<(), ImageError> {
+    let want = width as usize * height as usize;
+    if rgb.len() == want * 3 {
+        return Ok(());
+    }
+    Err(ImageError::Size {
+        path: path.display().to_string(),
+        width,
+        height,
+        got: rgb.len() / 3,
+        want,
+    })
+}
+
+fn png_error(path: &Path) -> impl Fn(png::EncodingError) -> ImageError + '_ {
+    move |source| ImageError::Png {
+        path: path.display().to_string(),
+        source,
+    }
+}
+
+fn stage_png_tagged(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgb: &[u8],
+    tag: PngTag,
+) -> Result<Staged, ImageError> {
+    check_rgb8(path, width, height, rgb)?;
+    stage(path, |out| {
+        encode_png_rgb8(out, width, height, rgb, tag).map_err(png_error(path))
+    })
+}
+
+/// Encodes an sRGB-tagged PNG into a uniquely named temporary file beside `path`, to
+/// [`commit`] later.
+pub fn stage_png_rgb8(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgb: &[u8],
+) -> Result<Staged, ImageError> {
+    stage_png_tagged(path, width, height, rgb, PngTag::Srgb)
+}
+
+/// Writes 8-bit sRGB bytes as an sRGB-tagged PNG, whole or not at all.
+pub fn write_png_rgb8(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<(), ImageError> {
+    commit(stage_png_rgb8(path, width, height, rgb)?)
+}
+
+/// Writes 8-bit codes of a data map (no transfer curve) as an untagged PNG ([`PngTag`]), whole
+/// or not at all.
+pub fn write_png_data8(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<(), ImageError> {
+    commit(stage_png_tagged(
+        path,
+        width,
+        height,
+        rgb,
+        PngTag::Untagged,
+    )?)
+}
+
+/// Writes a linear RGB buffer as an sRGB PNG preview with exposure `exposure` stops.
+pub fn write_png_linear(
+    path: &Path,
+    width: u32,
+    height: u32,
+    pixels: &[Vec3],
+    exposure: f32,
+) -> Result<(), ImageError> {
+    write_png_rgb8(path, width, height, &to_srgb8(pixels, exposure))
+}
+
+/// [`write_png_linear`] staged, to [`commit`] later.
+pub fn stage_png_linear(
+    path: &Path,
+    width: u32,
+    height: u32,
+    pixels: &[Vec3],
+    exposure: f32,
+) -> Result<Staged, ImageError> {
+    stage_png_rgb8(path, width, height, &to_srgb8(pixels, exposure))
+}
+
+/// Writes `frames` (all the same size) as a looping, sRGB-tagged animated PNG (APNG: `acTL`,
+/// `fcTL` and `fdAT` chunks), `fps` frames per second, whole or not at all.
+pub fn write_apng(path: &Path, frames: &[Rgb8], fps: u16) -> Result<(), ImageError> {
+    let invalid = |what: String| ImageError::Invalid {
+        path: path.display().to_string(),
+        what,
+    };
+    let first = frames
+        .first()
+        .ok_or_else(|| invalid("an animation needs at least one frame".into()))?;
+    for (k, f) in frames.iter().enumerate() {
+        if (f.width, f.height) != (first.width, first.height) {
+            return Err(invalid(format!(
+                "frame {k} is {}x{}, frame 0 {}x{}",
+                f.width, f.height, first.width, first.height
+            )));
+        }
+        check_rgb8(path, f.width, f.height, &f.data)?;
+    }
+    let staged = stage(path, |out| {
+        let err = png_error(path);
+        let mut enc = encoder(out, first.width, first.height, PngTag::Srgb);
+        enc.set_animated(frames.len() as u32, 0).map_err(&err)?;
+        enc.set_frame_delay(1, fps.max(1)).map_err(&err)?;
+        let mut w = enc.write_header().map_err(&err)?;
+        for f in frames {
+            w.write_image_data(&f.data).map_err(&err)?;
+        }
+        w.finish().map_err(&err)
+    })?;
+    commit(staged)
+}
+
+/// Reads an 8-bit PNG as RGB: RGBA loses its alpha, grey is repeated in R, G and B, palettes
+/// are expanded and 16-bit samples keep their high byte.
+pub fn read_png_rgb8(path: &Path) -> Result<Rgb8, ImageError> {
+    let name = path.display().to_string();
+    let decode = |source| ImageError::PngRead {
+        path: name.clone(),
+        source,
+    };
+    let file = std::fs::File::open(path).map_err(|source| ImageError::Io {
+        path: name.clone(),
+        source,
+    })?;
+    let mut dec = png::Decoder::new(std::io::BufReader::new(file));
+    dec.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
+    let mut reader = dec.read_info().map_err(decode)?;
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).map_err(decode)?;
+    buf.truncate(info.buffer_size());
+    let data = match info.color_type {
+        png::ColorType::Rgb => buf,
+        png::ColorType::Rgba => buf
+            .chunks_exact(4)
+            .flat_map(|p| [p[0], p[1], p[2]])
+            .collect(),
+        png::ColorType::Grayscale => buf.iter().flat_map(|&g| [g, g, g]).collect(),
+        png::ColorType::GrayscaleAlpha => buf
+            .chunks_exact(2)
+            .flat_map(|p| [p[0], p[0], p[0]])
+            .collect(),
+        png::ColorType::Indexed => {
+            return Err(ImageError::Invalid {
+                path: name,
+                what: "indexed colour was not expanded".into(),
+            })
+        }
+    };
+    Ok(Rgb8 {
+        width: info.width,
+        height: info.height,
+        data,
+    })
+}
+
+/// The chunk types of a PNG byte stream in order (PNG spec §5.3: after the 8-byte signature,
+/// length, type, data, CRC), e.g. to check which colour-space chunks a file carries.
+pub fn png_chunk_types(bytes: &[u8]) -> Vec<String> {
+    let mut at = 8;
+    let mut out = Vec::new();
+    while at + 8 <= bytes.len() {
+        let len = u32::from_be_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+        out.push(String::from_utf8_lossy(&bytes[at + 4..at + 8]).into_owned());
+        at += 12 + len;
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn data_pngs_carry_no_colour_space_chunk() {
+        let rgb = [10u8, 128, 255, 0, 0, 0];
+        let chunks = |tag| {
+            let mut v = Vec::new();
+            encode_png_rgb8(&mut v, 2, 1, &rgb, tag).unwrap();
+            png_chunk_types(&v)
+        };
+        let (srgb, data) = (chunks(PngTag::Srgb), chunks(PngTag::Untagged));
+        assert!(srgb.iter().any(|c| c == "sRGB"), "{srgb:?}");
+        for c in ["sRGB", "gAMA", "cHRM", "iCCP"] {
+            assert!(!data.iter().any(|d| d == c), "{c} in {data:?}");
+        }
+        assert_eq!(data.first().map(String::as_str), Some("IHDR"));
+        assert_eq!(data.last().map(String::as_str), Some("IEND"));
+    }
+
+    #[test]
+    fn png_round_trip_and_size_check() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("t.png");
+        let px = vec![Vec3::new(1.0, 0.5, 0.0); 6];
+        write_png_linear(&p, 3, 2, &px, 0.0).unwrap();
+        let img = read_png_rgb8(&p).unwrap();
+        assert_eq!((img.width, img.height), (3, 2));
+        // round(255 · encode(0.5)) = round(255 · 0.735357) = 188 (IEC 61966-2-1).
+        assert_eq!(&img.data[..3], &[255, 188, 0]);
+        let e = write_png_linear(&p, 4, 2, &px, 0.0).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                ImageError::Size {
+                    want: 8,
+                    got: 6,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        // Only the final name is left: no temporary survives a write or a refused one.
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn animated_png_holds_every_frame_and_refuses_mixed_sizes() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("a.png");
+        let frames: Vec<Rgb8> = (0..3u8)
+            .map(|k| Rgb8::filled(2, 2, [k * 100, 7, 255 - k]))
+            .collect();
+        write_apng(&p, &frames, 12).unwrap();
+        let chunks = png_chunk_types(&std::fs::read(&p).unwrap());
+        let count = |t: &str| chunks.iter().filter(|c| *c == t).count();
+        assert_eq!((count("acTL"), count("fcTL"), count("fdAT")), (1, 3, 2));
+        let mut r = png::Decoder::new(std::fs::File::open(&p).unwrap())
+            .read_info()
+            .unwrap();
+        assert_eq!(r.info().animation_control.unwrap().num_frames, 3);
+        let mut buf = vec![0; r.output_buffer_size()];
+        for f in &frames {
+            r.next_frame(&mut buf).unwrap();
+            assert_eq!(buf, f.data);
+        }
+        let mut mixed = frames.clone();
+        mixed.push(Rgb8::filled(3, 2, [0, 0, 0]));
+        let e = write_apng(&p, &mixed, 12).unwrap_err();
+        assert!(e.to_string().contains("frame 3 is 3x2"), "{e}");
+        assert!(matches!(
+            write_apng(&p, &[], 12),
+            Err(ImageError::Invalid { .. })
+        ));
+        // The refused writes left the earlier animation whole.
+        assert_eq!(read_png_rgb8(&p).unwrap(), frames[0]);
+    }
+}
