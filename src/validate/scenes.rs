@@ -380,10 +380,11 @@ fn band_pattern(
 /// The curl's chatoyance: `a` and `b` are one scene rendered with the light on either side
 /// along the fibre; `band_mm` is the curl kernel's extent along the fibre (the tangential
 /// distortion's z semi-axis S_z, tree mm = world mm). Windows: across the fibre ± S_z / 2 (the
-/// bands are 25–60 mm long that way, so this only averages noise), along it ± 2 S_z, i.e. twice
-/// a band pair: one kernel's slope ∂m/∂z, which tilts the fibre, is one bright and one dark band
-/// over its 2 S_z (Liu et al. 2016 §5.1, eq. 15), so the window keeps the bands and removes the
-/// shading's slower change. Pixel pitch: the median world distance between horizontally
+/// bands are 25–60 mm long that way, so this only averages noise), along it ± S_z, i.e. one band
+/// pair: one kernel's slope ∂m/∂z, which tilts the fibre, is one bright and one dark band over
+/// its 2 S_z (Liu et al. 2016 §5.1, eq. 15), so the window is the shortest that keeps a whole
+/// band pair, and removes what changes more slowly along the fibre: the shading, and the radial
+/// distortion's wander, whose kernels are 12 mm along z (curly_maple), twice the curl's. Pixel pitch: the median world distance between horizontally
 /// neighbouring pixels of `set`.
 pub fn curl_flip(
     a: &Image,
@@ -412,7 +413,7 @@ pub fn curl_flip(
         return none;
     };
     let px = |mm_len: f64| ((mm_len / mm as f64).round() as i32).max(1);
-    let (along, across) = (px(2.0 * band_mm), px(0.5 * band_mm));
+    let (along, across) = (px(band_mm), px(0.5 * band_mm));
     let (ha, hb) = (
         band_pattern(a, set, film, along, across),
         band_pattern(b, set, film, along, across),
@@ -868,7 +869,13 @@ pub fn measure(
                     let lights: Vec<Light> = (scene.lights.iter().cloned())
                         .chain(mirrored_x(&scene.lights))
                         .collect();
-                    let set = without_glints(scene, &hits, &on(&["bowl"]), &lights);
+                    // Judged on the bowl's floor (faces within 25° of up): the face the scene
+                    // cuts quartersawn, normal along θ̂, where the curl's tangential dips tilt
+                    // the fibre out of the surface. On the walls the face turns towards r̂ (where
+                    // the radial distortion's wander tilts the fibre out of it as well) and
+                    // towards the fibre, and the coat's highlights and the rim sit there.
+                    let floor = mask(&hits, &bowl, Some(Vec3::Z));
+                    let set = without_glints(scene, &hits, &floor, &lights);
                     curl_flip(img, b, &hits, &set, &scene.camera.frame, mm as f64)
                 }
                 _ => CurlFlip {
@@ -880,12 +887,13 @@ pub fn measure(
             vec![
                 lit("bowl", &["bowl"]),
                 Measure {
-                    what: "curl bands flipping with the light, Weber contrast".into(),
+                    what: "curl bands on the floor flipping with the light, Weber contrast".into(),
                     value: flip.weber,
                     limit: Limit::AtLeast(VISIBLE_WEBER),
                 },
                 Measure {
-                    what: "curl band patterns, light on either side, correlation".into(),
+                    what: "curl band patterns on the floor, light on either side, correlation"
+                        .into(),
                     value: flip.correlation,
                     limit: Limit::AtMost(MAX_CURL_CORRELATION),
                 },
@@ -1025,11 +1033,11 @@ mod tests {
     #[test]
     fn curl_flip_of_swapping_bands() {
         // Bands across a fibre along x, period 7 px = 7 mm (pitch 1 mm): 1 ± 0.2 sin(2π x / 7).
-        // band_mm 5 gives windows ±10 px along (21 = 3 periods, so the mean is exactly 1) and ±3
+        // band_mm 3 gives windows ±3 px along (7 = 1 period, so the mean is exactly 1) and ±2
         // across: h = ±0.2 sin, amplitude 0.2, Weber 2 · 0.2 / 1.2 = 1/3; correlation −1 when the
         // bands swap, +1 (and no flipping part) when they stay.
-        // 62 columns: the judged ones (x = 10–51) are 6 whole periods, so their RMS is a/√2.
-        let (w, h) = (62u32, 30u32);
+        // 48 columns: the judged ones (x = 3–44) are 6 whole periods, so their RMS is a/√2.
+        let (w, h) = (48u32, 30u32);
         let band = |sign: f32| {
             move |x: u32, _| 1.0 + sign * 0.2 * (std::f32::consts::TAU * x as f32 / 7.0).sin()
         };
@@ -1049,10 +1057,10 @@ mod tests {
             n: -Vec3::Z,
         };
         let set = vec![true; (w * h) as usize];
-        let f = curl_flip(&a, &b, &hits, &set, &film, 5.0);
+        let f = curl_flip(&a, &b, &hits, &set, &film, 3.0);
         assert!((f.weber - 1.0 / 3.0).abs() < 1e-4, "{f:?}");
         assert!((f.correlation + 1.0).abs() < 1e-4, "{f:?}");
-        let same = curl_flip(&a, &a, &hits, &set, &film, 5.0);
+        let same = curl_flip(&a, &a, &hits, &set, &film, 3.0);
         assert!(
             same.weber < 1e-6 && (same.correlation - 1.0).abs() < 1e-6,
             "{same:?}"
