@@ -547,13 +547,14 @@ pub fn sphere_line_misses(ray: &Ray, center: Vec3, radius: f32) -> bool {
 
 /// Nearest positive distance at which `ray` (unit direction) meets a sphere.
 pub fn intersect_sphere(ray: &Ray, center: Vec3, radius: f32) -> Option<f32> {
-    if sphere_line_misses(ray, center, radius) {
-        return None;
-    }
     let oc = ray.o - center;
     let b = oc.dot(ray.d);
-    let c = oc.length_squared() - radius * radius;
+    // The test of `sphere_line_misses`, on the same values.
     let disc = sphere_discriminant(oc, b, ray.d, radius);
+    if disc < 0.0 {
+        return None;
+    }
+    let c = oc.length_squared() - radius * radius;
     let q = -b - b.signum() * disc.sqrt();
     let (t0, t1) = if q != 0.0 { (c / q, q) } else { (-b, -b) };
     let (t0, t1) = (t0.min(t1), t0.max(t1));
