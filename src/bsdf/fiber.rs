@@ -5,7 +5,8 @@
 //! derived in notes/bsdf.md.
 
 use super::rough_transmission::TransmittedPart;
-use crate::math::{safe_asin, safe_sqrt, Frame, PI};
+use crate::math::elementary::{acos, asin, exp, sin_cos};
+use crate::math::{safe_sqrt, Frame, PI};
 use glam::{Vec2, Vec3};
 
 /// How the fibre lobe is normalised.
@@ -52,10 +53,18 @@ pub struct FiberAxis {
     frame: Frame,
 }
 
+/// cos x by the polynomial of [`sin_cos`]: the lobe's transcendental functions are all
+/// `math::elementary`'s, which vectorise in [`FiberAxis::eval_pdf_many_at`]'s loops and give the
+/// same bits there as in the one-direction forms.
+#[inline(always)]
+fn cos(x: f32) -> f32 {
+    sin_cos(x).1
+}
+
 /// Normalised Gaussian g(β, x) = exp(−x²/2β²) / (β√(2π)) (Marschner et al. 2005, §4.2).
 #[inline]
 pub fn gaussian(beta: f32, x: f32) -> f32 {
-    gaussian_scale(beta, gaussian_exponent(beta, x).exp())
+    gaussian_scale(beta, exp(gaussian_exponent(beta, x)))
 }
 
 /// Directions per call of [`FiberAxis::eval_pdf_many_at`] (its columns live on the stack).
@@ -79,8 +88,8 @@ fn gaussian_scale(beta: f32, e: f32) -> f32 {
 #[inline(always)]
 fn lobe_cos(norm: FiberNormalization, psi_i: f32, at: &FiberAtWo) -> f32 {
     match norm {
-        FiberNormalization::EnergyBounded => psi_i.cos(),
-        FiberNormalization::Published => (0.5 * (at.psi_r - psi_i)).cos(),
+        FiberNormalization::EnergyBounded => cos(psi_i),
+        FiberNormalization::Published => cos(0.5 * (at.psi_r - psi_i)),
     }
 }
 
@@ -103,7 +112,7 @@ fn arc_from_argument(t: f32) -> f32 {
     } else if t >= 1.0 {
         0.0
     } else {
-        t.acos()
+        acos(t)
     }
 }
 
@@ -181,7 +190,7 @@ impl FiberAxis {
     /// Longitudinal angle ψ = asin(ω·u) (Marschner et al. 2005, eq. 2).
     #[inline]
     fn psi(&self, w: Vec3) -> f32 {
-        safe_asin(w.dot(self.frame.n))
+        asin(w.dot(self.frame.n))
     }
 
     /// The lobe without its colour k_f, for interior directions `wo`, `wi`.
@@ -190,11 +199,11 @@ impl FiberAxis {
         let g = gaussian(beta, psi_i + psi_r);
         match norm {
             FiberNormalization::EnergyBounded => {
-                let c = psi_i.cos().max(psi_r.cos()).max(MIN_COS_PSI);
+                let c = cos(psi_i).max(cos(psi_r)).max(MIN_COS_PSI);
                 g / (2.0 * PI * c)
             }
             FiberNormalization::Published => {
-                let c = (0.5 * (psi_r - psi_i)).cos();
+                let c = cos(0.5 * (psi_r - psi_i));
                 g / (c * c).max(MIN_COS_PSI * MIN_COS_PSI)
             }
         }
@@ -210,7 +219,7 @@ impl FiberAxis {
             let cos2 = 1.0 - mean * mean;
             PsiSpread {
                 share: p.share,
-                psi: mean.asin(),
+                psi: asin(mean),
                 cos_psi: cos2.sqrt(),
                 var: var / cos2,
             }
@@ -257,7 +266,7 @@ impl FiberAxis {
         let psi_r = self.psi(wo);
         FiberAtWo {
             psi_r,
-            cos_psi_r: psi_r.cos(),
+            cos_psi_r: cos(psi_r),
         }
     }
 
@@ -273,8 +282,8 @@ impl FiberAxis {
         z_min: f32,
     ) -> (f32, f32) {
         let sin_psi = wi.dot(self.frame.n);
-        let psi_i = safe_asin(sin_psi);
-        let g = gaussian_scale(beta, gaussian_exponent(beta, psi_i + at.psi_r).exp());
+        let psi_i = asin(sin_psi);
+        let g = gaussian_scale(beta, exp(gaussian_exponent(beta, psi_i + at.psi_r)));
         let f = lobe_value(norm, g, lobe_cos(norm, psi_i, at), at);
         // As in `pdf`: sin ψi clamped, ψi = asin of it (= `psi(wi)`), so g is the same; the arc
         // (an acos) only where `pdf_value` needs it.
@@ -310,13 +319,13 @@ impl FiberAxis {
             sin_psi[k] = wi[k].dot(self.frame.n);
         }
         for k in 0..n {
-            psi[k] = safe_asin(sin_psi[k]);
+            psi[k] = asin(sin_psi[k]);
         }
         for k in 0..n {
             g[k] = gaussian_exponent(beta, psi[k] + at.psi_r);
         }
         for x in &mut g[..n] {
-            *x = x.exp();
+            *x = exp(*x);
         }
         for k in 0..n {
             g[k] = gaussian_scale(beta, g[k]);
@@ -396,7 +405,7 @@ impl FiberAxis {
         if !(psi_i.abs() < 0.5 * PI) {
             return None;
         }
-        let (sin_psi, cos_psi) = psi_i.sin_cos();
+        let (sin_psi, cos_psi) = sin_cos(psi_i);
         if cos_psi < MIN_COS_PSI {
             return None;
         }
@@ -410,7 +419,7 @@ impl FiberAxis {
             return None;
         }
         let phi = phi0 + offset;
-        let (sp, cp) = phi.sin_cos();
+        let (sp, cp) = sin_cos(phi);
         let w = sin_psi * self.frame.n + cos_psi * (cp * self.frame.s + sp * self.frame.t);
         if !(w.z > z_min) {
             return None;
@@ -438,7 +447,7 @@ impl FiberAxis {
         if delta <= 0.0 {
             return 0.0;
         }
-        gaussian(beta, sin_psi.asin() + psi_r) / (2.0 * delta.max(MIN_ARC) * cos_psi)
+        gaussian(beta, asin(sin_psi) + psi_r) / (2.0 * delta.max(MIN_ARC) * cos_psi)
     }
 }
 

@@ -609,18 +609,22 @@ impl WoodAtWo<'_> {
                 wi_in[k] = refract_in(wi[k], p.eta);
             }
             let wi_in = &wi_in[..n];
-            let lobe = |axis: &FiberAxis, at: &FiberAtWo, in_f: bool, in_pdf: bool| {
-                let (mut f, mut pdf) = ([0.0; BATCH], [0.0; BATCH]);
-                if in_f || (with_pdf && in_pdf) {
-                    let (beta, norm) = (p.highlight_width, b.norm);
-                    axis.eval_pdf_many_at(
-                        at, wi_in, beta, norm, b.z_crit, with_pdf, &mut f, &mut pdf,
-                    );
-                }
-                (f, pdf)
-            };
-            let (f_fib, p_fib) = lobe(&b.fiber, &self.fiber, p.ray_mask < 1.0, probs.fiber > 0.0);
-            let (f_ray, p_ray) = lobe(&b.ray, &self.ray, p.ray_mask > 0.0, probs.ray > 0.0);
+            let (f_fib, p_fib) = self.lobe_many(
+                &b.fiber,
+                &self.fiber,
+                wi_in,
+                with_pdf,
+                p.ray_mask < 1.0,
+                probs.fiber > 0.0,
+            );
+            let (f_ray, p_ray) = self.lobe_many(
+                &b.ray,
+                &self.ray,
+                wi_in,
+                with_pdf,
+                p.ray_mask > 0.0,
+                probs.ray > 0.0,
+            );
             let mut t = [0.0; BATCH];
             for k in 0..n {
                 t[k] = self.transmission(wi[k].z);
@@ -638,6 +642,30 @@ impl WoodAtWo<'_> {
                 }
             }
         }
+    }
+
+    /// One fibre lobe (`axis`, seen from `at`) at up to [`BATCH`] interior directions, its
+    /// values and densities, or zeros where neither is needed (`in_f`: the lobe is in f;
+    /// `in_pdf`: it is sampled). A method rather than a closure so that it inlines into the
+    /// caller's SIMD level.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn lobe_many(
+        &self,
+        axis: &FiberAxis,
+        at: &FiberAtWo,
+        wi_in: &[Vec3],
+        with_pdf: bool,
+        in_f: bool,
+        in_pdf: bool,
+    ) -> ([f32; BATCH], [f32; BATCH]) {
+        let b = self.bsdf;
+        let (mut f, mut pdf) = ([0.0; BATCH], [0.0; BATCH]);
+        if in_f || (with_pdf && in_pdf) {
+            let (beta, norm) = (b.params.highlight_width, b.norm);
+            axis.eval_pdf_many_at(at, wi_in, beta, norm, b.z_crit, with_pdf, &mut f, &mut pdf);
+        }
+        (f, pdf)
     }
 
     /// T(θo) T(θi) / η², the finish's share of f (notes/bsdf.md eq. 1.4) for cos θi = `wi_z`.
