@@ -16,11 +16,11 @@ use xylem::validate::scenes::{measure, measure_rendered, Measure};
 /// of the ring a pixel is on, does not move the ring contrast's means.
 /// The bowl's curl is judged on its floor (the quartersawn face): flipping-band Weber 0.166 and
 /// band correlation −0.935 here; the curl-free control fails (0.019, `bowl_check_fails_without_
-/// the_curl`). Measured but not yet asserted (open, notes/scenes.md "Open"):
-/// `cornell_wood_marble`'s rings (Weber 0.07–0.08 on its three wooden surfaces) and the blue
-/// variant's cooler light on the wood.
+/// the_curl`). `cornell_wood_marble`'s rings (knotty pine, magnified; notes/scenes.md
+/// "cornell_wood_marble's rings") are checked on its floor and both side walls, like
+/// `cornell_bunny`'s.
 #[allow(clippy::type_complexity)]
-const CASES: [(&str, u32, Option<u32>, &[&str]); 14] = [
+const CASES: [(&str, u32, Option<u32>, &[&str]); 15] = [
     ("cornell_box", 2, None, &[]),
     ("sweep_board", 4, Some(8), &[]),
     ("parquet_floor", 1, Some(4), &[]),
@@ -29,6 +29,7 @@ const CASES: [(&str, u32, Option<u32>, &[&str]); 14] = [
     ("turned_bowl", 2, Some(16), &["median", "curl band"]),
     ("teapot", 4, Some(16), &[]),
     ("cornell_wood_marble", 4, None, &["firefly"]),
+    ("cornell_wood_marble", 2, Some(16), &["rings"]),
     ("cornell_bunny", 4, None, &["firefly"]),
     ("cornell_bunny", 2, Some(16), &["rings"]),
     ("cornell_bunny_black", 4, None, &["firefly"]),
