@@ -134,8 +134,10 @@ fn scenes(out: &Path, only: &[String]) -> anyhow::Result<bool> {
             s.exposure,
         )?;
         if let Some(c) = companion {
-            // The check's second render (turned_bowl: the key light mirrored along the fibre).
-            let png = out.join(format!("{name}_light_mirrored.png"));
+            // The check's second render (turned_bowl: the key light mirrored along the fibre;
+            // cornell_bunny: without its background).
+            let label = crate::validate::scenes::companion_label(name);
+            let png = out.join(format!("{name}_{label}.png"));
             write_png_rgb8(&png, w, h, &to_srgb8(&c.beauty, s.exposure))?;
         }
         let secs = r.elapsed.as_secs_f64();
