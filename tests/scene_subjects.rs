@@ -16,11 +16,13 @@ use xylem::validate::scenes::{measure, measure_rendered, Measure};
 /// of the ring a pixel is on, does not move the ring contrast's means.
 /// The bowl's curl is judged on its floor (the quartersawn face): flipping-band Weber 0.166 and
 /// band correlation −0.935 here; the curl-free control fails (0.019, `bowl_check_fails_without_
-/// the_curl`). Measured but not yet asserted (open, notes/scenes.md "Open"):
-/// `cornell_wood_marble`'s rings (Weber 0.07–0.08 on its three wooden surfaces) and the blue
-/// variant's cooler light on the wood.
+/// the_curl`). `cornell_wood_marble`'s rings (knotty pine, magnified; notes/scenes.md
+/// "cornell_wood_marble's rings") are checked on its floor and both side walls, like
+/// `cornell_bunny`'s. The blue lighting variant's light on the wood is checked against the same
+/// scene rendered without its background (cooler by ≥ 5 standard errors; the broken version is
+/// `blue_variant_check_fails_with_a_black_background`).
 #[allow(clippy::type_complexity)]
-const CASES: [(&str, u32, Option<u32>, &[&str]); 14] = [
+const CASES: [(&str, u32, Option<u32>, &[&str]); 15] = [
     ("cornell_box", 2, None, &[]),
     ("sweep_board", 4, Some(8), &[]),
     ("parquet_floor", 1, Some(4), &[]),
@@ -29,8 +31,9 @@ const CASES: [(&str, u32, Option<u32>, &[&str]); 14] = [
     ("turned_bowl", 2, Some(16), &["median", "curl band"]),
     ("teapot", 4, Some(16), &[]),
     ("cornell_wood_marble", 4, None, &["firefly"]),
+    ("cornell_wood_marble", 2, Some(16), &["rings"]),
     ("cornell_bunny", 4, None, &["firefly"]),
-    ("cornell_bunny", 2, Some(16), &["rings"]),
+    ("cornell_bunny", 2, Some(16), &["rings", "light on"]),
     ("cornell_bunny_black", 4, None, &["firefly"]),
     ("cornell_bunny_black", 2, Some(16), &["rings", "light on"]),
     ("dovetail", 2, Some(8), &[]),
@@ -115,6 +118,20 @@ fn subject_checks_fail_on_a_broken_scene() {
     let m = measure("cornell_wood_marble", &s.scene, &names, &img, None, 0.0);
     let firefly = m.iter().find(|m| m.what.starts_with("firefly")).unwrap();
     assert!(!firefly.pass(), "{firefly}");
+}
+
+/// The blue variant's check needs its blue background: with the background black (its colour
+/// [0, 0, 0], the lights otherwise as shipped) the light on the wood is no cooler than without
+/// it, so the "cooler, in standard errors" figure stays below 5.
+#[test]
+fn blue_variant_check_fails_with_a_black_background() {
+    let blue = "color = [0.35, 0.55, 1.0]";
+    let m = measured("cornell_bunny", 2, Some(16), |text| {
+        assert!(text.contains(blue));
+        text.replace(blue, "color = [0.0, 0.0, 0.0]")
+    });
+    let cooler = m.iter().find(|m| m.what.starts_with("light on")).unwrap();
+    assert!(!cooler.pass(), "{cooler}");
 }
 
 /// The Cornell box's bleeding check needs the coloured walls: with the red wall white, the

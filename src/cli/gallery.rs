@@ -94,9 +94,7 @@ fn scenes(out: &Path, only: &[String]) -> anyhow::Result<bool> {
     } else {
         only.iter().map(String::as_str).collect()
     };
-    let mut table = String::from(
-        "| scene | size, spp | render time | subject check |\n| --- | --- | --- | --- |\n",
-    );
+    let mut rows: Vec<(String, String)> = Vec::new();
     let mut ok = true;
     let bar = super::progress::Bar::new(true);
     for name in names {
@@ -136,8 +134,10 @@ fn scenes(out: &Path, only: &[String]) -> anyhow::Result<bool> {
             s.exposure,
         )?;
         if let Some(c) = companion {
-            // The check's second render (turned_bowl: the key light mirrored along the fibre).
-            let png = out.join(format!("{name}_light_mirrored.png"));
+            // The check's second render (turned_bowl: the key light mirrored along the fibre;
+            // cornell_bunny: without its background).
+            let label = crate::validate::scenes::companion_label(name);
+            let png = out.join(format!("{name}_{label}.png"));
             write_png_rgb8(&png, w, h, &to_srgb8(&c.beauty, s.exposure))?;
         }
         let secs = r.elapsed.as_secs_f64();
@@ -147,16 +147,56 @@ fn scenes(out: &Path, only: &[String]) -> anyhow::Result<bool> {
             ok &= m.pass();
         }
         let checks: Vec<String> = measures.iter().map(|m| m.to_string()).collect();
-        writeln!(
-            table,
-            "| `{name}` | {w}×{h}, {} | {secs:.1} s | {} |",
-            s.settings.spp,
-            checks.join("; ")
-        )?;
+        rows.push((
+            name.to_string(),
+            format!(
+                "| `{name}` | {w}×{h}, {} | {secs:.1} s | {} |",
+                s.settings.spp,
+                checks.join("; ")
+            ),
+        ));
     }
-    crate::output::write_atomic(&out.join("checks.md"), table.as_bytes())
-        .with_context(|| format!("writing {}", out.join("checks.md").display()))?;
+    let file = out.join("checks.md");
+    // With --scene, the other scenes' rows of an earlier run stay.
+    let old = if only.is_empty() {
+        String::new()
+    } else {
+        std::fs::read_to_string(&file).unwrap_or_default()
+    };
+    crate::output::write_atomic(&file, merge_check_rows(&old, &rows).as_bytes())
+        .with_context(|| format!("writing {}", file.display()))?;
     Ok(ok)
+}
+
+/// The checks table: the rows of `old` (an earlier checks.md; its header and any row that is not
+/// a scene's are dropped) with each scene of `rows` replacing its own row in place, and the
+/// scenes `old` did not have appended in order.
+fn merge_check_rows(old: &str, rows: &[(String, String)]) -> String {
+    let mut table = String::from(
+        "| scene | size, spp | render time | subject check |\n| --- | --- | --- | --- |\n",
+    );
+    let scene_of = |line: &str| {
+        let rest = line.strip_prefix("| `")?;
+        Some(rest[..rest.find('`')?].to_string())
+    };
+    let mut used = vec![false; rows.len()];
+    for line in old.lines() {
+        let Some(name) = scene_of(line) else { continue };
+        let row = match rows.iter().position(|(n, _)| *n == name) {
+            Some(k) => {
+                used[k] = true;
+                rows[k].1.as_str()
+            }
+            None => line,
+        };
+        let _ = writeln!(table, "{row}");
+    }
+    for ((_, row), used) in rows.iter().zip(used) {
+        if !used {
+            let _ = writeln!(table, "{row}");
+        }
+    }
+    table
 }
 
 /// A light sweep over a close-up of each figured preset on the README board, as a looping APNG
@@ -193,4 +233,32 @@ fn sweeps(out: &Path, frames: usize) -> anyhow::Result<()> {
         println!("{name}: sweep close-up written");
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::merge_check_rows;
+
+    #[test]
+    fn merge_keeps_the_other_scenes_rows() {
+        let old =
+            "| scene | size, spp | render time | subject check |\n| --- | --- | --- | --- |\n\
+                   | `a` | 1×1, 1 | 1.0 s | x |\n| `b` | 1×1, 1 | 2.0 s | y |\n";
+        let rows = [
+            ("b".to_string(), "| `b` | 2×2, 2 | 3.0 s | z |".to_string()),
+            ("c".to_string(), "| `c` | 1×1, 1 | 4.0 s | w |".to_string()),
+        ];
+        let t = merge_check_rows(old, &rows);
+        let body: Vec<&str> = t.lines().skip(2).collect();
+        assert_eq!(
+            body,
+            [
+                "| `a` | 1×1, 1 | 1.0 s | x |",
+                "| `b` | 2×2, 2 | 3.0 s | z |",
+                "| `c` | 1×1, 1 | 4.0 s | w |"
+            ]
+        );
+        // No earlier table: the new rows alone, under the header.
+        assert_eq!(merge_check_rows("", &rows).lines().count(), 4);
+    }
 }
