@@ -556,39 +556,48 @@ pub fn light_terms(
     wi.extend((0..n).map(|k| sp.frame.to_local(Vec3::new(wx[k], wy[k], wz[k]))));
     f.resize(n, Vec3::ZERO);
     bsdf_pdf.resize(n, 0.0);
-    bsdf.eval_pdf_many(wi, !ls.is_delta, &mut f[..n], &mut bsdf_pdf[..n]);
+    let (f, bsdf_pdf, wi) = (&mut f[..n], &mut bsdf_pdf[..n], &wi[..n]);
+    let (active, pdf, li, dist) = (&active[..n], &ls.pdf[..n], &ls.li[..n], &ls.dist[..n]);
+    let out = &mut out[..n];
+    bsdf.eval_pdf_many(wi, !ls.is_delta, f, bsdf_pdf);
     for k in 0..n {
-        if !(active[k] && ls.pdf[k] > 0.0 && ls.li[k] != Vec3::ZERO) {
-            f[k] = Vec3::ZERO;
-        }
+        let keep = active[k] & (pdf[k] > 0.0) & (li[k] != Vec3::ZERO);
+        f[k] = if keep { f[k] } else { Vec3::ZERO };
     }
     shadow.culled_many(sp, ls, segments, culled);
     scale.resize(n, 0.0);
+    let scale = &mut scale[..n];
     for k in 0..n {
-        scale[k] = mis_scale(wi[k].z, ls.pdf[k], bsdf_pdf[k], ls.is_delta);
+        scale[k] = mis_scale(wi[k].z, pdf[k], bsdf_pdf[k], ls.is_delta);
+    }
+    // The unoccluded terms of all samples (a loop in lanes), then the few shadow segments the
+    // boxes did not cull traced one by one; inactive samples keep what `out` held.
+    for k in 0..n {
+        // A zero f stays zero whatever the scale (which may be infinite where pdf = 0).
+        let term = if f[k] == Vec3::ZERO {
+            Vec3::ZERO
+        } else {
+            f[k] * li[k] * scale[k]
+        };
+        out[k] = if active[k] { term } else { out[k] };
     }
     for k in 0..n {
-        if !active[k] {
+        if !active[k] || f[k] == Vec3::ZERO {
             continue;
         }
-        out[k] = Vec3::ZERO;
-        if f[k] == Vec3::ZERO {
-            continue;
-        }
-        let d = Vec3::new(wx[k], wy[k], wz[k]);
         rays.0 += 1;
+        let d = Vec3::new(wx[k], wy[k], wz[k]);
         if !culled[k]
             && !shadow.accel.unoccluded(
                 &Ray {
                     o: offset_origin(sp, d),
                     d,
                 },
-                shadow_t_max(ls.dist[k]),
+                shadow_t_max(dist[k]),
             )
         {
-            continue;
+            out[k] = Vec3::ZERO;
         }
-        out[k] = f[k] * ls.li[k] * scale[k];
     }
 }
 
@@ -767,11 +776,14 @@ fn next_event_frames(
         moving_terms,
         rays,
     );
-    for k in (0..n).filter(|&k| alive[k]) {
-        let mut l = Vec3::ZERO;
-        for (j, t) in terms.iter().enumerate() {
-            l += if j == m { moving_terms[k] } else { *t };
-        }
-        nee[k] = l;
+    // Σ_j terms[j] in the lights' order with the moving light's term at j = m: the sum of the
+    // terms before it is the same in every frame, so it is formed once; the same additions in
+    // the same order as summing each frame from scratch, hence the same bits.
+    let before = terms[..m].iter().fold(Vec3::ZERO, |l, t| l + *t);
+    let after = &terms[m + 1..];
+    let (nee, alive, moving_terms) = (&mut nee[..n], &alive[..n], &moving_terms[..n]);
+    for k in 0..n {
+        let l = after.iter().fold(before + moving_terms[k], |l, t| l + *t);
+        nee[k] = if alive[k] { l } else { nee[k] };
     }
 }
