@@ -123,30 +123,23 @@ impl Aov {
     }
 }
 
-/// One pixel's accumulated samples.
+/// One pixel's accumulated radiance samples in one frame (a light sweep keeps one per frame;
+/// the AOVs, the same in every frame, are summed once in a [`PixelSum`]).
 #[derive(Clone, Copy, Debug, Default)]
-pub struct PixelSum {
+pub struct RadianceSum {
     sum: Vec3,
-    /// Σ (luminance)², for the standard error.
-    sum_sq: f64,
-    aov: Aov,
     /// Samples taken (finite or not).
     count: u32,
+    /// Σ (luminance)², for the standard error.
+    sum_sq: f64,
     /// Samples whose radiance was NaN or infinite (dropped).
     pub nonfinite: u32,
 }
 
-impl PixelSum {
+impl RadianceSum {
     /// Adds one sample; non-finite radiance is counted and dropped (it contributes zero).
-    pub fn add(&mut self, radiance: Vec3, aov: &Aov) {
-        self.aov.add(aov);
-        self.add_radiance(radiance);
-    }
-
-    /// Adds one sample's radiance only (a light sweep keeps the AOVs, the same in every frame,
-    /// in one sum of its own).
     #[inline(always)]
-    pub fn add_radiance(&mut self, radiance: Vec3) {
+    pub fn add(&mut self, radiance: Vec3) {
         self.count += 1;
         if radiance.is_finite() {
             self.sum += radiance;
@@ -155,6 +148,31 @@ impl PixelSum {
         } else {
             self.nonfinite += 1;
         }
+    }
+
+    /// The mean radiance and the standard error of its luminance (the sample variance with
+    /// Bessel's correction over the count).
+    fn mean_and_error(&self) -> (Vec3, f32) {
+        let n = self.count.max(1) as f64;
+        let mean = self.sum / n as f32;
+        let m = crate::math::luminance(mean) as f64;
+        let var = ((self.sum_sq / n - m * m) * n / (n - 1.0).max(1.0)).max(0.0);
+        (mean, (var / n).sqrt() as f32)
+    }
+}
+
+/// One pixel's accumulated samples: radiance and first-hit AOVs.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PixelSum {
+    radiance: RadianceSum,
+    aov: Aov,
+}
+
+impl PixelSum {
+    /// Adds one sample; non-finite radiance is counted and dropped (it contributes zero).
+    pub fn add(&mut self, radiance: Vec3, aov: &Aov) {
+        self.aov.add(aov);
+        self.radiance.add(radiance);
     }
 }
 
@@ -178,20 +196,30 @@ pub struct Image {
 impl Image {
     /// Averages pixel sums into an image.
     pub fn from_sums(width: u32, height: u32, sums: &[PixelSum]) -> Self {
+        let mut img = Self::from_radiance(width, height, sums.iter().map(|s| &s.radiance));
+        img.aov = (sums.iter())
+            .map(|s| {
+                let mut a = s.aov;
+                a.scale(1.0 / s.radiance.count.max(1) as f32);
+                a
+            })
+            .collect();
+        img
+    }
+
+    /// Averages radiance sums into an image without AOVs (`aov` empty).
+    pub fn from_radiance<'a>(
+        width: u32,
+        height: u32,
+        sums: impl ExactSizeIterator<Item = &'a RadianceSum>,
+    ) -> Self {
         let mut beauty = Vec::with_capacity(sums.len());
         let mut std_error = Vec::with_capacity(sums.len());
-        let mut aov = Vec::with_capacity(sums.len());
         let mut nonfinite = 0u64;
         for s in sums {
-            let n = s.count.max(1) as f64;
-            let mean = s.sum / n as f32;
+            let (mean, error) = s.mean_and_error();
             beauty.push(mean);
-            let m = crate::math::luminance(mean) as f64;
-            let var = ((s.sum_sq / n - m * m) * n / (n - 1.0).max(1.0)).max(0.0);
-            std_error.push((var / n).sqrt() as f32);
-            let mut a = s.aov;
-            a.scale(1.0 / n as f32);
-            aov.push(a);
+            std_error.push(error);
             nonfinite += s.nonfinite as u64;
         }
         Image {
@@ -199,7 +227,7 @@ impl Image {
             height,
             beauty,
             std_error,
-            aov,
+            aov: Vec::new(),
             nonfinite,
         }
     }

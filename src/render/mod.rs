@@ -16,7 +16,7 @@ pub mod resources;
 pub mod wide_bvh;
 
 pub use camera::{Camera, Projection};
-pub use film::{Aov, Filter, Image, PixelSum};
+pub use film::{Aov, Filter, Image, PixelSum, RadianceSum};
 pub use frames::LightFrames;
 pub use geometry::{Accel, Instance, Ray, Transform, TriMesh};
 pub use integrator::{
@@ -410,7 +410,7 @@ fn render_tile_in(
     let max_depth = settings.integrator.max_depth();
     // Pixel-major (pixel i, frame k at i·frames + k): a pixel's samples update one contiguous
     // run of sums instead of one cache line in each of `frames` arrays.
-    let mut sums = vec![PixelSum::default(); n * frames];
+    let mut sums = vec![RadianceSum::default(); n * frames];
     let mut aov_sums = vec![PixelSum::default(); n];
     let mut radiance = vec![Vec3::ZERO; frames];
     let mut scratch = FramesScratch::default();
@@ -435,7 +435,7 @@ fn render_tile_in(
                 &mut rays,
             );
             for (sum, l) in sums[i * frames..(i + 1) * frames].iter_mut().zip(&radiance) {
-                sum.add_radiance(*l);
+                sum.add(*l);
             }
             aov_sums[i].add(Vec3::ZERO, &ps.aov);
         }
@@ -443,10 +443,7 @@ fn render_tile_in(
     let aov = Image::from_sums(tw, th, &aov_sums).aov;
     let frames = (0..frames)
         .map(|k| {
-            let frame_sums: Vec<PixelSum> = sums.iter().skip(k).step_by(frames).copied().collect();
-            let mut img = Image::from_sums(tw, th, &frame_sums);
-            img.aov = Vec::new();
-            img
+            Image::from_radiance(tw, th, sums.iter().skip(k).step_by(frames))
         })
         .collect();
     TileFrames {

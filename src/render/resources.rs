@@ -1,7 +1,7 @@
 //! What a render or a sweep will need — memory, disk, threads, input bytes — estimated before any
 //! large allocation or write, and refused with a clear error above what the machine has.
 
-use super::film::{Aov, PixelSum};
+use super::film::{Aov, PixelSum, RadianceSum};
 use super::geometry::{Instance, TriMesh};
 use glam::Vec3;
 use std::mem::size_of;
@@ -102,7 +102,7 @@ impl Resources {
     /// radiance are held until written (the cache itself is per tile), plus the shared AOVs.
     pub fn sweep(width: u32, height: u32, frames: usize, naive: bool) -> Self {
         let px = width as u64 * height as u64;
-        let per_frame = (size_of::<PixelSum>() + size_of::<Vec3>() + size_of::<f32>()) as u64;
+        let per_frame = (size_of::<RadianceSum>() + size_of::<Vec3>() + size_of::<f32>()) as u64;
         let held = if naive { 1 } else { frames as u64 };
         Resources {
             what: format!("{frames} frames of a {width}x{height} sweep"),
