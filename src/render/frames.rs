@@ -126,15 +126,16 @@ impl LightFrames {
         self.hittable
     }
 
-    /// Calls `f(k, nearest_light(frame k's lights, ray, t_max))` for every frame k. When the ray
-    /// surely misses the moving light's box (or nothing moves), the answer is that of the fixed
-    /// lights alone, found once.
+    /// Calls `f(k, hit)` for every frame k where `nearest_light(frame k's lights, ray, t_max)`
+    /// is `Some(hit)` (frames whose ray meets no light are skipped). When the ray surely misses
+    /// the moving light's box (or nothing moves), the answer is that of the fixed lights alone,
+    /// found once.
     #[inline(always)]
     pub(crate) fn nearest_per_frame(
         &self,
         ray: &Ray,
         t_max: f32,
-        mut f: impl FnMut(usize, Option<LightHit>),
+        mut f: impl FnMut(usize, LightHit),
     ) {
         let misses = self.moving.is_none()
             || self.swept.is_none_or(|(lo, hi)| {
@@ -142,9 +143,10 @@ impl LightFrames {
                 segment_misses_box(ray.o.into(), inv, f32::INFINITY, lo, hi)
             });
         if misses {
-            let hit = nearest_light(&self.fixed, ray, t_max);
-            for k in 0..self.frames.len() {
-                f(k, hit);
+            if let Some(hit) = nearest_light(&self.fixed, ray, t_max) {
+                for k in 0..self.frames.len() {
+                    f(k, hit);
+                }
             }
         } else if let Some(s) = &self.sphere {
             // A frame whose sphere the ray's line misses (`sphere_line_misses`, the test that
@@ -162,19 +164,21 @@ impl LightFrames {
                 }
                 for j in 0..n {
                     let k = start + j;
-                    f(
-                        k,
-                        if miss[j] {
-                            fixed
-                        } else {
-                            nearest_light(&self.frames[k], ray, t_max)
-                        },
-                    );
+                    let hit = if miss[j] {
+                        fixed
+                    } else {
+                        nearest_light(&self.frames[k], ray, t_max)
+                    };
+                    if let Some(hit) = hit {
+                        f(k, hit);
+                    }
                 }
             }
         } else {
             for (k, lights) in self.frames.iter().enumerate() {
-                f(k, nearest_light(lights, ray, t_max));
+                if let Some(hit) = nearest_light(lights, ray, t_max) {
+                    f(k, hit);
+                }
             }
         }
     }

@@ -656,17 +656,15 @@ pub(crate) fn radiance_frames(
         // Emission along the current ray: a light in front of the surface, or the environment.
         let hit_surface = t_hit.is_finite();
         let alive = &mut scratch.alive;
-        lights.nearest_per_frame(&ray, t_hit, |k, hit| {
-            if let (true, Some((_, t, le, light_pdf))) = (alive[k], hit) {
-                if t < t_hit || !hit_surface {
-                    let w = if specular {
-                        1.0
-                    } else {
-                        power_heuristic(prev_pdf, light_pdf)
-                    };
-                    out[k] += beta * le * w;
-                    alive[k] = false;
-                }
+        lights.nearest_per_frame(&ray, t_hit, |k, (_, t, le, light_pdf)| {
+            if alive[k] && (t < t_hit || !hit_surface) {
+                let w = if specular {
+                    1.0
+                } else {
+                    power_heuristic(prev_pdf, light_pdf)
+                };
+                out[k] += beta * le * w;
+                alive[k] = false;
             }
         });
         let Some(sp) = &sp_opt else { break };

@@ -442,9 +442,7 @@ fn render_tile_in(
     }
     let aov = Image::from_sums(tw, th, &aov_sums).aov;
     let frames = (0..frames)
-        .map(|k| {
-            Image::from_radiance(tw, th, sums.iter().skip(k).step_by(frames))
-        })
+        .map(|k| Image::from_radiance(tw, th, sums.iter().skip(k).step_by(frames)))
         .collect();
     TileFrames {
         aov,
