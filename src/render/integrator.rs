@@ -648,7 +648,11 @@ pub(crate) fn radiance_frames(
     let mut beta = Vec3::ONE;
     let mut ray = ps.ray;
     let mut t_hit = ps.t_hit;
-    let mut sp_opt = ps.point;
+    // The first vertex is read where it lies (`ps.point`), the later ones from `bounce`: a
+    // shading point holds a whole BSDF (hundreds of bytes), so it is not copied from one to
+    // the other.
+    let mut bounce: Option<ShadingPoint> = None;
+    let mut at_first = true;
     let mut prev_pdf = 0.0f32;
     let mut specular = true;
     let mut depth = 0u32;
@@ -667,7 +671,8 @@ pub(crate) fn radiance_frames(
                 alive[k] = false;
             }
         });
-        let Some(sp) = &sp_opt else { break };
+        let vertex = if at_first { &ps.point } else { &bounce };
+        let Some(sp) = vertex else { break };
         if depth >= max_depth || !scratch.alive.contains(&true) {
             break;
         }
@@ -710,12 +715,16 @@ pub(crate) fn radiance_frames(
             d,
         };
         rays.0 += 1;
-        (t_hit, sp_opt) = match scene.accel.intersect(&ray, f32::INFINITY) {
+        at_first = false;
+        match scene.accel.intersect(&ray, f32::INFINITY) {
             // The last vertex only needs its distance (emission in front of it), not shading.
-            Some(h) if last => (h.t, None),
-            Some(h) => (h.t, Some(shading_point(scene, &ray, &h, None))),
-            None => (f32::INFINITY, None),
-        };
+            Some(h) if last => (t_hit, bounce) = (h.t, None),
+            Some(h) => {
+                t_hit = h.t;
+                bounce = Some(shading_point(scene, &ray, &h, None));
+            }
+            None => (t_hit, bounce) = (f32::INFINITY, None),
+        }
     }
 }
 
