@@ -661,6 +661,9 @@ impl std::fmt::Display for Measure {
             Limit::AtMost(m) => ("≤", m),
         };
         let verdict = if self.pass() { "pass" } else { "FAIL" };
+        // The limit to 6 decimals: one taken from an f32 (a light's colour) prints as 0.82, not
+        // 0.8199999928474426.
+        let m = (m * 1e6).round() / 1e6;
         write!(f, "{}: {:.3} ({op} {m}) {verdict}", self.what, self.value)
     }
 }
