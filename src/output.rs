@@ -27,10 +27,14 @@ impl Staged {
             _ => Path::new("."),
         };
         let stem = path.file_name().map(|n| n.to_string_lossy().into_owned());
-        let tmp = tempfile::Builder::new()
-            .prefix(&format!(".{}.", stem.unwrap_or_default()))
-            .suffix(".tmp")
-            .tempfile_in(dir)?;
+        let prefix = format!(".{}.", stem.unwrap_or_default());
+        let mut builder = tempfile::Builder::new();
+        builder.prefix(&prefix).suffix(".tmp");
+        // A temporary file is created owner-only (0600); an output is a plain file, so it gets
+        // what `File::create` would give it: 0666 less the umask.
+        #[cfg(unix)]
+        builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+        let tmp = builder.tempfile_in(dir)?;
         Ok(Staged {
             tmp,
             path: path.to_path_buf(),
@@ -163,6 +167,19 @@ mod tests {
         drop(s);
         assert_eq!(std::fs::read_to_string(&p).unwrap(), "new");
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    /// An output's mode is a plain created file's (0666 less the umask), not a temporary's 0600.
+    #[cfg(unix)]
+    #[test]
+    fn committed_files_have_the_permissions_of_a_created_file() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let (plain, staged) = (dir.path().join("plain"), dir.path().join("staged"));
+        std::fs::write(&plain, "x").unwrap();
+        write_atomic(&staged, b"x").unwrap();
+        let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode(&staged), mode(&plain));
     }
 
     #[test]
