@@ -183,27 +183,46 @@ fn cube_check_fails_without_the_veneer() {
     assert!(!edge.pass(), "{edge}");
 }
 
+/// Scene `name` measured as by [`measured`], with every `preset = "{preset}"` in it pointed at
+/// a copy of that preset whose text `from` (which must occur) reads `to`.
+fn measured_with_preset_edit(
+    name: &str,
+    div: u32,
+    spp: Option<u32>,
+    preset: &str,
+    from: &str,
+    to: &str,
+) -> Vec<Measure> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let text = std::fs::read_to_string(dir.join(format!("presets/{preset}.toml"))).unwrap();
+    assert!(text.contains(from), "{preset} has no {from:?}");
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join(format!("{preset}_edited.toml"));
+    std::fs::write(&file, text.replace(from, to)).unwrap();
+    let named = format!("preset = \"{preset}\"");
+    measured(name, div, spp, |text| {
+        assert!(text.contains(&named), "{name} does not use {preset}");
+        text.replace(
+            &named,
+            &format!("preset_file = {:?}", file.display().to_string()),
+        )
+    })
+}
+
 /// The bowl's curl check needs the curl: the same bowl of the curly_maple preset with its curl
 /// (the tangential distortion's magnitude) set to 0 keeps its rings, pores and in-plane wander,
 /// and fails the flipping-band contrast on the floor: 0.019 without the curl against 0.166 with
 /// it (≥ 0.1), at this size and the scene's seeds (notes/scenes.md, "The curly bowl's check").
 #[test]
 fn bowl_check_fails_without_the_curl() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
-    let preset = std::fs::read_to_string(dir.join("presets/curly_maple.toml")).unwrap();
-    let curl = "[distortion.tangential]\nmagnitude = 0.32\n";
-    assert!(preset.contains(curl));
-    let flat = preset.replace(curl, "[distortion.tangential]\nmagnitude = 0.0\n");
-    let file = std::env::temp_dir().join(format!("xylem_no_curl_{}.toml", std::process::id()));
-    std::fs::write(&file, flat).unwrap();
-    let m = measured("turned_bowl", 2, Some(16), |text| {
-        assert!(text.contains("preset = \"curly_maple\""));
-        text.replace(
-            "preset = \"curly_maple\"",
-            &format!("preset_file = {:?}", file.display().to_string()),
-        )
-    });
-    std::fs::remove_file(&file).ok();
+    let m = measured_with_preset_edit(
+        "turned_bowl",
+        2,
+        Some(16),
+        "curly_maple",
+        "[distortion.tangential]\nmagnitude = 0.32\n",
+        "[distortion.tangential]\nmagnitude = 0.0\n",
+    );
     let bands = m.iter().find(|m| m.what.starts_with("curl bands")).unwrap();
     assert!(!bands.pass(), "{bands}");
 }
@@ -214,21 +233,14 @@ fn bowl_check_fails_without_the_curl() {
 /// 0.274, 0.255 with the rings (≥ 0.1; notes/scenes.md).
 #[test]
 fn cornell_ring_check_fails_without_ring_colour() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
-    let preset = std::fs::read_to_string(dir.join("presets/knotty_pine.toml")).unwrap();
-    let latewood = "latewood = [0.46, 0.24, 0.10]";
-    assert!(preset.contains(latewood));
-    let flat = preset.replace(latewood, "latewood = [0.74, 0.52, 0.29]");
-    let tmp = tempfile::tempdir().unwrap();
-    let file = tmp.path().join("pine_without_ring_colour.toml");
-    std::fs::write(&file, flat).unwrap();
-    let m = measured("cornell_wood_marble", 2, Some(16), |text| {
-        assert_eq!(text.matches("preset = \"knotty_pine\"").count(), 3);
-        text.replace(
-            "preset = \"knotty_pine\"",
-            &format!("preset_file = {:?}", file.display().to_string()),
-        )
-    });
+    let m = measured_with_preset_edit(
+        "cornell_wood_marble",
+        2,
+        Some(16),
+        "knotty_pine",
+        "latewood = [0.46, 0.24, 0.10]",
+        "latewood = [0.74, 0.52, 0.29]",
+    );
     let rings: Vec<&Measure> = (m.iter())
         .filter(|m| m.what.contains("rings Weber"))
         .collect();
