@@ -15,7 +15,7 @@ macro_rules! embed {
 }
 
 /// (path relative to the repository root, contents).
-const FILES: [(&str, &[u8]); 22] = embed![
+const FILES: [(&str, &[u8]); 25] = embed![
     "scenes/box_joint.toml",
     "scenes/carved_bunny.toml",
     "scenes/cornell_box.toml",
@@ -38,6 +38,9 @@ const FILES: [(&str, &[u8]); 22] = embed![
     "data/marschner2005/padauk/diffuse.png",
     "data/marschner2005/padauk/fiber_axis.png",
     "data/marschner2005/padauk/fiber_color.png",
+    "data/marschner2005/walnut1/diffuse.png",
+    "data/marschner2005/walnut1/fiber_axis.png",
+    "data/marschner2005/walnut1/fiber_color.png",
 ];
 
 /// The built-in scenes' names (`sweep_board` for scenes/sweep_board.toml).
