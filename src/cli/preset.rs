@@ -320,9 +320,10 @@ pub(super) fn preset_board(
     // The face's true cut: `SHOWCASE_PITH_DISTANCE_MM` from the pith, flat- or quartersawn as
     // the species shows its figure (the board's top face, centre [0, 0, 9] in object space).
     let tree: toml::Table = format!(
-        "axis = [1.0, 0.0, 0.0]\nsawn = {{ pith_distance = {:.1}, ring_angle_deg = {:.1}, face_point = [0.0, 0.0, 9.0] }}",
+        "axis = [1.0, 0.0, 0.0]\nsawn = {{ pith_distance = {:.1}, ring_angle_deg = {:.1}, slope_deg = {:.1}, face_point = [0.0, 0.0, 9.0] }}",
         wood::SHOWCASE_PITH_DISTANCE_MM,
-        wood::showcase_ring_angle_deg(name)
+        wood::showcase_ring_angle_deg(name),
+        wood::SHOWCASE_SLOPE_DEG
     )
     .parse()?;
     board.insert("tree".into(), tree.into());

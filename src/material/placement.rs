@@ -28,6 +28,13 @@ pub struct SawnCut {
     /// tree: another board of the same cut).
     #[serde(default)]
     pub azimuth_deg: f32,
+    /// Slope of the face to the pith along the grain, degrees (−45 to 45): a board sawn parallel
+    /// to the bark of a tapering log, or off the pith's line, rises through the rings along its
+    /// length, so a flat-sawn face cuts them in nested parabolas (cathedral arches; on a face
+    /// r ≈ d + y²/2d + x·sin s, a ring r₀ shows where y² = 2d(r₀ − d − x·sin s)). The fibres dip
+    /// into the face by the same angle (grain runout). 0: parallel to the pith.
+    #[serde(default)]
+    pub slope_deg: f32,
     /// The face's centre, object space (the box `size = [.., .., 18]` has its top face's centre
     /// at [0, 0, 9]).
     #[serde(default)]
@@ -49,6 +56,7 @@ impl SawnCut {
             ring_angle_deg,
             height: 0.0,
             azimuth_deg: 0.0,
+            slope_deg: 0.0,
             face_point: face_point.into(),
             face_normal: plus_z(),
         }
@@ -113,6 +121,9 @@ pub struct Placement {
     pub axis: Vec3,
     /// Radians.
     pub rotation: f32,
+    /// A tree-space rotation applied after `Rz(rotation) · A` (identity but for a sloped
+    /// [`SawnCut`]).
+    pub tilt: Mat3,
     /// Tree millimetres per object unit (> 0).
     pub scale: f32,
     /// Solid block, veneer or boards.
@@ -127,6 +138,7 @@ impl Default for Placement {
             origin: Vec3::ZERO,
             axis: Vec3::Z,
             rotation: 0.0,
+            tilt: Mat3::IDENTITY,
             scale: 1.0,
             cutting: Cutting::Solid,
             world_space: false,
@@ -166,6 +178,12 @@ impl Placement {
                 cut.azimuth_deg
             ));
         }
+        if !(-45.0..=45.0).contains(&cut.slope_deg) {
+            return Err(format!(
+                "slope_deg {} is out of range (allowed -45 to 45)",
+                cut.slope_deg
+            ));
+        }
         if !finite(cut.face_point) || Vec3::from(cut.face_point).abs().max_element() > 1e7 {
             return Err("face_point must be finite, each coordinate within ±1e7".into());
         }
@@ -196,6 +214,13 @@ impl Placement {
             scale,
             ..Placement::default()
         };
+        if cut.slope_deg != 0.0 {
+            // Tilt about the face's across-grain line (ẑ × normal): the grain ẑ turns towards
+            // the face normal, so the face climbs through the rings along +axis.
+            let normal = p.rotation_matrix() * normal;
+            let tilt = Quat::from_axis_angle(Vec3::Z.cross(normal), cut.slope_deg.to_radians());
+            p.tilt = Mat3::from_quat(tilt);
+        }
         p.origin = centre - p.rotation_matrix() * Vec3::from(cut.face_point) * scale;
         Ok(p)
     }
@@ -205,10 +230,12 @@ impl Placement {
     /// height (the inverse of [`Placement::sawn`], for any solid placement).
     pub fn cut_at(&self, p: Vec3, n: Vec3) -> CutAt {
         let q = self.object_to_tree().transform_point3(p);
-        let m = (self.rotation_matrix() * n).normalize_or_zero();
+        let m = self.rotation_matrix() * n;
+        let m = Vec3::new(m.x, m.y, 0.0).normalize_or_zero();
         let radial = Vec3::new(q.x, q.y, 0.0).normalize_or_zero();
-        // The face meets the rings at the angle between its normal and the radial direction
-        // (the rings' normal), as a line: 0° when the normal is radial.
+        // The face meets the rings at the angle between its normal (across the pith, i.e. less
+        // any slope along it) and the radial direction (the rings' normal), as a line: 0° when
+        // the normal is radial.
         let cos = m.dot(radial).abs().min(1.0);
         CutAt {
             pith_distance: q.truncate().length(),
@@ -217,10 +244,10 @@ impl Placement {
         }
     }
 
-    /// The rotation part `Rz(rotation) · A` of a solid cutting (object → tree directions).
+    /// The rotation part `tilt · Rz(rotation) · A` of a solid cutting (object → tree directions).
     pub fn rotation_matrix(&self) -> Mat3 {
         let a = Quat::from_rotation_arc(self.axis.normalize(), Vec3::Z);
-        Mat3::from_quat(Quat::from_rotation_z(self.rotation) * a)
+        self.tilt * Mat3::from_quat(Quat::from_rotation_z(self.rotation) * a)
     }
 
     /// The affine object → tree map of a solid cutting.
@@ -305,6 +332,25 @@ mod tests {
             .cut_at(face, Vec3::Z);
         assert!((at.pith_distance - 80.0).abs() < 1e-3 && (at.height - 300.0).abs() < 1e-3);
         assert!((at.ring_angle_deg - 45.0).abs() < 0.01);
+    }
+
+    /// A sloped flat-sawn face climbs through the rings along the grain by sin(slope) per mm,
+    /// and its fibres dip into it by the slope.
+    #[test]
+    fn sloped_cut_climbs_through_the_rings() {
+        let face = Vec3::new(0.0, 0.0, 9.0);
+        let cut = SawnCut {
+            slope_deg: 3.0,
+            ..SawnCut::flat(120.0, face)
+        };
+        let p = Placement::sawn(Vec3::X, 1.0, &cut).unwrap();
+        let r = |x: f32| p.cut_at(face + Vec3::X * x, Vec3::Z).pith_distance;
+        assert!((r(0.0) - 120.0).abs() < 1e-3);
+        let rise = (r(100.0) - r(-100.0)) / 200.0;
+        assert!((rise - 3f32.to_radians().sin()).abs() < 1e-4, "{rise}");
+        assert!(p.cut_at(face, Vec3::Z).ring_angle_deg < 0.01);
+        let fibre_in_face = p.rotation_matrix().transpose() * Vec3::Z;
+        assert!((fibre_in_face.z.asin().to_degrees().abs() - 3.0).abs() < 1e-3);
     }
 
     #[test]

@@ -905,6 +905,7 @@ impl Builder<'_> {
             scale,
             cutting,
             world_space: t.space == SpaceName::World,
+            tilt: glam::Mat3::IDENTITY,
         })
     }
 

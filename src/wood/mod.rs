@@ -42,6 +42,12 @@ pub const PRESET_NAMES: [&str; 11] = [
 /// arches, not the pith.
 pub const SHOWCASE_PITH_DISTANCE_MM: f32 = 120.0;
 
+/// Slope of every showcase board's face to the pith along the grain (degrees; `SawnCut::slope_deg`):
+/// boards are sawn along the bark of a tapering, not quite straight log, so a flat-sawn face rises
+/// through the rings along its length and shows cathedral arches (parallel to the pith it shows
+/// only straight stripes, mirror-symmetric about its centre line).
+pub const SHOWCASE_SLOPE_DEG: f32 = 3.0;
+
 /// Presets whose figure shows on a flat-sawn face (tangential to the rings): quilt and birdseye,
 /// the cathedral arches of oak, walnut and cherry, round knots; yellowheart as it is commonly sold
 /// (plain-sawn lumber). The rest show on a quartersawn face: the ribbon stripe of interlocked grain
