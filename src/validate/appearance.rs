@@ -984,6 +984,9 @@ fn write_png(dir: &Path, rel: &str, img: &Rgb8) -> Result<(), String> {
         .map_err(|e| format!("{}: {e}", path.display()))
 }
 
+/// The largest share of all compared rows that may pass only by the 25 % leg (issue 25).
+pub const MAX_LEG_SHARE: f64 = 0.1;
+
 /// Light angles of the side-by-side frames and the preset sheet (degrees along the grain).
 pub const SHEET_ANGLES: [f32; 3] = [-40.0, 0.0, 40.0];
 
@@ -1214,11 +1217,23 @@ pub fn run_report(
             &rows,
         );
     }
+    let (mut rows, mut by_leg) = (0, 0);
     for pair in pairs {
         progress(&pair.preset);
         let r = compare_pair(pair, base, preset_dir, sweep)?;
         ok &= r.passes();
+        rows += r.rows.len();
+        by_leg += r.rows.iter().filter(|c| c.passes() && !c.in_band()).count();
         md += &pair_section(&r, dir, sweep)?;
+    }
+    if !pairs.is_empty() {
+        let leg_ok = by_leg as f64 <= MAX_LEG_SHARE * rows as f64;
+        ok &= leg_ok;
+        md += &format!(
+            "\n**Rows passing only by the 25 % leg: {by_leg} of {rows}** (goal: at most {:.0} %): {}.\n",
+            100.0 * MAX_LEG_SHARE,
+            if leg_ok { "pass" } else { "FAIL" }
+        );
     }
     if builtin {
         progress("walnut");
