@@ -9,6 +9,8 @@
 //! - [`fit`]: `xylem fit` by round trip — known boards rendered, fitted back, compared;
 //! - [`gltf`]: the exported glTF material (a KHR_materials_anisotropy reference shader) against
 //!   xylem's fibre highlight;
+//! - [`pattern`]: pattern statistics of a board face (correlation lengths, spectra, orientation
+//!   coherence, dark streaks, rings, fibre-field correlation), measured against preset (issue 25);
 //! - [`report`]: validation/REPORT.md, one replaceable section per suite.
 
 pub mod appearance;
@@ -17,6 +19,7 @@ pub mod fit;
 pub mod gltf;
 pub mod highlight;
 pub mod layered_reference;
+pub mod pattern;
 pub mod report;
 pub mod rough_finish;
 pub mod scenes;

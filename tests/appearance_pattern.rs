@@ -1,0 +1,182 @@
+//! Pattern statistics (issue 25, src/validate/pattern.rs) on Marschner et al. 2005's measured
+//! boards and on presets: a measured board passes against itself, boards of different species
+//! fail, and the pre-issue-25 walnut and padauk presets (tests/data/issue25_controls/, frozen
+//! copies) fail at least one pattern statistic against their measured boards.
+
+use std::path::Path;
+use xylem::validate::appearance::{BoardMaps, Comparison, Subject};
+use xylem::validate::pattern::{compare_patterns, pattern_statistics, PATTERN_STATISTICS};
+
+/// The pitch notes/measured.md assumes for the measured boards (presets are sampled at it).
+const PITCH: f64 = 0.25;
+
+fn base() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn measured(name: &str) -> BoardMaps {
+    Subject::Measured {
+        dir: format!("data/marschner2005/{name}"),
+        grain_along_x: name == "maple",
+    }
+    .maps(base())
+    .unwrap()
+}
+
+fn preset(name: &str, controls: bool) -> BoardMaps {
+    Subject::Preset {
+        name: name.into(),
+        seed: 7,
+        dir: controls.then(|| base().join("tests/data/issue25_controls")),
+    }
+    .maps(base())
+    .unwrap()
+}
+
+fn whole(m: &BoardMaps) -> Vec<(&'static str, Option<f64>)> {
+    let n = if m.grain_along_x {
+        m.board.height
+    } else {
+        m.board.width
+    };
+    pattern_statistics(m, PITCH, 0..n as usize)
+}
+
+fn print_rows(title: &str, rows: &[Comparison]) {
+    println!("{title}");
+    for c in rows {
+        println!(
+            "  {:<42} preset {:>8.3}  measured {:>8.3}  band {:>8.3} … {:<8.3} {}",
+            c.name,
+            c.preset,
+            c.measured,
+            c.band.0,
+            c.band.1,
+            if c.passes() { "pass" } else { "FAIL" }
+        );
+    }
+}
+
+fn failed(rows: &[Comparison]) -> Vec<&str> {
+    rows.iter()
+        .filter(|c| !c.passes())
+        .map(|c| c.name.as_str())
+        .collect()
+}
+
+/// The table of notes/appearance.md: every statistic on the three measured boards and on today's
+/// curly_maple, padauk and walnut presets (seed 7, quartersawn 120 mm from the pith). No
+/// statistic may be NaN; every one applies to some board.
+#[test]
+fn pattern_statistics_of_the_measured_boards_and_presets() {
+    let boards: Vec<(String, BoardMaps)> = ["maple", "padauk", "walnut1"]
+        .iter()
+        .map(|n| (format!("measured {n}"), measured(n)))
+        .chain(
+            ["curly_maple", "padauk", "walnut"]
+                .iter()
+                .map(|n| (format!("preset {n}"), preset(n, false))),
+        )
+        .collect();
+    let values: Vec<Vec<(&str, Option<f64>)>> = boards.iter().map(|(_, m)| whole(m)).collect();
+    print!("| statistic |");
+    for (n, _) in &boards {
+        print!(" {n} |");
+    }
+    println!();
+    for (k, name) in PATTERN_STATISTICS.iter().enumerate() {
+        print!("| {name} |");
+        for v in &values {
+            assert_eq!(v[k].0, *name);
+            match v[k].1 {
+                Some(x) => {
+                    assert!(x.is_finite());
+                    print!(" {x:.3} |")
+                }
+                None => print!(" n/a |"),
+            }
+        }
+        println!();
+        assert!(
+            values.iter().any(|v| v[k].1.is_some()),
+            "{name} never applies"
+        );
+    }
+}
+
+/// Positive sanity check: a measured board against itself passes every statistic (the criterion
+/// is not stricter than a board's own value), and no statistic is left out as not applicable
+/// without being so on the board.
+#[test]
+fn a_measured_board_passes_against_itself() {
+    for name in ["maple", "padauk", "walnut1"] {
+        let m = measured(name);
+        let rows = compare_patterns(&m, &m, PITCH);
+        print_rows(name, &rows);
+        assert!(failed(&rows).is_empty(), "{name}: {:?}", failed(&rows));
+        let applicable = whole(&m).iter().filter(|v| v.1.is_some()).count();
+        assert_eq!(rows.len(), applicable);
+    }
+}
+
+/// Different species differ in pattern: maple against walnut1 (and walnut1 against padauk) fails
+/// several statistics.
+#[test]
+fn different_species_fail_several_statistics() {
+    for (a, b) in [
+        ("maple", "walnut1"),
+        ("walnut1", "padauk"),
+        ("padauk", "maple"),
+    ] {
+        let rows = compare_patterns(&measured(a), &measured(b), PITCH);
+        print_rows(&format!("{a} against {b}"), &rows);
+        println!("  failed: {:?}", failed(&rows));
+        assert!(failed(&rows).len() >= 3, "{a} against {b}");
+    }
+}
+
+/// Negative control (issue 25): the pre-issue-25 padauk preset's blotchy "lava" contours against
+/// the measured board's fine straight streaks.
+#[test]
+fn pre_issue_25_padauk_fails_a_pattern_statistic() {
+    let rows = compare_patterns(&preset("padauk", true), &measured("padauk"), PITCH);
+    print_rows("pre-issue-25 padauk against measured padauk", &rows);
+    let f = failed(&rows);
+    println!("  failed: {f:?}");
+    // Lava against streaks: its blotches put too much power in long waves across the grain
+    // (slope −0.98 against −0.42, band −0.50 … −0.32) and its dark contours run too long
+    // (elongation 5.2 against 2.8).
+    let lava = [
+        "luminance correlation length across (mm)",
+        "luminance spectrum slope across",
+        "orientation coherence",
+        "dark feature elongation (along/across)",
+    ];
+    assert!(lava.iter().any(|n| f.contains(n)), "{f:?}");
+    // Its interlock is too smooth along the grain (dip correlation 6.9 mm against 1.2 mm).
+    assert!(f
+        .iter()
+        .any(|n| n.contains("correlation length") && !n.starts_with("luminance")));
+}
+
+/// Negative control (issue 25): the pre-issue-25 walnut preset's round pores and nearly straight
+/// fibres against walnut1's dark pore streaks and fibre wander.
+#[test]
+fn pre_issue_25_walnut_fails_a_pattern_statistic() {
+    let rows = compare_patterns(&preset("walnut", true), &measured("walnut1"), PITCH);
+    print_rows("pre-issue-25 walnut against measured walnut1", &rows);
+    let f = failed(&rows);
+    println!("  failed: {f:?}");
+    // Pores: short dashes (luminance correlation along 0.62 mm against 1.78 mm) covering too
+    // much of the face (0.28 against 0.19).
+    let pores = [
+        "luminance correlation length along (mm)",
+        "dark feature elongation (along/across)",
+        "dark feature area fraction",
+    ];
+    assert!(pores.iter().any(|n| f.contains(n)), "{f:?}");
+    // Fibres: almost straight (dip spread 0.09° against 1.8°) and smooth (dip correlation along
+    // 9.8 mm against 0.73 mm).
+    assert!(f.contains(&"fibre dip spread (deg)"), "{f:?}");
+    assert!(f.iter().any(|n| n.starts_with("dip correlation")), "{f:?}");
+}
