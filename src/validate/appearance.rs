@@ -580,27 +580,31 @@ axis = {axis}
         res: u32,
         spp: u32,
     ) -> Result<SweepLuminance, String> {
-        let text = self.sweep_scene(frames, 60.0, res, spp);
-        let loaded = scene::from_str(&text, "<appearance sweep>", base, "appearance")
-            .map_err(|e| e.to_string())?;
-        let (path, moving) =
-            SweepPath::from_scene(&loaded, None, None).map_err(|e| e.to_string())?;
-        let r = render_sweep(
-            &loaded.scene,
-            &loaded.settings,
-            &path,
-            moving,
-            0..path.frames(),
-            &RunOptions::default(),
-        )
-        .map_err(|e| e.to_string())?;
-        Ok(SweepLuminance {
-            width: r.width,
-            height: r.height,
-            angles: (0..r.frames.len()).map(|k| path.light_deg(k)).collect(),
-            frames: r.frames.iter().map(|f| f.beauty.clone()).collect(),
-        })
+        sweep_luminance(&self.sweep_scene(frames, 60.0, res, spp), base)
     }
+}
+
+/// Renders the sweep scene `text` (files relative to `base`): per-pixel luminance of every
+/// frame.
+pub fn sweep_luminance(text: &str, base: &Path) -> Result<SweepLuminance, String> {
+    let loaded = scene::from_str(text, "<appearance sweep>", base, "appearance")
+        .map_err(|e| e.to_string())?;
+    let (path, moving) = SweepPath::from_scene(&loaded, None, None).map_err(|e| e.to_string())?;
+    let r = render_sweep(
+        &loaded.scene,
+        &loaded.settings,
+        &path,
+        moving,
+        0..path.frames(),
+        &RunOptions::default(),
+    )
+    .map_err(|e| e.to_string())?;
+    Ok(SweepLuminance {
+        width: r.width,
+        height: r.height,
+        angles: (0..r.frames.len()).map(|k| path.light_deg(k)).collect(),
+        frames: r.frames.iter().map(|f| f.beauty.clone()).collect(),
+    })
 }
 
 /// The frames of a top-down sweep (linear RGB, row-major) and their light angles.
@@ -687,7 +691,7 @@ impl SweepSettings {
 
 /// Chatoyance statistics of a rendered sweep: the whole board's median and p90/p10 of the
 /// per-pixel max/min, and the medians of [`STRIPS`] strips across the grain.
-fn chatoyance_statistics(s: &SweepLuminance, grain_along_x: bool) -> ([f64; 2], Vec<[f64; 2]>) {
+pub fn chatoyance_statistics(s: &SweepLuminance, grain_along_x: bool) -> ([f64; 2], Vec<[f64; 2]>) {
     let c = s.chatoyance();
     let (w, h) = (s.width as usize, s.height as usize);
     let stats = |v: &[f64]| [quantile(v, 0.5), quantile(v, 0.9) / quantile(v, 0.1)];

@@ -192,6 +192,7 @@ fn breakdown(params: &wood::WoodParams, points: &[Vec3]) -> anyhow::Result<()> {
                 pores: None,
                 rays: None,
                 knots: None,
+                fibre_wander: None,
                 ..p.clone()
             }
         }),
