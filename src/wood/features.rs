@@ -284,7 +284,7 @@ impl Rays {
     }
 }
 
-/// Fine-scale grain deviation ([`FibreWanderParams`], notes/wood.md §9): two small tilt angles of
+/// Fine-scale grain deviation ([`FibreWanderParams`], notes/wood.md §9a): two small tilt angles of
 /// the fibre, each a zero-mean 3D sparse convolution noise (Wyvill kernel, signed weights, one
 /// band; Liu et al. 2016 §4, eq. 4 and 7) with kernels long along the grain and short across it,
 /// oriented by the cylindrical frame at the query, scaled so that each angle has the standard
@@ -300,10 +300,10 @@ pub struct FibreWander {
 impl FibreWander {
     /// Variance of one band of signed-weight Wyvill sparse convolution noise of magnitude 1 per
     /// unit density: E[w²] · ∫K² dV / V = (1/3) · (4π · 1024/45045) / (4π/3) = 1024/45045
-    /// (weights uniform in [−1, 1), ∫₀¹ r² (1 − r²)⁶ dr = 1024/45045; notes/wood.md §9).
+    /// (weights uniform in [−1, 1), ∫₀¹ r² (1 − r²)⁶ dr = 1024/45045; notes/wood.md §9a).
     pub const VARIANCE_PER_DENSITY: f32 = 1024.0 / 45045.0;
     /// Lag, in kernel semi-axes, at which that noise's autocorrelation along an axis falls to
-    /// 1/e (numerical integration of the kernel's autocorrelation, notes/wood.md §9; ½ at 0.549,
+    /// 1/e (numerical integration of the kernel's autocorrelation, notes/wood.md §9a; ½ at 0.549,
     /// 0 at 2).
     pub const CORRELATION_LAG: f32 = 0.656;
 

@@ -214,7 +214,7 @@ impl Default for HighlightParams {
     }
 }
 
-/// Fine-scale grain deviation (ours, notes/wood.md §9): the fibres of real wood are not parallel
+/// Fine-scale grain deviation (ours, notes/wood.md §9a): the fibres of real wood are not parallel
 /// to the stem even in straight-grained wood; they dip and wander by a few degrees over
 /// millimetres to centimetres and bend around vessels and ray bundles (Hoadley, "Understanding
 /// Wood", ch. 2 and 5; Panshin & de Zeeuw, "Textbook of Wood Technology", ch. 9 on grain
@@ -232,7 +232,7 @@ pub struct FibreWanderParams {
     /// in-plane wander of a flat-sawn face, the dip out of a quartersawn one.
     pub tangential: f32,
     /// Correlation length along the grain, mm: the lag at which the autocorrelation of either
-    /// angle falls to 1/e (the kernel's semi-axis is this / 0.656; notes/wood.md §9).
+    /// angle falls to 1/e (the kernel's semi-axis is this / 0.656; notes/wood.md §9a).
     pub along: f32,
     /// Correlation length across the grain (r̂ and θ̂), mm, as `along`.
     pub across: f32,

@@ -55,7 +55,7 @@ pub struct WoodVolume {
     pores: Option<Pores>,
     rays: Option<Rays>,
     knots: Option<Knots>,
-    /// Fine-scale grain deviation (notes/wood.md §9), evaluated only for fibres.
+    /// Fine-scale grain deviation (notes/wood.md §9a), evaluated only for fibres.
     wander: Option<FibreWander>,
     jacobian: JacobianModel,
 }
