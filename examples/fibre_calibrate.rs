@@ -2,20 +2,16 @@
 //! statistics of `xylem validate appearance`, the rendered chatoyance, and the along/across-grain
 //! autocorrelation of the fibre dip and in-plane angle, for a quartersawn or flat-sawn cut.
 //!
-//! `cargo run --release --example fibre_calibrate -- PRESET MEASURED_DIR (x|y) (quarter|flat)
-//! [PRESET_DIR] [--no-sweep] [--png OUT.png]`
+//! `cargo run --release --example fibre_calibrate -- PRESET_OR_FILE MEASURED_DIR (x|y)
+//! RING_ANGLE_DEG [--diffuse OUT.png]`
 //!
-//! Flat-sawn: the face at object z = 9 lies 120 mm from the pith (origin (−111, 0, 0), fibres
-//! along object x), quartersawn as `validate appearance` (origin (0, 120, 0)).
+//! The comparison is `validate appearance`'s (`compare_pair`: the preset cut as the gallery's
+//! showcase board at that angle to the rings, 0 flat-sawn, 90 quartersawn); this adds the
+//! autocorrelations, and with `--diffuse` the preset's diffuse map as 8-bit codes (as the
+//! measured diffuse.png stores its linear values), grain along the rows.
 
-use glam::Vec3;
-use std::path::{Path, PathBuf};
-use xylem::material::Placement;
-use xylem::validate::appearance::{
-    chatoyance_statistics as chat_stats, compare_boards, quantile, sweep_luminance, BoardMaps,
-    Subject, BOARD_MM, PRESET_TREE,
-};
-use xylem::wood::{WoodParams, WoodVolume};
+use std::path::Path;
+use xylem::validate::appearance::{compare_pair, BoardMaps, Pair, SweepSettings};
 
 /// Autocorrelation of `angle` (per texel) at `lag` texels along (true) or across the grain.
 fn autocorr(maps: &BoardMaps, angle: &dyn Fn(usize) -> f64, lag: usize, along: bool) -> f64 {
@@ -64,44 +60,19 @@ fn print_autocorr(label: &str, maps: &BoardMaps) {
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let name = args[0].clone();
-    let measured_dir = args[1].clone();
-    let grain_along_x = args[2] == "x";
-    let flat = args[3] == "flat";
-    let dir = args
-        .get(4)
-        .filter(|a| !a.starts_with("--"))
-        .map(PathBuf::from);
-    let no_sweep = args.iter().any(|a| a == "--no-sweep");
+    let pair = Pair {
+        preset: args[0].clone(),
+        measured_dir: args[1].clone(),
+        grain_along_x: args[2] == "x",
+        ring_angle_deg: args[3].parse().expect("ring angle in degrees"),
+    };
     let base = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let params = match &dir {
-        Some(d) => WoodParams::from_toml_file(d.join(format!("{name}.toml"))).unwrap(),
-        None => xylem::wood::preset(&name).unwrap(),
-    };
-    let volume = WoodVolume::new(params, 7).unwrap();
-    let origin = if flat {
-        Vec3::new(-111.0, 0.0, 0.0)
-    } else {
-        Vec3::new(0.0, 120.0, 0.0)
-    };
-    let placement = Placement {
-        origin,
-        axis: Vec3::X,
-        ..Placement::default()
-    };
-    let n = 390;
-    let pm = BoardMaps::from_preset(&volume, &placement, (n, n), BOARD_MM / n as f32, 9.0);
-    let measured = Subject::Measured {
-        dir: measured_dir.clone(),
-        grain_along_x,
-    };
-    let mm = measured.maps(base).unwrap();
+    let report = compare_pair(&pair, base, None, SweepSettings::FULL).unwrap();
     println!(
-        "{name} ({}) against {measured_dir}",
-        if flat { "flat-sawn" } else { "quartersawn" }
+        "{} (ring angle {}°) against {}",
+        pair.preset, pair.ring_angle_deg, pair.measured_dir
     );
-    let rows = compare_boards(&pm, &mm);
-    for r in &rows {
+    for r in &report.rows {
         println!(
             "{:45} preset {:8.4}  measured {:8.4}  band {:8.4} … {:8.4}  {}",
             r.name,
@@ -109,62 +80,25 @@ fn main() {
             r.measured,
             r.band.0,
             r.band.1,
-            if r.passes() { "pass" } else { "FAIL" }
+            r.verdict()
         );
     }
+    let pm = &report.preset_maps;
     if let Some(i) = args.iter().position(|a| a == "--diffuse") {
-        // The preset's diffuse map as 8-bit codes (as the measured diffuse.png stores its linear
-        // values), transposed so the grain runs along the rows as on walnut1.
-        let mut rgb = Vec::with_capacity(n * n * 3);
-        for row in 0..n {
-            for col in 0..n {
-                let c = pm.board.diffuse[col * n + row];
+        let (w, h) = (pm.board.width as usize, pm.board.height as usize);
+        let mut rgb = Vec::with_capacity(w * h * 3);
+        for row in 0..w {
+            for col in 0..h {
+                let c = pm.board.diffuse[col * w + row];
                 rgb.extend(
                     c.to_array()
                         .map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8),
                 );
             }
         }
-        xylem::picture::png::write_png_data8(Path::new(&args[i + 1]), n as u32, n as u32, &rgb)
+        xylem::picture::png::write_png_data8(Path::new(&args[i + 1]), h as u32, w as u32, &rgb)
             .unwrap();
     }
-    print_autocorr("preset  ", &pm);
-    print_autocorr("measured", &mm);
-    if no_sweep {
-        return;
-    }
-    let preset = Subject::Preset {
-        name: name.clone(),
-        seed: 7,
-        dir: dir.clone(),
-    };
-    let flat_tree = "{ origin = [-111.0, 0.0, 0.0], axis = [1.0, 0.0, 0.0], rotation_deg = 0.0 }";
-    let mut text = preset.sweep_scene(25, 60.0, 130, 4);
-    if flat {
-        text = text.replace(PRESET_TREE, flat_tree);
-    }
-    let ps = sweep_luminance(&text, base).unwrap();
-    let ms = measured.sweep(base, 25, 130, 4).unwrap();
-    let (pc, _) = chat_stats(&ps, true);
-    let (mc, strips) = chat_stats(&ms, grain_along_x);
-    for (k, label) in ["chatoyance median (max/min)", "chatoyance p90/p10"]
-        .iter()
-        .enumerate()
-    {
-        let v: Vec<f64> = strips.iter().map(|s| s[k]).collect();
-        let (lo, hi) = (quantile(&v, 0.1), quantile(&v, 0.9));
-        let ok = (pc[k] >= lo && pc[k] <= hi) || (pc[k] - mc[k]).abs() <= 0.25 * mc[k];
-        println!(
-            "{label:45} preset {:8.4}  measured {:8.4}  band {lo:8.4} … {hi:8.4}  {}",
-            pc[k],
-            mc[k],
-            if ok { "pass" } else { "FAIL" }
-        );
-    }
-    if let Some(i) = args.iter().position(|a| a == "--png") {
-        // The middle frame (light at the zenith) of the preset's sweep.
-        let f = &ps.frames[ps.frames.len() / 2];
-        xylem::picture::png::write_png_linear(Path::new(&args[i + 1]), ps.width, ps.height, f, 0.0)
-            .unwrap();
-    }
+    print_autocorr("preset  ", pm);
+    print_autocorr("measured", &report.measured_maps);
 }

@@ -145,6 +145,7 @@ fn surface_case() -> Value {
         scale: 1.0,
         cutting: Cutting::Solid,
         world_space: true,
+        tilt: Default::default(),
     };
     let mut rng = Pcg32::new(77, 1);
     let n = 64;

@@ -556,7 +556,14 @@ fn a_far_eye_and_far_tree_origins_are_named_not_blamed_on_other_fields() {
     assert_ne!(eye, board);
     let e = load(&eye).expect("a far eye is an error");
     assert!(e.contains("camera.eye") && !e.contains("camera.up"), "{e}");
-    let origin = board.replace("origin = [0.0, 120.0, 0.0]", "origin = [0.0, 1e12, 0.0]");
+    let tree = board
+        .lines()
+        .find(|l| l.starts_with("tree = "))
+        .expect("the board's tree line");
+    let origin = board.replace(
+        tree,
+        "tree = { origin = [0.0, 1e12, 0.0], axis = [1.0, 0.0, 0.0] }",
+    );
     assert_ne!(origin, board);
     let e = load(&origin).expect("a tree origin at 1e12 mm is an error");
     assert!(e.contains("objects[1].tree.origin"), "{e}");

@@ -2,13 +2,14 @@
 //! bit, for every preset and level of `needs`, in whole blocks and the partial block at the end,
 //! at the pith and far out where the growth wave leaves its fast range.
 
-mod common;
+#[path = "common/texel.rs"]
+mod texel;
 
 use glam::Vec3;
 use xylem::simd::Simd;
 use xylem::wood::{self, Needs, WoodTexel, WoodVolume};
 
-use common::texel_bits as bits;
+use texel::texel_bits as bits;
 
 fn points() -> Vec<Vec3> {
     let mut p = wood::sample_points(3000, 17);

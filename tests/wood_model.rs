@@ -1,7 +1,8 @@
 //! The solid-wood model (issue 4): finite values over a dense cube for every preset, at the pith
 //! and under strong distortion; unit, orthonormal directions.
 
-mod common;
+#[path = "common/texel.rs"]
+mod texel;
 
 use glam::Vec3;
 use xylem::wood::{self, Needs, WoodVolume, PRESET_NAMES};
@@ -357,7 +358,7 @@ fn texel_hash(v: &WoodVolume) -> u64 {
         let r = 20.0 + 180.0 * rng.next_f32();
         let a = std::f32::consts::TAU * rng.next_f32();
         let p = Vec3::new(r * a.cos(), r * a.sin(), 400.0 * rng.next_f32());
-        for bits in common::texel_bits(&v.eval(p, Needs::ALL)) {
+        for bits in texel::texel_bits(&v.eval(p, Needs::ALL)) {
             for b in bits.to_le_bytes() {
                 h = (h ^ b as u64).wrapping_mul(0x100_0000_01b3);
             }

@@ -584,6 +584,7 @@ impl PyWoodSurface {
                 scale,
                 cutting: Cutting::Solid,
                 world_space: true,
+                tilt: Default::default(),
             },
         })
     }

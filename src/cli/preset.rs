@@ -186,19 +186,6 @@ fn cuts(
 
 /// The README board scene, the gallery renders every preset on.
 const GALLERY_SCENE: &str = "scenes/sweep_board.toml";
-/// Presets shown flat-sawn (the face tangential to the rings, 120 mm from the pith), where their
-/// figure shows: quilt and birdseye on the tangential face, oak's and cherry's cathedral arches,
-/// round knots. The rest are quartersawn, as the README board (ribbon stripe of interlocked grain,
-/// oak ray fleck, curl across the grain).
-const FLAT_SAWN: [&str; 7] = [
-    "quilted_maple",
-    "birdseye_maple",
-    "red_oak",
-    "walnut",
-    "cherry",
-    "knotty_pine",
-    "yellowheart",
-];
 /// The gallery's camera: 65° above the board, 330 mm from it, the board filling a 2:1 frame.
 const GALLERY_EYE: [f32; 3] = [0.0, -140.0, 300.0];
 const GALLERY_FOV_DEG: f64 = 24.0;
@@ -294,7 +281,7 @@ pub(super) fn board_table() -> anyhow::Result<toml::Table> {
 }
 
 /// Preset `name` on the board of `scene` ([`board_table`]), with only the board's preset and cut
-/// (quartersawn, or flat-sawn for [`FLAT_SAWN`]), the frame size, spp and camera changed.
+/// (its showcase cut, `wood::showcase_ring_angle_deg`), the frame size, spp and camera changed.
 pub(super) fn preset_board(
     scene: &toml::Table,
     name: &str,
@@ -330,16 +317,51 @@ pub(super) fn preset_board(
         })
         .and_then(|o| o.as_table_mut())
         .context("the gallery scene has no object named `board`")?;
-    let origin = if FLAT_SAWN.contains(&name) {
-        [0.0, 0.0, -120.0]
-    } else {
-        [0.0, 120.0, 0.0]
-    };
-    set(board, &["tree", "origin"], origin.to_vec().into());
+    // The face's true cut: flat- or quartersawn as the species shows its figure.
+    let cut = crate::material::SawnCut::showcase_board(wood::showcase_ring_angle_deg(name));
+    let tree: toml::Table = format!("tree = {}", cut.tree_toml()).parse()?;
+    let tree = tree["tree"].clone();
+    board.insert("tree".into(), tree);
     Ok(crate::scene::from_str(
         &toml::to_string(&scene)?,
         GALLERY_SCENE,
         Path::new("scenes"),
         name,
     )?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every gallery board's top face lies where its cut says: `SHOWCASE_PITH_DISTANCE_MM` (at
+    /// least 100 mm) from the pith, tangential to the rings for the flat-sawn presets and radial
+    /// for the quartersawn. The gallery once placed its "flat-sawn" boards on the pith axis,
+    /// shifted along it (the face 9 mm from the pith).
+    #[test]
+    fn gallery_boards_are_cut_where_they_say() {
+        let board = board_table().unwrap();
+        for name in wood::PRESET_NAMES {
+            let loaded =
+                preset_board(&board, name, (64, 32), 1, GALLERY_EYE, GALLERY_FOV_DEG).unwrap();
+            let inst = loaded
+                .scene
+                .accel
+                .instances
+                .iter()
+                .find(|i| {
+                    matches!(
+                        loaded.scene.materials[i.material as usize],
+                        crate::material::Material::Wood(_)
+                    )
+                })
+                .expect("the board");
+            let at = inst
+                .placement
+                .cut_at(glam::Vec3::new(0.0, 0.0, 9.0), glam::Vec3::Z);
+            assert!(at.pith_distance >= 100.0, "{name}: {at:?}");
+            let want = wood::showcase_ring_angle_deg(name);
+            assert!((at.ring_angle_deg - want).abs() < 1.0, "{name}: {at:?}");
+        }
+    }
 }

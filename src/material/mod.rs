@@ -18,7 +18,7 @@ pub use measured::{
     energy_bounded_fiber_color, BoardFace, ColorSpace, MeasuredBoard, MeasuredError, MeasuredFiles,
     MeasuredMaterial, DEFAULT_FIBER_COLOR_SCALE, DEFAULT_HIGHLIGHT_WIDTH_DEG,
 };
-pub use placement::{Cutting, Placement};
+pub use placement::{CutAt, Cutting, Placement, SawnCut};
 
 use crate::bsdf::{
     Bsdf, BsdfSample, FinishModel, Glass, Lambertian, Mirror, WoodBsdf, WoodBsdfParams,

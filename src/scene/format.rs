@@ -536,6 +536,10 @@ pub struct TreeTable {
     /// solid: turn about the pith (degrees, default 0): flat- vs quarter-sawn.
     #[serde(default)]
     pub rotation_deg: f32,
+    /// solid: the cut stated physically instead of `origin` and `rotation_deg`, e.g.
+    /// `{ pith_distance = 120.0, ring_angle_deg = 0.0, face_point = [0.0, 0.0, 9.0] }`
+    /// (flat-sawn 0°, quartersawn 90°; `material::SawnCut`).
+    pub sawn: Option<crate::material::SawnCut>,
     /// Tree mm per object unit (0.000001–1e6, default 1).
     #[serde(default = "one")]
     pub scale: f32,

@@ -881,16 +881,31 @@ impl Builder<'_> {
                 }
             }
         };
+        let axis = self.unit3(&f("axis"), t.axis)?;
+        let scale = self.range(&f("scale"), t.scale, 1e-6, 1e6)?;
+        if let Some(sawn) = &t.sawn {
+            if t.cut != CutName::Solid || t.origin != [0.0; 3] || t.rotation_deg != 0.0 {
+                return Err(self.invalid(
+                    f("sawn"),
+                    "`sawn` places a solid cut by itself: give it or `origin`/`rotation_deg`, not both",
+                ));
+            }
+            let mut p =
+                Placement::sawn(axis, scale, sawn).map_err(|e| self.invalid(f("sawn"), e))?;
+            p.world_space = t.space == SpaceName::World;
+            return Ok(p);
+        }
         Ok(Placement {
             // Beyond the scene's extent the growth time loses all precision (NaN at 1e12).
             origin: self.point(&f("origin"), t.origin, MAX_EXTENT_MM)?,
-            axis: self.unit3(&f("axis"), t.axis)?,
+            axis,
             rotation: self
                 .range(&f("rotation_deg"), t.rotation_deg, -360.0, 360.0)?
                 .to_radians(),
-            scale: self.range(&f("scale"), t.scale, 1e-6, 1e6)?,
+            scale,
             cutting,
             world_space: t.space == SpaceName::World,
+            tilt: glam::Mat3::IDENTITY,
         })
     }
 

@@ -37,6 +37,43 @@ pub const PRESET_NAMES: [&str; 11] = [
     "knotty_pine",
 ];
 
+/// Distance from the pith (mm) of the face of every showcase board: the gallery's, `validate
+/// appearance`'s preset boards. Far enough out (about a 25 cm log) that a flat-sawn face shows
+/// arches, not the pith.
+pub const SHOWCASE_PITH_DISTANCE_MM: f32 = 120.0;
+
+/// Slope of every showcase board's face to the pith along the grain (degrees; `SawnCut::slope_deg`):
+/// boards are sawn along the bark of a tapering, not quite straight log, so a flat-sawn face rises
+/// through the rings along its length and shows cathedral arches (parallel to the pith it shows
+/// only straight stripes, mirror-symmetric about its centre line).
+pub const SHOWCASE_SLOPE_DEG: f32 = 3.0;
+
+/// Presets whose figure shows on a flat-sawn face (tangential to the rings): quilt and birdseye,
+/// the cathedral arches of oak, walnut and cherry, round knots; yellowheart as it is commonly sold
+/// (plain-sawn lumber). The rest show on a quartersawn face: the ribbon stripe of interlocked grain
+/// (mahogany, padauk), oak ray fleck, curl across the grain (Hoadley, *Understanding Wood*, 2000,
+/// ch. 11).
+const FLAT_SAWN_SHOWCASE: [&str; 7] = [
+    "quilted_maple",
+    "birdseye_maple",
+    "red_oak",
+    "walnut",
+    "cherry",
+    "knotty_pine",
+    "yellowheart",
+];
+
+/// The ring angle (degrees: 0 flat-sawn, 90 quartersawn) of the face on which preset `name`'s
+/// figure shows ([`FLAT_SAWN_SHOWCASE`]); with [`SHOWCASE_PITH_DISTANCE_MM`] it is the cut of
+/// every showcase board (`material::SawnCut`).
+pub fn showcase_ring_angle_deg(name: &str) -> f32 {
+    if FLAT_SAWN_SHOWCASE.contains(&name) {
+        0.0
+    } else {
+        90.0
+    }
+}
+
 /// The preset files, embedded so lookup works from any directory.
 const PRESET_FILES: [&str; 11] = [
     include_str!("../../scenes/presets/african_mahogany.toml"),
