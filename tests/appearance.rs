@@ -42,14 +42,23 @@ fn calibrated_presets_match_the_measured_boards() {
     use std::path::Path;
     use xylem::validate::appearance::{builtin_pairs, compare_pair, SweepSettings};
     let base = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let (mut rows, mut by_leg) = (0, 0);
     for pair in &builtin_pairs() {
         let report = compare_pair(pair, base, None, SweepSettings::FULL).unwrap();
         for c in &report.rows {
+            println!("{}: {} {}", pair.preset, c.name, c.verdict());
             assert!(c.passes(), "{}: {c:?}", pair.preset);
         }
+        rows += report.rows.len();
+        by_leg += report.rows.iter().filter(|c| !c.in_band()).count();
         // The comparison covers the rendered sweep too, not only the maps.
         assert!(report.rows.iter().any(|c| c.name.starts_with("chatoyance")));
     }
+    // Issue 25: at most 10 % of the rows may pass by the 25 % leg alone.
+    assert!(
+        by_leg as f64 <= xylem::validate::appearance::MAX_LEG_SHARE * rows as f64,
+        "{by_leg} of {rows} rows pass only by the 25 % leg"
+    );
 }
 
 /// `validate appearance --board` reads a board's grain and cut from its maps: the three measured
