@@ -342,7 +342,7 @@ fn preset_text_without_wander(name: &str) -> String {
     };
     if name == "curly_maple" {
         text.replace(
-            "[highlight]\nearlywood = 13.0\nlatewood = 26.0",
+            "[highlight]\nearlywood = 13.0\nlatewood = 22.0",
             "[highlight]\nearlywood = 12.0\nlatewood = 13.0",
         )
     } else {
