@@ -2,32 +2,14 @@
 //! bit, for every preset and level of `needs`, in whole blocks and the partial block at the end,
 //! at the pith and far out where the growth wave leaves its fast range.
 
+#[path = "common/texel.rs"]
+mod texel;
+
 use glam::Vec3;
 use xylem::simd::Simd;
 use xylem::wood::{self, Needs, WoodTexel, WoodVolume};
 
-fn bits(t: &WoodTexel) -> Vec<u32> {
-    let mut v = Vec::new();
-    for x in [
-        t.diffuse,
-        t.fiber_color,
-        t.fiber_dir,
-        t.ray_dir,
-        t.bump_grad,
-    ] {
-        v.extend(x.to_array().map(f32::to_bits));
-    }
-    for x in [
-        t.ray_mask,
-        t.pore_mask,
-        t.bump,
-        t.highlight_width,
-        t.growth_time,
-    ] {
-        v.push(x.to_bits());
-    }
-    v
-}
+use texel::texel_bits as bits;
 
 fn points() -> Vec<Vec3> {
     let mut p = wood::sample_points(3000, 17);

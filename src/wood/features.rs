@@ -2,7 +2,7 @@
 //! magnitudes (§6.2), pores and rays (§6.1.6), growth-rate noise (eq. 24) and the interlock angle
 //! (§6.1.5). All noise comes from `crate::noise`.
 
-use super::params::{NoiseParams, PoreParams, RayParams};
+use super::params::{FibreWanderParams, NoiseParams, PoreParams, RayParams, WanderScale};
 use crate::math::Frame;
 use crate::noise::{Cells, Kernel, SeededSparse, SparseConvolution, SparseConvolution1, Weights};
 use glam::Vec3;
@@ -281,6 +281,110 @@ impl Rays {
     #[inline]
     pub fn mask(&self, q: Vec3) -> f32 {
         self.noise.eval(q).min(1.0) * self.strength
+    }
+}
+
+/// Fine-scale grain deviation ([`FibreWanderParams`], notes/wood.md §9a): two small tilt angles of
+/// the fibre, each a zero-mean 3D sparse convolution noise (Wyvill kernel, signed weights, one
+/// band; Liu et al. 2016 §4, eq. 4 and 7) with kernels long along the grain and short across it,
+/// oriented by the cylindrical frame at the query, scaled so that each angle has the standard
+/// deviation asked for (Campbell's theorem: variance = density · 1024/45045 · magnitude²).
+#[derive(Clone, Debug)]
+pub struct FibreWander {
+    /// Per scale, tilt towards r̂ and towards θ̂ (None: that angle is zero at that scale).
+    angles: Vec<[Option<SeededSparse>; 2]>,
+    /// Pore deflection strength (fibres pushed out by this × pore radius × mask).
+    pub pore_deflection: f32,
+}
+
+impl FibreWander {
+    /// Variance of one band of signed-weight Wyvill sparse convolution noise of magnitude 1 per
+    /// unit density: E[w²] · ∫K² dV / V = (1/3) · (4π · 1024/45045) / (4π/3) = 1024/45045
+    /// (weights uniform in [−1, 1), ∫₀¹ r² (1 − r²)⁶ dr = 1024/45045; notes/wood.md §9a).
+    pub const VARIANCE_PER_DENSITY: f32 = 1024.0 / 45045.0;
+    /// Lag, in kernel semi-axes, at which that noise's autocorrelation along an axis falls to
+    /// 1/e (numerical integration of the kernel's autocorrelation, notes/wood.md §9a; ½ at 0.549,
+    /// 0 at 2).
+    pub const CORRELATION_LAG: f32 = 0.656;
+
+    /// The wander of `p`; `seeds` gives each noise field its own (coarse r, coarse θ, fine r,
+    /// fine θ).
+    pub fn new(p: &FibreWanderParams, seeds: [u32; 4]) -> Self {
+        let mut angles = vec![Self::scale(&p.coarse(), [seeds[0], seeds[1]])];
+        if let Some(f) = &p.fine {
+            angles.push(Self::scale(f, [seeds[2], seeds[3]]));
+        }
+        FibreWander {
+            angles,
+            pore_deflection: p.pore_deflection,
+        }
+    }
+
+    /// The two angles' noises of one scale.
+    fn scale(p: &WanderScale, seeds: [u32; 2]) -> [Option<SeededSparse>; 2] {
+        let across = p.across / Self::CORRELATION_LAG;
+        let env = Vec3::new(across, across, p.along / Self::CORRELATION_LAG);
+        let std_unit = (p.density * Self::VARIANCE_PER_DENSITY).sqrt();
+        let noise = |deg: f32, seed: u32| {
+            (deg > 0.0).then(|| {
+                SeededSparse::new(
+                    SparseConvolution {
+                        kernel: Kernel::Wyvill,
+                        density: p.density,
+                        envelope: env,
+                        // Equal r and θ semi-axes: the kernel's bounding box is the same at any
+                        // rotation about ẑ, so these cells never shrink it (eq. 11).
+                        cell: CELL_SCALE * env,
+                        magnitude: deg.to_radians() / std_unit,
+                        weights: Weights::Signed,
+                        cells: Cells::Cartesian,
+                        bands: 1,
+                        size_factor: 0.5,
+                        dropoff: 1.0,
+                    },
+                    seed,
+                )
+            })
+        };
+        [noise(p.radial, seeds[0]), noise(p.tangential, seeds[1])]
+    }
+
+    /// The two tilt angles (radians) at `q`: towards r̂ and towards θ̂, kernels along `cyl`
+    /// (the cylindrical frame at `q`).
+    #[inline]
+    pub fn angles(&self, q: Vec3, cyl: &Frame) -> (f32, f32) {
+        let a = |n: &Option<SeededSparse>| {
+            n.as_ref()
+                .map_or(0.0, |n| n.eval_oriented_with::<false>(q, cyl, 1, 1.0).0)
+        };
+        self.angles
+            .iter()
+            .fold((0.0, 0.0), |(r, t), [nr, nt]| (r + a(nr), t + a(nt)))
+    }
+
+    /// The fibre of `fiber` (s = r̂, t across, n along the fibre) tilted at `q`: n + tan(a_r) s +
+    /// tan(a_t) t, normalised, so its projection on the (s, n) plane makes exactly a_r with n and
+    /// that on the (t, n) plane exactly a_t.
+    #[inline]
+    pub fn tilt(&self, q: Vec3, fiber: &Frame) -> Vec3 {
+        let (ar, at) = self.angles(q, &crate::field::cylinder_frame(q));
+        (fiber.n + ar.tan() * fiber.s + at.tan() * fiber.t).normalize()
+    }
+
+    /// The fibre `fiber` bent around a pore whose mask has gradient `grad` at the point (fibre
+    /// frame axis `along`, pore radius `radius` mm): a fibre beside the vessel is displaced
+    /// outwards (−∇⊥m) by δ = pore_deflection · radius · m, so its tangent turns by
+    /// dδ/dn = pore_deflection · radius · ∂m/∂n (streamlines around an obstacle; Hoadley,
+    /// "Understanding Wood" ch. 2).
+    #[inline]
+    pub fn around_pore(&self, fiber: Vec3, along: Vec3, grad: Vec3, radius: f32) -> Vec3 {
+        let dn = grad.dot(along);
+        let across = grad - dn * along;
+        let len = across.length();
+        if self.pore_deflection <= 0.0 || len < 1e-12 || !len.is_finite() {
+            return fiber;
+        }
+        (fiber - (self.pore_deflection * radius * dn / len) * across).normalize()
     }
 }
 

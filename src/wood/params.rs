@@ -37,6 +37,10 @@ pub struct WoodParams {
     /// Knots; absent: clear wood.
     #[serde(default)]
     pub knots: Option<KnotParams>,
+    /// Fine-scale grain deviation (fibre dip and wander, deflection around pores); absent: the
+    /// fibres of the frame, interlock, knots and distortion alone, bit for bit.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fibre_wander: Option<FibreWanderParams>,
 }
 
 /// Growth rings (§6.1.4): mean yearly ring width and the year's earlywood/latewood proportions of
@@ -210,6 +214,73 @@ impl Default for HighlightParams {
     }
 }
 
+/// Fine-scale grain deviation (ours, notes/wood.md §9a): the fibres of real wood are not parallel
+/// to the stem even in straight-grained wood; they dip and wander by a few degrees over
+/// millimetres to centimetres and bend around vessels and ray bundles (Hoadley, "Understanding
+/// Wood", ch. 2 and 5; Panshin & de Zeeuw, "Textbook of Wood Technology", ch. 9 on grain
+/// deviation). Two small rotation angles of the fibre, each a zero-mean sparse convolution noise
+/// (Wyvill kernel, signed weights, one band; Liu et al. 2016 §4) with kernels oriented by the
+/// cylindrical frame (long along the grain, short across it), applied at the distorted point
+/// before the fibre is transported by J⁻¹ (Liu et al. 2016 eq. 17), so wander and figure combine.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FibreWanderParams {
+    /// Standard deviation of the fibre's tilt towards r̂ (a rotation about θ̂), degrees: the dip
+    /// out of a flat-sawn face, the in-plane wander of a quartersawn one.
+    pub radial: f32,
+    /// Standard deviation of the fibre's tilt towards θ̂ (a rotation about r̂), degrees: the
+    /// in-plane wander of a flat-sawn face, the dip out of a quartersawn one.
+    pub tangential: f32,
+    /// Correlation length along the grain, mm: the lag at which the autocorrelation of either
+    /// angle falls to 1/e (the kernel's semi-axis is this / 0.656; notes/wood.md §9a).
+    pub along: f32,
+    /// Correlation length across the grain (r̂ and θ̂), mm, as `along`.
+    pub across: f32,
+    /// Mean number of kernels overlapping a point (more: closer to Gaussian).
+    #[serde(default = "two")]
+    pub density: f32,
+    /// Deflection of the fibres around pores: a fibre beside a vessel is pushed outwards by
+    /// this × the pore radius × the pore mask, and turns by the along-fibre slope of that push
+    /// (0: none; needs a `[pores]` section).
+    #[serde(default)]
+    pub pore_deflection: f32,
+    /// A second, independent scale added to the first (its angles' variances add): cell-scale
+    /// waviness, e.g. fibres deflected around vessels and rays, correlated over tenths of a
+    /// millimetre where the first is over centimetres.
+    #[serde(default)]
+    pub fine: Option<WanderScale>,
+}
+
+/// One scale of [`FibreWanderParams`]: the same fields, without pore deflection.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WanderScale {
+    /// Standard deviation of the tilt towards r̂, degrees.
+    pub radial: f32,
+    /// Standard deviation of the tilt towards θ̂, degrees.
+    pub tangential: f32,
+    /// Correlation length along the grain, mm (1/e lag).
+    pub along: f32,
+    /// Correlation length across the grain, mm (1/e lag).
+    pub across: f32,
+    /// Mean number of kernels overlapping a point.
+    #[serde(default = "two")]
+    pub density: f32,
+}
+
+impl FibreWanderParams {
+    /// The first scale's fields as a [`WanderScale`].
+    pub fn coarse(&self) -> WanderScale {
+        WanderScale {
+            radial: self.radial,
+            tangential: self.tangential,
+            along: self.along,
+            across: self.across,
+            density: self.density,
+        }
+    }
+}
+
 /// Knots after Larsson et al. 2022: branches leave the pith in whorls as cones with their own rings
 /// (the knot ring width follows from the cone angle, see `knots.rs`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -296,6 +367,13 @@ impl Checker<'_> {
             value: v.to_string(),
             allowed,
         }
+    }
+    fn wander(&self, name: &str, w: &WanderScale) -> Result<(), WoodError> {
+        self.range(&format!("{name}.radial"), w.radial, 0.0, 20.0)?;
+        self.range(&format!("{name}.tangential"), w.tangential, 0.0, 20.0)?;
+        self.range(&format!("{name}.along"), w.along, 0.05, 1000.0)?;
+        self.range(&format!("{name}.across"), w.across, 0.02, 1000.0)?;
+        self.range(&format!("{name}.density"), w.density, 0.25, 16.0)
     }
     fn noise(&self, name: &str, n: &NoiseParams) -> Result<(), WoodError> {
         self.range(&format!("{name}.magnitude"), n.magnitude, 0.0, 100.0)?;
@@ -419,6 +497,13 @@ impl WoodParams {
         }
         c.range("highlight.earlywood", self.highlight.earlywood, 0.5, 45.0)?;
         c.range("highlight.latewood", self.highlight.latewood, 0.5, 45.0)?;
+        if let Some(w) = &self.fibre_wander {
+            c.wander("fibre_wander", &w.coarse())?;
+            if let Some(f) = &w.fine {
+                c.wander("fibre_wander.fine", f)?;
+            }
+            c.range("fibre_wander.pore_deflection", w.pore_deflection, 0.0, 4.0)?;
+        }
         if let Some(k) = &self.knots {
             c.range("knots.whorl_spacing", k.whorl_spacing, 10.0, 100_000.0)?;
             if !(1..=12).contains(&k.per_whorl) {

@@ -3,7 +3,9 @@
 
 use super::color::BeerColor;
 use super::error::WoodError;
-use super::features::{footprint_weight, sub_seed, DistortionNoise, Noise1, Pores, Rays};
+use super::features::{
+    footprint_weight, sub_seed, DistortionNoise, FibreWander, Noise1, Pores, Rays,
+};
 use super::growth::{SmoothRectangleWave, SmoothTriangleWave};
 use super::knots::{KnotSample, Knots};
 use super::params::WoodParams;
@@ -53,6 +55,8 @@ pub struct WoodVolume {
     pores: Option<Pores>,
     rays: Option<Rays>,
     knots: Option<Knots>,
+    /// Fine-scale grain deviation (notes/wood.md §9a), evaluated only for fibres.
+    wander: Option<FibreWander>,
     jacobian: JacobianModel,
 }
 
@@ -67,6 +71,7 @@ mod salt {
     pub const PORES: u32 = 6;
     pub const RAYS: u32 = 7;
     pub const PHASE: u32 = 8;
+    pub const WANDER: [u32; 4] = [9, 10, 11, 12];
     pub const KNOTS: u64 = 0x6b6e_6f74;
 }
 
@@ -155,6 +160,10 @@ impl WoodVolume {
             .knots
             .as_ref()
             .map(|k| Knots::new(k, p.rings.width, seed ^ salt::KNOTS));
+        let wander = p
+            .fibre_wander
+            .as_ref()
+            .map(|w| FibreWander::new(w, salt::WANDER.map(|s| sub_seed(seed, s))));
         Ok(WoodVolume {
             inv_ring_width: 1.0 / p.rings.width,
             growth,
@@ -168,6 +177,7 @@ impl WoodVolume {
             pores,
             rays,
             knots,
+            wander,
             params,
             seed,
             jacobian: JacobianModel::Simplified,
@@ -390,6 +400,16 @@ impl WoodVolume {
         }
         if needs.fibers {
             let mut fiber = frame.n;
+            if let Some(w) = &self.wander {
+                fiber = w.tilt(q, &frame);
+                if let Some(pores) = self.pores.as_ref().filter(|_| w.pore_deflection > 0.0) {
+                    let fade = footprint_weight(pores.diameter, footprint);
+                    if fade > 0.0 {
+                        let (_, grad) = pores.mask::<true>(q, &frame, g);
+                        fiber = w.around_pore(fiber, frame.n, fade * grad, 0.5 * pores.diameter);
+                    }
+                }
+            }
             if let (Some(k), Some(knots)) = (&c.knot, &self.knots) {
                 fiber = knots.deflect_fiber(fiber, k);
             }

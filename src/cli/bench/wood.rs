@@ -177,13 +177,14 @@ fn fixed_passes(args: &Args, points: &[Vec3], passes: usize) -> anyhow::Result<E
 /// Colour-only and full-model speed with each feature switched off in turn: the saving is that
 /// feature's cost.
 fn breakdown(params: &wood::WoodParams, points: &[Vec3]) -> anyhow::Result<()> {
-    let variants: [(&str, fn(&mut wood::WoodParams)); 7] = [
+    let variants: [(&str, fn(&mut wood::WoodParams)); 8] = [
         ("no growth noise", |p| p.growth = None),
         ("no interlock", |p| p.interlock = None),
         ("no distortion", |p| p.distortion = Default::default()),
         ("no pores", |p| p.pores = None),
         ("no rays", |p| p.rays = None),
         ("no knots", |p| p.knots = None),
+        ("no fibre wander", |p| p.fibre_wander = None),
         ("rings + colour only", |p| {
             *p = wood::WoodParams {
                 growth: None,
@@ -192,6 +193,7 @@ fn breakdown(params: &wood::WoodParams, points: &[Vec3]) -> anyhow::Result<()> {
                 pores: None,
                 rays: None,
                 knots: None,
+                fibre_wander: None,
                 ..p.clone()
             }
         }),
