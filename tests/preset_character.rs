@@ -566,6 +566,11 @@ fn quilt_shows_at_every_light_angle_unclipped() {
             "figure contrast {kn} (flat {kf}) at {angle}"
         );
         fails_old |= c0 >= 0.005 || k0 < 0.06;
+        // Negative control of the contrast: the same board without the quilt.
+        assert!(
+            kf < 0.06,
+            "the quilt-free board has figure contrast {kf} at {angle}"
+        );
     }
     assert!(fails_old, "the old quilt passes at every angle");
 }
