@@ -222,6 +222,12 @@ pub(super) fn gallery(
     for name in &names {
         wood::preset(name)?;
     }
+    // The scene resolves a relative `preset_file` against its own folder: make DIR absolute.
+    let presets = presets
+        .map(std::path::absolute)
+        .transpose()
+        .context("--presets")?;
+    let presets = presets.as_deref();
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let board = board_table()?;
     let (mut thumbs, mut labels) = (Vec::new(), Vec::new());
