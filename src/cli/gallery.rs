@@ -72,6 +72,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             16,
             &[-40.0, 0.0, 40.0],
             &[],
+            None,
         )?;
     }
     if part("sweeps") {

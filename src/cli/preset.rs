@@ -59,6 +59,10 @@ enum What {
         /// Only these presets (default: all).
         #[arg(long)]
         only: Vec<String>,
+        /// Read each preset from DIR/<name>.toml instead of the built-in one (iterate on a
+        /// preset without recompiling).
+        #[arg(long, value_name = "DIR")]
+        presets: Option<PathBuf>,
     },
 }
 
@@ -85,7 +89,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             spp,
             angles,
             only,
-        } => gallery(&out, res, spp, &angles, &only)?,
+            presets,
+        } => gallery(&out, res, spp, &angles, &only, presets.as_deref())?,
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -199,6 +204,7 @@ pub(super) fn gallery(
     spp: u32,
     angles: &[f32],
     only: &[String],
+    presets: Option<&Path>,
 ) -> anyhow::Result<()> {
     use crate::picture::contact::{contact_sheet_rows, Rgb8};
     use crate::picture::png::write_png_rgb8;
@@ -216,13 +222,20 @@ pub(super) fn gallery(
     for name in &names {
         wood::preset(name)?;
     }
+    // The scene resolves a relative `preset_file` against its own folder: make DIR absolute.
+    let presets = presets
+        .map(std::path::absolute)
+        .transpose()
+        .context("--presets")?;
+    let presets = presets.as_deref();
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let board = board_table()?;
     let (mut thumbs, mut labels) = (Vec::new(), Vec::new());
     for name in &names {
-        let loaded = preset_board(
+        let loaded = preset_board_with(
             &board,
             name,
+            presets,
             (width, height),
             spp,
             GALLERY_EYE,
@@ -285,6 +298,19 @@ pub(super) fn board_table() -> anyhow::Result<toml::Table> {
 pub(super) fn preset_board(
     scene: &toml::Table,
     name: &str,
+    res: (u32, u32),
+    spp: u32,
+    eye: [f32; 3],
+    fov_deg: f64,
+) -> anyhow::Result<crate::scene::LoadedScene> {
+    preset_board_with(scene, name, None, res, spp, eye, fov_deg)
+}
+
+/// [`preset_board`] with the preset read from `presets`/`name`.toml when `presets` is given.
+fn preset_board_with(
+    scene: &toml::Table,
+    name: &str,
+    presets: Option<&Path>,
     (width, height): (u32, u32),
     spp: u32,
     eye: [f32; 3],
@@ -299,7 +325,19 @@ pub(super) fn preset_board(
         }
         at.insert(last.to_string(), v);
     };
-    set(&mut scene, &["materials", "board", "preset"], name.into());
+    match presets {
+        Some(dir) => {
+            let file = dir.join(format!("{name}.toml"));
+            let board = scene
+                .get_mut("materials")
+                .and_then(|m| m.get_mut("board"))
+                .and_then(|b| b.as_table_mut())
+                .context("the gallery scene has no material `board`")?;
+            board.remove("preset");
+            board.insert("preset_file".into(), file.display().to_string().into());
+        }
+        None => set(&mut scene, &["materials", "board", "preset"], name.into()),
+    }
     set(&mut scene, &["render", "width"], i64::from(width).into());
     set(&mut scene, &["render", "height"], i64::from(height).into());
     set(&mut scene, &["render", "spp"], i64::from(spp).into());

@@ -13,6 +13,9 @@ use glam::{Mat3, Vec3};
 /// The golden angle π (3 − √5), radians.
 const GOLDEN_ANGLE: f32 = 2.399_963;
 
+/// How much further the branch collar (`KnotParams::swell`) reaches along the trunk than across.
+const SWELL_ELONGATION: f32 = 2.0;
+
 /// Width of the bark rim around a dead knot, mm.
 const BARK_RIM: f32 = 0.4;
 
@@ -32,6 +35,9 @@ pub struct Knots {
     blend: f32,
     /// Extra absorbance of knot wood (multiples of the latewood path).
     pub darkening: f32,
+    /// Largest lowering of the trunk time round a knot (years; 0: none) and its fade width (mm).
+    swell: f32,
+    inv_swell_width: f32,
     seed: u64,
 }
 
@@ -69,6 +75,8 @@ impl Knots {
             death_year: p.death_year,
             blend: 0.3,
             darkening: p.darkening,
+            swell: p.swell,
+            inv_swell_width: 1.0 / p.swell_width,
             seed,
         }
     }
@@ -106,6 +114,7 @@ impl Knots {
     pub fn eval(&self, q: Vec3, theta: f32, r: f32, t_trunk: f32) -> Option<KnotSample> {
         let kf = (q.z - r * self.tan_rise) / self.spacing;
         let (step, mut best, mut flow) = (self.step(), None::<KnotSample>, Mat3::ZERO);
+        let mut swell = 0.0f32;
         for k in [kf.floor() as i64, kf.floor() as i64 + 1] {
             let j0 = ((theta - self.phase(k)) / step).floor();
             for j in [j0, j0 + 1.0] {
@@ -126,6 +135,22 @@ impl Knots {
                 if rho > 1e-6 && sample.inside == 0.0 && weight > 0.0 {
                     flow += weight * cylinder_flow(axis, offset / rho, sample.radius / rho);
                 }
+                if self.swell > 0.0 && sample.inside == 0.0 && weight > 0.0 {
+                    // The collar: exp(−x²) of the distance x from the knot's surface in swell
+                    // widths; a live knot's rings merge with the trunk's, so there it also
+                    // rises from 0 at the surface (no step in time).
+                    // The collar reaches `SWELL_ELONGATION` times further along the trunk
+                    // (offset along ẑ) than across it: loops longer along the grain.
+                    let along = if rho > 1e-6 { offset.z / rho } else { 0.0 };
+                    let stretch = 1.0 + (SWELL_ELONGATION - 1.0) * along * along;
+                    let x = ((rho - sample.radius) * self.inv_swell_width / stretch).max(0.0);
+                    let rise = if self.death_year.is_some() {
+                        1.0
+                    } else {
+                        1.0 - (-(4.0 * x) * (4.0 * x)).exp()
+                    };
+                    swell = swell.max(weight * rise * (-x * x).exp());
+                }
                 // Inside a knot beats its bark rim beats outside, then the earlier time.
                 let rank = |k: &KnotSample| 2.0 * k.inside + k.bark;
                 let nearer = match &best {
@@ -140,7 +165,14 @@ impl Knots {
                 }
             }
         }
-        best.map(|b| KnotSample { flow, ..b })
+        best.map(|b| {
+            let time = if b.inside == 0.0 && b.bark == 0.0 && swell > 0.0 {
+                b.time - self.swell * swell
+            } else {
+                b.time
+            };
+            KnotSample { flow, time, ..b }
+        })
     }
 
     /// The knot of the branch with unit `axis` at distance `rho` from it, trunk time `t_trunk`.
@@ -233,6 +265,8 @@ mod tests {
             cone: 6.0,
             death_year: death,
             darkening: 0.5,
+            swell: 0.0,
+            swell_width: 20.0,
         }
     }
 

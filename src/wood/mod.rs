@@ -4,6 +4,7 @@
 mod board;
 mod color;
 mod error;
+mod eyes;
 mod features;
 mod growth;
 mod knots;
@@ -14,6 +15,7 @@ mod volume;
 pub use board::*;
 pub use color::BeerColor;
 pub use error::WoodError;
+pub use eyes::{EyeSample, Eyes};
 pub use growth::{SmoothRectangleWave, SmoothTriangleWave};
 pub use knots::{smooth_min, KnotSample, Knots};
 pub use params::*;

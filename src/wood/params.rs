@@ -41,6 +41,39 @@ pub struct WoodParams {
     /// fibres of the frame, interlock, knots and distortion alone, bit for bit.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fibre_wander: Option<FibreWanderParams>,
+    /// Birdseye: radial bud traces the rings dip around, with dark centres; absent: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eyes: Option<EyeParams>,
+}
+
+/// Birdseye figure (ours, `eyes.rs`): aborted bud traces running radially, each an eye on a
+/// flat-sawn face with the rings dipping round it and a dark centre.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EyeParams {
+    /// Mean number of eyes per cm² of tangential (flat-sawn) face.
+    pub density: f32,
+    /// Range `[min, max]` of the dimple's diameter, mm (uniform); the visible eye, the ring loop
+    /// round the centre, is about half of it to all of it.
+    pub diameter: [f32; 2],
+    /// Depth of the rings' dip at an eye's centre, mm.
+    pub depth: f32,
+    /// Radial length of a trace, mm (it fades in and out over this length).
+    #[serde(default = "eye_length")]
+    pub length: f32,
+    /// Radius of the dark centre, mm.
+    #[serde(default = "eye_core")]
+    pub core: f32,
+    /// Extra absorbance at the centre (multiples of the latewood path).
+    #[serde(default = "one")]
+    pub darkening: f32,
+}
+
+fn eye_length() -> f32 {
+    40.0
+}
+fn eye_core() -> f32 {
+    0.4
 }
 
 /// Growth rings (§6.1.4): mean yearly ring width and the year's earlywood/latewood proportions of
@@ -301,6 +334,24 @@ pub struct KnotParams {
     /// Extra absorbance of knot wood (multiples of the latewood path).
     #[serde(default = "half")]
     pub darkening: f32,
+    /// The trunk's growth layers swell round a branch (the branch collar): outside a knot the
+    /// trunk time is lowered by up to `swell` years, fading over `swell_width` mm from the knot's
+    /// surface, so on a flat-sawn face the rings loop round the knot. 0 (absent): no swell.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub swell: f32,
+    /// Distance from the knot's surface over which the swell fades, mm.
+    #[serde(default = "swell_width", skip_serializing_if = "is_swell_width")]
+    pub swell_width: f32,
+}
+
+fn is_zero(v: &f32) -> bool {
+    *v == 0.0
+}
+fn swell_width() -> f32 {
+    20.0
+}
+fn is_swell_width(v: &f32) -> bool {
+    *v == 20.0
 }
 
 fn one() -> f32 {
@@ -515,6 +566,17 @@ impl WoodParams {
                 c.range("knots.death_year", d, 0.0, 1000.0)?;
             }
             c.range("knots.darkening", k.darkening, 0.0, 10.0)?;
+            c.range("knots.swell", k.swell, 0.0, 50.0)?;
+            c.range("knots.swell_width", k.swell_width, 0.5, 500.0)?;
+        }
+        if let Some(e) = &self.eyes {
+            c.range("eyes.density", e.density, 0.0, 10.0)?;
+            c.range("eyes.diameter[0]", e.diameter[0], 0.1, 50.0)?;
+            c.range("eyes.diameter[1]", e.diameter[1], e.diameter[0], 50.0)?;
+            c.range("eyes.depth", e.depth, 0.0, 20.0)?;
+            c.range("eyes.length", e.length, 1.0, 1000.0)?;
+            c.range("eyes.core", e.core, 0.01, 10.0)?;
+            c.range("eyes.darkening", e.darkening, 0.0, 10.0)?;
         }
         Ok(())
     }

@@ -3,6 +3,7 @@
 
 use super::color::BeerColor;
 use super::error::WoodError;
+use super::eyes::Eyes;
 use super::features::{
     footprint_weight, sub_seed, DistortionNoise, FibreWander, Noise1, Pores, Rays,
 };
@@ -57,6 +58,8 @@ pub struct WoodVolume {
     knots: Option<Knots>,
     /// Fine-scale grain deviation (notes/wood.md §9a), evaluated only for fibres.
     wander: Option<FibreWander>,
+    /// Birdseye traces (ours, `eyes.rs`).
+    eyes: Option<Eyes>,
     jacobian: JacobianModel,
 }
 
@@ -73,6 +76,7 @@ mod salt {
     pub const PHASE: u32 = 8;
     pub const WANDER: [u32; 4] = [9, 10, 11, 12];
     pub const KNOTS: u64 = 0x6b6e_6f74;
+    pub const EYES: u64 = 0x6579_6573;
 }
 
 /// What `eval` computes at the distorted point before deciding what else it needs.
@@ -82,6 +86,8 @@ struct Core {
     r: f32,
     time: f32,
     knot: Option<KnotSample>,
+    /// Dark-centre weight of the birdseye traces (0 without eyes).
+    eye_core: f32,
 }
 
 impl WoodVolume {
@@ -164,6 +170,7 @@ impl WoodVolume {
             .fibre_wander
             .as_ref()
             .map(|w| FibreWander::new(w, salt::WANDER.map(|s| sub_seed(seed, s))));
+        let eyes = p.eyes.as_ref().map(|e| Eyes::new(e, seed ^ salt::EYES));
         Ok(WoodVolume {
             inv_ring_width: 1.0 / p.rings.width,
             growth,
@@ -178,6 +185,7 @@ impl WoodVolume {
             rays,
             knots,
             wander,
+            eyes,
             params,
             seed,
             jacobian: JacobianModel::Simplified,
@@ -252,6 +260,13 @@ impl WoodVolume {
         self.interlock.map_or(0.0, |n| n.eval(r).0)
     }
 
+    /// The knot at tree-space point `p` (after distortion, as `eval` sees it): whether `p` is
+    /// inside a knot or on its bark rim, the knot's radius there and the combined growth time;
+    /// `None` without knots or far from every knot.
+    pub fn knot_at(&self, p: Vec3) -> Option<KnotSample> {
+        self.core(p, Needs::COLOR, 0.0).knot
+    }
+
     /// The distortion f(p) with its Jacobian (§5, eq. 15 and 22).
     #[inline]
     pub fn distortion(&self, p: Vec3) -> Distortion {
@@ -262,6 +277,32 @@ impl WoodVolume {
     /// narrower than `footprint` mm are dropped (0: every band).
     #[inline]
     fn distort<const JACOBIAN: bool>(&self, p: Vec3, footprint: f32) -> Distortion {
+        self.distort_eyes::<JACOBIAN>(p, footprint).0
+    }
+
+    /// [`WoodVolume::distort`] and the eyes' dark-centre weight (0 without eyes). The eyes'
+    /// dimple is one more radial displacement, evaluated at p like the noise terms; with the
+    /// exact Jacobian model it is left to the simplified transport (its gradient is small).
+    #[inline]
+    fn distort_eyes<const JACOBIAN: bool>(&self, p: Vec3, footprint: f32) -> (Distortion, f32) {
+        let mut d = self.distort_noise::<JACOBIAN>(p, footprint);
+        let mut core = 0.0;
+        if let Some(eyes) = &self.eyes {
+            let e = eyes.eval(p);
+            if e.m != 0.0 || e.grad_m != Vec3::ZERO {
+                d.add(Displacement {
+                    dir: cylinder_frame(p).s,
+                    m: e.m,
+                    grad_m: e.grad_m,
+                });
+            }
+            core = e.core;
+        }
+        (d, core)
+    }
+
+    #[inline]
+    fn distort_noise<const JACOBIAN: bool>(&self, p: Vec3, footprint: f32) -> Distortion {
         let mut d = Distortion::identity(p);
         if self.distortion.iter().any(Option::is_some) {
             let frame = cylinder_frame(p);
@@ -292,10 +333,10 @@ impl WoodVolume {
 
     #[inline]
     fn core(&self, p: Vec3, needs: Needs, footprint: f32) -> Core {
-        let dist = if needs.fibers || needs.bump {
-            self.distort::<true>(p, footprint)
+        let (dist, eye_core) = if needs.fibers || needs.bump {
+            self.distort_eyes::<true>(p, footprint)
         } else {
-            self.distort::<false>(p, footprint)
+            self.distort_eyes::<false>(p, footprint)
         };
         let q = dist.point;
         let r = (q.x * q.x + q.y * q.y).sqrt();
@@ -313,6 +354,7 @@ impl WoodVolume {
             r,
             time,
             knot,
+            eye_core,
         }
     }
 
@@ -387,10 +429,13 @@ impl WoodVolume {
             };
         }
         if needs.color {
-            let extra = match (&c.knot, &self.knots) {
+            let mut extra = match (&c.knot, &self.knots) {
                 (Some(k), Some(kn)) => kn.darkening * (k.inside + 3.0 * k.bark),
                 _ => 0.0,
             };
+            if let Some(eyes) = &self.eyes {
+                extra += eyes.darkening * c.eye_core;
+            }
             let a = self
                 .color
                 .absorbance(g, texel.pore_mask, texel.ray_mask, extra);
@@ -439,7 +484,7 @@ impl WoodVolume {
         assert_eq!(points.len(), out.len(), "eval_many: one texel per point");
         assert!(simd <= Simd::best(), "{simd:?} not available");
         let mut done = 0;
-        if needs == Needs::COLOR && self.knots.is_none() {
+        if needs == Needs::COLOR && self.knots.is_none() && self.eyes.is_none() {
             for (p, o) in points.chunks_exact(BATCH).zip(out.chunks_exact_mut(BATCH)) {
                 let p: &[Vec3; BATCH] = p.try_into().expect("a whole block");
                 let o: &mut [WoodTexel; BATCH] = o.try_into().expect("a whole block");
