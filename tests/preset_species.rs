@@ -624,6 +624,13 @@ fn checks(preset: &str) -> Vec<Check> {
         },
         Check {
             preset: "african_mahogany",
+            fact: "lustrous, not copper: chatoyance median and p90/p10 within the measured boards'",
+            measure: chatoyance_figures,
+            holds: chatoyance_holds,
+            control: Control::Before,
+        },
+        Check {
+            preset: "african_mahogany",
             fact: "ribbon stripe on the quartersawn face: dip sd ≥ 4°, stripe period 8–40 mm",
             measure: ribbon_figures,
             holds: |f| f[0] >= 4.0 && within(f[1], (8.0, 40.0)),
