@@ -40,14 +40,80 @@ fn pearson_of_known_pairs() {
 #[test]
 fn calibrated_presets_match_the_measured_boards() {
     use std::path::Path;
-    use xylem::validate::appearance::{compare_pair, SweepSettings, PAIRS};
+    use xylem::validate::appearance::{builtin_pairs, compare_pair, SweepSettings};
     let base = Path::new(env!("CARGO_MANIFEST_DIR"));
-    for pair in &PAIRS {
+    let (mut rows, mut by_leg) = (0, 0);
+    for pair in &builtin_pairs() {
         let report = compare_pair(pair, base, None, SweepSettings::FULL).unwrap();
         for c in &report.rows {
+            println!("{}: {} {}", pair.preset, c.name, c.verdict());
             assert!(c.passes(), "{}: {c:?}", pair.preset);
         }
+        rows += report.rows.len();
+        by_leg += report.rows.iter().filter(|c| !c.in_band()).count();
         // The comparison covers the rendered sweep too, not only the maps.
         assert!(report.rows.iter().any(|c| c.name.starts_with("chatoyance")));
     }
+    // Issue 25: at most 10 % of the rows may pass by the 25 % leg alone.
+    assert!(
+        by_leg as f64 <= xylem::validate::appearance::MAX_LEG_SHARE * rows as f64,
+        "{by_leg} of {rows} rows pass only by the 25 % leg"
+    );
+}
+
+/// `validate appearance --board` reads a board's grain and cut from its maps: the three measured
+/// boards as their README describes them (maple along x, padauk and walnut1 along y; walnut1
+/// flat-sawn, the others quartersawn). Control: the same maps turned a quarter (rows and columns
+/// swapped) must read along the other axis, with the same cut.
+#[test]
+fn measured_boards_grain_and_cut_are_detected() {
+    use xylem::validate::appearance::detect_board;
+    let base = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/marschner2005");
+    for (board, along_x, flat) in [
+        ("maple", true, false),
+        ("padauk", false, false),
+        ("walnut1", false, true),
+    ] {
+        let d = detect_board(&base.join(board)).unwrap();
+        println!("{board}: {d:?}");
+        assert_eq!(d.grain_along_x, along_x, "{board}");
+        assert_eq!(d.ring_angle_deg == 0.0, flat, "{board}: {d:?}");
+        // Turned a quarter: x and y swap in the images and in the fibre axis.
+        let dir = tempfile::tempdir().unwrap();
+        for map in ["diffuse", "fiber_color", "fiber_axis"] {
+            let img = image_rgb8(&base.join(board).join(format!("{map}.png")));
+            let (w, h, px) = img;
+            let mut t = vec![0u8; px.len()];
+            for y in 0..h {
+                for x in 0..w {
+                    let (src, dst) = (3 * (y * w + x), 3 * (x * h + y));
+                    t[dst..dst + 3].copy_from_slice(&px[src..src + 3]);
+                    if map == "fiber_axis" {
+                        t.swap(dst, dst + 1);
+                    }
+                }
+            }
+            xylem::picture::png::write_png_rgb8(
+                &dir.path().join(format!("{map}.png")),
+                h as u32,
+                w as u32,
+                &t,
+            )
+            .unwrap();
+        }
+        let turned = detect_board(dir.path()).unwrap();
+        assert_eq!(turned.grain_along_x, !along_x, "{board} turned: {turned:?}");
+        assert_eq!(turned.ring_angle_deg, d.ring_angle_deg, "{board} turned");
+    }
+}
+
+/// An 8-bit RGB PNG as (width, height, pixels).
+fn image_rgb8(path: &std::path::Path) -> (usize, usize, Vec<u8>) {
+    let decoder = png::Decoder::new(std::fs::File::open(path).unwrap());
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    assert_eq!(info.color_type, png::ColorType::Rgb);
+    buf.truncate(info.buffer_size());
+    (info.width as usize, info.height as usize, buf)
 }

@@ -317,16 +317,11 @@ pub(super) fn preset_board(
         })
         .and_then(|o| o.as_table_mut())
         .context("the gallery scene has no object named `board`")?;
-    // The face's true cut: `SHOWCASE_PITH_DISTANCE_MM` from the pith, flat- or quartersawn as
-    // the species shows its figure (the board's top face, centre [0, 0, 9] in object space).
-    let tree: toml::Table = format!(
-        "axis = [1.0, 0.0, 0.0]\nsawn = {{ pith_distance = {:.1}, ring_angle_deg = {:.1}, slope_deg = {:.1}, face_point = [0.0, 0.0, 9.0] }}",
-        wood::SHOWCASE_PITH_DISTANCE_MM,
-        wood::showcase_ring_angle_deg(name),
-        wood::SHOWCASE_SLOPE_DEG
-    )
-    .parse()?;
-    board.insert("tree".into(), tree.into());
+    // The face's true cut: flat- or quartersawn as the species shows its figure.
+    let cut = crate::material::SawnCut::showcase_board(wood::showcase_ring_angle_deg(name));
+    let tree: toml::Table = format!("tree = {}", cut.tree_toml()).parse()?;
+    let tree = tree["tree"].clone();
+    board.insert("tree".into(), tree);
     Ok(crate::scene::from_str(
         &toml::to_string(&scene)?,
         GALLERY_SCENE,

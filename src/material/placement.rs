@@ -71,6 +71,36 @@ impl SawnCut {
     pub fn quarter(pith_distance: f32, face_point: Vec3) -> SawnCut {
         SawnCut::new(pith_distance, 90.0, face_point)
     }
+
+    /// The top face (centre [0, 0, 9]) of an 18 mm board lying flat, as every showcase board is
+    /// cut: `wood::SHOWCASE_PITH_DISTANCE_MM` from the pith at `ring_angle_deg`, and faces nearer
+    /// flat- than quartersawn sloped `wood::SHOWCASE_SLOPE_DEG` along the grain (arches).
+    pub fn showcase_board(ring_angle_deg: f32) -> SawnCut {
+        use crate::wood::{SHOWCASE_PITH_DISTANCE_MM, SHOWCASE_SLOPE_DEG};
+        SawnCut {
+            slope_deg: if ring_angle_deg < 45.0 {
+                SHOWCASE_SLOPE_DEG
+            } else {
+                0.0
+            },
+            ..SawnCut::new(
+                SHOWCASE_PITH_DISTANCE_MM,
+                ring_angle_deg,
+                Vec3::new(0.0, 0.0, 9.0),
+            )
+        }
+    }
+
+    /// The scene file's `tree` inline table of this cut for a board whose grain runs along
+    /// object x.
+    pub fn tree_toml(&self) -> String {
+        format!(
+            "{{ axis = [1.0, 0.0, 0.0], sawn = {} }}",
+            toml::to_string(self)
+                .map(|t| format!("{{ {} }}", t.trim().replace('\n', ", ")))
+                .unwrap_or_default()
+        )
+    }
 }
 
 /// Where a face point lies in the tree ([`Placement::cut_at`]).
