@@ -104,12 +104,18 @@ fn face_colour(subject: &Subject) -> FaceColour {
     }
 }
 
-fn preset_colour(dir: &Path, name: &str) -> FaceColour {
-    face_colour(&Subject::Preset {
+/// The preset board of `validate appearance` (seed 7, quartersawn 120 mm from the pith).
+fn board(dir: &Path, name: &str) -> Subject {
+    Subject::Preset {
         name: name.into(),
         seed: 7,
         dir: Some(dir.to_path_buf()),
-    })
+        ring_angle_deg: 90.0,
+    }
+}
+
+fn preset_colour(dir: &Path, name: &str) -> FaceColour {
+    face_colour(&board(dir, name))
 }
 
 fn measured_colour(board: &str) -> FaceColour {
@@ -135,11 +141,7 @@ fn highlight_saturation_ratio(c: &FaceColour) -> f64 {
 /// grain over ±60°, 13 frames, 96² pixels, 2 spp): (median, p90/p10) of the per-pixel max/min
 /// luminance.
 fn chatoyance(dir: &Path, name: &str) -> (f64, f64) {
-    sweep_chatoyance(&Subject::Preset {
-        name: name.into(),
-        seed: 7,
-        dir: Some(dir.to_path_buf()),
-    })
+    sweep_chatoyance(&board(dir, name))
 }
 
 fn sweep_chatoyance(subject: &Subject) -> (f64, f64) {
@@ -307,13 +309,7 @@ fn ray_fleck(v: &WoodVolume) -> (f64, f64) {
 /// the profile across the grain of the mean fibre dip; (its standard deviation in degrees, the
 /// dominant period in mm).
 fn ribbon(dir: &Path, name: &str) -> (f64, f64) {
-    let m = Subject::Preset {
-        name: name.into(),
-        seed: 7,
-        dir: Some(dir.to_path_buf()),
-    }
-    .maps(base())
-    .unwrap();
+    let m = board(dir, name).maps(base()).unwrap();
     let (w, h) = (m.board.width as usize, m.board.height as usize);
     let profile: Vec<f64> = (0..h)
         .map(|c| (0..w).map(|a| m.dip_deg(c * w + a)).sum::<f64>() / w as f64)
