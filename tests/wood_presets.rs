@@ -58,7 +58,7 @@ fn out_of_range_value_is_rejected_with_the_range() {
         "{msg}"
     );
     // Growth noise beyond the monotonicity bound.
-    let text = base().replace("noise_amplitude = 0.25", "noise_amplitude = 1.5");
+    let text = base().replace("noise_amplitude = 0.42", "noise_amplitude = 1.5");
     assert!(err_of(&text).contains("growth.noise_amplitude"));
 }
 
