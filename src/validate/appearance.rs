@@ -823,6 +823,8 @@ pub struct PairReport {
     pub preset_sweep: SweepLuminance,
     /// The measured board's rendered sweep.
     pub measured_sweep: SweepLuminance,
+    /// Pattern statistics (`validate::pattern`), preset against measured.
+    pub pattern_rows: Vec<Comparison>,
 }
 
 impl PairReport {
@@ -879,9 +881,12 @@ pub fn compare_pair_seeded(
         let column = |s: &[[f64; 2]]| -> Vec<f64> { s.iter().map(|s| s[k]).collect() };
         rows.push(strip_comparison(name, &column(&pstrips), &column(&mstrips)));
     }
+    let pitch = f64::from(BOARD_MM) / pm.board.width.max(1) as f64;
+    let pattern_rows = super::pattern::compare_patterns(&pm, &mm, pitch);
     Ok(PairReport {
         pair: pair.clone(),
         rows,
+        pattern_rows,
         preset_maps: pm,
         measured_maps: mm,
         preset_sweep: ps,
@@ -1122,7 +1127,42 @@ fn pair_section(r: &PairReport, dir: &Path, sweep: SweepSettings) -> Result<Stri
         r.rows.len(),
         by_leg
     );
-    let failed: Vec<&Comparison> = r.rows.iter().filter(|c| !c.passes()).collect();
+    md +=
+        "\nPattern statistics (notes/appearance.md §5; compared the same way, over 8 pieces):\n\n";
+    let prow: Vec<Vec<String>> = r
+        .pattern_rows
+        .iter()
+        .map(|c| {
+            vec![
+                c.name.clone(),
+                format!("{:.4}", c.preset),
+                format!("{:.4}", c.measured),
+                format!("{:.4} … {:.4}", c.band.0, c.band.1),
+                c.verdict().into(),
+            ]
+        })
+        .collect();
+    md += &markdown_table(
+        &[
+            "pattern statistic",
+            "preset",
+            "measured",
+            "measured 10–90 % band",
+            "result",
+        ],
+        &prow,
+    );
+    md += &format!(
+        "\n{} of {} pattern rows pass.\n",
+        r.pattern_rows.iter().filter(|c| c.passes()).count(),
+        r.pattern_rows.len()
+    );
+    let failed: Vec<&Comparison> = r
+        .rows
+        .iter()
+        .chain(&r.pattern_rows)
+        .filter(|c| !c.passes())
+        .collect();
     if !failed.is_empty() {
         md += "\nNot reached:\n\n";
         for c in failed {
@@ -1296,7 +1336,7 @@ pub fn run_report(
     for pair in pairs {
         progress(&pair.preset);
         let r = compare_pair(pair, base, preset_dir, sweep)?;
-        ok &= r.passes();
+        ok &= r.passes() && r.pattern_rows.iter().all(Comparison::passes);
         rows += r.rows.len();
         by_leg += r.rows.iter().filter(|c| c.passes() && !c.in_band()).count();
         md += &pair_section(&r, dir, sweep)?;
