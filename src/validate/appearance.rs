@@ -1073,6 +1073,32 @@ pub fn preset_sheet(
     ))
 }
 
+/// A Markdown table of comparisons: value, measured median, band and verdict per row.
+fn comparison_table(what: &str, rows: &[Comparison]) -> String {
+    let cells: Vec<Vec<String>> = rows
+        .iter()
+        .map(|c| {
+            vec![
+                c.name.clone(),
+                format!("{:.4}", c.preset),
+                format!("{:.4}", c.measured),
+                format!("{:.4} … {:.4}", c.band.0, c.band.1),
+                c.verdict().into(),
+            ]
+        })
+        .collect();
+    markdown_table(
+        &[
+            what,
+            "preset",
+            "measured",
+            "measured 10–90 % band",
+            "result",
+        ],
+        &cells,
+    )
+}
+
 /// The report section of one pair: its table, plots and side-by-side frames (written into
 /// `dir/plots/`).
 fn pair_section(r: &PairReport, dir: &Path, sweep: SweepSettings) -> Result<String, String> {
@@ -1097,29 +1123,7 @@ fn pair_section(r: &PairReport, dir: &Path, sweep: SweepSettings) -> Result<Stri
         sweep.res,
         sweep.spp
     );
-    let rows: Vec<Vec<String>> = r
-        .rows
-        .iter()
-        .map(|c| {
-            vec![
-                c.name.clone(),
-                format!("{:.4}", c.preset),
-                format!("{:.4}", c.measured),
-                format!("{:.4} … {:.4}", c.band.0, c.band.1),
-                c.verdict().into(),
-            ]
-        })
-        .collect();
-    md += &markdown_table(
-        &[
-            "statistic",
-            "preset",
-            "measured",
-            "measured 10–90 % band",
-            "result",
-        ],
-        &rows,
-    );
+    md += &comparison_table("statistic", &r.rows);
     let by_leg = r.rows.iter().filter(|c| c.passes() && !c.in_band()).count();
     md += &format!(
         "\n{} of {} rows pass, {} of them only by the 25 % leg (outside the band).\n",
@@ -1129,29 +1133,7 @@ fn pair_section(r: &PairReport, dir: &Path, sweep: SweepSettings) -> Result<Stri
     );
     md +=
         "\nPattern statistics (notes/appearance.md §5; compared the same way, over 8 pieces):\n\n";
-    let prow: Vec<Vec<String>> = r
-        .pattern_rows
-        .iter()
-        .map(|c| {
-            vec![
-                c.name.clone(),
-                format!("{:.4}", c.preset),
-                format!("{:.4}", c.measured),
-                format!("{:.4} … {:.4}", c.band.0, c.band.1),
-                c.verdict().into(),
-            ]
-        })
-        .collect();
-    md += &markdown_table(
-        &[
-            "pattern statistic",
-            "preset",
-            "measured",
-            "measured 10–90 % band",
-            "result",
-        ],
-        &prow,
-    );
+    md += &comparison_table("pattern statistic", &r.pattern_rows);
     md += &format!(
         "\n{} of {} pattern rows pass.\n",
         r.pattern_rows.iter().filter(|c| c.passes()).count(),
