@@ -72,7 +72,7 @@ fn main() {
         "{} (ring angle {}°) against {}",
         pair.preset, pair.ring_angle_deg, pair.measured_dir
     );
-    for r in &report.rows {
+    for r in report.rows.iter().chain(&report.pattern_rows) {
         println!(
             "{:45} preset {:8.4}  measured {:8.4}  band {:8.4} … {:8.4}  {}",
             r.name,
@@ -83,6 +83,11 @@ fn main() {
             r.verdict()
         );
     }
+    let passed = report.pattern_rows.iter().filter(|r| r.passes()).count();
+    println!(
+        "pattern rows passing: {passed} of {}",
+        report.pattern_rows.len()
+    );
     let pm = &report.preset_maps;
     if let Some(i) = args.iter().position(|a| a == "--diffuse") {
         let (w, h) = (pm.board.width as usize, pm.board.height as usize);

@@ -603,3 +603,85 @@ fn bad_fibre_wander_parameters_name_file_field_and_range() {
     .to_string();
     assert!(err.contains("bad.toml") && err.contains("wiggle"), "{err}");
 }
+
+/// A plain wood whose earlywood and latewood colours are the same (so the rings change nothing)
+/// with a `[texture]` section `texture` (TOML lines).
+fn plain_with_texture(texture: &str) -> String {
+    format!(
+        "[rings]\nwidth = 4.0\nproportions = [0.5, 0.3, 0.15, 0.05]\n\
+         [color]\nearlywood = [0.5, 0.3, 0.2]\nlatewood = [0.5, 0.3, 0.2]\n\
+         [texture]\n{texture}\n"
+    )
+}
+
+/// The texture's extra path at `p`, read back from the diffuse colour by inverting Beer's law
+/// (notes/wood.md §9c): with earlywood = latewood = c, −ln d = −ln c · (1 + path).
+fn texture_path(v: &WoodVolume, p: Vec3) -> f64 {
+    let d = v.eval(p, Needs::COLOR).diffuse;
+    (d.x as f64).ln() / 0.5f64.ln() - 1.0
+}
+
+/// notes/wood.md §9c: the cell texture's extra path has the standard deviation asked for
+/// (Campbell's theorem, as the wander's) and its autocorrelation falls to 1/e at the correlation
+/// lengths along and across the grain. 20000 points over 120 × 3000 mm of stem, seed 7.
+/// Tolerances 5 % on the std and ±0.05 on the correlations. Negative control: at twice each
+/// length the correlation must have fallen well below 1/e (a texture whose kernels were sized
+/// from the lengths without the 0.656 factor would sit near 1/e there and fail).
+#[test]
+fn cell_texture_has_the_derived_std_and_correlation_lengths() {
+    let text = plain_with_texture("path = 0.1\nalong = 2.0\nacross = 0.5");
+    let v = WoodVolume::new(wood::WoodParams::from_toml_str(&text, "t").unwrap(), 7).unwrap();
+    let mut rng = xylem::math::Pcg32::new(5, 0);
+    let (mut at, mut along, mut across, mut along2, mut across2) =
+        (vec![], vec![], vec![], vec![], vec![]);
+    for _ in 0..20_000 {
+        let r = 100.0 + 40.0 * rng.next_f32();
+        let a = std::f32::consts::TAU * rng.next_f32();
+        let p = Vec3::new(r * a.cos(), r * a.sin(), 3000.0 * rng.next_f32());
+        let radial = Vec3::new(a.cos(), a.sin(), 0.0);
+        at.push(texture_path(&v, p));
+        along.push(texture_path(&v, p + Vec3::Z * 2.0));
+        across.push(texture_path(&v, p + radial * 0.5));
+        along2.push(texture_path(&v, p + Vec3::Z * 4.0));
+        across2.push(texture_path(&v, p + radial * 1.0));
+    }
+    let s = std(&at);
+    println!("texture path std {s:.4} (0.1)");
+    assert!((s / 0.1 - 1.0).abs() < 0.05, "std {s}");
+    let e = (-1.0f64).exp();
+    for (what, c, want_near) in [
+        ("along", corr(&at, &along), true),
+        ("across", corr(&at, &across), true),
+        ("twice along", corr(&at, &along2), false),
+        ("twice across", corr(&at, &across2), false),
+    ] {
+        println!("texture correlation {what}: {c:.3} (1/e = {e:.3})");
+        if want_near {
+            assert!((c - e).abs() < 0.05, "{what}: {c}");
+        } else {
+            assert!(c < e - 0.15, "{what}: {c}");
+        }
+    }
+}
+
+/// Invalid texture parameters are rejected with the file, the field and the allowed range.
+#[test]
+fn bad_texture_parameters_name_file_field_and_range() {
+    for (field, range) in [
+        ("path = -0.1\nalong = 1.0\nacross = 0.2", "`texture.path`"),
+        ("path = 0.1\nalong = 0.0\nacross = 0.2", "`texture.along`"),
+        (
+            "path = 0.1\nalong = 1.0\nacross = 0.001",
+            "`texture.across`",
+        ),
+        (
+            "path = 0.1\nalong = 1.0\nacross = 0.2\ndensity = 0.0",
+            "`texture.density`",
+        ),
+    ] {
+        let err = wood::WoodParams::from_toml_str(&plain_with_texture(field), "bad.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("bad.toml") && err.contains(range), "{err}");
+    }
+}

@@ -2,7 +2,9 @@
 //! magnitudes (§6.2), pores and rays (§6.1.6), growth-rate noise (eq. 24) and the interlock angle
 //! (§6.1.5). All noise comes from `crate::noise`.
 
-use super::params::{FibreWanderParams, NoiseParams, PoreParams, RayParams, WanderScale};
+use super::params::{
+    FibreWanderParams, NoiseParams, PoreParams, RayParams, TextureParams, WanderScale,
+};
 use crate::math::Frame;
 use crate::noise::{Cells, Kernel, SeededSparse, SparseConvolution, SparseConvolution1, Weights};
 use glam::Vec3;
@@ -322,29 +324,8 @@ impl FibreWander {
 
     /// The two angles' noises of one scale.
     fn scale(p: &WanderScale, seeds: [u32; 2]) -> [Option<SeededSparse>; 2] {
-        let across = p.across / Self::CORRELATION_LAG;
-        let env = Vec3::new(across, across, p.along / Self::CORRELATION_LAG);
-        let std_unit = (p.density * Self::VARIANCE_PER_DENSITY).sqrt();
         let noise = |deg: f32, seed: u32| {
-            (deg > 0.0).then(|| {
-                SeededSparse::new(
-                    SparseConvolution {
-                        kernel: Kernel::Wyvill,
-                        density: p.density,
-                        envelope: env,
-                        // Equal r and θ semi-axes: the kernel's bounding box is the same at any
-                        // rotation about ẑ, so these cells never shrink it (eq. 11).
-                        cell: CELL_SCALE * env,
-                        magnitude: deg.to_radians() / std_unit,
-                        weights: Weights::Signed,
-                        cells: Cells::Cartesian,
-                        bands: 1,
-                        size_factor: 0.5,
-                        dropoff: 1.0,
-                    },
-                    seed,
-                )
-            })
+            (deg > 0.0).then(|| grain_noise(deg.to_radians(), (p.along, p.across), p.density, seed))
         };
         [noise(p.radial, seeds[0]), noise(p.tangential, seeds[1])]
     }
@@ -385,6 +366,75 @@ impl FibreWander {
             return fiber;
         }
         (fiber - (self.pore_deflection * radius * dn / len) * across).normalize()
+    }
+}
+
+/// Zero-mean noise of standard deviation `std` with 1/e correlation lengths (`along`, `across`)
+/// the grain (mm): one band of signed-weight Wyvill sparse convolution (Liu et al. 2016 §4,
+/// eq. 4 and 7) with `density` kernels overlapping a point, kernels oriented by the cylindrical
+/// frame at the query; the magnitude from Campbell's theorem
+/// ([`FibreWander::VARIANCE_PER_DENSITY`]), the semi-axes from [`FibreWander::CORRELATION_LAG`].
+fn grain_noise(std: f32, (along, across): (f32, f32), density: f32, seed: u32) -> SeededSparse {
+    let across = across / FibreWander::CORRELATION_LAG;
+    let env = Vec3::new(across, across, along / FibreWander::CORRELATION_LAG);
+    SeededSparse::new(
+        SparseConvolution {
+            kernel: Kernel::Wyvill,
+            density,
+            envelope: env,
+            // Equal r and θ semi-axes: the kernel's bounding box is the same at any rotation
+            // about ẑ, so these cells never shrink it (eq. 11).
+            cell: CELL_SCALE * env,
+            magnitude: std / (density * FibreWander::VARIANCE_PER_DENSITY).sqrt(),
+            weights: Weights::Signed,
+            cells: Cells::Cartesian,
+            bands: 1,
+            size_factor: 0.5,
+            dropoff: 1.0,
+        },
+        seed,
+    )
+}
+
+/// Cell-scale colour texture ([`TextureParams`], notes/wood.md §9c): an extra Beer's-law absorption
+/// path (latewood units) that varies over fractions of a millimetre, long along the grain, as the
+/// density and extractive content of neighbouring fibres, vessels and parenchyma strands do (the
+/// "texture" of the wood trade: Hoadley, "Understanding Wood", ch. 5).
+#[derive(Clone, Debug)]
+pub struct CellTexture {
+    /// Per scale (cells, then streaks), the noise and its across-grain correlation length (mm):
+    /// the feature size the footprint filter fades it at.
+    scales: Vec<(SeededSparse, f32)>,
+}
+
+impl CellTexture {
+    /// The texture of `p`, its noises seeded by `seeds` (cells, streaks).
+    pub fn new(p: &TextureParams, seeds: [u32; 2]) -> Self {
+        let scale = |t: &TextureParams, seed| {
+            (
+                grain_noise(t.path, (t.along, t.across), t.density, seed),
+                t.across,
+            )
+        };
+        let mut scales = vec![scale(p, seeds[0])];
+        scales.extend(p.streaks.as_deref().map(|s| scale(s, seeds[1])));
+        CellTexture { scales }
+    }
+
+    /// The extra absorption path at the distorted point `q` (zero mean) for a pixel footprint
+    /// `footprint` mm wide: each scale fades out as the footprint grows from twice its
+    /// across-grain correlation length to four times it (and is not evaluated beyond), as pores do.
+    #[inline]
+    pub fn path(&self, q: Vec3, footprint: f32) -> f32 {
+        let cyl = crate::field::cylinder_frame(q);
+        let mut sum = 0.0;
+        for (noise, across) in &self.scales {
+            let w = footprint_weight(2.0 * across, footprint);
+            if w > 0.0 {
+                sum += w * noise.eval_oriented_with::<false>(q, &cyl, 1, 1.0).0;
+            }
+        }
+        sum
     }
 }
 

@@ -44,6 +44,33 @@ pub struct WoodParams {
     /// Birdseye: radial bud traces the rings dip around, with dark centres; absent: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub eyes: Option<EyeParams>,
+    /// Cell-scale colour texture (fibres, vessels and parenchyma below the pixel); absent: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub texture: Option<TextureParams>,
+}
+
+/// Cell-scale colour texture (ours, notes/wood.md §9c): a zero-mean extra absorption path, added
+/// to Liu et al. 2016 eq. 25's ℓ_g g + ℓ_p p, that varies over fractions of a millimetre and is
+/// longer along the grain than across it: the fine "texture" by which the trade grades woods,
+/// from the size and contrast of their cells (Hoadley, "Understanding Wood", ch. 5).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TextureParams {
+    /// Standard deviation of the extra path, in latewood absorbance units (0.1: ±10 % of the
+    /// latewood's absorbance).
+    pub path: f32,
+    /// Correlation length along the grain, mm (1/e lag, as [`FibreWanderParams::along`]).
+    pub along: f32,
+    /// Correlation length across the grain, mm (1/e lag).
+    pub across: f32,
+    /// Mean number of kernels overlapping a point.
+    #[serde(default = "two")]
+    pub density: f32,
+    /// A second, independent scale added to this one (the same fields; its paths' variances
+    /// add): streaks millimetres across and centimetres long, e.g. the colour streaks of maple,
+    /// where the first scale is the cells. Its own `streaks` must be absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub streaks: Option<Box<TextureParams>>,
 }
 
 /// Birdseye figure (ours, `eyes.rs`): aborted bud traces running radially, each an eye on a
@@ -426,6 +453,12 @@ impl Checker<'_> {
         self.range(&format!("{name}.across"), w.across, 0.02, 1000.0)?;
         self.range(&format!("{name}.density"), w.density, 0.25, 16.0)
     }
+    fn texture(&self, name: &str, t: &TextureParams) -> Result<(), WoodError> {
+        self.range(&format!("{name}.path"), t.path, 0.0, 2.0)?;
+        self.range(&format!("{name}.along"), t.along, 0.05, 1000.0)?;
+        self.range(&format!("{name}.across"), t.across, 0.02, 1000.0)?;
+        self.range(&format!("{name}.density"), t.density, 0.25, 16.0)
+    }
     fn noise(&self, name: &str, n: &NoiseParams) -> Result<(), WoodError> {
         self.range(&format!("{name}.magnitude"), n.magnitude, 0.0, 100.0)?;
         for (i, s) in n.size.iter().enumerate() {
@@ -554,6 +587,15 @@ impl WoodParams {
                 c.wander("fibre_wander.fine", f)?;
             }
             c.range("fibre_wander.pore_deflection", w.pore_deflection, 0.0, 4.0)?;
+        }
+        if let Some(t) = &self.texture {
+            c.texture("texture", t)?;
+            if let Some(s) = &t.streaks {
+                c.texture("texture.streaks", s)?;
+                if s.streaks.is_some() {
+                    return Err(c.err("texture.streaks.streaks", "a table", "absent".into()));
+                }
+            }
         }
         if let Some(k) = &self.knots {
             c.range("knots.whorl_spacing", k.whorl_spacing, 10.0, 100_000.0)?;

@@ -5,7 +5,7 @@ use super::color::BeerColor;
 use super::error::WoodError;
 use super::eyes::Eyes;
 use super::features::{
-    footprint_weight, sub_seed, DistortionNoise, FibreWander, Noise1, Pores, Rays,
+    footprint_weight, sub_seed, CellTexture, DistortionNoise, FibreWander, Noise1, Pores, Rays,
 };
 use super::growth::{SmoothRectangleWave, SmoothTriangleWave};
 use super::knots::{KnotSample, Knots};
@@ -58,6 +58,7 @@ pub struct WoodVolume {
     knots: Option<Knots>,
     /// Fine-scale grain deviation (notes/wood.md §9a), evaluated only for fibres.
     wander: Option<FibreWander>,
+    texture: Option<CellTexture>,
     /// Birdseye traces (ours, `eyes.rs`).
     eyes: Option<Eyes>,
     jacobian: JacobianModel,
@@ -75,6 +76,7 @@ mod salt {
     pub const RAYS: u32 = 7;
     pub const PHASE: u32 = 8;
     pub const WANDER: [u32; 4] = [9, 10, 11, 12];
+    pub const TEXTURE: [u32; 2] = [13, 14];
     pub const KNOTS: u64 = 0x6b6e_6f74;
     pub const EYES: u64 = 0x6579_6573;
 }
@@ -171,6 +173,10 @@ impl WoodVolume {
             .as_ref()
             .map(|w| FibreWander::new(w, salt::WANDER.map(|s| sub_seed(seed, s))));
         let eyes = p.eyes.as_ref().map(|e| Eyes::new(e, seed ^ salt::EYES));
+        let texture = p
+            .texture
+            .as_ref()
+            .map(|t| CellTexture::new(t, salt::TEXTURE.map(|s| sub_seed(seed, s))));
         Ok(WoodVolume {
             inv_ring_width: 1.0 / p.rings.width,
             growth,
@@ -185,6 +191,7 @@ impl WoodVolume {
             rays,
             knots,
             wander,
+            texture,
             eyes,
             params,
             seed,
@@ -436,6 +443,9 @@ impl WoodVolume {
             if let Some(eyes) = &self.eyes {
                 extra += eyes.darkening * c.eye_core;
             }
+            if let Some(t) = &self.texture {
+                extra += t.path(q, footprint);
+            }
             let a = self
                 .color
                 .absorbance(g, texel.pore_mask, texel.ray_mask, extra);
@@ -625,6 +635,12 @@ impl WoodVolume {
                 ray[i] = rays.mask(Vec3::new(qx[i], qy[i], qz[i]));
             }
         }
+        let mut texture: Lanes = [0.0; BATCH];
+        if let Some(t) = &self.texture {
+            for i in 0..BATCH {
+                texture[i] = t.path(Vec3::new(qx[i], qy[i], qz[i]), 0.0);
+            }
+        }
         // Beer's law in lanes, a channel at a time.
         let mut diffuse = [[0.0f32; BATCH]; 3];
         let mut fiber = [[0.0f32; BATCH]; 3];
@@ -632,7 +648,7 @@ impl WoodVolume {
             for i in 0..BATCH {
                 let a = self
                     .color
-                    .channel_absorbance(ch, g[i], pore[i], ray[i], 0.0);
+                    .channel_absorbance(ch, g[i], pore[i], ray[i], texture[i]);
                 (diffuse[ch][i], fiber[ch][i]) = self.color.channel_colors(ch, a);
             }
         }
