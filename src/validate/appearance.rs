@@ -1018,17 +1018,29 @@ fn nearest_frame(s: &SweepLuminance, angle: f32) -> usize {
 }
 
 /// Frames of the two sweeps side by side (preset above, measured below) at [`SHEET_ANGLES`]:
-/// same cut, same light, one exposure (0 stops), so their brightness compares directly.
+/// same cut, same light, one exposure (0 stops), so their brightness compares directly. A measured
+/// board whose grain runs along its rows is shown transposed, so both run left to right.
 fn side_by_side(r: &PairReport) -> Rgb8 {
     let mut thumbs = Vec::new();
     let mut labels = Vec::new();
-    for (s, who) in [(&r.preset_sweep, "preset"), (&r.measured_sweep, "measured")] {
+    let measured_turn = !r.pair.grain_along_x;
+    for (s, who, turn) in [
+        (&r.preset_sweep, "preset", false),
+        (&r.measured_sweep, "measured", measured_turn),
+    ] {
         for angle in SHEET_ANGLES {
             let k = nearest_frame(s, angle);
+            let (w, h) = (s.width as usize, s.height as usize);
+            let frame: Vec<Vec3> = if turn {
+                (0..w * h).map(|i| s.frames[k][(i % h) * w + i / h]).collect()
+            } else {
+                s.frames[k].clone()
+            };
+            let (width, height) = if turn { (s.height, s.width) } else { (s.width, s.height) };
             thumbs.push(Rgb8 {
-                width: s.width,
-                height: s.height,
-                data: to_srgb8(&s.frames[k], 0.0),
+                width,
+                height,
+                data: to_srgb8(&frame, 0.0),
             });
             labels.push(format!("{who} {:+.0}°", s.angles[k]));
         }
