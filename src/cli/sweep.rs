@@ -65,8 +65,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     crate::render::resources::check_threads(args.threads)?;
     let mut loaded = crate::scene::load_with(scene, args.ignore_limits)?;
     // The scene file's digest, recorded with every frame so that `--assemble` refuses slices
-    // of different scene files (the load above has already bounded and read it).
-    let scene_crc = crc32fast::hash(&std::fs::read(scene)?);
+    // of different scene files (read as the load above read it: bounded, or the embedded copy
+    // of a built-in scene).
+    let scene_crc = crc32fast::hash(&crate::scene::source(scene)?.0);
     for w in &loaded.warnings {
         eprintln!("warning: {w}");
     }

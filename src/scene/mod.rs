@@ -109,20 +109,11 @@ pub fn load(path: &Path) -> Result<LoadedScene, SceneError> {
 
 /// [`load`], with the geometry memory check skipped when `ignore_limits` (`--ignore-limits`).
 pub fn load_with(path: &Path, ignore_limits: bool) -> Result<LoadedScene, SceneError> {
-    // A built-in scene named by its repository path or name, where no such file exists here
-    // (an installed binary run from another folder; `crate::builtin`).
-    let bytes = match crate::builtin::lookup(path).filter(|_| !path.exists()) {
-        Some(embedded) => embedded.to_vec(),
-        None => {
-            crate::render::resources::read_bounded(path, crate::render::resources::MAX_SCENE_BYTES)
-                .map_err(SceneError::Input)?
-        }
-    };
-    let text = String::from_utf8(bytes).map_err(|_| SceneError::Parse {
+    let (bytes, base) = source(path)?;
+    let text = String::from_utf8(bytes.into_owned()).map_err(|_| SceneError::Parse {
         path: path.display().to_string(),
         message: "not UTF-8 text (a scene is a TOML file)".into(),
     })?;
-    let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
     let name = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
@@ -135,6 +126,21 @@ pub fn load_with(path: &Path, ignore_limits: bool) -> Result<LoadedScene, SceneE
         ignore_limits,
     }
     .build(file, &name)
+}
+
+/// A scene file's bytes and the folder its relative files (meshes, maps) resolve against: the
+/// file's own folder, or `scenes/` for a built-in scene named by a path that does not exist
+/// here (an installed binary run from another folder; `crate::builtin`), whose meshes and maps
+/// then come from the embedded copies too. Bounded by
+/// [`MAX_SCENE_BYTES`](crate::render::resources::MAX_SCENE_BYTES).
+pub fn source(path: &Path) -> Result<(std::borrow::Cow<'static, [u8]>, PathBuf), SceneError> {
+    use crate::render::resources::MAX_SCENE_BYTES;
+    let bytes = crate::builtin::read(path, MAX_SCENE_BYTES).map_err(SceneError::Input)?;
+    let base = match crate::builtin::stand_in(path) {
+        Some((repo_path, _)) => Path::new(repo_path).parent().unwrap().to_path_buf(),
+        None => path.parent().unwrap_or(Path::new(".")).to_path_buf(),
+    };
+    Ok((bytes, base))
 }
 
 /// Parses the scene text only (no meshes built), for checks and the sweep setup.
