@@ -169,8 +169,30 @@ pub fn check_threads(threads: usize) -> Result<(), ResourceError> {
 }
 
 /// Memory available to this process: `MemAvailable` of /proc/meminfo, lowered to the cgroup's
-/// remaining allowance (`memory.max − memory.current`) where one is set. None where unknown.
+/// remaining allowance (`memory.max − memory.current`) where one is set, and to the address
+/// space left under `ulimit -v` (`RLIMIT_AS − VmSize`) where one is set. None where unknown.
 pub fn available_memory() -> Option<u64> {
+    let have = available_system_memory()?;
+    let mut lim = libc::rlimit {
+        rlim_cur: 0,
+        rlim_max: 0,
+    };
+    // SAFETY: `lim` is a writable rlimit.
+    if unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut lim) } != 0
+        || lim.rlim_cur == libc::RLIM_INFINITY
+    {
+        return Some(have);
+    }
+    let status = std::fs::read_to_string("/proc/self/status").ok();
+    let vm_kib: u64 = (status.as_deref())
+        .and_then(|s| s.lines().find_map(|l| l.strip_prefix("VmSize:")))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
+        .unwrap_or(0);
+    Some(have.min((lim.rlim_cur as u64).saturating_sub(vm_kib * 1024)))
+}
+
+/// [`available_memory`] before the address-space limit.
+fn available_system_memory() -> Option<u64> {
     let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
     let kib: u64 = meminfo
         .lines()
