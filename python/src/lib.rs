@@ -722,8 +722,10 @@ fn load_scene(
         other => value_error(other),
     })?;
     if let Some(spp) = spp {
-        if spp == 0 {
-            return Err(value_error("spp = 0: need at least 1 sample per pixel"));
+        if !(1..=1_000_000).contains(&spp) {
+            return Err(value_error(format!(
+                "spp = {spp}: out of range (allowed 1 to 1000000 samples per pixel)"
+            )));
         }
         loaded.settings.spp = spp;
     }
@@ -771,6 +773,7 @@ fn render<'py>(
     seed: Option<u64>,
     threads: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
+    xylem::render::resources::check_threads(threads).map_err(value_error)?;
     let loaded = load_scene(scene, spp, res, seed)?;
     let run = xylem::render::RunOptions {
         threads,
@@ -815,6 +818,7 @@ fn sweep<'py>(
     seed: Option<u64>,
     threads: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
+    xylem::render::resources::check_threads(threads).map_err(value_error)?;
     let loaded = load_scene(scene, spp, res, seed)?;
     let (path, moving) =
         xylem::sweep::SweepPath::from_scene(&loaded, frames, arc).map_err(value_error)?;

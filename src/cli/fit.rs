@@ -14,8 +14,8 @@ pub struct Args {
     /// Map size W×H in texels (default: the board's size in pixels).
     #[arg(long, value_parser = parse_texels)]
     pub texels: Option<(usize, usize)>,
-    /// Worker threads (0 = all cores).
-    #[arg(long, default_value_t = 0)]
+    /// Worker threads (0 = all cores; at most 16 per core).
+    #[arg(long, default_value_t = 0, value_parser = super::parse_threads)]
     pub threads: usize,
     /// No progress bar.
     #[arg(long)]

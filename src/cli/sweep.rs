@@ -24,8 +24,8 @@ pub struct Args {
     /// Render only frames A..B (A to B-1) or A..=B, e.g. for a job array; assemble afterwards.
     #[arg(long)]
     pub frames_range: Option<String>,
-    /// Samples per pixel (overrides the scene's render.spp).
-    #[arg(long)]
+    /// Samples per pixel, 1 to 1000000 (overrides the scene\'s render.spp).
+    #[arg(long, value_parser = super::parse_spp)]
     pub spp: Option<u32>,
     /// Speed/accuracy preset measured in validation/TRADEOFF.md (spp and wood-model knobs);
     /// `--spp` still overrides its sample count.
@@ -34,8 +34,8 @@ pub struct Args {
     /// Render each frame from scratch, without the per-sweep cache (to time or check it).
     #[arg(long)]
     pub naive: bool,
-    /// Worker threads (0 = all cores).
-    #[arg(long, default_value_t = 0)]
+    /// Worker threads (0 = all cores; at most 16 per core).
+    #[arg(long, default_value_t = 0, value_parser = super::parse_threads)]
     pub threads: usize,
     /// Do not show the progress bar.
     #[arg(long)]
@@ -62,7 +62,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let Some(scene) = &args.scene else {
         anyhow::bail!("give a scene file (or --assemble DIR)");
     };
-    crate::render::resources::check_threads(args.threads)?;
     let mut loaded = crate::scene::load_with(scene, args.ignore_limits)?;
     // The scene file's digest, recorded with every frame so that `--assemble` refuses slices
     // of different scene files (read as the load above read it: bounded, or the embedded copy
@@ -76,7 +75,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             .with_context(|| format!("applying --quality {q}"))?;
     }
     if let Some(spp) = args.spp {
-        anyhow::ensure!(spp >= 1, "--spp 0: need at least 1 sample per pixel");
         loaded.settings.spp = spp;
     }
     let arc = args

@@ -29,11 +29,11 @@ pub struct Args {
     /// Side of the square window (mm), centred on the axis.
     #[arg(long, default_value_t = 100.0)]
     pub size: f32,
-    /// Image side in pixels.
+    /// Image side in pixels, 1 to 16384.
     #[arg(long, default_value_t = 256)]
     pub res: u32,
-    /// Exposure of the PNG in stops (an EXR keeps the linear values).
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    /// Exposure of the PNG in stops, -30 to 30 (an EXR keeps the linear values).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = super::parse_exposure)]
     pub exposure: f32,
     /// Output file: `.png` (sRGB, exposure applied) or `.exr` (linear float RGB).
     #[arg(long)]

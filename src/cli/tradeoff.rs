@@ -30,8 +30,8 @@ pub struct Args {
     /// Also write every render (reference and each row) as a PNG into this folder.
     #[arg(long)]
     pub images: Option<PathBuf>,
-    /// Worker threads (0 = all cores).
-    #[arg(long, default_value_t = 0)]
+    /// Worker threads (0 = all cores; at most 16 per core).
+    #[arg(long, default_value_t = 0, value_parser = super::parse_threads)]
     pub threads: usize,
 }
 
