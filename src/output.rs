@@ -5,11 +5,21 @@
 //! is atomic on one file system: a reader sees the old file or the new one, never a mix, and two
 //! runs writing the same name never share a temporary. A run that writes a group of files that
 //! belong together (a render's EXR and PNG, a sweep's frames) holds a [`FolderLock`] while it
-//! commits them, so the group always comes from one run.
+//! commits them, so the group always comes from one run. A set of outputs that a reader must
+//! take whole (fit's maps, bake's maps) is committed by [`commit_set`]: its record, written
+//! last, lists every member with its size and CRC-32, and a kill mid-commit leaves no record
+//! and no member of the previous set ([`verify_set`] checks a folder).
+//!
+//! Temporaries carry this host's name and the process id ([`Staged::new`]); the first file a
+//! process stages in a folder removes the temporaries there of dead processes of this host
+//! (runs killed before they could clean up), never those of live runs or other hosts.
 
+use std::collections::BTreeSet;
 use std::fs::File;
 use std::io;
+use std::io::{Read, Seek};
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 use tempfile::NamedTempFile;
 
 /// A file being written under a temporary name beside `path`; [`Staged::commit`] renames it
@@ -26,8 +36,14 @@ impl Staged {
             Some(d) if !d.as_os_str().is_empty() => d,
             _ => Path::new("."),
         };
+        remove_stale_temporaries(dir);
         let stem = path.file_name().map(|n| n.to_string_lossy().into_owned());
-        let prefix = format!(".{}.", stem.unwrap_or_default());
+        let prefix = format!(
+            ".{}{TMP_MARK}{}-{}-",
+            stem.unwrap_or_default(),
+            host(),
+            std::process::id()
+        );
         let mut builder = tempfile::Builder::new();
         builder.prefix(&prefix).suffix(".tmp");
         // A temporary file is created owner-only (0600); an output is a plain file, so it gets
@@ -51,6 +67,13 @@ impl Staged {
         &self.path
     }
 
+    /// The size and CRC-32 of what was written (read back from the temporary file).
+    pub fn checksum(&mut self) -> io::Result<(u64, u32)> {
+        let f = self.tmp.as_file_mut();
+        f.rewind()?;
+        checksum(f)
+    }
+
     /// Renames the temporary file over the final name. (No `fsync`: this guards against killed
     /// and concurrent runs, which the page cache survives, not against power loss.)
     pub fn commit(self) -> io::Result<()> {
@@ -59,11 +82,175 @@ impl Staged {
     }
 }
 
-/// Writes `bytes` to `path` through a [`Staged`] file.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
+/// Writes `bytes` into a [`Staged`] file for `path`, to commit later.
+pub fn stage_bytes(path: &Path, bytes: &[u8]) -> io::Result<Staged> {
     let mut staged = Staged::new(path)?;
     io::Write::write_all(staged.file(), bytes)?;
-    staged.commit()
+    Ok(staged)
+}
+
+/// Writes `bytes` to `path` through a [`Staged`] file.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    stage_bytes(path, bytes)?.commit()
+}
+
+/// The length and CRC-32 of everything `r` yields.
+fn checksum(mut r: impl Read) -> io::Result<(u64, u32)> {
+    let mut h = crc32fast::Hasher::new();
+    let mut buf = vec![0; 1 << 16];
+    let mut len = 0u64;
+    loop {
+        let n = r.read(&mut buf)?;
+        if n == 0 {
+            return Ok((len, h.finalize()));
+        }
+        h.update(&buf[..n]);
+        len += n as u64;
+    }
+}
+
+/// What marks xylem's temporary names: `.NAME.xylem-tmp.HOST-PID-RANDOM.tmp`.
+const TMP_MARK: &str = ".xylem-tmp.";
+
+/// This host's name (`gethostname`), or `host` where unknown.
+fn host() -> String {
+    let mut buf = [0u8; 256];
+    // SAFETY: `buf` is writable for its length; the name is NUL-terminated when it fits.
+    let ok = unsafe { libc::gethostname(buf.as_mut_ptr().cast(), buf.len()) } == 0;
+    let end = buf.iter().position(|&b| b == 0).unwrap_or(0);
+    let name = String::from_utf8_lossy(&buf[..end]).replace(['/', '-'], "_");
+    if ok && !name.is_empty() {
+        name
+    } else {
+        "host".into()
+    }
+}
+
+/// Whether process `pid` of this host is alive (`kill(pid, 0)`: no such process means dead).
+fn alive(pid: i32) -> bool {
+    // SAFETY: signal 0 only checks for the process.
+    let r = unsafe { libc::kill(pid, 0) };
+    r == 0 || io::Error::last_os_error().raw_os_error() != Some(libc::ESRCH)
+}
+
+/// Removes from `dir` the temporaries of dead processes of this host (runs killed before they
+/// could delete them), once per folder and process; live runs' temporaries and other hosts'
+/// (a farm sharing the folder) stay. Failures are ignored: this is tidying, not output.
+pub fn remove_stale_temporaries(dir: &Path) {
+    static DONE: Mutex<BTreeSet<PathBuf>> = Mutex::new(BTreeSet::new());
+    let key = std::path::absolute(dir).unwrap_or_else(|_| dir.to_path_buf());
+    if !DONE.lock().map(|mut d| d.insert(key)).unwrap_or(false) {
+        return;
+    }
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let me = host();
+    for e in entries.flatten() {
+        let name = e.file_name();
+        let Some(name) = name.to_str() else { continue };
+        let Some(tail) = name.rsplit_once(TMP_MARK).map(|(_, t)| t) else {
+            continue;
+        };
+        // HOST-PID-RANDOM.tmp
+        let mut parts = tail.rsplitn(3, '-');
+        let (Some(_random), Some(pid), Some(h)) = (parts.next(), parts.next(), parts.next()) else {
+            continue;
+        };
+        let dead = pid.parse::<i32>().is_ok_and(|p| p > 0 && !alive(p));
+        if h == me && dead && name.ends_with(".tmp") {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
+}
+
+/// A set file's record: the members with their sizes and CRC-32s, beside what the caller adds.
+const SET_FILES: &str = "files";
+
+/// Commits `members` (staged in `dir`) as one set completed by `record` (a JSON object file in
+/// `dir`, written last): first the old record goes, then every member of the old set it named
+/// and every old file under a new member's name, then the new members are renamed into place,
+/// and last the record is written — `extra` with a `files` list of every member's name, size
+/// and CRC-32. A kill at any point leaves either the old complete set, or members of the new
+/// set alone without a record; never members of two runs side by side. The caller holds the
+/// folder's lock.
+pub fn commit_set(
+    dir: &Path,
+    mut members: Vec<Staged>,
+    record: &str,
+    mut extra: serde_json::Map<String, serde_json::Value>,
+) -> io::Result<PathBuf> {
+    let record_path = dir.join(record);
+    let mut files = Vec::new();
+    for m in &mut members {
+        let (bytes, crc) = m.checksum()?;
+        let name = m.path.file_name().unwrap_or_default().to_string_lossy();
+        files
+            .push(serde_json::json!({"name": name, "bytes": bytes, "crc32": format!("{crc:08x}")}));
+    }
+    extra.insert(SET_FILES.into(), files.into());
+    let text = serde_json::to_string_pretty(&extra).map_err(io::Error::other)?;
+    let record_file = stage_bytes(&record_path, text.as_bytes())?;
+    let old = set_members(&record_path).unwrap_or_default();
+    remove_if_present(&record_path)?;
+    for name in old {
+        remove_if_present(&dir.join(name))?;
+    }
+    for m in &members {
+        remove_if_present(&m.path)?;
+    }
+    for m in members {
+        m.commit()?;
+    }
+    record_file.commit()?;
+    Ok(record_path)
+}
+
+/// The member names a set's record lists (plain names only: a record cannot point outside its
+/// folder). None where the record is missing or unreadable.
+fn set_members(record: &Path) -> Option<Vec<String>> {
+    let text =
+        crate::render::resources::read_text_bounded(record, MAX_RECORD_BYTES, "JSON").ok()?;
+    let v: serde_json::Value = serde_json::from_str(&text).ok()?;
+    let names = v.get(SET_FILES)?.as_array()?.iter();
+    let names = names.filter_map(|f| f.get("name")?.as_str().map(String::from));
+    let plain = |n: &String| !n.is_empty() && !n.contains('/') && n != "." && n != "..";
+    Some(names.filter(plain).collect())
+}
+
+/// The largest set record read (a record lists a few files; this bounds `/dev/zero`).
+const MAX_RECORD_BYTES: u64 = 1 << 20;
+
+/// Checks that `dir` holds the complete set `record` describes: the record exists and every
+/// member has the size and CRC-32 it lists. The error names the record or the member at fault.
+pub fn verify_set(dir: &Path, record: &str) -> Result<(), String> {
+    let path = dir.join(record);
+    let text = crate::render::resources::read_text_bounded(&path, MAX_RECORD_BYTES, "JSON")
+        .map_err(|e| format!("{e} (an incomplete set: its record is written last)"))?;
+    let v: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    let files = (v.get(SET_FILES).and_then(|f| f.as_array()))
+        .ok_or_else(|| format!("{}: no `{SET_FILES}` list", path.display()))?;
+    for f in files {
+        let name = f.get("name").and_then(|n| n.as_str()).unwrap_or("");
+        let member = dir.join(name);
+        let file =
+            crate::render::resources::open_regular(&member, u64::MAX).map_err(|e| e.to_string())?;
+        let (len, crc) = checksum(file).map_err(|e| format!("{}: {e}", member.display()))?;
+        let crc = format!("{crc:08x}");
+        let want = (
+            f.get("bytes").and_then(|b| b.as_u64()),
+            f.get("crc32").and_then(|c| c.as_str()),
+        );
+        if want != (Some(len), Some(crc.as_str())) {
+            return Err(format!(
+                "{}: not the file {} lists (another run's)",
+                member.display(),
+                path.display()
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Removes `path` if it exists (a stale output that must not outlive the run replacing it).
