@@ -72,7 +72,9 @@ fn png_error(path: &Path) -> impl Fn(png::EncodingError) -> ImageError + '_ {
     }
 }
 
-fn stage_png_tagged(
+/// Encodes 8-bit RGB with the colour-space chunk of `tag` into a uniquely named temporary file
+/// beside `path`, to [`commit`] later.
+pub fn stage_png_tagged(
     path: &Path,
     width: u32,
     height: u32,
