@@ -707,6 +707,17 @@ impl PyWoodSurface {
     }
 }
 
+/// `threads`: 0 (all cores) up to 16 per core, as `--threads`.
+fn check_threads(threads: usize) -> PyResult<()> {
+    use xylem::render::resources::{check_threads, ResourceError};
+    check_threads(threads).map_err(|e| match e {
+        ResourceError::Threads { max, .. } => value_error(format!(
+            "threads = {threads}: out of range (allowed 0 = all cores, up to {max})"
+        )),
+        other => value_error(other),
+    })
+}
+
 /// A scene file loaded with the overrides of `xylem render` (`spp`, `res` = (width, height),
 /// `seed`).
 fn load_scene(
@@ -773,7 +784,7 @@ fn render<'py>(
     seed: Option<u64>,
     threads: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
-    xylem::render::resources::check_threads(threads).map_err(value_error)?;
+    check_threads(threads)?;
     let loaded = load_scene(scene, spp, res, seed)?;
     let run = xylem::render::RunOptions {
         threads,
@@ -818,7 +829,7 @@ fn sweep<'py>(
     seed: Option<u64>,
     threads: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
-    xylem::render::resources::check_threads(threads).map_err(value_error)?;
+    check_threads(threads)?;
     let loaded = load_scene(scene, spp, res, seed)?;
     let (path, moving) =
         xylem::sweep::SweepPath::from_scene(&loaded, frames, arc).map_err(value_error)?;
