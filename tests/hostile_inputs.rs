@@ -193,6 +193,17 @@ fn scenes_refuse_fifos_as_scene_mesh_and_map() {
     assert_refused(&render("fifo.toml"), &["fifo.toml", "a FIFO"]);
     std::os::unix::fs::symlink("/dev/zero", dir.join("zero.toml")).unwrap();
     assert_refused(&render("zero.toml"), &["zero.toml", "a device"]);
+    // A species preset file as a FIFO or a device.
+    let o = xylem(
+        &["texture", "--preset-file", "fifo.toml", "--out", "t.png"],
+        dir,
+    );
+    assert_refused(&o, &["fifo.toml", "a FIFO"]);
+    let o = xylem(
+        &["texture", "--preset-file", "zero.toml", "--out", "t.png"],
+        dir,
+    );
+    assert_refused(&o, &["zero.toml", "a device"]);
     // A mesh and a measured map as FIFOs.
     mkfifo(&dir.join("fifo.obj"));
     mkfifo(&dir.join("fifo.png"));

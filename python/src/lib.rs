@@ -353,7 +353,10 @@ fn wood_params(
 ) -> PyResult<xylem::wood::WoodParams> {
     match (preset, preset_file) {
         (Some(name), None) => xylem::wood::preset(&name).map_err(wood_error),
-        (None, Some(file)) => xylem::wood::WoodParams::from_toml_file(file).map_err(wood_error),
+        (None, Some(file)) => xylem::scene::read_preset_file(&file).map_err(|e| match e {
+            e @ xylem::scene::PresetFileError::Read(_) => PyOSError::new_err(e.to_string()),
+            xylem::scene::PresetFileError::Wood(w) => wood_error(w),
+        }),
         _ => Err(value_error(format!(
             "give exactly one of `preset` (one of: {}) or `preset_file`",
             xylem::wood::PRESET_NAMES.join(", ")

@@ -297,7 +297,7 @@ impl SolidTexture for WoodSlice {
 fn wood_source(args: &Args) -> anyhow::Result<Option<Box<dyn SolidTexture>>> {
     let params = match (&args.preset, &args.preset_file) {
         (Some(name), _) => crate::wood::preset(name)?,
-        (None, Some(file)) => crate::wood::WoodParams::from_toml_file(file)?,
+        (None, Some(file)) => crate::scene::read_preset_file(file)?,
         (None, None) => return Ok(None),
     };
     let volume = crate::wood::WoodVolume::new(params, args.seed)?;

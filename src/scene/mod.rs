@@ -109,11 +109,7 @@ pub fn load(path: &Path) -> Result<LoadedScene, SceneError> {
 
 /// [`load`], with the geometry memory check skipped when `ignore_limits` (`--ignore-limits`).
 pub fn load_with(path: &Path, ignore_limits: bool) -> Result<LoadedScene, SceneError> {
-    let (bytes, base) = source(path)?;
-    let text = String::from_utf8(bytes.into_owned()).map_err(|_| SceneError::Parse {
-        path: path.display().to_string(),
-        message: "not UTF-8 text (a scene is a TOML file)".into(),
-    })?;
+    let (text, base) = source_text(path)?;
     let name = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
@@ -141,6 +137,41 @@ pub fn source(path: &Path) -> Result<(std::borrow::Cow<'static, [u8]>, PathBuf),
         None => path.parent().unwrap_or(Path::new(".")).to_path_buf(),
     };
     Ok((bytes, base))
+}
+
+/// [`source`] as text (a scene is a UTF-8 TOML file).
+pub fn source_text(path: &Path) -> Result<(String, PathBuf), SceneError> {
+    let (bytes, base) = source(path)?;
+    let text = String::from_utf8(bytes.into_owned()).map_err(|_| SceneError::Parse {
+        path: path.display().to_string(),
+        message: "not UTF-8 text (a scene is a TOML file)".into(),
+    })?;
+    Ok((text, base))
+}
+
+/// Why a species preset file could not be used.
+#[derive(Debug, thiserror::Error)]
+pub enum PresetFileError {
+    /// Missing, not a regular file (a FIFO, a device) or larger than
+    /// [`MAX_SCENE_BYTES`](crate::render::resources::MAX_SCENE_BYTES).
+    #[error("preset file {0}")]
+    Read(crate::render::resources::ResourceError),
+    /// Not a valid preset (the error names the file, the field and the range).
+    #[error(transparent)]
+    Wood(#[from] crate::wood::WoodError),
+}
+
+/// Reads a species preset file (`preset_file` of a wood material, `--preset-file`): regular
+/// TOML text of at most [`MAX_SCENE_BYTES`](crate::render::resources::MAX_SCENE_BYTES), so a
+/// FIFO or a device is refused instead of blocking or reading forever.
+pub fn read_preset_file(path: &Path) -> Result<crate::wood::WoodParams, PresetFileError> {
+    use crate::render::resources::{read_text_bounded, MAX_SCENE_BYTES};
+    let text =
+        read_text_bounded(path, MAX_SCENE_BYTES, "TOML text").map_err(PresetFileError::Read)?;
+    Ok(crate::wood::WoodParams::from_toml_str(
+        &text,
+        &path.display().to_string(),
+    )?)
 }
 
 /// Parses the scene text only (no meshes built), for checks and the sweep setup.
@@ -626,10 +657,8 @@ impl Builder<'_> {
                     let params = match (preset, preset_file) {
                         (Some(name), None) => crate::wood::preset(name)
                             .map_err(|e| self.invalid(f("preset"), e.to_string()))?,
-                        (None, Some(file)) => {
-                            crate::wood::WoodParams::from_toml_file(self.base.join(file))
-                                .map_err(|e| self.invalid(f("preset_file"), e.to_string()))?
-                        }
+                        (None, Some(file)) => read_preset_file(&self.base.join(file))
+                            .map_err(|e| self.invalid(f("preset_file"), e.to_string()))?,
                         _ => {
                             return Err(self.invalid(
                                 f("preset"),
