@@ -149,6 +149,9 @@ fn fit_refuses_hostile_frames_and_manifests_at_once() {
     let tmp = tempfile::tempdir().unwrap();
     let cap = capture(tmp.path());
     let fit = ["fit", "cap", "--out", "fitted", "--quiet"];
+    // 8192² texels of 9 frames: about 15 GiB, beyond the 4 GiB cap, refused before reading.
+    let o = xylem(&[&fit[..], &["--texels", "8192"]].concat(), tmp.path());
+    assert_refused(&o, &["8192x8192 texels", "of memory", "lower --texels"]);
     // A 433-byte EXR declaring 100000² pixels (120 GB of RGB floats).
     std::fs::write(cap.join("hostile.exr"), exr_declaring(100_000)).unwrap();
     set_first_frame(&cap, "hostile.exr");
