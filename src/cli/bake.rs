@@ -17,7 +17,7 @@ pub struct Args {
     /// Which face of the log the board shows.
     #[arg(long, default_value = "tangential")]
     pub cut: BakeCut,
-    /// Texels along the board's length.
+    /// Texels along the board's length, 1 to 16384.
     #[arg(long, default_value_t = 1024)]
     pub res: u32,
     /// Distance of the board's centre from the pith (mm).

@@ -12,7 +12,7 @@ pub struct Args {
     /// The scene file (TOML); its `[sweep]` table sets the defaults of the options below.
     #[arg(required_unless_present = "assemble")]
     pub scene: Option<PathBuf>,
-    /// Number of frames along the arc.
+    /// Number of frames along the arc, 1 to 100000.
     #[arg(long)]
     pub frames: Option<usize>,
     /// The arc of light angles from the zenith, FROM..TO in degrees (e.g. -60..60).
@@ -47,8 +47,8 @@ pub struct Args {
     /// ≈ 50 ms more CPU per 512×384 frame (notes/sweep.md), `none` writes raw floats.
     #[arg(long, value_enum, default_value = "rle")]
     pub exr_compression: crate::render::image_io::ExrCompression,
-    /// Largest thumbnail width on the contact sheet, in pixels.
-    #[arg(long, default_value_t = 240)]
+    /// Largest thumbnail width on the contact sheet, in pixels, 8 to 4096.
+    #[arg(long, default_value_t = 240, value_parser = clap::value_parser!(u32).range(8..=4096))]
     pub thumb_width: u32,
     /// Render even when the memory or disk estimate exceeds what the machine has.
     #[arg(long)]
@@ -147,7 +147,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 /// Assembles a folder of frames and reports what it wrote.
 fn assemble_dir(dir: &Path, thumb_width: u32) -> anyhow::Result<ExitCode> {
     let opts = AssembleOptions {
-        thumb_width: thumb_width.max(8),
+        thumb_width,
         ..Default::default()
     };
     let done = crate::output::FolderLock::try_new(dir, crate::output::LockMode::Exclusive)

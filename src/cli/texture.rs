@@ -57,7 +57,7 @@ pub struct Args {
     /// (textures with a `time` parameter: clouds, rust).
     #[arg(long, value_name = "SECONDS", conflicts_with_all = ["preset", "preset_file"])]
     pub animate: Option<f32>,
-    /// Frames of an `--animate` sequence (12 per second of the animation file).
+    /// Frames of an `--animate` sequence, 1 to 1000 (12 per second of the animation file).
     #[arg(long, default_value_t = 24)]
     pub frames: usize,
 }
