@@ -27,6 +27,73 @@ use tempfile::NamedTempFile;
 pub struct Staged {
     tmp: NamedTempFile,
     path: PathBuf,
+    _live: Live,
+}
+
+/// The temporary files of this process not yet committed or dropped, for
+/// [`remove_temporaries_on_signal`].
+static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn live() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    LIVE.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// A temporary's entry in [`LIVE`], removed when the [`Staged`] file is committed or dropped.
+struct Live(PathBuf);
+
+impl Drop for Live {
+    fn drop(&mut self) {
+        let mut live = live();
+        if let Some(i) = live.iter().rposition(|p| *p == self.0) {
+            live.swap_remove(i);
+        }
+    }
+}
+
+/// Makes SIGINT and SIGTERM remove this process's temporaries ([`Staged`] files not yet
+/// committed) before the process ends as the signal's default action would end it (so the exit
+/// status still tells the signal). The handler only writes the signal's number to a pipe; a
+/// thread waiting on the pipe removes the files, holding the registry's lock so that no new
+/// temporary appears meanwhile, and re-raises the signal. For the `xylem` binary: a library
+/// embedder (Python) keeps its own signal handling.
+pub fn remove_temporaries_on_signal() {
+    use std::sync::atomic::{AtomicI32, Ordering};
+    static PIPE: AtomicI32 = AtomicI32::new(-1);
+    extern "C" fn on_signal(sig: libc::c_int) {
+        let b = sig as u8;
+        // SAFETY: write(2) is async-signal-safe; the pipe outlives the process.
+        unsafe { libc::write(PIPE.load(Ordering::Relaxed), (&b as *const u8).cast(), 1) };
+    }
+    let mut fds = [0; 2];
+    // SAFETY: `fds` has room for the two descriptors.
+    if unsafe { libc::pipe(fds.as_mut_ptr()) } != 0 {
+        return;
+    }
+    PIPE.store(fds[1], Ordering::Relaxed);
+    std::thread::spawn(move || {
+        let mut b = 0u8;
+        // SAFETY: reads one byte into `b`; retried when interrupted.
+        while unsafe { libc::read(fds[0], (&mut b as *mut u8).cast(), 1) } != 1 {}
+        let live = live();
+        for p in live.iter() {
+            let _ = std::fs::remove_file(p);
+        }
+        // SAFETY: restores the default action and ends the process with the signal.
+        unsafe {
+            libc::signal(b as libc::c_int, libc::SIG_DFL);
+            libc::raise(b as libc::c_int);
+        }
+        drop(live);
+    });
+    for sig in [libc::SIGINT, libc::SIGTERM] {
+        // SAFETY: `on_signal` only calls write(2); an ignored signal (a background job's SIGINT,
+        // nohup) stays ignored.
+        unsafe {
+            if libc::signal(sig, on_signal as *const () as libc::sighandler_t) == libc::SIG_IGN {
+                libc::signal(sig, libc::SIG_IGN);
+            }
+        }
+    }
 }
 
 impl Staged {
@@ -50,8 +117,13 @@ impl Staged {
         // what `File::create` would give it: 0666 less the umask.
         #[cfg(unix)]
         builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+        // Created and registered under the registry's lock, so a signal's clean-up sees it.
+        let mut registry = live();
         let tmp = builder.tempfile_in(dir)?;
+        registry.push(tmp.path().to_path_buf());
+        drop(registry);
         Ok(Staged {
+            _live: Live(tmp.path().to_path_buf()),
             tmp,
             path: path.to_path_buf(),
         })

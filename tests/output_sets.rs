@@ -1,6 +1,7 @@
 //! Multi-file outputs are committed as a set (issue 26): `bake` killed at points spread over its
 //! run never leaves files of two runs side by side, its record `bake.json` (written last)
-//! verifies whenever present, and the next run removes the temporaries of killed runs.
+//! verifies whenever present, the next run removes the temporaries of killed runs, and SIGINT
+//! or SIGTERM remove the run's own.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -9,12 +10,23 @@ use std::time::{Duration, Instant};
 use xylem::output::{commit_set, stage_bytes, verify_set};
 
 fn bake(seed: u32, out: &Path) -> Command {
+    bake_at(256, seed, out)
+}
+
+fn bake_at(res: u32, seed: u32, out: &Path) -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_xylem"));
-    c.args(["bake", "walnut", "--board", "100x50x10", "--res", "256"])
-        .args(["--seed", &seed.to_string(), "--out"])
-        .arg(out)
-        .stdout(Stdio::null())
-        .stderr(Stdio::null());
+    c.args([
+        "bake",
+        "walnut",
+        "--board",
+        "100x50x10",
+        "--res",
+        &res.to_string(),
+    ])
+    .args(["--seed", &seed.to_string(), "--out"])
+    .arg(out)
+    .stdout(Stdio::null())
+    .stderr(Stdio::null());
     c
 }
 
@@ -110,4 +122,43 @@ fn a_set_replaces_every_member_of_the_set_before_it() {
     std::fs::remove_file(dir.join("set.json")).unwrap();
     let e = verify_set(dir, "set.json").unwrap_err();
     assert!(e.contains("set.json") && e.contains("incomplete"), "{e}");
+}
+
+#[test]
+fn sigint_and_sigterm_remove_the_runs_own_temporaries() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("o");
+    let start = Instant::now();
+    assert!(bake_at(1024, 1, &out).status().unwrap().success());
+    let run = start.elapsed();
+    std::fs::remove_dir_all(&out).unwrap();
+    let signals = 8;
+    let mut hits = 0;
+    for k in 0..signals {
+        let mut child = bake_at(1024, 1, &out).spawn().unwrap();
+        // The maps are staged at the end of the run: signals spread over its last part.
+        std::thread::sleep(run.mul_f64(0.5 + 0.55 * k as f64 / signals as f64));
+        let sig = if k % 2 == 0 {
+            libc::SIGINT
+        } else {
+            libc::SIGTERM
+        };
+        // SAFETY: signals the child this test started (still unreaped, so its pid is its own).
+        unsafe { libc::kill(child.id() as i32, sig) };
+        let status = child.wait().unwrap();
+        use std::os::unix::process::ExitStatusExt;
+        // Ended by the signal (as its default action would), or done before it came.
+        assert!(
+            status.signal() == Some(sig) || status.success(),
+            "signal {sig}: {status:?}"
+        );
+        hits += usize::from(status.signal() == Some(sig));
+        let (_, hidden) = listing(&out);
+        assert!(
+            hidden.is_empty(),
+            "signal {sig}: temporaries left: {hidden:?}"
+        );
+        let _ = std::fs::remove_dir_all(&out);
+    }
+    assert!(hits > 0, "no signal arrived before the bake ended");
 }

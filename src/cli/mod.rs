@@ -55,6 +55,8 @@ enum Command {
 /// Entry point of the binary: runs the subcommand and turns an error into a message and exit code 1.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
+    // Ctrl-C or a kill(1) leaves no temporary behind (notes/limits.md).
+    crate::output::remove_temporaries_on_signal();
     // A forced SIMD level with an unknown name is refused here, before any work.
     if let Err(e) = crate::simd::Simd::from_env() {
         eprintln!("error: {e}");
