@@ -66,7 +66,7 @@ pub fn remove_temporaries_on_signal() {
     }
     let mut fds = [0; 2];
     // SAFETY: `fds` has room for the two descriptors.
-    if unsafe { libc::pipe(fds.as_mut_ptr()) } != 0 {
+    if unsafe { libc::pipe2(fds.as_mut_ptr(), libc::O_CLOEXEC) } != 0 {
         return;
     }
     PIPE.store(fds[1], Ordering::Relaxed);
