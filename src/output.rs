@@ -240,8 +240,8 @@ pub fn remove_stale_temporaries(dir: &Path) {
 const SET_FILES: &str = "files";
 
 /// Commits `members` (staged in `dir`) as one set completed by `record` (a JSON object file in
-/// `dir`, written last): first the old record goes, then every member of the old set it named
-/// and every old file under a new member's name, then the new members are renamed into place,
+/// `dir`, written last): first the old record goes, then every member of the old set it names
+/// (where still as it lists it) and every old file under a new member's name, then the new members are renamed into place,
 /// and last the record is written — `extra` with a `files` list of every member's name, size
 /// and CRC-32. A kill at any point leaves either the old complete set, or members of the new
 /// set alone without a record; never members of two runs side by side. The caller holds the
@@ -263,7 +263,7 @@ pub fn commit_set(
     extra.insert(SET_FILES.into(), files.into());
     let text = serde_json::to_string_pretty(&extra).map_err(io::Error::other)?;
     let record_file = stage_bytes(&record_path, text.as_bytes())?;
-    let old = set_members(&record_path).unwrap_or_default();
+    let old = set_members(dir, &record_path);
     remove_if_present(&record_path)?;
     for name in old {
         remove_if_present(&dir.join(name))?;
@@ -278,16 +278,46 @@ pub fn commit_set(
     Ok(record_path)
 }
 
-/// The member names a set's record lists (plain names only: a record cannot point outside its
-/// folder). None where the record is missing or unreadable.
-fn set_members(record: &Path) -> Option<Vec<String>> {
-    let text =
-        crate::render::resources::read_text_bounded(record, MAX_RECORD_BYTES, "JSON").ok()?;
-    let v: serde_json::Value = serde_json::from_str(&text).ok()?;
-    let names = v.get(SET_FILES)?.as_array()?.iter();
-    let names = names.filter_map(|f| f.get("name")?.as_str().map(String::from));
-    let plain = |n: &String| !n.is_empty() && !n.contains('/') && n != "." && n != "..";
-    Some(names.filter(plain).collect())
+/// The `files` list of the set record at `path`.
+fn record_files(path: &Path) -> Result<Vec<serde_json::Value>, String> {
+    let text = crate::render::resources::read_text_bounded(path, MAX_RECORD_BYTES, "JSON")
+        .map_err(|e| format!("{e} (an incomplete set: its record is written last)"))?;
+    let v: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    match v.get(SET_FILES) {
+        Some(serde_json::Value::Array(files)) => Ok(files.clone()),
+        _ => Err(format!("{}: no `{SET_FILES}` list", path.display())),
+    }
+}
+
+/// A record entry's member in `dir`: its name, and whether the file has the size and CRC-32
+/// the entry lists. Only a plain name is accepted (a record cannot point outside its folder).
+fn member_status(dir: &Path, entry: &serde_json::Value) -> Result<(String, bool), String> {
+    let name = entry.get("name").and_then(|n| n.as_str()).unwrap_or("");
+    if name.is_empty() || name.contains('/') || name == "." || name == ".." {
+        return Err(format!(
+            "{}: member `{name}` (allowed: a file name in the folder)",
+            dir.display()
+        ));
+    }
+    let member = dir.join(name);
+    let file =
+        crate::render::resources::open_regular(&member, u64::MAX).map_err(|e| e.to_string())?;
+    let (len, crc) = checksum(file).map_err(|e| format!("{}: {e}", member.display()))?;
+    let crc = format!("{crc:08x}");
+    let want = (
+        entry.get("bytes").and_then(|b| b.as_u64()),
+        entry.get("crc32").and_then(|c| c.as_str()),
+    );
+    Ok((name.to_string(), want == (Some(len), Some(crc.as_str()))))
+}
+
+/// The members of the set recorded at `record` that are still as it lists them (so a record
+/// never makes [`commit_set`] remove a file it did not write); none where it is unreadable.
+fn set_members(dir: &Path, record: &Path) -> Vec<String> {
+    let files = record_files(record).unwrap_or_default();
+    let status = files.iter().filter_map(|f| member_status(dir, f).ok());
+    status.filter(|(_, same)| *same).map(|(n, _)| n).collect()
 }
 
 /// The largest set record read (a record lists a few files; this bounds `/dev/zero`).
@@ -297,27 +327,12 @@ const MAX_RECORD_BYTES: u64 = 1 << 20;
 /// member has the size and CRC-32 it lists. The error names the record or the member at fault.
 pub fn verify_set(dir: &Path, record: &str) -> Result<(), String> {
     let path = dir.join(record);
-    let text = crate::render::resources::read_text_bounded(&path, MAX_RECORD_BYTES, "JSON")
-        .map_err(|e| format!("{e} (an incomplete set: its record is written last)"))?;
-    let v: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
-    let files = (v.get(SET_FILES).and_then(|f| f.as_array()))
-        .ok_or_else(|| format!("{}: no `{SET_FILES}` list", path.display()))?;
-    for f in files {
-        let name = f.get("name").and_then(|n| n.as_str()).unwrap_or("");
-        let member = dir.join(name);
-        let file =
-            crate::render::resources::open_regular(&member, u64::MAX).map_err(|e| e.to_string())?;
-        let (len, crc) = checksum(file).map_err(|e| format!("{}: {e}", member.display()))?;
-        let crc = format!("{crc:08x}");
-        let want = (
-            f.get("bytes").and_then(|b| b.as_u64()),
-            f.get("crc32").and_then(|c| c.as_str()),
-        );
-        if want != (Some(len), Some(crc.as_str())) {
+    for f in record_files(&path)? {
+        let (name, same) = member_status(dir, &f)?;
+        if !same {
             return Err(format!(
                 "{}: not the file {} lists (another run's)",
-                member.display(),
+                dir.join(name).display(),
                 path.display()
             ));
         }

@@ -122,6 +122,24 @@ fn a_set_replaces_every_member_of_the_set_before_it() {
     std::fs::remove_file(dir.join("set.json")).unwrap();
     let e = verify_set(dir, "set.json").unwrap_err();
     assert!(e.contains("set.json") && e.contains("incomplete"), "{e}");
+    // A record naming a file it did not write (other size or CRC), or one outside the folder,
+    // never makes the next set remove it.
+    std::fs::write(dir.join("keep.txt"), "mine").unwrap();
+    let forged = r#"{"files": [{"name": "keep.txt", "bytes": 4, "crc32": "00000000"},
+        {"name": "../outside", "bytes": 1, "crc32": "00000000"}]}"#;
+    std::fs::write(dir.join("set.json"), forged).unwrap();
+    commit_set(
+        dir,
+        vec![stage("x.png", "4")],
+        "set.json",
+        serde_json::Map::new(),
+    )
+    .unwrap();
+    assert_eq!(
+        std::fs::read_to_string(dir.join("keep.txt")).unwrap(),
+        "mine"
+    );
+    verify_set(dir, "set.json").unwrap();
 }
 
 #[test]
