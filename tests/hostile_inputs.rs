@@ -288,3 +288,26 @@ fn a_slice_of_other_settings_never_rewrites_a_captures_manifest() {
         .status
         .success());
 }
+
+#[test]
+fn a_reader_that_stops_early_ends_the_program_quietly() {
+    use std::os::unix::process::ExitStatusExt;
+    for args in [&["preset", "list"][..], &["texture", "--list"][..]] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_xylem"))
+            .args(args)
+            .env("RUST_BACKTRACE", "0")
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take()); // the reader is gone before the first line
+        let o = child.wait_with_output().unwrap();
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert!(!e.contains("panicked"), "{args:?}: {e}");
+        assert!(
+            o.status.signal() == Some(libc::SIGPIPE) || o.status.success(),
+            "{args:?}: {:?}",
+            o.status
+        );
+    }
+}
