@@ -283,10 +283,11 @@ fn a_slice_of_other_settings_never_rewrites_a_captures_manifest() {
         manifest
     );
     assert_eq!(std::fs::read(dir.join("s/frame_0000.exr")).unwrap(), frame);
-    // A slice of the same settings is welcome.
-    assert!(sweep(&["--frames", "3", "--frames-range", "1..2"])
-        .status
-        .success());
+    // A slice of the same settings is welcome; the folder is complete after it, and it says so.
+    let o = sweep(&["--frames", "3", "--frames-range", "1..2"]);
+    assert!(o.status.success());
+    let said = String::from_utf8_lossy(&o.stdout);
+    assert!(said.contains("every frame is in"), "{said}");
 }
 
 #[test]

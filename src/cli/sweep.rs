@@ -135,6 +135,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 println!("  {}", f.display());
             }
         }
+        // A slice: the folder may be complete now (this was the last slice) or not yet.
+        None if crate::sweep::sequence::read_records(&job.out).is_ok() => println!(
+            "every frame is in {} now; assemble them: xylem sweep --assemble {}",
+            job.out.display(),
+            job.out.display()
+        ),
         None => println!(
             "not every frame is in {} yet; when all are: xylem sweep --assemble {}",
             job.out.display(),
