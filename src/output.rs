@@ -72,8 +72,14 @@ pub fn remove_temporaries_on_signal() {
     PIPE.store(fds[1], Ordering::Relaxed);
     std::thread::spawn(move || {
         let mut b = 0u8;
-        // SAFETY: reads one byte into `b`; retried when interrupted.
-        while unsafe { libc::read(fds[0], (&mut b as *mut u8).cast(), 1) } != 1 {}
+        loop {
+            // SAFETY: reads one byte into `b`.
+            match unsafe { libc::read(fds[0], (&mut b as *mut u8).cast(), 1) } {
+                1 => break,
+                -1 if io::Error::last_os_error().kind() == io::ErrorKind::Interrupted => {}
+                _ => return,
+            }
+        }
         let live = live();
         for p in live.iter() {
             let _ = std::fs::remove_file(p);
