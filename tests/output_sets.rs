@@ -6,7 +6,7 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 use xylem::output::{commit_set, stage_bytes, verify_set};
 
 fn bake(seed: u32, out: &Path) -> Command {
