@@ -1,9 +1,11 @@
 //! Repository files compiled into the binary, so an installed `xylem` (`cargo install --path .`)
 //! runs the built-in scenes, `validate` and the measured boards from any folder: the scene files
-//! (`scenes/*.toml`), the BSDF validation cases (`validation/bsdf_cases.toml`) and Marschner et
-//! al. 2005's measured maps (`data/marschner2005/`). A file on disk always wins; the embedded
-//! copy is used only where the path does not exist. (The species presets are embedded by
-//! `wood::preset` itself.)
+//! (`scenes/*.toml`), the meshes they place (`scenes/meshes/*.obj`), the BSDF validation cases
+//! (`validation/bsdf_cases.toml`) and Marschner et al. 2005's measured maps
+//! (`data/marschner2005/`). A file on disk always wins; the embedded copy is used only where the
+//! path does not exist. A built-in scene loaded from its embedded copy resolves its relative
+//! files against `scenes/` (its folder in the repository), so its meshes and maps are found
+//! here too. (The species presets are embedded by `wood::preset` itself.)
 
 use std::borrow::Cow;
 use std::path::{Component, Path, PathBuf};
@@ -15,7 +17,7 @@ macro_rules! embed {
 }
 
 /// (path relative to the repository root, contents).
-const FILES: [(&str, &[u8]); 25] = embed![
+const FILES: [(&str, &[u8]); 29] = embed![
     "scenes/box_joint.toml",
     "scenes/carved_bunny.toml",
     "scenes/cornell_box.toml",
@@ -31,6 +33,10 @@ const FILES: [(&str, &[u8]); 25] = embed![
     "scenes/sweep_board.toml",
     "scenes/teapot.toml",
     "scenes/turned_bowl.toml",
+    "scenes/meshes/bunny.obj",
+    "scenes/meshes/dovetail_pins.obj",
+    "scenes/meshes/dovetail_tails.obj",
+    "scenes/meshes/parquet.obj",
     "validation/bsdf_cases.toml",
     "data/marschner2005/maple/diffuse.png",
     "data/marschner2005/maple/fiber_axis.png",
@@ -67,10 +73,10 @@ fn normalise(path: &Path) -> Option<PathBuf> {
     Some(out.iter().collect())
 }
 
-/// The embedded contents for `path`: its repository-relative form (`scenes/sweep_board.toml`,
-/// `scenes/../data/…` folded), or a built-in scene's bare name (`sweep_board`) or file name
-/// (`sweep_board.toml`).
-pub fn lookup(path: &Path) -> Option<&'static [u8]> {
+/// The embedded file for `path` as (repository path, contents): its repository-relative form
+/// (`scenes/sweep_board.toml`, `scenes/../data/…` folded), or a built-in scene's bare name
+/// (`sweep_board`) or file name (`sweep_board.toml`).
+fn entry(path: &Path) -> Option<(&'static str, &'static [u8])> {
     let rel = normalise(path)?;
     let scene = match rel.to_str() {
         Some(s) if !s.contains('/') => Some(format!(
@@ -82,18 +88,30 @@ pub fn lookup(path: &Path) -> Option<&'static [u8]> {
     FILES
         .iter()
         .find(|(p, _)| Path::new(p) == rel || scene.as_deref() == Some(*p))
-        .map(|(_, bytes)| *bytes)
+        .copied()
 }
 
-/// The bytes of `path` from disk, or the embedded copy where the path does not exist; the
-/// disk's error otherwise (naming nothing: callers name the file).
-pub fn read(path: &Path) -> std::io::Result<Cow<'static, [u8]>> {
-    match std::fs::read(path) {
-        Ok(b) => Ok(Cow::Owned(b)),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            lookup(path).map(Cow::Borrowed).ok_or(e)
-        }
-        Err(e) => Err(e),
+/// The embedded contents for `path` (see [`entry`] for the names it answers to).
+pub fn lookup(path: &Path) -> Option<&'static [u8]> {
+    entry(path).map(|(_, bytes)| bytes)
+}
+
+/// The embedded file that stands in for `path` — (repository path, contents) — where `path`
+/// does not exist on disk; None where the disk has it or nothing is embedded under that name.
+pub fn stand_in(path: &Path) -> Option<(&'static str, &'static [u8])> {
+    entry(path).filter(|_| !path.exists())
+}
+
+/// The bytes of `path` from disk — a regular file of at most `max` bytes
+/// ([`read_bounded`](crate::render::resources::read_bounded)) — or the embedded copy where the
+/// path does not exist.
+pub fn read(
+    path: &Path,
+    max: u64,
+) -> Result<Cow<'static, [u8]>, crate::render::resources::ResourceError> {
+    match stand_in(path) {
+        Some((_, bytes)) => Ok(Cow::Borrowed(bytes)),
+        None => crate::render::resources::read_bounded(path, max).map(Cow::Owned),
     }
 }
 

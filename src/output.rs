@@ -5,11 +5,21 @@
 //! is atomic on one file system: a reader sees the old file or the new one, never a mix, and two
 //! runs writing the same name never share a temporary. A run that writes a group of files that
 //! belong together (a render's EXR and PNG, a sweep's frames) holds a [`FolderLock`] while it
-//! commits them, so the group always comes from one run.
+//! commits them, so the group always comes from one run. A set of outputs that a reader must
+//! take whole (fit's maps, bake's maps) is committed by [`commit_set`]: its record, written
+//! last, lists every member with its size and CRC-32, and a kill mid-commit leaves no record
+//! and no member of the previous set ([`verify_set`] checks a folder).
+//!
+//! Temporaries carry this host's name and the process id ([`Staged::new`]); the first file a
+//! process stages in a folder removes the temporaries there of dead processes of this host
+//! (runs killed before they could clean up), never those of live runs or other hosts.
 
+use std::collections::BTreeSet;
 use std::fs::File;
 use std::io;
+use std::io::{Read, Seek};
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 use tempfile::NamedTempFile;
 
 /// A file being written under a temporary name beside `path`; [`Staged::commit`] renames it
@@ -17,6 +27,79 @@ use tempfile::NamedTempFile;
 pub struct Staged {
     tmp: NamedTempFile,
     path: PathBuf,
+    _live: Live,
+}
+
+/// The temporary files of this process not yet committed or dropped, for
+/// [`remove_temporaries_on_signal`].
+static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn live() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    LIVE.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// A temporary's entry in [`LIVE`], removed when the [`Staged`] file is committed or dropped.
+struct Live(PathBuf);
+
+impl Drop for Live {
+    fn drop(&mut self) {
+        let mut live = live();
+        if let Some(i) = live.iter().rposition(|p| *p == self.0) {
+            live.swap_remove(i);
+        }
+    }
+}
+
+/// Makes SIGINT and SIGTERM remove this process's temporaries ([`Staged`] files not yet
+/// committed) before the process ends as the signal's default action would end it (so the exit
+/// status still tells the signal). The handler only writes the signal's number to a pipe; a
+/// thread waiting on the pipe removes the files, holding the registry's lock so that no new
+/// temporary appears meanwhile, and re-raises the signal. For the `xylem` binary: a library
+/// embedder (Python) keeps its own signal handling.
+pub fn remove_temporaries_on_signal() {
+    use std::sync::atomic::{AtomicI32, Ordering};
+    static PIPE: AtomicI32 = AtomicI32::new(-1);
+    extern "C" fn on_signal(sig: libc::c_int) {
+        let b = sig as u8;
+        // SAFETY: write(2) is async-signal-safe; the pipe outlives the process.
+        unsafe { libc::write(PIPE.load(Ordering::Relaxed), (&b as *const u8).cast(), 1) };
+    }
+    let mut fds = [0; 2];
+    // SAFETY: `fds` has room for the two descriptors.
+    if unsafe { libc::pipe2(fds.as_mut_ptr(), libc::O_CLOEXEC) } != 0 {
+        return;
+    }
+    PIPE.store(fds[1], Ordering::Relaxed);
+    std::thread::spawn(move || {
+        let mut b = 0u8;
+        loop {
+            // SAFETY: reads one byte into `b`.
+            match unsafe { libc::read(fds[0], (&mut b as *mut u8).cast(), 1) } {
+                1 => break,
+                -1 if io::Error::last_os_error().kind() == io::ErrorKind::Interrupted => {}
+                _ => return,
+            }
+        }
+        let live = live();
+        for p in live.iter() {
+            let _ = std::fs::remove_file(p);
+        }
+        // SAFETY: restores the default action and ends the process with the signal.
+        unsafe {
+            libc::signal(b as libc::c_int, libc::SIG_DFL);
+            libc::raise(b as libc::c_int);
+        }
+        drop(live);
+    });
+    for sig in [libc::SIGINT, libc::SIGTERM] {
+        // SAFETY: `on_signal` only calls write(2); an ignored signal (a background job's SIGINT,
+        // nohup) stays ignored.
+        unsafe {
+            if libc::signal(sig, on_signal as *const () as libc::sighandler_t) == libc::SIG_IGN {
+                libc::signal(sig, libc::SIG_IGN);
+            }
+        }
+    }
 }
 
 impl Staged {
@@ -26,16 +109,27 @@ impl Staged {
             Some(d) if !d.as_os_str().is_empty() => d,
             _ => Path::new("."),
         };
+        remove_stale_temporaries(dir);
         let stem = path.file_name().map(|n| n.to_string_lossy().into_owned());
-        let prefix = format!(".{}.", stem.unwrap_or_default());
+        let prefix = format!(
+            ".{}{TMP_MARK}{}-{}-",
+            stem.unwrap_or_default(),
+            host(),
+            std::process::id()
+        );
         let mut builder = tempfile::Builder::new();
         builder.prefix(&prefix).suffix(".tmp");
         // A temporary file is created owner-only (0600); an output is a plain file, so it gets
         // what `File::create` would give it: 0666 less the umask.
         #[cfg(unix)]
         builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+        // Created and registered under the registry's lock, so a signal's clean-up sees it.
+        let mut registry = live();
         let tmp = builder.tempfile_in(dir)?;
+        registry.push(tmp.path().to_path_buf());
+        drop(registry);
         Ok(Staged {
+            _live: Live(tmp.path().to_path_buf()),
             tmp,
             path: path.to_path_buf(),
         })
@@ -51,6 +145,13 @@ impl Staged {
         &self.path
     }
 
+    /// The size and CRC-32 of what was written (read back from the temporary file).
+    pub fn checksum(&mut self) -> io::Result<(u64, u32)> {
+        let f = self.tmp.as_file_mut();
+        f.rewind()?;
+        checksum(f)
+    }
+
     /// Renames the temporary file over the final name. (No `fsync`: this guards against killed
     /// and concurrent runs, which the page cache survives, not against power loss.)
     pub fn commit(self) -> io::Result<()> {
@@ -59,11 +160,190 @@ impl Staged {
     }
 }
 
-/// Writes `bytes` to `path` through a [`Staged`] file.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
+/// Writes `bytes` into a [`Staged`] file for `path`, to commit later.
+pub fn stage_bytes(path: &Path, bytes: &[u8]) -> io::Result<Staged> {
     let mut staged = Staged::new(path)?;
     io::Write::write_all(staged.file(), bytes)?;
-    staged.commit()
+    Ok(staged)
+}
+
+/// Writes `bytes` to `path` through a [`Staged`] file.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    stage_bytes(path, bytes)?.commit()
+}
+
+/// The length and CRC-32 of everything `r` yields.
+fn checksum(mut r: impl Read) -> io::Result<(u64, u32)> {
+    let mut h = crc32fast::Hasher::new();
+    let mut buf = vec![0; 1 << 16];
+    let mut len = 0u64;
+    loop {
+        let n = r.read(&mut buf)?;
+        if n == 0 {
+            return Ok((len, h.finalize()));
+        }
+        h.update(&buf[..n]);
+        len += n as u64;
+    }
+}
+
+/// What marks xylem's temporary names: `.NAME.xylem-tmp.HOST-PID-RANDOM.tmp`.
+const TMP_MARK: &str = ".xylem-tmp.";
+
+/// This host's name (`gethostname`), or `host` where unknown.
+fn host() -> String {
+    let mut buf = [0u8; 256];
+    // SAFETY: `buf` is writable for its length; the name is NUL-terminated when it fits.
+    let ok = unsafe { libc::gethostname(buf.as_mut_ptr().cast(), buf.len()) } == 0;
+    let end = buf.iter().position(|&b| b == 0).unwrap_or(0);
+    let name = String::from_utf8_lossy(&buf[..end]).replace(['/', '-'], "_");
+    if ok && !name.is_empty() {
+        name
+    } else {
+        "host".into()
+    }
+}
+
+/// Whether process `pid` of this host is alive (`kill(pid, 0)`: no such process means dead).
+fn alive(pid: i32) -> bool {
+    // SAFETY: signal 0 only checks for the process.
+    let r = unsafe { libc::kill(pid, 0) };
+    r == 0 || io::Error::last_os_error().raw_os_error() != Some(libc::ESRCH)
+}
+
+/// Removes from `dir` the temporaries of dead processes of this host (runs killed before they
+/// could delete them), once per folder and process; live runs' temporaries and other hosts'
+/// (a farm sharing the folder) stay. Failures are ignored: this is tidying, not output.
+pub fn remove_stale_temporaries(dir: &Path) {
+    static DONE: Mutex<BTreeSet<PathBuf>> = Mutex::new(BTreeSet::new());
+    let key = std::path::absolute(dir).unwrap_or_else(|_| dir.to_path_buf());
+    if !DONE.lock().map(|mut d| d.insert(key)).unwrap_or(false) {
+        return;
+    }
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let me = host();
+    for e in entries.flatten() {
+        let name = e.file_name();
+        let Some(name) = name.to_str() else { continue };
+        let Some(tail) = name.rsplit_once(TMP_MARK).map(|(_, t)| t) else {
+            continue;
+        };
+        // HOST-PID-RANDOM.tmp
+        let mut parts = tail.rsplitn(3, '-');
+        let (Some(_random), Some(pid), Some(h)) = (parts.next(), parts.next(), parts.next()) else {
+            continue;
+        };
+        let dead = pid.parse::<i32>().is_ok_and(|p| p > 0 && !alive(p));
+        if h == me && dead && name.ends_with(".tmp") {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
+}
+
+/// A set file's record: the members with their sizes and CRC-32s, beside what the caller adds.
+const SET_FILES: &str = "files";
+
+/// Commits `members` (staged in `dir`) as one set completed by `record` (a JSON object file in
+/// `dir`, written last): first the old record goes, then every member of the old set it names
+/// (where still as it lists it) and every old file under a new member's name, then the new members are renamed into place,
+/// and last the record is written — `extra` with a `files` list of every member's name, size
+/// and CRC-32. A kill at any point leaves either the old complete set, or members of the new
+/// set alone without a record; never members of two runs side by side. The caller holds the
+/// folder's lock.
+pub fn commit_set(
+    dir: &Path,
+    mut members: Vec<Staged>,
+    record: &str,
+    mut extra: serde_json::Map<String, serde_json::Value>,
+) -> io::Result<PathBuf> {
+    let record_path = dir.join(record);
+    let mut files = Vec::new();
+    for m in &mut members {
+        let (bytes, crc) = m.checksum()?;
+        let name = m.path.file_name().unwrap_or_default().to_string_lossy();
+        files
+            .push(serde_json::json!({"name": name, "bytes": bytes, "crc32": format!("{crc:08x}")}));
+    }
+    extra.insert(SET_FILES.into(), files.into());
+    let text = serde_json::to_string_pretty(&extra).map_err(io::Error::other)?;
+    let record_file = stage_bytes(&record_path, text.as_bytes())?;
+    let old = set_members(dir, &record_path);
+    remove_if_present(&record_path)?;
+    for name in old {
+        remove_if_present(&dir.join(name))?;
+    }
+    for m in &members {
+        remove_if_present(&m.path)?;
+    }
+    for m in members {
+        m.commit()?;
+    }
+    record_file.commit()?;
+    Ok(record_path)
+}
+
+/// The `files` list of the set record at `path`.
+fn record_files(path: &Path) -> Result<Vec<serde_json::Value>, String> {
+    let text = crate::render::resources::read_text_bounded(path, MAX_RECORD_BYTES, "JSON")
+        .map_err(|e| format!("{e} (an incomplete set: its record is written last)"))?;
+    let v: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    match v.get(SET_FILES) {
+        Some(serde_json::Value::Array(files)) => Ok(files.clone()),
+        _ => Err(format!("{}: no `{SET_FILES}` list", path.display())),
+    }
+}
+
+/// A record entry's member in `dir`: its name, and whether the file has the size and CRC-32
+/// the entry lists. Only a plain name is accepted (a record cannot point outside its folder).
+fn member_status(dir: &Path, entry: &serde_json::Value) -> Result<(String, bool), String> {
+    let name = entry.get("name").and_then(|n| n.as_str()).unwrap_or("");
+    if name.is_empty() || name.contains('/') || name == "." || name == ".." {
+        return Err(format!(
+            "{}: member `{name}` (allowed: a file name in the folder)",
+            dir.display()
+        ));
+    }
+    let member = dir.join(name);
+    let file =
+        crate::render::resources::open_regular(&member, u64::MAX).map_err(|e| e.to_string())?;
+    let (len, crc) = checksum(file).map_err(|e| format!("{}: {e}", member.display()))?;
+    let crc = format!("{crc:08x}");
+    let want = (
+        entry.get("bytes").and_then(|b| b.as_u64()),
+        entry.get("crc32").and_then(|c| c.as_str()),
+    );
+    Ok((name.to_string(), want == (Some(len), Some(crc.as_str()))))
+}
+
+/// The members of the set recorded at `record` that are still as it lists them (so a record
+/// never makes [`commit_set`] remove a file it did not write); none where it is unreadable.
+fn set_members(dir: &Path, record: &Path) -> Vec<String> {
+    let files = record_files(record).unwrap_or_default();
+    let status = files.iter().filter_map(|f| member_status(dir, f).ok());
+    status.filter(|(_, same)| *same).map(|(n, _)| n).collect()
+}
+
+/// The largest set record read (a record lists a few files; this bounds `/dev/zero`).
+const MAX_RECORD_BYTES: u64 = 1 << 20;
+
+/// Checks that `dir` holds the complete set `record` describes: the record exists and every
+/// member has the size and CRC-32 it lists. The error names the record or the member at fault.
+pub fn verify_set(dir: &Path, record: &str) -> Result<(), String> {
+    let path = dir.join(record);
+    for f in record_files(&path)? {
+        let (name, same) = member_status(dir, &f)?;
+        if !same {
+            return Err(format!(
+                "{}: not the file {} lists (another run's)",
+                dir.join(name).display(),
+                path.display()
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Removes `path` if it exists (a stale output that must not outlive the run replacing it).

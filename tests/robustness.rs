@@ -378,9 +378,27 @@ fn assemble_refuses_slices_that_disagree_and_absurd_records() {
     slice("2..4", &["--spp", "2"]);
     let o = run(&["sweep", "--assemble", o_]);
     assert_clean_error(&o, "spp = ");
+    // A slice of another arc is refused before it renders: the folder's manifest is of the
+    // scene's arc (issue 26) ...
+    let o = run(&[
+        "sweep",
+        s,
+        "--quiet",
+        "--out",
+        o_,
+        "--frames-range",
+        "2..4",
+        "--arc",
+        "-30..30",
+    ]);
+    assert_clean_error(&o, "manifest.json");
+    // ... and where no manifest says so, `--assemble` refuses records of two arcs.
+    let manifest = out.join("manifest.json");
+    std::fs::remove_file(&manifest).unwrap();
     slice("2..4", &["--arc", "-30..30"]);
     let o = run(&["sweep", "--assemble", o_]);
     assert_clean_error(&o, "arc_deg");
+    std::fs::remove_file(&manifest).unwrap();
     slice("2..4", &[]);
     let o = run(&["sweep", "--assemble", o_]);
     assert!(o.status.success(), "{}", stderr(&o));

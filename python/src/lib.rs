@@ -353,7 +353,10 @@ fn wood_params(
 ) -> PyResult<xylem::wood::WoodParams> {
     match (preset, preset_file) {
         (Some(name), None) => xylem::wood::preset(&name).map_err(wood_error),
-        (None, Some(file)) => xylem::wood::WoodParams::from_toml_file(file).map_err(wood_error),
+        (None, Some(file)) => xylem::scene::read_preset_file(&file).map_err(|e| match e {
+            e @ xylem::scene::PresetFileError::Read(_) => PyOSError::new_err(e.to_string()),
+            xylem::scene::PresetFileError::Wood(w) => wood_error(w),
+        }),
         _ => Err(value_error(format!(
             "give exactly one of `preset` (one of: {}) or `preset_file`",
             xylem::wood::PRESET_NAMES.join(", ")
@@ -707,6 +710,17 @@ impl PyWoodSurface {
     }
 }
 
+/// `threads`: 0 (all cores) up to 16 per core, as `--threads`.
+fn check_threads(threads: usize) -> PyResult<()> {
+    use xylem::render::resources::{check_threads, ResourceError};
+    check_threads(threads).map_err(|e| match e {
+        ResourceError::Threads { max, .. } => value_error(format!(
+            "threads = {threads}: out of range (allowed 0 = all cores, up to {max})"
+        )),
+        other => value_error(other),
+    })
+}
+
 /// A scene file loaded with the overrides of `xylem render` (`spp`, `res` = (width, height),
 /// `seed`).
 fn load_scene(
@@ -722,8 +736,10 @@ fn load_scene(
         other => value_error(other),
     })?;
     if let Some(spp) = spp {
-        if spp == 0 {
-            return Err(value_error("spp = 0: need at least 1 sample per pixel"));
+        if !(1..=1_000_000).contains(&spp) {
+            return Err(value_error(format!(
+                "spp = {spp}: out of range (allowed 1 to 1000000 samples per pixel)"
+            )));
         }
         loaded.settings.spp = spp;
     }
@@ -771,6 +787,7 @@ fn render<'py>(
     seed: Option<u64>,
     threads: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
+    check_threads(threads)?;
     let loaded = load_scene(scene, spp, res, seed)?;
     let run = xylem::render::RunOptions {
         threads,
@@ -815,6 +832,7 @@ fn sweep<'py>(
     seed: Option<u64>,
     threads: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
+    check_threads(threads)?;
     let loaded = load_scene(scene, spp, res, seed)?;
     let (path, moving) =
         xylem::sweep::SweepPath::from_scene(&loaded, frames, arc).map_err(value_error)?;

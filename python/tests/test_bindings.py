@@ -129,6 +129,10 @@ def test_errors_name_the_field(root):
         xylem.render(scene, res=(0, 10))
     with pytest.raises(OSError, match=r"missing.toml"):
         xylem.render(str(root / "missing.toml"))
+    with pytest.raises(ValueError, match=r"spp = 1000001: out of range \(allowed 1 to 1000000"):
+        xylem.render(scene, spp=1000001)
+    with pytest.raises(ValueError, match=r"threads = 99999: out of range \(allowed 0 = all cores"):
+        xylem.render(scene, threads=99999)
     with pytest.raises(ValueError, match=r"no \[sweep\] table"):
         xylem.sweep(str(root / "scenes" / "teapot.toml"), spp=1, res=(4, 4))
 
@@ -156,3 +160,13 @@ def test_render_releases_the_gil(root):
     assert out["seconds"] > 0.05, "render too short to tell"
     during = [x for x in ticks if start < x < end]
     assert len(during) >= 5, f"only {len(during)} ticks during a {end - start:.2f} s render"
+
+
+def test_builtin_scenes_render_by_bare_name_from_an_empty_folder(tmp_path, monkeypatch):
+    """Built-in scenes, their meshes and measured maps come from the module (issue 26)."""
+    monkeypatch.chdir(tmp_path)
+    for name in ["sweep_board", "cornell_bunny", "measured_maple_sweep"]:
+        img = xylem.render(name, spp=1, res=(8, 6))
+        assert img["beauty"].shape == (6, 8, 3), name
+    sw = xylem.sweep("sweep_board", frames=2, spp=1, res=(8, 6))
+    assert sw["frames"].shape == (2, 6, 8, 3)

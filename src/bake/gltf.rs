@@ -86,15 +86,30 @@ pub enum GltfError {
 }
 
 /// Writes `maps` (baked over `board`'s top face) as a `.glb` at `path`, whole or not at all
-/// ([`crate::output::write_atomic`]).
+/// ([`stage_glb`], then renamed).
 pub fn write_glb(
     path: &Path,
     board: &BoardCut,
     maps: &BakedMaps,
     name: &str,
 ) -> Result<(), GltfError> {
+    stage_glb(path, board, maps, name)?
+        .commit()
+        .map_err(|source| GltfError::Io {
+            path: path.display().to_string(),
+            source,
+        })
+}
+
+/// Encodes the `.glb` of [`write_glb`] into a temporary file beside `path`, to commit later.
+pub fn stage_glb(
+    path: &Path,
+    board: &BoardCut,
+    maps: &BakedMaps,
+    name: &str,
+) -> Result<crate::output::Staged, GltfError> {
     let bytes = glb_bytes(board, maps, name).map_err(|e| e.at(path))?;
-    crate::output::write_atomic(path, &bytes).map_err(|source| GltfError::Io {
+    crate::output::stage_bytes(path, &bytes).map_err(|source| GltfError::Io {
         path: path.display().to_string(),
         source,
     })

@@ -11,10 +11,11 @@
 //! image's top, z out of the face. Data maps (anisotropy, normal) are stored linearly, not sRGB.
 
 pub use crate::material::{across_fiber, BakedMaps, FaceRect};
-use crate::picture::png::{write_png_data8, write_png_rgb8};
+use crate::output::Staged;
+use crate::picture::png::{stage_png_rgb8, stage_png_tagged, PngTag};
 use crate::picture::srgb::to_srgb8;
 use crate::picture::ImageError;
-use crate::render::image_io::{write_exr_layers, ExrLayer};
+use crate::render::image_io::{stage_exr_layers, ExrCompression, ExrLayer};
 
 pub mod gltf;
 use crate::wood::{Needs, WoodVolume};
@@ -221,20 +222,20 @@ pub(crate) fn textures(m: &BakedMaps) -> DataCodes {
     }
 }
 
-/// Writes every map as `NAME.png` and `NAME.exr` into `dir` and returns the files written.
+/// Stages every map as `NAME.png` and `NAME.exr` in `dir`, to commit as one set
+/// ([`crate::output::commit_set`]; `xylem bake` adds the `.glb` and the record `bake.json`).
 /// PNG: base colour in sRGB (tagged so); the data maps (`DataCodes`: anisotropy, normal,
 /// metallic-roughness, highlight width, ray mask, fibre direction) as linear codes with no
 /// colour-space chunk. EXR: the same maps as 32-bit floats, with the anisotropy and normal maps
 /// *decoded* (direction components in [−1, 1], strength; unit normal) and β in radians.
-pub fn write_maps(
-    dir: &std::path::Path,
-    m: &BakedMaps,
-) -> Result<Vec<std::path::PathBuf>, ImageError> {
+pub fn stage_maps(dir: &std::path::Path, m: &BakedMaps) -> Result<Vec<Staged>, ImageError> {
     let (w, h) = (m.width, m.height);
-    let mut files = Vec::new();
-    let p = dir.join("base_color.png");
-    write_png_rgb8(&p, w, h, &to_srgb8(&m.base_color, 0.0))?;
-    files.push(p);
+    let mut files = vec![stage_png_rgb8(
+        &dir.join("base_color.png"),
+        w,
+        h,
+        &to_srgb8(&m.base_color, 0.0),
+    )?];
     let c = textures(m);
     let pngs: [(&str, Vec<u8>); 6] = [
         ("anisotropy", c.anisotropy),
@@ -246,8 +247,7 @@ pub fn write_maps(
     ];
     for (name, bytes) in pngs {
         let p = dir.join(format!("{name}.png"));
-        write_png_data8(&p, w, h, &bytes)?;
-        files.push(p);
+        files.push(stage_png_tagged(&p, w, h, &bytes, PngTag::Untagged)?);
     }
     let flat = |v: &[Vec3]| v.iter().flat_map(|c| c.to_array()).collect::<Vec<f32>>();
     let aniso: Vec<Vec3> = m
@@ -264,18 +264,20 @@ pub fn write_maps(
         ("fiber_direction", &["R", "G", "B"], flat(&m.fiber)),
     ];
     for (name, channels, data) in exrs {
+        let layer = ExrLayer {
+            name: "",
+            channels,
+            data,
+        };
         let p = dir.join(format!("{name}.exr"));
-        write_exr_layers(
+        files.push(stage_exr_layers(
             &p,
             w,
             h,
-            &[ExrLayer {
-                name: "",
-                channels,
-                data,
-            }],
-        )?;
-        files.push(p);
+            &[layer],
+            ExrCompression::Zip,
+            &[],
+        )?);
     }
     Ok(files)
 }

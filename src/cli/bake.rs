@@ -1,7 +1,8 @@
 //! `xylem bake`: texture maps of a preset over a board's face, and the board as a glTF 2.0
 //! binary (`DIR/PRESET.glb`), for other tools.
 
-use crate::bake::{bake, gltf::write_glb, write_maps, BakeCut, BoardCut};
+use crate::bake::{bake, gltf::stage_glb, stage_maps, BakeCut, BoardCut};
+use crate::output::{commit_set, FolderLock, LockMode};
 use anyhow::Context;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -16,7 +17,7 @@ pub struct Args {
     /// Which face of the log the board shows.
     #[arg(long, default_value = "tangential")]
     pub cut: BakeCut,
-    /// Texels along the board's length.
+    /// Texels along the board's length, 1 to 16384.
     #[arg(long, default_value_t = 1024)]
     pub res: u32,
     /// Distance of the board's centre from the pith (mm).
@@ -52,6 +53,9 @@ fn parse_board(s: &str) -> Result<[f32; 3], String> {
     Ok(out)
 }
 
+/// The record of a bake's outputs, written last: the settings and every file's size and CRC-32.
+const BAKE_RECORD: &str = "bake.json";
+
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     anyhow::ensure!(
         (1..=16384).contains(&args.res),
@@ -74,10 +78,27 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let maps = bake(&volume, &board, args.res);
-    let mut files = write_maps(&args.out, &maps)?;
+    // Every map and the .glb are staged first, then committed as one set whose record
+    // `bake.json` comes last (`output::commit_set`): a full disk leaves the previous bake as it
+    // was, a kill while committing leaves no `bake.json` and no file of the previous bake.
+    let _lock = FolderLock::try_new(&args.out, LockMode::Exclusive)?;
+    let mut staged = stage_maps(&args.out, &maps)?;
     let glb = args.out.join(format!("{}.glb", args.preset));
-    write_glb(&glb, &board, &maps, &args.preset)?;
-    files.push(glb);
+    staged.push(stage_glb(&glb, &board, &maps, &args.preset)?);
+    let mut files: Vec<_> = staged.iter().map(|s| s.path().to_path_buf()).collect();
+    let record = serde_json::json!({
+        "preset": args.preset,
+        "board_mm": args.board,
+        "cut": args.cut.to_string(),
+        "res": args.res,
+        "radius_mm": args.radius,
+        "seed": args.seed,
+    });
+    let record = record.as_object().cloned().unwrap_or_default();
+    files.push(
+        commit_set(&args.out, staged, BAKE_RECORD, record)
+            .with_context(|| format!("committing the bake in {}", args.out.display()))?,
+    );
     println!(
         "baked {} ({} cut, {}x{} texels) into {}:",
         args.preset,

@@ -11,11 +11,13 @@ pub struct Args {
     /// Output folder for the maps, residual map and report.
     #[arg(long)]
     pub out: PathBuf,
-    /// Map size W×H in texels (default: the board's size in pixels).
+    /// Map size W×H in texels, each 1 to 8192 (default: the board's size in pixels); refused
+    /// when the fit's memory estimate (12 bytes per texel per frame, and more) exceeds what is
+    /// available.
     #[arg(long, value_parser = parse_texels)]
     pub texels: Option<(usize, usize)>,
-    /// Worker threads (0 = all cores).
-    #[arg(long, default_value_t = 0)]
+    /// Worker threads (0 = all cores; at most 16 per core).
+    #[arg(long, default_value_t = 0, value_parser = super::parse_threads)]
     pub threads: usize,
     /// No progress bar.
     #[arg(long)]

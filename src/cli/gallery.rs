@@ -100,9 +100,8 @@ fn scenes(out: &Path, only: &[String]) -> anyhow::Result<bool> {
     let bar = super::progress::Bar::new(true);
     for name in names {
         let path = PathBuf::from(format!("scenes/{name}.toml"));
-        let text = std::fs::read_to_string(&path).with_context(|| {
-            format!("reading {} (run from the repository root)", path.display())
-        })?;
+        // From disk, or the built-in copy (`crate::builtin`).
+        let (text, _) = crate::scene::source_text(&path)?;
         let objects: Vec<Option<String>> = crate::scene::parse(&text, &path.display().to_string())?
             .objects
             .into_iter()
@@ -162,7 +161,9 @@ fn scenes(out: &Path, only: &[String]) -> anyhow::Result<bool> {
     let old = if only.is_empty() {
         String::new()
     } else {
-        std::fs::read_to_string(&file).unwrap_or_default()
+        // A table of a few rows (16 MiB bounds `/dev/zero` and the like).
+        crate::render::resources::read_text_bounded(&file, 16 << 20, "Markdown text")
+            .unwrap_or_default()
     };
     crate::output::write_atomic(&file, merge_check_rows(&old, &rows).as_bytes())
         .with_context(|| format!("writing {}", file.display()))?;

@@ -55,6 +55,12 @@ enum Command {
 /// Entry point of the binary: runs the subcommand and turns an error into a message and exit code 1.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
+    // Ctrl-C or a kill(1) leaves no temporary behind (notes/limits.md).
+    crate::output::remove_temporaries_on_signal();
+    // Output piped into a reader that stops early (`xylem … | head`) ends the program quietly
+    // with SIGPIPE's usual status, as any Unix tool, instead of a panic on the failed print.
+    // SAFETY: restores the default action of one signal.
+    unsafe { libc::signal(libc::SIGPIPE, libc::SIG_DFL) };
     // A forced SIMD level with an unknown name is refused here, before any work.
     if let Err(e) = crate::simd::Simd::from_env() {
         eprintln!("error: {e}");
@@ -83,6 +89,46 @@ pub fn main() -> ExitCode {
 
 /// The error and its causes joined by `: `, leaving out a cause whose text the message already
 /// holds (our error types print their source, so `{:#}` gave every OS error twice).
+/// `--threads`: 0 (all cores) up to [`MAX_THREADS_PER_CORE`] per core
+/// ([`check_threads`](crate::render::resources::check_threads)).
+///
+/// [`MAX_THREADS_PER_CORE`]: crate::render::resources::MAX_THREADS_PER_CORE
+pub(crate) fn parse_threads(s: &str) -> Result<usize, String> {
+    let n: usize = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{s}` is not a whole number (allowed 0 = all cores, or more)"))?;
+    crate::render::resources::check_threads(n).map_err(|e| e.to_string())?;
+    Ok(n)
+}
+
+/// The most samples per pixel `--spp` may ask for: the scene's `render.spp` range.
+pub(crate) const MAX_SPP: u32 = 1_000_000;
+
+/// `--spp`: 1 to [`MAX_SPP`] samples per pixel.
+pub(crate) fn parse_spp(s: &str) -> Result<u32, String> {
+    match s.trim().parse::<u32>() {
+        Ok(n) if (1..=MAX_SPP).contains(&n) => Ok(n),
+        _ => Err(format!(
+            "`{s}` is out of range (allowed 1 to {MAX_SPP} samples per pixel)"
+        )),
+    }
+}
+
+/// The largest `--exposure` magnitude in stops: ±30 stops scales by 2^±30 ≈ 10^±9, beyond
+/// which every pixel of any image is black or white.
+pub(crate) const MAX_EXPOSURE_STOPS: f32 = 30.0;
+
+/// `--exposure`: a finite number of stops within ±[`MAX_EXPOSURE_STOPS`].
+pub(crate) fn parse_exposure(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(x) if x.is_finite() && x.abs() <= MAX_EXPOSURE_STOPS => Ok(x),
+        _ => Err(format!(
+            "`{s}` is out of range (allowed -{MAX_EXPOSURE_STOPS} to {MAX_EXPOSURE_STOPS} stops)"
+        )),
+    }
+}
+
 fn error_chain(e: &anyhow::Error) -> String {
     let mut msg = e.to_string();
     for cause in e.chain().skip(1) {

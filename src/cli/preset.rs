@@ -282,8 +282,8 @@ pub(super) fn gallery(
 /// The README board scene ([`GALLERY_SCENE`]) as a TOML table, without its sweep's measurement
 /// regions (they are in pixels of the scene's own frame size).
 pub(super) fn board_table() -> anyhow::Result<toml::Table> {
-    let text = std::fs::read_to_string(GALLERY_SCENE)
-        .with_context(|| format!("reading {GALLERY_SCENE} (run from the repository root)"))?;
+    // From disk, or the built-in copy (`crate::builtin`).
+    let (text, _) = crate::scene::source_text(Path::new(GALLERY_SCENE))?;
     let mut scene: toml::Table = text
         .parse()
         .with_context(|| format!("parsing {GALLERY_SCENE}"))?;

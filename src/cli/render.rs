@@ -1,7 +1,7 @@
 //! `xylem render`: render a scene file to `DIR/<scene>.exr` (beauty + AOV layers) and
 //! `DIR/<scene>.png` (sRGB preview).
 
-use anyhow::{bail, Context};
+use anyhow::Context;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -9,8 +9,8 @@ use std::process::ExitCode;
 pub struct Args {
     /// Scene file (TOML, see scenes/README.md).
     scene: PathBuf,
-    /// Samples per pixel (overrides the scene's render.spp).
-    #[arg(long)]
+    /// Samples per pixel, 1 to 1000000 (overrides the scene\'s render.spp).
+    #[arg(long, value_parser = super::parse_spp)]
     spp: Option<u32>,
     /// Image size WxH (overrides render.width / render.height), e.g. 512x512.
     #[arg(long, value_parser = parse_res)]
@@ -18,8 +18,8 @@ pub struct Args {
     /// Output folder.
     #[arg(long, default_value = "out")]
     out: PathBuf,
-    /// Worker threads (0 = all cores).
-    #[arg(long, default_value_t = 0)]
+    /// Worker threads (0 = all cores; at most 16 per core).
+    #[arg(long, default_value_t = 0, value_parser = super::parse_threads)]
     threads: usize,
     /// Random seed (overrides render.seed).
     #[arg(long)]
@@ -52,15 +52,11 @@ pub(crate) fn parse_res(s: &str) -> Result<(u32, u32), String> {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    crate::render::resources::check_threads(args.threads)?;
     let mut loaded = crate::scene::load_with(&args.scene, args.ignore_limits)?;
     for w in &loaded.warnings {
         eprintln!("warning: {w}");
     }
     if let Some(spp) = args.spp {
-        if spp == 0 {
-            bail!("--spp 0: need at least 1 sample per pixel");
-        }
         loaded.settings.spp = spp;
     }
     if let Some(seed) = args.seed {

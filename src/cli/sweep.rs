@@ -12,7 +12,7 @@ pub struct Args {
     /// The scene file (TOML); its `[sweep]` table sets the defaults of the options below.
     #[arg(required_unless_present = "assemble")]
     pub scene: Option<PathBuf>,
-    /// Number of frames along the arc.
+    /// Number of frames along the arc, 1 to 100000.
     #[arg(long)]
     pub frames: Option<usize>,
     /// The arc of light angles from the zenith, FROM..TO in degrees (e.g. -60..60).
@@ -24,8 +24,8 @@ pub struct Args {
     /// Render only frames A..B (A to B-1) or A..=B, e.g. for a job array; assemble afterwards.
     #[arg(long)]
     pub frames_range: Option<String>,
-    /// Samples per pixel (overrides the scene's render.spp).
-    #[arg(long)]
+    /// Samples per pixel, 1 to 1000000 (overrides the scene\'s render.spp).
+    #[arg(long, value_parser = super::parse_spp)]
     pub spp: Option<u32>,
     /// Speed/accuracy preset measured in validation/TRADEOFF.md (spp and wood-model knobs);
     /// `--spp` still overrides its sample count.
@@ -34,8 +34,8 @@ pub struct Args {
     /// Render each frame from scratch, without the per-sweep cache (to time or check it).
     #[arg(long)]
     pub naive: bool,
-    /// Worker threads (0 = all cores).
-    #[arg(long, default_value_t = 0)]
+    /// Worker threads (0 = all cores; at most 16 per core).
+    #[arg(long, default_value_t = 0, value_parser = super::parse_threads)]
     pub threads: usize,
     /// Do not show the progress bar.
     #[arg(long)]
@@ -47,8 +47,8 @@ pub struct Args {
     /// ≈ 50 ms more CPU per 512×384 frame (notes/sweep.md), `none` writes raw floats.
     #[arg(long, value_enum, default_value = "rle")]
     pub exr_compression: crate::render::image_io::ExrCompression,
-    /// Largest thumbnail width on the contact sheet, in pixels.
-    #[arg(long, default_value_t = 240)]
+    /// Largest thumbnail width on the contact sheet, in pixels, 8 to 4096.
+    #[arg(long, default_value_t = 240, value_parser = clap::value_parser!(u32).range(8..=4096))]
     pub thumb_width: u32,
     /// Render even when the memory or disk estimate exceeds what the machine has.
     #[arg(long)]
@@ -62,11 +62,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let Some(scene) = &args.scene else {
         anyhow::bail!("give a scene file (or --assemble DIR)");
     };
-    crate::render::resources::check_threads(args.threads)?;
     let mut loaded = crate::scene::load_with(scene, args.ignore_limits)?;
     // The scene file's digest, recorded with every frame so that `--assemble` refuses slices
-    // of different scene files (the load above has already bounded and read it).
-    let scene_crc = crc32fast::hash(&std::fs::read(scene)?);
+    // of different scene files (read as the load above read it: bounded, or the embedded copy
+    // of a built-in scene).
+    let scene_crc = crc32fast::hash(&crate::scene::source(scene)?.0);
     for w in &loaded.warnings {
         eprintln!("warning: {w}");
     }
@@ -75,7 +75,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             .with_context(|| format!("applying --quality {q}"))?;
     }
     if let Some(spp) = args.spp {
-        anyhow::ensure!(spp >= 1, "--spp 0: need at least 1 sample per pixel");
         loaded.settings.spp = spp;
     }
     let arc = args
@@ -136,6 +135,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
                 println!("  {}", f.display());
             }
         }
+        // A slice: the folder may be complete now (this was the last slice) or not yet.
+        None if crate::sweep::sequence::read_records(&job.out).is_ok() => println!(
+            "every frame is in {} now; assemble them: xylem sweep --assemble {}",
+            job.out.display(),
+            job.out.display()
+        ),
         None => println!(
             "not every frame is in {} yet; when all are: xylem sweep --assemble {}",
             job.out.display(),
@@ -148,7 +153,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 /// Assembles a folder of frames and reports what it wrote.
 fn assemble_dir(dir: &Path, thumb_width: u32) -> anyhow::Result<ExitCode> {
     let opts = AssembleOptions {
-        thumb_width: thumb_width.max(8),
+        thumb_width,
         ..Default::default()
     };
     let done = crate::output::FolderLock::try_new(dir, crate::output::LockMode::Exclusive)

@@ -29,11 +29,11 @@ pub struct Args {
     /// Side of the square window (mm), centred on the axis.
     #[arg(long, default_value_t = 100.0)]
     pub size: f32,
-    /// Image side in pixels.
+    /// Image side in pixels, 1 to 16384.
     #[arg(long, default_value_t = 256)]
     pub res: u32,
-    /// Exposure of the PNG in stops (an EXR keeps the linear values).
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    /// Exposure of the PNG in stops, -30 to 30 (an EXR keeps the linear values).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = super::parse_exposure)]
     pub exposure: f32,
     /// Output file: `.png` (sRGB, exposure applied) or `.exr` (linear float RGB).
     #[arg(long)]
@@ -57,7 +57,7 @@ pub struct Args {
     /// (textures with a `time` parameter: clouds, rust).
     #[arg(long, value_name = "SECONDS", conflicts_with_all = ["preset", "preset_file"])]
     pub animate: Option<f32>,
-    /// Frames of an `--animate` sequence (12 per second of the animation file).
+    /// Frames of an `--animate` sequence, 1 to 1000 (12 per second of the animation file).
     #[arg(long, default_value_t = 24)]
     pub frames: usize,
 }
@@ -297,7 +297,7 @@ impl SolidTexture for WoodSlice {
 fn wood_source(args: &Args) -> anyhow::Result<Option<Box<dyn SolidTexture>>> {
     let params = match (&args.preset, &args.preset_file) {
         (Some(name), _) => crate::wood::preset(name)?,
-        (None, Some(file)) => crate::wood::WoodParams::from_toml_file(file)?,
+        (None, Some(file)) => crate::scene::read_preset_file(file)?,
         (None, None) => return Ok(None),
     };
     let volume = crate::wood::WoodVolume::new(params, args.seed)?;

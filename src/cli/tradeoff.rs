@@ -11,11 +11,11 @@ use std::process::ExitCode;
 pub struct Args {
     /// Scene file (TOML).
     pub scene: PathBuf,
-    /// Image width for the measurements (the height keeps the scene's aspect ratio).
+    /// Image width for the measurements, 8 to 4096 (the height keeps the scene's aspect ratio).
     #[arg(long, default_value_t = 160)]
     pub width: u32,
-    /// Samples per pixel of the reference render (full model).
-    #[arg(long, default_value_t = 256)]
+    /// Samples per pixel of the reference render (full model), 1 to 1000000.
+    #[arg(long, default_value_t = 256, value_parser = super::parse_spp)]
     pub reference_spp: u32,
     /// Report to write.
     #[arg(long, default_value = "validation/TRADEOFF.md")]
@@ -30,8 +30,8 @@ pub struct Args {
     /// Also write every render (reference and each row) as a PNG into this folder.
     #[arg(long)]
     pub images: Option<PathBuf>,
-    /// Worker threads (0 = all cores).
-    #[arg(long, default_value_t = 0)]
+    /// Worker threads (0 = all cores; at most 16 per core).
+    #[arg(long, default_value_t = 0, value_parser = super::parse_threads)]
     pub threads: usize,
 }
 

@@ -233,10 +233,11 @@ impl Capture {
     pub fn open(dir: &Path) -> Result<Capture, CaptureError> {
         let manifest_path = dir.join(MANIFEST_FILE);
         let path = manifest_path.display().to_string();
-        let text = std::fs::read_to_string(&manifest_path).map_err(|e| CaptureError::Read {
-            path: path.clone(),
-            cause: e.to_string(),
-        })?;
+        let text =
+            crate::sweep::manifest::read_text(&manifest_path).map_err(|e| CaptureError::Read {
+                path: path.clone(),
+                cause: e.reason(),
+            })?;
         let m: Manifest = serde_json::from_str(&text).map_err(|e| CaptureError::Parse {
             path: path.clone(),
             cause: e.to_string(),
@@ -576,12 +577,14 @@ impl Capture {
 /// An 8- or 16-bit PNG as linear RGB (sRGB decoded when `srgb`, IEC 61966-2-1), each channel
 /// v / (2^bits − 1) first.
 fn read_png(path: &Path, srgb: bool) -> Result<(u32, u32, Vec<Vec3>), String> {
-    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
-    let mut decoder = png::Decoder::new(std::io::BufReader::new(file));
-    decoder.set_transformations(png::Transformations::EXPAND);
-    let mut reader = decoder.read_info().map_err(|e| e.to_string())?;
-    let mut buf = vec![0; reader.output_buffer_size()];
-    let info = reader.next_frame(&mut buf).map_err(|e| e.to_string())?;
+    use crate::picture::png::{decode_png, open_png};
+    let px_bytes = std::mem::size_of::<Vec3>() as u64;
+    let (info, buf) = decode_png(
+        path,
+        open_png(path)?,
+        png::Transformations::EXPAND,
+        px_bytes,
+    )?;
     let channels = info.color_type.samples();
     let sixteen = info.bit_depth == png::BitDepth::Sixteen;
     let bytes = if sixteen { 2 } else { 1 };
@@ -593,8 +596,7 @@ fn read_png(path: &Path, srgb: bool) -> Result<(u32, u32, Vec<Vec3>), String> {
             v / max
         }
     };
-    let data = &buf[..info.buffer_size()];
-    let px = data
+    let px = buf
         .chunks_exact(channels * bytes)
         .map(|p| {
             let ch = |i: usize| -> f32 {

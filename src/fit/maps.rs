@@ -10,7 +10,6 @@
 use super::model::TexelFit;
 use crate::material::MeasuredBoard;
 use crate::output::{FolderLock, LockError, LockMode, Staged};
-use crate::picture::file::commit;
 use crate::picture::png::stage_png_rgb8;
 use crate::picture::ImageError;
 use crate::render::image_io::{stage_exr_layers, ExrCompression, ExrLayer};
@@ -138,9 +137,14 @@ pub fn stage_board_pngs(dir: &Path, board: &MeasuredBoard) -> Result<Vec<Staged>
     Ok(staged)
 }
 
+/// The record of a fit's outputs: the report, with the maps' sizes and CRC-32s, written last.
+pub const FIT_RECORD: &str = "fit.json";
+
 /// Writes the maps, the residual map, `maps.exr` and `report` (as `fit.json`) into `dir`,
-/// holding the folder's lock; every file is staged first and renamed only when all are
-/// encoded, so a failure leaves no partial map under a final name.
+/// holding the folder's lock; every file is staged first, and all are committed as one set
+/// whose record `fit.json` comes last ([`crate::output::commit_set`]): a failure or a full
+/// disk while encoding leaves the previous fit untouched, and a kill while committing leaves
+/// no `fit.json` and no map of the previous fit.
 pub fn write_maps(
     dir: &Path,
     maps: &FittedMaps,
@@ -195,19 +199,12 @@ pub fn write_maps(
         ExrCompression::Zip,
         &[("fit", "per-texel wood BSDF maps (xylem fit)".to_string())],
     )?);
-    let text = serde_json::to_string_pretty(report).unwrap_or_default();
-    let json_path = dir.join("fit.json");
-    let mut json = Staged::new(&json_path).map_err(|cause| MapsError::Io {
-        path: json_path.display().to_string(),
+    // fit.json, the report, is the set's record: written last, listing every map's size and
+    // CRC-32 (`output::commit_set`).
+    let record = report.as_object().cloned().unwrap_or_default();
+    crate::output::commit_set(dir, staged, FIT_RECORD, record).map_err(|cause| MapsError::Io {
+        path: dir.join(FIT_RECORD).display().to_string(),
         cause,
     })?;
-    std::io::Write::write_all(json.file(), text.as_bytes()).map_err(|cause| MapsError::Io {
-        path: json_path.display().to_string(),
-        cause,
-    })?;
-    staged.push(json);
-    for s in staged {
-        commit(s)?;
-    }
     Ok(())
 }

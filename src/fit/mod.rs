@@ -58,6 +58,20 @@ pub enum FitError {
         /// Requested height (texels).
         h: usize,
     },
+    /// The fit would need more memory than is available ([`fit_memory`]).
+    #[error("fitting {w}x{h} texels from {frames} frames needs about {need} of memory but {have} is available; lower --texels")]
+    Memory {
+        /// Map width (texels).
+        w: usize,
+        /// Map height (texels).
+        h: usize,
+        /// Frames in the capture.
+        frames: usize,
+        /// The estimate.
+        need: crate::render::resources::Bytes,
+        /// What is available.
+        have: crate::render::resources::Bytes,
+    },
     /// The worker thread pool could not be started.
     #[error("cannot start {threads} worker threads: {cause}")]
     Threads {
@@ -140,11 +154,38 @@ pub struct FitStats {
     pub texels_failed: usize,
 }
 
-/// Fits every texel of the capture's board (all cores, progress bar).
+/// Peak memory estimate (bytes) of a fit of `texels` from `frames` frames of `pixels` each
+/// read by `threads` workers at once: every frame's samples at every texel (12 bytes per texel
+/// per frame) are held until the fit, plus per texel its point, film position, fit and maps
+/// (128 bytes), plus per worker one frame being read (12 bytes a pixel, twice for its decoding).
+pub fn fit_memory(texels: usize, frames: usize, pixels: u64, threads: usize) -> u64 {
+    let t = texels as u64;
+    t * frames as u64 * 12 + t * 128 + threads as u64 * pixels * 24
+}
+
+/// Fits every texel of the capture's board (all cores, progress bar), after checking the
+/// map size (1 to 8192 per side) and the memory estimate ([`fit_memory`]).
 pub fn fit(capture: &Capture, opts: &FitOptions) -> Result<(FittedMaps, FitStats), FitError> {
     let (w, h) = opts.texels.unwrap_or_else(|| default_texels(capture));
     if w == 0 || h == 0 || w > 8192 || h > 8192 {
         return Err(FitError::Texels { w, h });
+    }
+    let frames = capture.frames.len();
+    let threads = match opts.threads {
+        0 => rayon::current_num_threads(),
+        t => t,
+    };
+    let pixels = capture.camera.width as u64 * capture.camera.height as u64;
+    let need = fit_memory(w * h, frames, pixels, threads);
+    if let Some(have) = crate::render::resources::available_memory().filter(|&a| need > a) {
+        use crate::render::resources::Bytes;
+        return Err(FitError::Memory {
+            w,
+            h,
+            frames,
+            need: Bytes(need),
+            have: Bytes(have),
+        });
     }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.threads)

@@ -10,6 +10,7 @@
 use super::face::{bilinear_taps, face_shading, FaceRect, FaceTexel};
 use super::{MaterialHit, Shading};
 use crate::bsdf::FinishModel;
+use crate::picture::png::{decode_png, open_png};
 use glam::{Vec2, Vec3};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -149,19 +150,17 @@ fn read_png8(field: &'static str, path: &Path) -> Result<Rgb8, MeasuredError> {
         cause,
     };
     // From disk, or the embedded copy of the repository's measured boards (`crate::builtin`).
-    let bytes = crate::builtin::read(path).map_err(|e| fail(e.to_string()))?;
-    let mut decoder = png::Decoder::new(std::io::Cursor::new(&bytes[..]));
-    decoder.set_transformations(png::Transformations::EXPAND);
-    let mut reader = decoder.read_info().map_err(|e| fail(e.to_string()))?;
-    let mut buf = vec![0; reader.output_buffer_size()];
-    let info = reader
-        .next_frame(&mut buf)
-        .map_err(|e| fail(e.to_string()))?;
+    let expand = png::Transformations::EXPAND;
+    let (info, buf) = match crate::builtin::stand_in(path) {
+        Some((_, bytes)) => decode_png(path, bytes, expand, 3),
+        None => decode_png(path, open_png(path).map_err(fail)?, expand, 3),
+    }
+    .map_err(fail)?;
     if info.bit_depth != png::BitDepth::Eight {
         return Err(fail(format!("{:?} bits per channel", info.bit_depth)));
     }
     let channels = info.color_type.samples();
-    let texels = buf[..info.buffer_size()]
+    let texels = buf
         .chunks_exact(channels)
         .map(|p| match channels {
             1 | 2 => [p[0]; 3],

@@ -72,7 +72,9 @@ fn png_error(path: &Path) -> impl Fn(png::EncodingError) -> ImageError + '_ {
     }
 }
 
-fn stage_png_tagged(
+/// Encodes 8-bit RGB with the colour-space chunk of `tag` into a uniquely named temporary file
+/// beside `path`, to [`commit`] later.
+pub fn stage_png_tagged(
     path: &Path,
     width: u32,
     height: u32,
@@ -168,24 +170,71 @@ pub fn write_apng(path: &Path, frames: &[Rgb8], fps: u16) -> Result<(), ImageErr
     commit(staged)
 }
 
+/// The most bytes the PNG decoder may allocate besides the image itself (chunk buffers, text,
+/// ICC profiles): the png crate's default of 64 MiB, stated here so that it stays bounded.
+const PNG_DECODER_BYTES: usize = 64 << 20;
+
+/// A PNG decoded into one buffer after its header's size was checked: the decoded buffer plus
+/// `extra_bytes_per_pixel` (what the caller builds from it) must pass
+/// [`check_image`](crate::render::resources::check_image) before anything is allocated.
+/// Errors name no file: callers do.
+pub fn decode_png(
+    path: &Path,
+    input: impl std::io::Read,
+    transformations: png::Transformations,
+    extra_bytes_per_pixel: u64,
+) -> Result<(png::OutputInfo, Vec<u8>), String> {
+    let limits = png::Limits {
+        bytes: PNG_DECODER_BYTES,
+    };
+    let mut dec = png::Decoder::new_with_limits(std::io::BufReader::new(input), limits);
+    dec.set_transformations(transformations);
+    let mut reader = dec.read_info().map_err(|e| e.to_string())?;
+    let (w, h) = (reader.info().width, reader.info().height);
+    let (color, depth) = reader.output_color_type();
+    let sample_bytes = if depth == png::BitDepth::Sixteen {
+        2
+    } else {
+        1
+    };
+    let decoded = color.samples() as u64 * sample_bytes;
+    crate::render::resources::check_image(
+        path,
+        w as u64,
+        h as u64,
+        decoded + extra_bytes_per_pixel,
+    )
+    .map_err(|e| e.reason())?;
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).map_err(|e| e.to_string())?;
+    buf.truncate(info.buffer_size());
+    Ok((info, buf))
+}
+
+/// Opens `path` for [`decode_png`] (a regular file of at most
+/// [`MAX_IMAGE_BYTES`](crate::render::resources::MAX_IMAGE_BYTES)).
+pub fn open_png(path: &Path) -> Result<std::io::Take<std::fs::File>, String> {
+    use crate::render::resources::{open_regular, MAX_IMAGE_BYTES};
+    use std::io::Read;
+    let file = open_regular(path, MAX_IMAGE_BYTES).map_err(|e| e.reason())?;
+    Ok(file.take(MAX_IMAGE_BYTES))
+}
+
 /// Reads an 8-bit PNG as RGB: RGBA loses its alpha, grey is repeated in R, G and B, palettes
 /// are expanded and 16-bit samples keep their high byte.
 pub fn read_png_rgb8(path: &Path) -> Result<Rgb8, ImageError> {
     let name = path.display().to_string();
-    let decode = |source| ImageError::PngRead {
+    let invalid = |what: String| ImageError::Invalid {
         path: name.clone(),
-        source,
+        what,
     };
-    let file = std::fs::File::open(path).map_err(|source| ImageError::Io {
-        path: name.clone(),
-        source,
-    })?;
-    let mut dec = png::Decoder::new(std::io::BufReader::new(file));
-    dec.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
-    let mut reader = dec.read_info().map_err(decode)?;
-    let mut buf = vec![0; reader.output_buffer_size()];
-    let info = reader.next_frame(&mut buf).map_err(decode)?;
-    buf.truncate(info.buffer_size());
+    let (info, buf) = decode_png(
+        path,
+        open_png(path).map_err(invalid)?,
+        png::Transformations::EXPAND | png::Transformations::STRIP_16,
+        3,
+    )
+    .map_err(invalid)?;
     let data = match info.color_type {
         png::ColorType::Rgb => buf,
         png::ColorType::Rgba => buf
@@ -197,12 +246,7 @@ pub fn read_png_rgb8(path: &Path) -> Result<Rgb8, ImageError> {
             .chunks_exact(2)
             .flat_map(|p| [p[0], p[0], p[0]])
             .collect(),
-        png::ColorType::Indexed => {
-            return Err(ImageError::Invalid {
-                path: name,
-                what: "indexed colour was not expanded".into(),
-            })
-        }
+        png::ColorType::Indexed => return Err(invalid("indexed colour was not expanded".into())),
     };
     Ok(Rgb8 {
         width: info.width,

@@ -303,45 +303,80 @@ pub fn aov_layers(aov: &[super::Aov]) -> Vec<ExrLayer<'static>> {
     ]
 }
 
-/// Reads the RGB channels of the first layer of an EXR (alpha ignored): (width, height, pixels).
-pub fn read_exr_rgb(path: &Path) -> Result<(usize, usize, Vec<Vec3>), ImageError> {
-    let img = exr::prelude::read_first_rgba_layer_from_file(
-        path,
-        |res, _| {
-            (
-                res.width(),
-                res.height(),
-                vec![Vec3::ZERO; res.width() * res.height()],
-            )
-        },
-        |buf: &mut (usize, usize, Vec<Vec3>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-            let w = buf.0;
-            buf.2[pos.y() * w + pos.x()] = Vec3::new(r, g, b);
-        },
-    )
-    .map_err(|e| ImageError::ExrRead {
+/// The error of an EXR that could not be read.
+fn exr_read_failed(path: &Path, message: impl ToString) -> ImageError {
+    ImageError::ExrRead {
         path: path.display().to_string(),
-        message: e.to_string(),
-    })?;
+        message: message.to_string(),
+    }
+}
+
+/// Opens an EXR and reads its headers, refusing before any pixel (or offset table) is read a
+/// file that is not a regular file of at most
+/// [`MAX_IMAGE_BYTES`](super::resources::MAX_IMAGE_BYTES) or a layer whose declared size fails
+/// [`check_image`](super::resources::check_image) with 8 bytes per channel (the decoded
+/// samples and a float copy of them) plus `extra_bytes_per_pixel` (what the caller builds).
+fn open_exr(
+    path: &Path,
+    extra_bytes_per_pixel: u64,
+) -> Result<exr::block::reader::Reader<std::io::BufReader<std::fs::File>>, ImageError> {
+    use super::resources::{check_image, open_regular, MAX_IMAGE_BYTES};
+    use std::io::{BufReader, Seek};
+    let fail = |message: String| exr_read_failed(path, message);
+    let mut file = open_regular(path, MAX_IMAGE_BYTES).map_err(|e| fail(e.reason()))?;
+    let meta = exr::meta::MetaData::read_from_buffered(BufReader::new(&file), false)
+        .map_err(|e| fail(e.to_string()))?;
+    for h in &meta.headers {
+        let bytes = 8 * h.channels.list.len() as u64 + extra_bytes_per_pixel;
+        let (w, ht) = (h.layer_size.width() as u64, h.layer_size.height() as u64);
+        check_image(path, w, ht, bytes).map_err(|e| fail(e.reason()))?;
+    }
+    file.rewind().map_err(|e| fail(e.to_string()))?;
+    exr::block::read(BufReader::new(file), false).map_err(|e| fail(e.to_string()))
+}
+
+/// Reads the RGB channels of the first layer of an EXR (alpha ignored): (width, height, pixels).
+/// The declared size is checked before decoding ([`open_exr`]).
+pub fn read_exr_rgb(path: &Path) -> Result<(usize, usize, Vec<Vec3>), ImageError> {
+    use exr::prelude::*;
+    let chunks = open_exr(path, std::mem::size_of::<Vec3>() as u64)?;
+    let img = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .rgba_channels(
+            |res, _: &RgbaChannels| {
+                (
+                    res.width(),
+                    res.height(),
+                    vec![Vec3::ZERO; res.width() * res.height()],
+                )
+            },
+            |buf: &mut (usize, usize, Vec<Vec3>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                let w = buf.0;
+                buf.2[pos.y() * w + pos.x()] = Vec3::new(r, g, b);
+            },
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .from_chunks(chunks)
+        .map_err(|e| exr_read_failed(path, e))?;
     Ok(img.layer_data.channel_data.pixels)
 }
 
-/// The first layer of an EXR with every channel and attribute.
+/// The first layer of an EXR with every channel and attribute (size checked by [`open_exr`]).
 fn read_exr_layer(
     path: &Path,
 ) -> Result<exr::prelude::Layer<exr::prelude::AnyChannels<exr::prelude::FlatSamples>>, ImageError> {
     use exr::prelude::*;
+    let chunks = open_exr(path, 0)?;
     let img = read()
         .no_deep_data()
         .largest_resolution_level()
         .all_channels()
         .first_valid_layer()
         .all_attributes()
-        .from_file(path)
-        .map_err(|e| ImageError::ExrRead {
-            path: path.display().to_string(),
-            message: e.to_string(),
-        })?;
+        .from_chunks(chunks)
+        .map_err(|e| exr_read_failed(path, e))?;
     Ok(img.layer_data)
 }
 

@@ -169,8 +169,30 @@ pub fn check_threads(threads: usize) -> Result<(), ResourceError> {
 }
 
 /// Memory available to this process: `MemAvailable` of /proc/meminfo, lowered to the cgroup's
-/// remaining allowance (`memory.max − memory.current`) where one is set. None where unknown.
+/// remaining allowance (`memory.max − memory.current`) where one is set, and to the address
+/// space left under `ulimit -v` (`RLIMIT_AS − VmSize`) where one is set. None where unknown.
 pub fn available_memory() -> Option<u64> {
+    let have = available_system_memory()?;
+    let mut lim = libc::rlimit {
+        rlim_cur: 0,
+        rlim_max: 0,
+    };
+    // SAFETY: `lim` is a writable rlimit.
+    if unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut lim) } != 0
+        || lim.rlim_cur == libc::RLIM_INFINITY
+    {
+        return Some(have);
+    }
+    let status = std::fs::read_to_string("/proc/self/status").ok();
+    let vm_kib: u64 = (status.as_deref())
+        .and_then(|s| s.lines().find_map(|l| l.strip_prefix("VmSize:")))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
+        .unwrap_or(0);
+    Some(have.min((lim.rlim_cur as u64).saturating_sub(vm_kib * 1024)))
+}
+
+/// [`available_memory`] before the address-space limit.
+fn available_system_memory() -> Option<u64> {
     let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
     let kib: u64 = meminfo
         .lines()
@@ -206,34 +228,40 @@ pub fn available_disk(dir: &Path) -> Option<u64> {
     Some(st.f_bavail as u64 * st.f_frsize as u64)
 }
 
-/// Reads an input file whole, refusing what is not a regular file (a device such as /dev/zero,
-/// a folder) or is larger than `max` bytes.
-pub fn read_bounded(path: &Path, max: u64) -> Result<Vec<u8>, ResourceError> {
-    use std::io::Read;
-    check_regular(path, max)?;
-    let input = |e: std::io::Error| ResourceError::Input {
-        path: path.display().to_string(),
-        message: e.to_string(),
-    };
-    let mut bytes = Vec::new();
-    // `take` also bounds a file that grows after the check.
-    std::fs::File::open(path)
-        .map_err(input)?
-        .take(max)
-        .read_to_end(&mut bytes)
-        .map_err(input)?;
-    Ok(bytes)
-}
-
-/// [`read_bounded`]'s checks alone, for files another library opens itself.
-pub fn check_regular(path: &Path, max: u64) -> Result<(), ResourceError> {
+/// Opens an input file, refusing what is not a regular file (a FIFO, a device such as
+/// /dev/zero, a socket, a folder) or is larger than `max` bytes. The file is opened
+/// non-blocking, so a FIFO without a writer is refused at once instead of waiting, and its type
+/// and size are checked on the opened handle, so nothing can be swapped in between.
+pub fn open_regular(path: &Path, max: u64) -> Result<std::fs::File, ResourceError> {
+    use std::os::unix::fs::{FileTypeExt, OpenOptionsExt};
     let input = |message: String| ResourceError::Input {
         path: path.display().to_string(),
         message,
     };
-    let meta = std::fs::metadata(path).map_err(|e| input(e.to_string()))?;
-    if !meta.is_file() {
-        return Err(input("not a regular file".into()));
+    let file = std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NONBLOCK)
+        .open(path)
+        .map_err(|e| input(e.to_string()))?;
+    let meta = file.metadata().map_err(|e| input(e.to_string()))?;
+    let t = meta.file_type();
+    let kind = if t.is_file() {
+        None
+    } else if t.is_dir() {
+        Some("a folder")
+    } else if t.is_fifo() {
+        Some("a FIFO")
+    } else if t.is_char_device() || t.is_block_device() {
+        Some("a device")
+    } else if t.is_socket() {
+        Some("a socket")
+    } else {
+        Some("a special file")
+    };
+    if let Some(kind) = kind {
+        return Err(input(format!(
+            "{kind}, not a regular file (allowed: a regular file)"
+        )));
     }
     if meta.len() > max {
         return Err(input(format!(
@@ -242,7 +270,86 @@ pub fn check_regular(path: &Path, max: u64) -> Result<(), ResourceError> {
             Bytes(max)
         )));
     }
-    Ok(())
+    Ok(file)
+}
+
+/// Reads an input file whole through [`open_regular`] (regular files of at most `max` bytes).
+pub fn read_bounded(path: &Path, max: u64) -> Result<Vec<u8>, ResourceError> {
+    use std::io::Read;
+    let mut bytes = Vec::new();
+    // `take` also bounds a file that grows after the check.
+    open_regular(path, max)?
+        .take(max)
+        .read_to_end(&mut bytes)
+        .map_err(|e| ResourceError::Input {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })?;
+    Ok(bytes)
+}
+
+/// [`read_bounded`] as UTF-8 text; `what` names the content in the error (e.g. "JSON").
+pub fn read_text_bounded(path: &Path, max: u64, what: &str) -> Result<String, ResourceError> {
+    String::from_utf8(read_bounded(path, max)?).map_err(|_| ResourceError::Input {
+        path: path.display().to_string(),
+        message: format!("not UTF-8 text (allowed: {what})"),
+    })
+}
+
+/// [`open_regular`]'s checks alone, for files another library opens itself.
+pub fn check_regular(path: &Path, max: u64) -> Result<(), ResourceError> {
+    open_regular(path, max).map(drop)
+}
+
+/// The largest side of an image read (pixels): twice `--res`'s 16384.
+pub const MAX_IMAGE_SIDE: u64 = 32768;
+/// The most pixels an image read may declare: 2²⁸ = 16384², the largest render.
+pub const MAX_IMAGE_PIXELS: u64 = 1 << 28;
+/// The largest image file read (EXR or PNG): a 16384² render's uncompressed 17-channel float
+/// EXR is 17 GiB.
+pub const MAX_IMAGE_BYTES: u64 = 20 << 30;
+
+/// Checks an image's declared size before it is decoded: each side 1 to [`MAX_IMAGE_SIDE`],
+/// at most [`MAX_IMAGE_PIXELS`] pixels, and `bytes_per_pixel` × pixels (what the decoder and
+/// the caller allocate for it) within the available memory.
+pub fn check_image(
+    path: &Path,
+    width: u64,
+    height: u64,
+    bytes_per_pixel: u64,
+) -> Result<(), ResourceError> {
+    let input = |message: String| ResourceError::Input {
+        path: path.display().to_string(),
+        message,
+    };
+    let pixels = width.saturating_mul(height);
+    if !(1..=MAX_IMAGE_SIDE).contains(&width)
+        || !(1..=MAX_IMAGE_SIDE).contains(&height)
+        || pixels > MAX_IMAGE_PIXELS
+    {
+        return Err(input(format!(
+            "declares {width}x{height} pixels (allowed: each side 1 to {MAX_IMAGE_SIDE}, at most {MAX_IMAGE_PIXELS} pixels = 16384²)"
+        )));
+    }
+    let need = pixels.saturating_mul(bytes_per_pixel);
+    match available_memory() {
+        Some(have) if need > have => Err(input(format!(
+            "a {width}x{height} image needs about {} of memory to decode but {} is available",
+            Bytes(need),
+            Bytes(have)
+        ))),
+        _ => Ok(()),
+    }
+}
+
+impl ResourceError {
+    /// The message without the file name (for errors that name the file themselves).
+    pub fn reason(&self) -> String {
+        match self {
+            ResourceError::Input { message, .. } => message.clone(),
+            other => other.to_string(),
+        }
+    }
 }
 
 #[cfg(test)]
@@ -264,7 +371,10 @@ mod tests {
     #[test]
     fn devices_and_oversized_files_are_refused_before_reading() {
         let e = read_bounded(Path::new("/dev/zero"), 1 << 20).unwrap_err();
-        assert!(e.to_string().contains("not a regular file"), "{e}");
+        assert!(
+            e.to_string().contains("a device, not a regular file"),
+            "{e}"
+        );
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("big.toml");
         std::fs::write(&p, vec![b' '; 2048]).unwrap();

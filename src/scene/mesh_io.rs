@@ -4,7 +4,7 @@
 
 use crate::render::TriMesh;
 use glam::Vec3;
-use std::io::{BufRead, BufReader};
+use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
 
 /// A mesh file that could not be read, naming the file and what is wrong.
@@ -34,35 +34,52 @@ fn bad(path: &Path, message: impl Into<String>) -> MeshError {
 }
 
 /// Loads an OBJ or PLY file by extension (a regular file of at most
-/// [`MAX_MESH_BYTES`](crate::render::resources::MAX_MESH_BYTES); `/dev/zero` is refused).
+/// [`MAX_MESH_BYTES`](crate::render::resources::MAX_MESH_BYTES); a FIFO or `/dev/zero` is
+/// refused), or the embedded copy of a built-in scene's mesh where the disk has none
+/// (`crate::builtin`).
 pub fn load_mesh(path: &Path) -> Result<TriMesh, MeshError> {
-    use crate::render::resources::{check_regular, ResourceError, MAX_MESH_BYTES};
-    check_regular(path, MAX_MESH_BYTES).map_err(|e| match e {
-        ResourceError::Input { message, .. } => bad(path, message),
-        other => bad(path, other.to_string()),
-    })?;
-    match path
+    use crate::render::resources::{open_regular, MAX_MESH_BYTES};
+    let ext = path
         .extension()
         .and_then(|e| e.to_str())
-        .map(|e| e.to_ascii_lowercase())
-        .as_deref()
-    {
-        Some("obj") => load_obj(path),
-        Some("ply") => load_ply(path),
-        _ => Err(MeshError::Extension {
+        .map(|e| e.to_ascii_lowercase());
+    if !matches!(ext.as_deref(), Some("obj" | "ply")) {
+        return Err(MeshError::Extension {
             path: path.display().to_string(),
-        }),
+        });
+    }
+    let mut input: Box<dyn BufRead> = match crate::builtin::stand_in(path) {
+        Some((_, bytes)) => Box::new(bytes),
+        None => {
+            let file = open_regular(path, MAX_MESH_BYTES).map_err(|e| bad(path, e.reason()))?;
+            Box::new(BufReader::new(file.take(MAX_MESH_BYTES)))
+        }
+    };
+    if ext.as_deref() == Some("obj") {
+        parse_obj(&mut input, path)
+    } else {
+        parse_ply(input).map_err(|m| bad(path, m))
     }
 }
 
-/// All models of an OBJ file merged into one mesh (normals kept when every model has them).
+/// Reads an OBJ mesh.
 pub fn load_obj(path: &Path) -> Result<TriMesh, MeshError> {
+    let file = std::fs::File::open(path).map_err(|e| bad(path, e.to_string()))?;
+    parse_obj(&mut BufReader::new(file), path)
+}
+
+/// All models of an OBJ stream merged into one mesh (normals kept when every model has them);
+/// `mtllib` lines are not followed (xylem's materials come from the scene file).
+fn parse_obj(input: &mut dyn BufRead, path: &Path) -> Result<TriMesh, MeshError> {
     let opts = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
         ..Default::default()
     };
-    let (models, _) = tobj::load_obj(path, &opts).map_err(|e| bad(path, e.to_string()))?;
+    let (models, _) = tobj::load_obj_buf(&mut &mut *input, &opts, |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    })
+    .map_err(|e| bad(path, e.to_string()))?;
     let mut out = TriMesh::default();
     for m in models {
         let mesh = &m.mesh;

@@ -109,20 +109,7 @@ pub fn load(path: &Path) -> Result<LoadedScene, SceneError> {
 
 /// [`load`], with the geometry memory check skipped when `ignore_limits` (`--ignore-limits`).
 pub fn load_with(path: &Path, ignore_limits: bool) -> Result<LoadedScene, SceneError> {
-    // A built-in scene named by its repository path or name, where no such file exists here
-    // (an installed binary run from another folder; `crate::builtin`).
-    let bytes = match crate::builtin::lookup(path).filter(|_| !path.exists()) {
-        Some(embedded) => embedded.to_vec(),
-        None => {
-            crate::render::resources::read_bounded(path, crate::render::resources::MAX_SCENE_BYTES)
-                .map_err(SceneError::Input)?
-        }
-    };
-    let text = String::from_utf8(bytes).map_err(|_| SceneError::Parse {
-        path: path.display().to_string(),
-        message: "not UTF-8 text (a scene is a TOML file)".into(),
-    })?;
-    let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let (text, base) = source_text(path)?;
     let name = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
@@ -135,6 +122,56 @@ pub fn load_with(path: &Path, ignore_limits: bool) -> Result<LoadedScene, SceneE
         ignore_limits,
     }
     .build(file, &name)
+}
+
+/// A scene file's bytes and the folder its relative files (meshes, maps) resolve against: the
+/// file's own folder, or `scenes/` for a built-in scene named by a path that does not exist
+/// here (an installed binary run from another folder; `crate::builtin`), whose meshes and maps
+/// then come from the embedded copies too. Bounded by
+/// [`MAX_SCENE_BYTES`](crate::render::resources::MAX_SCENE_BYTES).
+pub fn source(path: &Path) -> Result<(std::borrow::Cow<'static, [u8]>, PathBuf), SceneError> {
+    use crate::render::resources::MAX_SCENE_BYTES;
+    let bytes = crate::builtin::read(path, MAX_SCENE_BYTES).map_err(SceneError::Input)?;
+    let base = match crate::builtin::stand_in(path) {
+        Some((repo_path, _)) => Path::new(repo_path).parent().unwrap().to_path_buf(),
+        None => path.parent().unwrap_or(Path::new(".")).to_path_buf(),
+    };
+    Ok((bytes, base))
+}
+
+/// [`source`] as text (a scene is a UTF-8 TOML file).
+pub fn source_text(path: &Path) -> Result<(String, PathBuf), SceneError> {
+    let (bytes, base) = source(path)?;
+    let text = String::from_utf8(bytes.into_owned()).map_err(|_| SceneError::Parse {
+        path: path.display().to_string(),
+        message: "not UTF-8 text (a scene is a TOML file)".into(),
+    })?;
+    Ok((text, base))
+}
+
+/// Why a species preset file could not be used.
+#[derive(Debug, thiserror::Error)]
+pub enum PresetFileError {
+    /// Missing, not a regular file (a FIFO, a device) or larger than
+    /// [`MAX_SCENE_BYTES`](crate::render::resources::MAX_SCENE_BYTES).
+    #[error("preset file {0}")]
+    Read(crate::render::resources::ResourceError),
+    /// Not a valid preset (the error names the file, the field and the range).
+    #[error(transparent)]
+    Wood(#[from] crate::wood::WoodError),
+}
+
+/// Reads a species preset file (`preset_file` of a wood material, `--preset-file`): regular
+/// TOML text of at most [`MAX_SCENE_BYTES`](crate::render::resources::MAX_SCENE_BYTES), so a
+/// FIFO or a device is refused instead of blocking or reading forever.
+pub fn read_preset_file(path: &Path) -> Result<crate::wood::WoodParams, PresetFileError> {
+    use crate::render::resources::{read_text_bounded, MAX_SCENE_BYTES};
+    let text =
+        read_text_bounded(path, MAX_SCENE_BYTES, "TOML text").map_err(PresetFileError::Read)?;
+    Ok(crate::wood::WoodParams::from_toml_str(
+        &text,
+        &path.display().to_string(),
+    )?)
 }
 
 /// Parses the scene text only (no meshes built), for checks and the sweep setup.
@@ -620,10 +657,8 @@ impl Builder<'_> {
                     let params = match (preset, preset_file) {
                         (Some(name), None) => crate::wood::preset(name)
                             .map_err(|e| self.invalid(f("preset"), e.to_string()))?,
-                        (None, Some(file)) => {
-                            crate::wood::WoodParams::from_toml_file(self.base.join(file))
-                                .map_err(|e| self.invalid(f("preset_file"), e.to_string()))?
-                        }
+                        (None, Some(file)) => read_preset_file(&self.base.join(file))
+                            .map_err(|e| self.invalid(f("preset_file"), e.to_string()))?,
                         _ => {
                             return Err(self.invalid(
                                 f("preset"),

@@ -58,6 +58,16 @@ pub enum SweepError {
     /// The sweep would need more memory or disk than the machine has.
     #[error(transparent)]
     Resources(#[from] ResourceError),
+    /// A slice's sweep differs from the capture already in its folder.
+    #[error("{path} describes another sweep ({theirs}) than this slice ({ours}); render the slice with the same scene, --frames and --arc, or into another --out")]
+    OtherSweep {
+        /// The folder's manifest.
+        path: String,
+        /// What the folder's manifest describes.
+        theirs: String,
+        /// What this slice would write.
+        ours: String,
+    },
 }
 
 /// What to render and where.
@@ -204,6 +214,10 @@ pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepE
         LockMode::Exclusive
     };
     let _lock = FolderLock::try_new(&job.out, mode)?;
+    let manifest = Manifest::of_sweep(loaded, &path, moving);
+    if job.range.is_some() {
+        check_same_sweep(&job.out, &manifest)?;
+    }
     // The old viewer, CSV and sheet describe frames about to change: they go before any frame.
     clear_assembled(&job.out)?;
     if job.range.is_none() {
@@ -241,7 +255,7 @@ pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepE
         &settings,
     )?;
     // The capture manifest for `xylem fit` (the same text from every slice).
-    Manifest::of_sweep(loaded, &path, moving)
+    manifest
         .write(&job.out)
         .map_err(|cause| SweepError::OutDir {
             path: job.out.join(MANIFEST_FILE).display().to_string(),
@@ -261,6 +275,34 @@ pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepE
         total,
         render_time: r.elapsed,
         assembled,
+    })
+}
+
+/// Refuses a slice whose manifest differs from the one already in `dir` (a capture of other
+/// settings, whose frames the slice would mix with its own); a folder without a manifest is
+/// fine. Every slice of one sweep writes the same manifest text.
+fn check_same_sweep(dir: &Path, ours: &Manifest) -> Result<(), SweepError> {
+    let file = dir.join(MANIFEST_FILE);
+    if std::fs::symlink_metadata(&file).is_err() {
+        return Ok(());
+    }
+    let text = super::manifest::read_text(&file)?;
+    let summary = |m: &Manifest| {
+        let camera = format!("{}x{}", m.camera.width, m.camera.height);
+        format!("{} frames, {camera} camera", m.frames.len())
+    };
+    let theirs = match serde_json::from_str::<Manifest>(&text) {
+        Ok(m) if m.text() == ours.text() => return Ok(()),
+        Ok(m) if summary(&m) == summary(ours) => {
+            format!("{}, other lights or camera pose", summary(&m))
+        }
+        Ok(m) => summary(&m),
+        Err(e) => format!("unreadable: {e}"),
+    };
+    Err(SweepError::OtherSweep {
+        path: file.display().to_string(),
+        theirs,
+        ours: summary(ours),
     })
 }
 

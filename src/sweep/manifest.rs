@@ -14,6 +14,16 @@ use std::path::Path;
 /// The manifest's file name in a sweep folder.
 pub const MANIFEST_FILE: &str = "manifest.json";
 
+/// The largest manifest read: 64 MiB (a frame's entry is about 300 bytes, so some 200 000
+/// frames); this bounds `/dev/zero` and the like.
+pub const MAX_MANIFEST_BYTES: u64 = 64 << 20;
+
+/// Reads a manifest's text: a regular file of at most [`MAX_MANIFEST_BYTES`] (a FIFO or a
+/// device is refused at once instead of blocking or reading forever).
+pub fn read_text(path: &Path) -> Result<String, crate::render::resources::ResourceError> {
+    crate::render::resources::read_text_bounded(path, MAX_MANIFEST_BYTES, "JSON text")
+}
+
 /// The format tag the manifest carries.
 pub const FORMAT: &str = "xylem-sweep-manifest/1";
 
@@ -200,9 +210,13 @@ impl Manifest {
         }
     }
 
+    /// The manifest's JSON text, as [`Manifest::write`] writes it.
+    pub fn text(&self) -> String {
+        serde_json::to_string_pretty(self).expect("a manifest serializes")
+    }
+
     /// Writes the manifest into `dir` atomically.
     pub fn write(&self, dir: &Path) -> std::io::Result<()> {
-        let text = serde_json::to_string_pretty(self).map_err(std::io::Error::other)?;
-        crate::output::write_atomic(&dir.join(MANIFEST_FILE), text.as_bytes())
+        crate::output::write_atomic(&dir.join(MANIFEST_FILE), self.text().as_bytes())
     }
 }

@@ -10,6 +10,7 @@ use crate::output::{remove_if_present, write_atomic};
 use crate::picture::contact::{contact_sheet, Rgb8};
 use crate::picture::png::{read_png_rgb8, write_apng, write_png_linear, write_png_rgb8};
 use crate::picture::ImageError;
+use crate::render::resources::read_text_bounded;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::ops::Range;
@@ -303,6 +304,9 @@ impl Default for AssembleOptions {
     }
 }
 
+/// The largest frame record read (a record is under 1 KiB; this bounds `/dev/zero`).
+pub const MAX_RECORD_BYTES: u64 = 1 << 20;
+
 /// Reads every `frame_NNNN.json` in `dir`, sorted by frame index, and checks that they describe
 /// one complete sweep (same frame count and size, every frame present exactly once).
 pub fn read_records(dir: &Path) -> Result<Vec<FrameRecord>, SequenceError> {
@@ -317,9 +321,11 @@ pub fn read_records(dir: &Path) -> Result<Vec<FrameRecord>, SequenceError> {
         if !(name.starts_with("frame_") && name.ends_with(".json")) {
             continue;
         }
-        let text = std::fs::read_to_string(&path).map_err(|cause| SequenceError::Io {
-            path: path.display().to_string(),
-            cause,
+        let text = read_text_bounded(&path, MAX_RECORD_BYTES, "JSON text").map_err(|e| {
+            SequenceError::Io {
+                path: path.display().to_string(),
+                cause: std::io::Error::other(e.reason()),
+            }
         })?;
         let rec: FrameRecord =
             serde_json::from_str(&text).map_err(|cause| SequenceError::Json {

@@ -290,12 +290,15 @@ impl CasesFile {
     }
 }
 
+/// The largest cases file read (it is text; this bounds `/dev/zero` and the like).
+const MAX_CASES_BYTES: u64 = 16 << 20;
+
 /// Reads and checks `path`: every case must make a valid `WoodBsdf`.
 pub fn load_suite(path: &Path) -> Result<Suite, CasesError> {
     // From disk, or the embedded validation/bsdf_cases.toml (`crate::builtin`).
-    let bytes = crate::builtin::read(path).map_err(|source| CasesError::Io {
+    let bytes = crate::builtin::read(path, MAX_CASES_BYTES).map_err(|e| CasesError::Io {
         path: path.to_owned(),
-        source,
+        source: std::io::Error::other(e.reason()),
     })?;
     let text = String::from_utf8_lossy(&bytes);
     let file: CasesFile = toml::from_str(&text).map_err(|source| CasesError::Toml {

@@ -381,8 +381,8 @@ pub fn to_camera_frames(
     seed: u64,
 ) -> Result<(), String> {
     std::fs::create_dir_all(dst).map_err(|e| format!("{}: {e}", dst.display()))?;
-    let text = std::fs::read_to_string(src.join(MANIFEST_FILE))
-        .map_err(|e| format!("{}: {e}", src.display()))?;
+    let text =
+        crate::sweep::manifest::read_text(&src.join(MANIFEST_FILE)).map_err(|e| e.to_string())?;
     let mut m: Manifest = serde_json::from_str(&text).map_err(|e| e.to_string())?;
     let frames: Vec<(usize, usize, Vec<Vec3>)> = m
         .frames

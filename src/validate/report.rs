@@ -31,10 +31,11 @@ pub fn replace_section(text: &str, name: &str, markdown: &str) -> String {
 /// Rewrites only the section `name` of the report at `path` (created if missing). The file is
 /// written to a temporary name and renamed, so a failure never leaves half a report.
 pub fn update_report_section(path: &Path, name: &str, markdown: &str) -> io::Result<()> {
-    let old = match std::fs::read_to_string(path) {
-        Ok(s) => s,
+    // A report is text well under 16 MiB (this bounds `/dev/zero` and the like).
+    let old = match std::fs::symlink_metadata(path) {
         Err(e) if e.kind() == io::ErrorKind::NotFound => String::new(),
-        Err(e) => return Err(e),
+        _ => crate::render::resources::read_text_bounded(path, 16 << 20, "Markdown text")
+            .map_err(|e| io::Error::other(e.to_string()))?,
     };
     let new = replace_section(&old, name, markdown);
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {

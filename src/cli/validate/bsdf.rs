@@ -48,8 +48,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         }
     }
     let result: BsdfValidation = if let Some(path) = &args.from_json {
-        let text =
-            std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+        // A results file: text well under 16 MiB (bounds `/dev/zero` and the like).
+        let text = crate::render::resources::read_text_bounded(path, 16 << 20, "JSON text")?;
         serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))?
     } else {
         let bar = indicatif::ProgressBar::new(suite.cases.len() as u64).with_style(
