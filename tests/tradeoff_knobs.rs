@@ -197,6 +197,12 @@ fn smallest_feature(p: &WoodParams) -> f32 {
     if let Some(x) = &p.rays {
         d = d.min(x.width);
     }
+    // The cell texture fades from twice its across-grain length (notes/wood.md §9c).
+    if let Some(t) = &p.texture {
+        for scale in std::iter::once(t).chain(t.streaks.as_deref()) {
+            d = d.min(2.0 * scale.across);
+        }
+    }
     for n in [
         &p.distortion.radial,
         &p.distortion.tangential,
@@ -325,12 +331,14 @@ mod baked {
 
     #[test]
     fn baked_texture_converges_to_the_procedural_colour() {
-        // Rings and figure without pores and rays (which stay sub-texel up to 0.1 mm texels):
+        // Rings and figure without pores, rays and cell texture (which stay sub-texel up to
+        // 0.1 mm texels):
         // bilinear interpolation of a smooth field errs by O(h²), so 16× finer texels must cut
         // the mean error far more than the 4× an O(h) (nearest-texel) lookup would.
         let mut p = preset("walnut").unwrap();
         p.pores = None;
         p.rays = None;
+        p.texture = None;
         let v = WoodVolume::new(p, 2).unwrap();
         let face = board().1;
         let coarse = colour_error(&v, &face, 64);

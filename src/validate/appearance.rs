@@ -1032,11 +1032,17 @@ fn side_by_side(r: &PairReport) -> Rgb8 {
             let k = nearest_frame(s, angle);
             let (w, h) = (s.width as usize, s.height as usize);
             let frame: Vec<Vec3> = if turn {
-                (0..w * h).map(|i| s.frames[k][(i % h) * w + i / h]).collect()
+                (0..w * h)
+                    .map(|i| s.frames[k][(i % h) * w + i / h])
+                    .collect()
             } else {
                 s.frames[k].clone()
             };
-            let (width, height) = if turn { (s.height, s.width) } else { (s.width, s.height) };
+            let (width, height) = if turn {
+                (s.height, s.width)
+            } else {
+                (s.width, s.height)
+            };
             thumbs.push(Rgb8 {
                 width,
                 height,
