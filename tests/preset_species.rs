@@ -504,8 +504,8 @@ fn checks(preset: &str) -> Vec<Check> {
             control: Control::Edit(
                 "yellow",
                 &[
-                    ("earlywood = [0.46, 0.17, 0.08]", "earlywood = [0.78, 0.58, 0.075]"),
-                    ("latewood = [0.38, 0.13, 0.06]", "latewood = [0.71, 0.51, 0.062]"),
+                    ("earlywood = [0.46, 0.17, 0.08]", "earlywood = [0.78, 0.64, 0.075]"),
+                    ("latewood = [0.38, 0.13, 0.06]", "latewood = [0.71, 0.565, 0.062]"),
                 ],
             ),
         },
@@ -542,8 +542,8 @@ fn checks(preset: &str) -> Vec<Check> {
             control: Control::Edit(
                 "brown",
                 &[
-                    ("earlywood = [0.78, 0.58, 0.075]", "earlywood = [0.46, 0.17, 0.08]"),
-                    ("latewood = [0.71, 0.51, 0.062]", "latewood = [0.38, 0.13, 0.06]"),
+                    ("earlywood = [0.78, 0.64, 0.075]", "earlywood = [0.46, 0.17, 0.08]"),
+                    ("latewood = [0.71, 0.565, 0.062]", "latewood = [0.38, 0.13, 0.06]"),
                 ],
             ),
         },
