@@ -58,6 +58,7 @@ pub struct WoodVolume {
     knots: Option<Knots>,
     /// Fine-scale grain deviation (notes/wood.md §9a), evaluated only for fibres.
     wander: Option<FibreWander>,
+    /// Cell-scale colour texture (notes/wood.md §9c), evaluated only for colour.
     texture: Option<CellTexture>,
     /// Birdseye traces (ours, `eyes.rs`).
     eyes: Option<Eyes>,
@@ -382,9 +383,9 @@ impl WoodVolume {
     }
 
     /// [`WoodVolume::eval`] band-limited by a pixel footprint `footprint` mm wide (tree space):
-    /// distortion bands narrower than the footprint are dropped, and pores and rays fade to their
-    /// mean mask as the footprint grows from their width to twice it (and are not evaluated at
-    /// all beyond). A footprint below the smallest feature (or 0) gives exactly `eval`.
+    /// distortion bands narrower than the footprint are dropped, pores and rays fade to their
+    /// mean mask as the footprint grows from their width to twice it, and the cell texture fades
+    /// to its zero mean the same way (none of them is evaluated beyond). A footprint below the smallest feature (or 0) gives exactly `eval`.
     pub fn eval_filtered(&self, p: Vec3, needs: Needs, footprint: f32) -> WoodTexel {
         let mut texel = WoodTexel::default();
         let c = self.core(p, needs, footprint);
