@@ -500,6 +500,40 @@ fn fibre_wander_angles_have_the_derived_std_and_correlation_lengths() {
     }
 }
 
+/// A wander scale whose tangential tilt has its own length along the grain (`tangential_along`,
+/// fibres bent round rays): each angle decorrelates to 1/e at its own length (±0.05); the
+/// control is the tangential angle at the radial one's 5 mm, which must have lost far more.
+#[test]
+fn tangential_wander_has_its_own_length_along_the_grain() {
+    let text = plain_with_wander(
+        "radial = 0.0\ntangential = 0.0\nalong = 5.0\nacross = 1.0\n\
+         [fibre_wander.fine]\nradial = 3.0\ntangential = 2.0\nalong = 5.0\nacross = 1.0\n\
+         tangential_along = 1.5",
+    );
+    let v = WoodVolume::new(wood::WoodParams::from_toml_str(&text, "t").unwrap(), 7).unwrap();
+    let mut rng = xylem::math::Pcg32::new(4, 0);
+    let (mut r0, mut t0, mut r5, mut t15, mut t5) = (vec![], vec![], vec![], vec![], vec![]);
+    for _ in 0..20_000 {
+        let r = 100.0 + 40.0 * rng.next_f32();
+        let a = std::f32::consts::TAU * rng.next_f32();
+        let p = Vec3::new(r * a.cos(), r * a.sin(), 3000.0 * rng.next_f32());
+        let (ar, at) = tilts(&v, p);
+        r0.push(ar);
+        t0.push(at);
+        r5.push(tilts(&v, p + Vec3::Z * 5.0).0);
+        t15.push(tilts(&v, p + Vec3::Z * 1.5).1);
+        t5.push(tilts(&v, p + Vec3::Z * 5.0).1);
+    }
+    let e = (-1.0f64).exp();
+    let (cr, ct, control) = (corr(&r0, &r5), corr(&t0, &t15), corr(&t0, &t5));
+    println!(
+        "radial at 5 mm {cr:.3}, tangential at 1.5 mm {ct:.3} (1/e = {e:.3}); control {control:.3}"
+    );
+    assert!((cr - e).abs() < 0.05, "radial: {cr}");
+    assert!((ct - e).abs() < 0.05, "tangential: {ct}");
+    assert!(control < 0.1, "tangential at 5 mm: {control}");
+}
+
 /// On a sampled board (390² texels over 97.5 mm, flat-sawn 120 mm from the pith, seed 7) the
 /// measured dip is the radial tilt and the in-plane angle the tangential one: their standard
 /// deviations are the parameters within 10 % (the dip's is ≈ 1 % lower in theory, since the face

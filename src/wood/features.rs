@@ -322,12 +322,19 @@ impl FibreWander {
         }
     }
 
-    /// The two angles' noises of one scale.
+    /// The two angles' noises of one scale (the tangential one along its own length if given).
     fn scale(p: &WanderScale, seeds: [u32; 2]) -> [Option<SeededSparse>; 2] {
-        let noise = |deg: f32, seed: u32| {
-            (deg > 0.0).then(|| grain_noise(deg.to_radians(), (p.along, p.across), p.density, seed))
+        let noise = |deg: f32, along: f32, seed: u32| {
+            (deg > 0.0).then(|| grain_noise(deg.to_radians(), (along, p.across), p.density, seed))
         };
-        [noise(p.radial, seeds[0]), noise(p.tangential, seeds[1])]
+        [
+            noise(p.radial, p.along, seeds[0]),
+            noise(
+                p.tangential,
+                p.tangential_along.unwrap_or(p.along),
+                seeds[1],
+            ),
+        ]
     }
 
     /// The two tilt angles (radians) at `q`: towards r̂ and towards θ̂, kernels along `cyl`

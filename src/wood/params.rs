@@ -326,6 +326,13 @@ pub struct WanderScale {
     /// Mean number of kernels overlapping a point.
     #[serde(default = "two")]
     pub density: f32,
+    /// Correlation length along the grain of the tangential tilt alone, mm (default: `along`):
+    /// at the cell scale the two tilts have different causes — fibres bend tangentially round
+    /// the rays, whose height sets the length, and radially round vessels and growth
+    /// irregularities (Hoadley, "Understanding Wood", ch. 2: fibres part round the ray spindles
+    /// seen on a tangential face).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tangential_along: Option<f32>,
 }
 
 impl FibreWanderParams {
@@ -337,6 +344,7 @@ impl FibreWanderParams {
             along: self.along,
             across: self.across,
             density: self.density,
+            tangential_along: None,
         }
     }
 }
@@ -451,6 +459,9 @@ impl Checker<'_> {
         self.range(&format!("{name}.tangential"), w.tangential, 0.0, 20.0)?;
         self.range(&format!("{name}.along"), w.along, 0.05, 1000.0)?;
         self.range(&format!("{name}.across"), w.across, 0.02, 1000.0)?;
+        if let Some(l) = w.tangential_along {
+            self.range(&format!("{name}.tangential_along"), l, 0.05, 1000.0)?;
+        }
         self.range(&format!("{name}.density"), w.density, 0.25, 16.0)
     }
     fn texture(&self, name: &str, t: &TextureParams) -> Result<(), WoodError> {
