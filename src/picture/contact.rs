@@ -109,12 +109,12 @@ pub fn contact_sheet_rows(thumbs: &[Rgb8], labels: &[String], cols: usize, gap: 
         return Rgb8::filled(1, 1, [24, 24, 24]);
     };
     let cols = cols.clamp(1, thumbs.len());
+    let rows = thumbs.len().div_ceil(cols) as u32;
     let mut data = Vec::new();
     for (r, row) in thumbs.chunks(cols).enumerate() {
         let labels = labels.get(r * cols..).unwrap_or(&[]);
-        data.extend(sheet_band(row, labels, cols, gap, r == 0).data);
+        data.extend(sheet_band(row, labels, cols, gap, r as u32 + 1 == rows).data);
     }
-    let rows = thumbs.len().div_ceil(cols) as u32;
     Rgb8 {
         width: cols as u32 * first.width + (cols as u32 + 1) * gap,
         height: rows * first.height + (rows + 1) * gap,
@@ -122,23 +122,25 @@ pub fn contact_sheet_rows(thumbs: &[Rgb8], labels: &[String], cols: usize, gap: 
     }
 }
 
-/// One row of a contact sheet of `cols` columns: `thumbs` (at most `cols`, all one size) with
-/// `labels[i]` in each lower-left corner, the gap below them and, for the `top` row, above.
-/// A sheet is its bands one below the other, so a long sweep's sheet can be written band by band.
-pub fn sheet_band(thumbs: &[Rgb8], labels: &[String], cols: usize, gap: u32, top: bool) -> Rgb8 {
+/// One row of a contact sheet of `cols` columns: the gap above it, `thumbs` (at most `cols`,
+/// all one size) with `labels[i]` in each lower-left corner, and, for the `last` row, the gap
+/// below. A sheet is its bands one below the other, so a long sweep's sheet can be written band
+/// by band. A label of a thumbnail under 9 px tall reaches into the gap above it, never further.
+pub fn sheet_band(thumbs: &[Rgb8], labels: &[String], cols: usize, gap: u32, last: bool) -> Rgb8 {
     let Some(first) = thumbs.first() else {
         return Rgb8::filled(1, 1, [24, 24, 24]);
     };
     let (tw, th) = (first.width, first.height);
     let cols = cols.max(1) as u32;
-    let y0 = if top { gap } else { 0 };
-    let mut band = Rgb8::filled(cols * tw + (cols + 1) * gap, y0 + th + gap, [24, 24, 24]);
+    let below = if last { gap } else { 0 };
+    let mut band = Rgb8::filled(cols * tw + (cols + 1) * gap, gap + th + below, [24, 24, 24]);
     for (i, t) in thumbs.iter().enumerate().take(cols as usize) {
         let x = gap + i as u32 * (tw + gap);
-        band.blit(t, x, y0);
+        band.blit(t, x, gap);
         if let Some(label) = labels.get(i) {
             let scale = if th >= 96 { 2 } else { 1 };
-            draw_label(&mut band, label, x + 2, y0 + th - 2 - 7 * scale, scale);
+            let y = (gap + th).saturating_sub(2 + 7 * scale);
+            draw_label(&mut band, label, x + 2, y, scale);
         }
     }
     band

@@ -388,9 +388,12 @@ mod tests {
         // 16384² pixels at ≥ 100 bytes each is ≥ 26 GiB, far beyond any of 8 GiB.
         let r = Resources::render(16384, 16384);
         assert!(r.memory > 26 << 30, "{}", Bytes(r.memory));
-        // 100000 frames of 512×384 at ≥ 16 bytes of radiance each: ≥ 290 GiB.
-        let s = Resources::sweep(512, 384, 100_000, false);
+        // 100000 frames of 512×384 held at once (one batch) at ≥ 16 bytes of radiance each:
+        // ≥ 290 GiB of memory; in batches of 48, the memory of 48 frames, but the same disk.
+        let s = Resources::sweep(512, 384, 100_000, 100_000, 2);
         assert!(s.memory > 290 << 30 && s.disk > 290 << 30);
+        let b = Resources::sweep(512, 384, 100_000, 48, 2);
+        assert!(b.memory < 1 << 30 && b.disk == s.disk);
         assert!(check_threads(100_000).is_err());
         assert!(check_threads(0).is_ok() && check_threads(1).is_ok());
     }

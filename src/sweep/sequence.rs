@@ -537,7 +537,13 @@ pub fn assemble(dir: &Path, opts: &AssembleOptions) -> Result<Assembled, Sequenc
                 let thumbs = (recs.iter())
                     .map(|rec| Ok(read(rec)?.shrink_to_width(opts.thumb_width.min(fit))))
                     .collect::<Result<Vec<_>, ImageError>>()?;
-                Ok(sheet_band(&thumbs, &labels[r * cols..], cols, gap, r == 0))
+                Ok(sheet_band(
+                    &thumbs,
+                    &labels[r * cols..],
+                    cols,
+                    gap,
+                    r + 1 == rows,
+                ))
             })
         },
         || {
