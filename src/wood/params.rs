@@ -230,6 +230,19 @@ pub struct RayParams {
     /// Largest ray mask (blend weight of the ray-fibre BSDF), in [0, 1].
     #[serde(default = "one")]
     pub strength: f32,
+    /// Standard deviation of the rays' sideways (θ) waviness, mm (0: flat radial sheets). Rays
+    /// follow the wandering fibres round them, so a sheet a few tenths of a millimetre thick
+    /// weaves in and out of a quartersawn face: the fleck is the ragged patch where it lies in
+    /// the face, not the whole kernel's ellipse (notes/wood.md §9d).
+    #[serde(default)]
+    pub wander: f32,
+    /// Correlation length (1/e) of that waviness, mm.
+    #[serde(default = "ray_wander_length")]
+    pub wander_length: f32,
+}
+
+fn ray_wander_length() -> f32 {
+    4.0
 }
 
 /// Beer's-law colour (§6.1.8, eq. 25): the earlywood (g = 0) and latewood (g = 1) colours fix σℓ₀
@@ -576,6 +589,8 @@ impl WoodParams {
             c.positive("rays.density", r.density, 16.0)?;
             c.range("rays.sharpness", r.sharpness, 0.0, 100.0)?;
             c.range("rays.strength", r.strength, 0.0, 1.0)?;
+            c.range("rays.wander", r.wander, 0.0, 10.0)?;
+            c.range("rays.wander_length", r.wander_length, 0.05, 1000.0)?;
         }
         for (name, col) in [
             ("color.earlywood", self.color.earlywood),
