@@ -279,6 +279,7 @@ fn python_bindings_and_mitsuba_plugin() {
         .env("XYLEM_REFERENCE", &ref_path)
         .env("PYTHONPATH", &site)
         .env("XYLEM_ROOT", root())
+        .env("XYLEM_BIN", env!("CARGO_BIN_EXE_xylem"))
         .env("PATH", &path)
         .current_dir(root());
     match libllvm() {

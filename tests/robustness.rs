@@ -119,7 +119,8 @@ fn resources_beyond_the_machine_are_refused_up_front() {
         out.to_str().unwrap(),
     ]);
     assert_clean_error(&o, "--threads 100000");
-    // 100000 frames of 512×384: ≥ 100000 · 196608 px · 16 bytes ≈ 293 GiB of radiance alone.
+    // 100000 frames of 512×384: streamed in batches within --memory, but ≈ 348 GiB of frame
+    // files on disk.
     let board = repo().join("scenes/sweep_board.toml");
     let start = Instant::now();
     let o = run(&[

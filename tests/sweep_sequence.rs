@@ -112,3 +112,57 @@ fn records_from_different_sweeps_are_refused() {
     ));
     std::fs::remove_dir_all(&empty).unwrap();
 }
+
+/// The streamed assembly (contact sheet band by band, animation a few frames at a time) gives
+/// the pixels of the whole-image layout: every thumbnail blitted into one sheet at
+/// (gap + column·(w + gap), gap + row·(h + gap)) with its label, and every frame in the APNG.
+#[test]
+fn the_streamed_sheet_and_animation_hold_every_frame_where_the_layout_puts_it() {
+    use xylem::picture::contact::{draw_label, sheet_columns, Rgb8};
+    let arc = LightArc::new(-60.0, 60.0, 30).unwrap();
+    let dir = temp_dir("streamed-sheet");
+    render_slice(&dir, &arc, 0..30);
+    assemble(&dir, &AssembleOptions::default()).unwrap();
+    let frames: Vec<Rgb8> = (0..30)
+        .map(|i| read_png_rgb8(&dir.join(format!("frame_{i:04}.png"))).unwrap())
+        .collect();
+    let (cols, gap, (w, h)) = (sheet_columns(30) as u32, 4, (16, 8));
+    let rows = 30u32.div_ceil(cols);
+    let mut want = Rgb8::filled(
+        cols * w + (cols + 1) * gap,
+        rows * h + (rows + 1) * gap,
+        [24, 24, 24],
+    );
+    for (i, f) in frames.iter().enumerate() {
+        let (c, r) = (i as u32 % cols, i as u32 / cols);
+        let (x, y) = (gap + c * (w + gap), gap + r * (h + gap));
+        want.blit(f, x, y);
+        draw_label(
+            &mut want,
+            &format!("{:.1}°", arc.angle_deg(i)),
+            x + 2,
+            y + h - 9,
+            1,
+        );
+    }
+    let sheet = read_png_rgb8(&dir.join(CONTACT_SHEET)).unwrap();
+    assert_eq!((sheet.width, sheet.height), (want.width, want.height));
+    let first_diff = (sheet.data.iter().zip(&want.data))
+        .position(|(a, b)| a != b)
+        .map(|i| ((i / 3) as u32 % want.width, (i / 3) as u32 / want.width));
+    assert_eq!(
+        first_diff, None,
+        "the sheet's pixels differ from the layout (x, y)"
+    );
+    let dec = png::Decoder::new(std::fs::File::open(dir.join(ANIMATION)).unwrap());
+    let mut reader = dec.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    for (i, f) in frames.iter().enumerate() {
+        let info = reader.next_frame(&mut buf).unwrap();
+        assert!(
+            buf[..info.buffer_size()] == f.data[..],
+            "animation frame {i}"
+        );
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}

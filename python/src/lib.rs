@@ -876,6 +876,36 @@ fn sweep<'py>(
     Ok(d)
 }
 
+/// Fits the capture in the folder `capture` (a sweep's `manifest.json` and frames) and writes
+/// its maps and report into `out`, as `xylem fit` does; returns the report as JSON text
+/// (`xylem.fit` parses it). One board per call, the GIL released, so a Ray or Dask pool of
+/// processes can fit many boards at once.
+#[pyfunction]
+#[pyo3(signature = (capture, out, texels=None, threads=0))]
+fn fit(
+    py: Python<'_>,
+    capture: PathBuf,
+    out: PathBuf,
+    texels: Option<(usize, usize)>,
+    threads: usize,
+) -> PyResult<String> {
+    check_threads(threads)?;
+    let report = py
+        .allow_threads(|| {
+            let opts = xylem::fit::FitOptions {
+                texels,
+                threads,
+                ..Default::default()
+            };
+            xylem::fit::fit_folder(&capture, &out, &opts)
+        })
+        .map_err(|e| match e {
+            xylem::fit::FolderError::Fit(f) => value_error(f),
+            other => PyOSError::new_err(other.to_string()),
+        })?;
+    Ok(report.to_string())
+}
+
 #[pymodule]
 fn _xylem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyWoodBsdf>()?;
@@ -883,6 +913,7 @@ fn _xylem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyWoodSurface>()?;
     m.add_function(wrap_pyfunction!(render, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(fit, m)?)?;
     m.add("PRESETS", xylem::wood::PRESET_NAMES.to_vec())?;
     Ok(())
 }

@@ -41,7 +41,7 @@ pub struct Args {
     #[arg(long)]
     pub quiet: bool,
     /// Assemble contact sheet, animated PNG, CSV and viewer from the frames already in DIR.
-    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "frames", "arc", "frames_range", "spp", "naive", "quality"])]
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "frames", "arc", "frames_range", "spp", "naive", "quality", "memory", "emit_openjd"])]
     pub assemble: Option<PathBuf>,
     /// Compression of each frame's EXR: `rle` is fast, `zip` gives files ≈ 20 % smaller for
     /// ≈ 50 ms more CPU per 512×384 frame (notes/sweep.md), `none` writes raw floats.
@@ -53,6 +53,15 @@ pub struct Args {
     /// Render even when the memory or disk estimate exceeds what the machine has.
     #[arg(long)]
     pub ignore_limits: bool,
+    /// Memory for the frames held at once, e.g. 512M or 4G (default: a quarter of the memory
+    /// available): frames are rendered and written in batches that fit it, so a long sweep
+    /// needs no more memory than a short one.
+    #[arg(long, value_name = "BYTES", value_parser = crate::sweep::batch::parse_bytes)]
+    pub memory: Option<u64>,
+    /// Render nothing: write DIR/template.json, an Open Job Description job template of this
+    /// sweep (render tasks over chunks of frames, then the assembly) for `openjd run` or a farm.
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["frames_range", "naive"])]
+    pub emit_openjd: Option<PathBuf>,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -83,6 +92,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .map(parse_arc)
         .transpose()
         .context("--arc")?;
+    if let Some(dir) = &args.emit_openjd {
+        return emit_openjd(&args, &loaded, scene, dir, arc);
+    }
     let bar = super::progress::Bar::new(!args.quiet);
     let job = SweepJob {
         frames: args.frames,
@@ -99,6 +111,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         },
         exr: args.exr_compression,
         ignore_limits: args.ignore_limits,
+        memory: args.memory,
         provenance: format!(
             "scene crc32 {scene_crc:08x}, quality {}",
             args.quality.map_or("none".to_string(), |q| q.to_string())
@@ -121,12 +134,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let report = run_job(&loaded, &job).with_context(|| format!("sweep of {}", scene.display()))?;
     let n = report.rendered.len();
     println!(
-        "rendered frames {}..{} of {} in {:.2} s ({:.3} s per frame) into {}",
+        "rendered frames {}..{} of {} in {:.2} s ({:.3} s per frame; {} batch{} of up to {}) into {}",
         report.rendered.start,
         report.rendered.end,
         report.total,
         report.render_time.as_secs_f64(),
         report.render_time.as_secs_f64() / n.max(1) as f64,
+        report.batches,
+        if report.batches == 1 { "" } else { "es" },
+        report.batch,
         job.out.display()
     );
     match report.assembled {
@@ -147,6 +163,67 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             job.out.display()
         ),
     }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Writes the sweep's Open Job Description template: every render task gets the options that
+/// decide the frames, so its slice matches the others.
+fn emit_openjd(
+    args: &Args,
+    loaded: &crate::scene::LoadedScene,
+    scene: &Path,
+    dir: &Path,
+    arc: Option<(f32, f32)>,
+) -> anyhow::Result<ExitCode> {
+    use crate::sweep::openjd::{default_chunk, write_template, OpenJdSweep};
+    let (path, _) = crate::sweep::SweepPath::from_scene(loaded, args.frames, arc)?;
+    let frames = path.frames();
+    let absolute = |p: &Path| {
+        std::path::absolute(p).with_context(|| format!("making {} absolute", p.display()))
+    };
+    let mut render_args = vec!["--frames".to_string(), frames.to_string()];
+    let mut add = |flag: &str, value: Option<String>| {
+        if let Some(v) = value {
+            render_args.extend([flag.to_string(), v]);
+        }
+    };
+    add("--arc", args.arc.clone());
+    add("--spp", args.spp.map(|n| n.to_string()));
+    add("--quality", args.quality.map(|q| q.to_string()));
+    add("--memory", args.memory.map(|m| m.to_string()));
+    add(
+        "--threads",
+        (args.threads != 0).then(|| args.threads.to_string()),
+    );
+    let exr =
+        clap::ValueEnum::to_possible_value(&args.exr_compression).map(|v| v.get_name().to_string());
+    add("--exr-compression", exr);
+    if args.ignore_limits {
+        render_args.push("--ignore-limits".into());
+    }
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| Path::new("out").join(&loaded.name));
+    let sweep = OpenJdSweep {
+        name: loaded.name.clone(),
+        xylem: std::env::current_exe().context("finding the xylem binary")?,
+        scene: absolute(scene)?,
+        out: absolute(&out)?,
+        frames,
+        chunk: default_chunk(frames),
+        render_args,
+        assemble_args: vec!["--thumb-width".into(), args.thumb_width.to_string()],
+    };
+    let file = write_template(dir, &sweep)
+        .with_context(|| format!("writing the job template into {}", dir.display()))?;
+    println!(
+        "wrote {} ({frames} frames in chunks of {}, then the assembly); run it with `openjd run {}` or submit {} as a job bundle",
+        file.display(),
+        sweep.chunk,
+        file.display(),
+        dir.display()
+    );
     Ok(ExitCode::SUCCESS)
 }
 

@@ -154,6 +154,48 @@ pub struct FitStats {
     pub texels_failed: usize,
 }
 
+/// Why a capture folder could not be fitted into maps ([`fit_folder`]).
+#[derive(Debug, thiserror::Error)]
+pub enum FolderError {
+    /// The capture could not be read.
+    #[error(transparent)]
+    Capture(#[from] CaptureError),
+    /// The fit could not run.
+    #[error(transparent)]
+    Fit(#[from] FitError),
+    /// The maps could not be written.
+    #[error(transparent)]
+    Maps(#[from] maps::MapsError),
+}
+
+/// Fits the capture in the folder `sweep` and writes its maps and report into `out`: what
+/// `xylem fit` does for each folder, and what the Python package's `fit` runs (one board per
+/// call, so a Ray or Dask pool can fit many). Returns the report.
+pub fn fit_folder(
+    sweep: &std::path::Path,
+    out: &std::path::Path,
+    opts: &FitOptions,
+) -> Result<serde_json::Value, FolderError> {
+    let capture = Capture::open(sweep)?;
+    let (maps, stats) = fit(&capture, opts)?;
+    let mut res: Vec<f32> = maps.residual.clone();
+    res.sort_by(f32::total_cmp);
+    let median = res.get(res.len() / 2).copied().unwrap_or(f32::NAN);
+    let report = serde_json::json!({
+        "sweep": sweep.display().to_string(),
+        "texels": [maps.width, maps.height],
+        "frames": stats.frames,
+        "arcs_azimuth_deg": capture.arc_azimuths(),
+        "eta": capture.board.eta,
+        "texels_not_fitted": stats.texels_failed,
+        "median_relative_residual": median,
+        "read_seconds": stats.read_time.as_secs_f64(),
+        "fit_seconds": stats.fit_time.as_secs_f64(),
+    });
+    write_maps(out, &maps, &report)?;
+    Ok(report)
+}
+
 /// Peak memory estimate (bytes) of a fit of `texels` from `frames` frames of `pixels` each
 /// read by `threads` workers at once: every frame's samples at every texel (12 bytes per texel
 /// per frame) are held until the fit, plus per texel its point, film position, fit and maps

@@ -51,7 +51,7 @@ impl Rgb8 {
     /// The image shrunk by the smallest whole factor that makes it at most `max_width` wide,
     /// averaging each factor × factor block in linear light (averaging sRGB codes would darken edges).
     pub fn shrink_to_width(&self, max_width: u32) -> Rgb8 {
-        let f = self.width.div_ceil(max_width.max(1)).max(1);
+        let f = shrink_factor(self.width, max_width);
         if f == 1 {
             return self.clone();
         }
@@ -79,6 +79,19 @@ impl Rgb8 {
     }
 }
 
+/// The whole factor [`Rgb8::shrink_to_width`] divides a `width`-wide image by.
+fn shrink_factor(width: u32, max_width: u32) -> u32 {
+    width.div_ceil(max_width.max(1)).max(1)
+}
+
+/// The size [`Rgb8::shrink_to_width`] gives a `width × height` image.
+pub fn shrunk_size(width: u32, height: u32, max_width: u32) -> (u32, u32) {
+    match shrink_factor(width, max_width) {
+        1 => (width, height),
+        f => ((width / f).max(1), (height / f).max(1)),
+    }
+}
+
 /// Columns of a contact sheet for `n` frames: about a 4:3 grid of frames.
 pub fn sheet_columns(n: usize) -> usize {
     ((n as f64 * 4.0 / 3.0).sqrt().ceil() as usize).clamp(1, n.max(1))
@@ -90,29 +103,47 @@ pub fn contact_sheet(thumbs: &[Rgb8], labels: &[String], gap: u32) -> Rgb8 {
     contact_sheet_rows(thumbs, labels, sheet_columns(thumbs.len()), gap)
 }
 
-/// [`contact_sheet`] with `cols` thumbnails per row.
+/// [`contact_sheet`] with `cols` thumbnails per row: its [`sheet_band`]s one below the other.
 pub fn contact_sheet_rows(thumbs: &[Rgb8], labels: &[String], cols: usize, gap: u32) -> Rgb8 {
     let Some(first) = thumbs.first() else {
         return Rgb8::filled(1, 1, [24, 24, 24]);
     };
+    let cols = cols.clamp(1, thumbs.len());
+    let rows = thumbs.len().div_ceil(cols) as u32;
+    let mut data = Vec::new();
+    for (r, row) in thumbs.chunks(cols).enumerate() {
+        let labels = labels.get(r * cols..).unwrap_or(&[]);
+        data.extend(sheet_band(row, labels, cols, gap, r as u32 + 1 == rows).data);
+    }
+    Rgb8 {
+        width: cols as u32 * first.width + (cols as u32 + 1) * gap,
+        height: rows * first.height + (rows + 1) * gap,
+        data,
+    }
+}
+
+/// One row of a contact sheet of `cols` columns: the gap above it, `thumbs` (at most `cols`,
+/// all one size) with `labels[i]` in each lower-left corner, and, for the `last` row, the gap
+/// below. A sheet is its bands one below the other, so a long sweep's sheet can be written band
+/// by band. A label of a thumbnail under 9 px tall reaches into the gap above it, never further.
+pub fn sheet_band(thumbs: &[Rgb8], labels: &[String], cols: usize, gap: u32, last: bool) -> Rgb8 {
+    let Some(first) = thumbs.first() else {
+        return Rgb8::filled(1, 1, [24, 24, 24]);
+    };
     let (tw, th) = (first.width, first.height);
-    let cols = cols.clamp(1, thumbs.len()) as u32;
-    let rows = (thumbs.len() as u32).div_ceil(cols);
-    let mut sheet = Rgb8::filled(
-        cols * tw + (cols + 1) * gap,
-        rows * th + (rows + 1) * gap,
-        [24, 24, 24],
-    );
-    for (i, t) in thumbs.iter().enumerate() {
-        let (c, r) = (i as u32 % cols, i as u32 / cols);
-        let (x, y) = (gap + c * (tw + gap), gap + r * (th + gap));
-        sheet.blit(t, x, y);
+    let cols = cols.max(1) as u32;
+    let below = if last { gap } else { 0 };
+    let mut band = Rgb8::filled(cols * tw + (cols + 1) * gap, gap + th + below, [24, 24, 24]);
+    for (i, t) in thumbs.iter().enumerate().take(cols as usize) {
+        let x = gap + i as u32 * (tw + gap);
+        band.blit(t, x, gap);
         if let Some(label) = labels.get(i) {
             let scale = if th >= 96 { 2 } else { 1 };
-            draw_label(&mut sheet, label, x + 2, y + th - 2 - 7 * scale, scale);
+            let y = (gap + th).saturating_sub(2 + 7 * scale);
+            draw_label(&mut band, label, x + 2, y, scale);
         }
     }
-    sheet
+    band
 }
 
 /// A 3×5 pixel font for labels: digits, sign, point, degree sign, `%`, `_` and the lowercase

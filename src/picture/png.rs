@@ -170,6 +170,113 @@ pub fn write_apng(path: &Path, frames: &[Rgb8], fps: u16) -> Result<(), ImageErr
     commit(staged)
 }
 
+/// Frames or bands [`write_apng_streamed`] and [`write_png_bands`] make at once (in parallel)
+/// before encoding them: two per worker keeps the workers busy and memory flat.
+fn stream_chunk() -> usize {
+    2 * rayon::current_num_threads().max(1)
+}
+
+/// [`write_apng`] of `count` frames of `width × height` made one chunk at a time by `frame(k)`
+/// (in parallel within a chunk), so a long sequence is never held whole.
+pub fn write_apng_streamed(
+    path: &Path,
+    (width, height): (u32, u32),
+    count: usize,
+    fps: u16,
+    frame: impl Fn(usize) -> Result<Rgb8, ImageError> + Sync,
+) -> Result<(), ImageError> {
+    use rayon::prelude::*;
+    if count == 0 {
+        return Err(ImageError::Invalid {
+            path: path.display().to_string(),
+            what: "an animation needs at least one frame".into(),
+        });
+    }
+    let staged = stage(path, |out| {
+        let err = png_error(path);
+        let mut enc = encoder(out, width, height, PngTag::Srgb);
+        enc.set_animated(count as u32, 0).map_err(&err)?;
+        enc.set_frame_delay(1, fps.max(1)).map_err(&err)?;
+        let mut w = enc.write_header().map_err(&err)?;
+        for start in (0..count).step_by(stream_chunk()) {
+            let chunk: Vec<Rgb8> = (start..(start + stream_chunk()).min(count))
+                .into_par_iter()
+                .map(&frame)
+                .collect::<Result<_, _>>()?;
+            for (k, f) in chunk.iter().enumerate() {
+                if (f.width, f.height) != (width, height) {
+                    return Err(ImageError::Invalid {
+                        path: path.display().to_string(),
+                        what: format!(
+                            "frame {} is {}x{}, the animation {width}x{height}",
+                            start + k,
+                            f.width,
+                            f.height
+                        ),
+                    });
+                }
+                check_rgb8(path, f.width, f.height, &f.data)?;
+                w.write_image_data(&f.data).map_err(&err)?;
+            }
+        }
+        w.finish().map_err(&err)
+    })?;
+    commit(staged)
+}
+
+/// Writes an sRGB-tagged PNG of `width × height` made of `bands` horizontal bands stacked top to
+/// bottom, each made by `band(k)` (full width; their heights must add up to `height`), a chunk
+/// at a time in parallel, so a tall image (a long sweep's contact sheet) is never held whole.
+pub fn write_png_bands(
+    path: &Path,
+    (width, height): (u32, u32),
+    bands: usize,
+    band: impl Fn(usize) -> Result<Rgb8, ImageError> + Sync,
+) -> Result<(), ImageError> {
+    use rayon::prelude::*;
+    use std::io::Write;
+    let invalid = |what: String| ImageError::Invalid {
+        path: path.display().to_string(),
+        what,
+    };
+    let staged = stage(path, |out| {
+        let err = png_error(path);
+        let mut w = encoder(out, width, height, PngTag::Srgb)
+            .write_header()
+            .map_err(&err)?;
+        let mut rows = w.stream_writer().map_err(&err)?;
+        let mut written = 0u64;
+        for start in (0..bands).step_by(stream_chunk()) {
+            let chunk: Vec<Rgb8> = (start..(start + stream_chunk()).min(bands))
+                .into_par_iter()
+                .map(&band)
+                .collect::<Result<_, _>>()?;
+            for b in &chunk {
+                check_rgb8(path, b.width, b.height, &b.data)?;
+                written += b.height as u64;
+                if b.width != width || written > height as u64 {
+                    return Err(invalid(format!(
+                        "a band of {}x{} does not fit the {width}x{height} image",
+                        b.width, b.height
+                    )));
+                }
+                rows.write_all(&b.data).map_err(|source| ImageError::Io {
+                    path: path.display().to_string(),
+                    source,
+                })?;
+            }
+        }
+        if written != height as u64 {
+            return Err(invalid(format!(
+                "bands of {written} rows in all, the image {height}"
+            )));
+        }
+        rows.finish().map_err(&err)?;
+        w.finish().map_err(&err)
+    })?;
+    commit(staged)
+}
+
 /// The most bytes the PNG decoder may allocate besides the image itself (chunk buffers, text,
 /// ICC profiles): the png crate's default of 64 MiB, stated here so that it stays bounded.
 const PNG_DECODER_BYTES: usize = 64 << 20;

@@ -98,17 +98,36 @@ impl Resources {
         }
     }
 
-    /// `frames` frames of a `width × height` sweep: every frame's pixel sums and finished
-    /// radiance are held until written (the cache itself is per tile), plus the shared AOVs.
-    pub fn sweep(width: u32, height: u32, frames: usize, naive: bool) -> Self {
+    /// `frames` frames of a `width × height` sweep rendered `batch` frames at a time: a batch's
+    /// frames are held until written ([`Resources::sweep_frame_bytes`] each), plus the shared
+    /// AOVs and the frames being written; the disk holds every frame.
+    pub fn sweep(width: u32, height: u32, frames: usize, batch: usize, threads: usize) -> Self {
         let px = width as u64 * height as u64;
-        let per_frame = (size_of::<RadianceSum>() + size_of::<Vec3>() + size_of::<f32>()) as u64;
-        let held = if naive { 1 } else { frames as u64 };
+        let batch = batch.min(frames) as u64;
         Resources {
-            what: format!("{frames} frames of a {width}x{height} sweep"),
-            memory: px * (held * per_frame + size_of::<Aov>() as u64),
+            what: format!("{frames} frames of a {width}x{height} sweep ({batch} at a time)"),
+            memory: batch * Self::sweep_frame_bytes(width, height, threads)
+                + Self::sweep_fixed_bytes(width, height, threads),
             disk: frames as u64 * px * (4 * FRAME_EXR_CHANNELS + 3) + px * 4 * 14,
         }
+    }
+
+    /// Bytes one more frame of a sweep batch holds: its finished radiance and standard error
+    /// twice (the tiles' results and the assembled image coexist at the end of
+    /// `render_frames`), and its pixel sums in the tiles being rendered.
+    pub fn sweep_frame_bytes(width: u32, height: u32, threads: usize) -> u64 {
+        let px = width as u64 * height as u64;
+        let image = (size_of::<Vec3>() + size_of::<f32>()) as u64;
+        let tile = (super::TILE * super::TILE) as u64;
+        2 * px * image + worker_threads(threads) * tile * size_of::<RadianceSum>() as u64
+    }
+
+    /// Bytes a sweep holds whatever its batch: the shared AOVs (tiles and image) and, per
+    /// worker, a frame being written (RGBA and standard error copies, EXR and PNG encodings).
+    pub fn sweep_fixed_bytes(width: u32, height: u32, threads: usize) -> u64 {
+        let px = width as u64 * height as u64;
+        let writing = 2 * 4 * FRAME_EXR_CHANNELS + 3 + 4;
+        px * (2 * size_of::<Aov>() as u64 + worker_threads(threads) * writing)
     }
 
     /// Building the BVHs of `instances`: each distinct mesh (one `Arc`) is stored once however
@@ -155,6 +174,14 @@ impl Resources {
             }
         }
         Ok(())
+    }
+}
+
+/// The worker threads `--threads` gives (0: one per core).
+fn worker_threads(threads: usize) -> u64 {
+    match threads {
+        0 => std::thread::available_parallelism().map_or(1, |n| n.get()) as u64,
+        n => n as u64,
     }
 }
 
@@ -361,9 +388,12 @@ mod tests {
         // 16384² pixels at ≥ 100 bytes each is ≥ 26 GiB, far beyond any of 8 GiB.
         let r = Resources::render(16384, 16384);
         assert!(r.memory > 26 << 30, "{}", Bytes(r.memory));
-        // 100000 frames of 512×384 at ≥ 16 bytes of radiance each: ≥ 290 GiB.
-        let s = Resources::sweep(512, 384, 100_000, false);
+        // 100000 frames of 512×384 held at once (one batch) at ≥ 16 bytes of radiance each:
+        // ≥ 290 GiB of memory; in batches of 48, the memory of 48 frames, but the same disk.
+        let s = Resources::sweep(512, 384, 100_000, 100_000, 2);
         assert!(s.memory > 290 << 30 && s.disk > 290 << 30);
+        let b = Resources::sweep(512, 384, 100_000, 48, 2);
+        assert!(b.memory < 1 << 30 && b.disk == s.disk);
         assert!(check_threads(100_000).is_err());
         assert!(check_threads(0).is_ok() && check_threads(1).is_ok());
     }

@@ -7,11 +7,10 @@ use super::path::MAX_FRAMES;
 use super::viewer::viewer_html;
 use crate::math::{luminance, Vec3};
 use crate::output::{remove_if_present, write_atomic};
-use crate::picture::contact::{contact_sheet, Rgb8};
-use crate::picture::png::{read_png_rgb8, write_apng, write_png_linear, write_png_rgb8};
+use crate::picture::contact::{sheet_band, sheet_columns, shrunk_size, Rgb8};
+use crate::picture::png::{read_png_rgb8, write_apng_streamed, write_png_bands, write_png_linear};
 use crate::picture::ImageError;
 use crate::render::resources::read_text_bounded;
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -289,7 +288,8 @@ pub struct AssembleOptions {
     pub animation_width: u32,
     /// Frames per second of the animated PNG and the viewer's playback.
     pub fps: u16,
-    /// Title of the viewer page.
+    /// Title of the viewer page; empty: "<scene> — light sweep" from the frames' records, so a
+    /// sweep assembled by `--assemble` gets the same page as one assembled by its own run.
     pub title: String,
 }
 
@@ -299,7 +299,7 @@ impl Default for AssembleOptions {
             thumb_width: 240,
             animation_width: 480,
             fps: 12,
-            title: "xylem light sweep".into(),
+            title: String::new(),
         }
     }
 }
@@ -488,47 +488,69 @@ pub fn clear_assembled(dir: &Path) -> Result<(), SequenceError> {
     Ok(())
 }
 
+/// The widest contact sheet [`assemble`] writes: a long sweep's thumbnails shrink to fit it.
+pub const MAX_SHEET_WIDTH: u32 = 4096;
+
 /// Builds the contact sheet, the animated PNG, the CSV and the viewer from the frames in `dir`.
-/// The stale outputs of an earlier assembly go first and the viewer is written last.
+/// The stale outputs of an earlier assembly go first and the viewer is written last. The sheet
+/// and the animation are written a few frames at a time, so assembling 4800 frames needs no
+/// more memory than 48 (notes/cluster.md).
 pub fn assemble(dir: &Path, opts: &AssembleOptions) -> Result<Assembled, SequenceError> {
     let records = read_records(dir)?;
     clear_assembled(dir)?;
-    // Decoding and shrinking are per frame: in parallel, each frame giving its thumbnail and its
-    // animation frame.
-    let shrunk: Vec<(Rgb8, Rgb8)> = records
-        .par_iter()
-        .map(|r| {
-            let path = dir.join(format!("{}.png", frame_stem(r.index)));
-            let img = read_png_rgb8(&path)?;
-            if (img.width, img.height) != (r.width, r.height) {
-                return Err(SequenceError::Mismatch {
-                    path: path.display().to_string(),
-                    what: format!(
-                        "is {}x{} but its record says {}x{}",
-                        img.width, img.height, r.width, r.height
-                    ),
-                });
-            }
-            Ok((
-                img.shrink_to_width(opts.thumb_width),
-                img.shrink_to_width(opts.animation_width),
-            ))
-        })
-        .collect::<Result<_, _>>()?;
-    let (thumbs, anim): (Vec<Rgb8>, Vec<Rgb8>) = shrunk.into_iter().unzip();
+    let (w, h) = (records[0].width, records[0].height);
+    let gap = 4;
+    let cols = sheet_columns(records.len());
+    let fit = (MAX_SHEET_WIDTH.saturating_sub(gap * (cols as u32 + 1)) / cols as u32).max(1);
+    let thumb = shrunk_size(w, h, opts.thumb_width.min(fit));
+    let anim = shrunk_size(w, h, opts.animation_width);
+    let read = |r: &FrameRecord| -> Result<Rgb8, ImageError> {
+        let path = dir.join(format!("{}.png", frame_stem(r.index)));
+        let img = read_png_rgb8(&path)?;
+        if (img.width, img.height) != (r.width, r.height) {
+            return Err(ImageError::Invalid {
+                path: path.display().to_string(),
+                what: format!(
+                    "is {}x{} but its record says {}x{}",
+                    img.width, img.height, r.width, r.height
+                ),
+            });
+        }
+        Ok(img)
+    };
     let labels: Vec<String> = records
         .iter()
         .map(|r| format!("{:.1}°", r.light_deg))
         .collect();
+    let rows = records.len().div_ceil(cols);
+    let sheet_size = (
+        cols as u32 * thumb.0 + (cols as u32 + 1) * gap,
+        rows as u32 * thumb.1 + (rows as u32 + 1) * gap,
+    );
     let sheet_path = dir.join(CONTACT_SHEET);
     let anim_path = dir.join(ANIMATION);
-    // The two PNG encodings are independent.
+    // The two PNG encodings are independent; each reads the frames it needs as it goes.
     let (sheet, animation) = rayon::join(
         || {
-            let sheet = contact_sheet(&thumbs, &labels, 4);
-            write_png_rgb8(&sheet_path, sheet.width, sheet.height, &sheet.data)
+            write_png_bands(&sheet_path, sheet_size, rows, |r| {
+                let recs = &records[r * cols..((r + 1) * cols).min(records.len())];
+                let thumbs = (recs.iter())
+                    .map(|rec| Ok(read(rec)?.shrink_to_width(opts.thumb_width.min(fit))))
+                    .collect::<Result<Vec<_>, ImageError>>()?;
+                Ok(sheet_band(
+                    &thumbs,
+                    &labels[r * cols..],
+                    cols,
+                    gap,
+                    r + 1 == rows,
+                ))
+            })
         },
-        || write_apng(&anim_path, &anim, opts.fps),
+        || {
+            write_apng_streamed(&anim_path, anim, records.len(), opts.fps, |k| {
+                Ok(read(&records[k])?.shrink_to_width(opts.animation_width))
+            })
+        },
     );
     sheet?;
     animation?;
@@ -536,7 +558,12 @@ pub fn assemble(dir: &Path, opts: &AssembleOptions) -> Result<Assembled, Sequenc
     let csv_path = dir.join(CSV);
     write_text_atomic(&csv_path, &csv_table(&records))?;
     let html_path = dir.join(VIEWER);
-    write_text_atomic(&html_path, &viewer_html(&records, &opts.title, opts.fps))?;
+    let title = match (opts.title.is_empty(), records[0].sweep.scene.as_str()) {
+        (false, _) => opts.title.clone(),
+        (true, "") => "xylem light sweep".to_string(),
+        (true, scene) => format!("{scene} — light sweep"),
+    };
+    write_text_atomic(&html_path, &viewer_html(&records, &title, opts.fps))?;
     Ok(Assembled {
         frames: records.len(),
         files: vec![sheet_path, anim_path, csv_path, html_path],
