@@ -4,21 +4,13 @@
 //! Fixed seeds.
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
+#[path = "common/capture.rs"]
+mod common_capture;
+
+use common_capture::small_capture as capture;
 use std::path::Path;
-use std::process::Command;
 use xylem::fit::{fit, Capture, FitOptions};
 use xylem::math::Pcg32;
-
-/// A 3-frame-per-arc capture of the built-in fit scene at 1 spp.
-fn capture(dir: &Path) {
-    let o = Command::new(env!("CARGO_BIN_EXE_xylem"))
-        .args(["sweep", "fit_maple_sweep", "--frames", "3", "--spp", "1"])
-        .args(["--quiet", "--out", "cap"])
-        .current_dir(dir)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-}
 
 /// Opens and fits (4×4 texels) the capture in `dir`: Ok, or the error's message.
 fn open_and_fit(dir: &Path) -> Result<(), String> {

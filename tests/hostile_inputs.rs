@@ -4,7 +4,11 @@
 //! scene are refused instead of blocking or reading forever, count options have ranges, and a
 //! slice never rewrites the manifest of a capture of other settings.
 
-use std::path::{Path, PathBuf};
+#[path = "common/capture.rs"]
+mod common_capture;
+
+use common_capture::small_capture as capture;
+use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
@@ -115,24 +119,6 @@ fn exr_declaring(n: i32) -> Vec<u8> {
     out.extend_from_slice(&le(&[0, 0, 0, 0, 64]));
     out.extend_from_slice(&[0; 64]);
     out
-}
-
-/// A small valid capture (the built-in fit scene, 3 frames of 1 spp).
-fn capture(dir: &Path) -> PathBuf {
-    let args = [
-        "sweep",
-        "fit_maple_sweep",
-        "--frames",
-        "3",
-        "--spp",
-        "1",
-        "--quiet",
-        "--out",
-        "cap",
-    ];
-    let o = xylem(&args, dir);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    dir.join("cap")
 }
 
 /// Points frames[0] of the capture's manifest at `image`.

@@ -64,11 +64,20 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         "arcs_azimuth_deg": capture.arc_azimuths(),
         "eta": capture.board.eta,
         "texels_not_fitted": stats.texels_failed,
+        "samples": stats.samples.to_json(),
         "median_relative_residual": median,
         "read_seconds": stats.read_time.as_secs_f64(),
         "fit_seconds": stats.fit_time.as_secs_f64(),
     });
     write_maps(&args.out, &maps, &report)?;
+    if 2 * stats.texels_failed > maps.width * maps.height {
+        eprintln!(
+            "warning: {} of {} texels not fitted (black in the maps, residual 1): {}",
+            stats.texels_failed,
+            maps.width * maps.height,
+            stats.samples.describe(&capture)
+        );
+    }
     println!(
         "fitted {}x{} texels from {} frames in {:.2} s (+{:.2} s reading); median relative residual {:.4}; {} texels not fitted; maps in {}",
         maps.width,

@@ -284,6 +284,22 @@ impl Capture {
             unit("camera.up", c.up)?,
             unit("camera.forward", c.forward)?,
         );
+        // A camera whose axes are not orthogonal projects the board onto a line (a 1×23 map).
+        for (field, a, b, an) in [
+            ("camera.up", up, right, "camera.right"),
+            ("camera.forward", forward, right, "camera.right"),
+            ("camera.forward", forward, up, "camera.up"),
+        ] {
+            if a.dot(b).abs() > 1e-3 {
+                return Err(bad(
+                    field,
+                    format!(
+                        "{a} is {:.2}° from {an} {b} (allowed: perpendicular, within 0.06°)",
+                        a.dot(b).clamp(-1.0, 1.0).acos().to_degrees()
+                    ),
+                ));
+            }
+        }
         if !vec3(c.eye).is_finite() {
             return Err(bad("camera.eye", "must be finite".into()));
         }
@@ -369,6 +385,14 @@ impl Capture {
                 ))
             }
         };
+        if let Some(clip) = m.clip {
+            if !(clip.is_finite() && clip > 0.0) {
+                return Err(bad(
+                    "clip",
+                    format!("{clip} (allowed finite and > 0: a pixel at or above the clip level counts as clipped, so 0 or less would clip every pixel)"),
+                ));
+            }
+        }
         if m.frames.is_empty() {
             return Err(bad("frames", "empty (allowed one or more frames)".into()));
         }

@@ -25,6 +25,18 @@ pub enum MapsError {
     /// The output folder's lock could not be taken.
     #[error(transparent)]
     Lock(#[from] LockError),
+    /// A map holds a NaN or an infinity (no fit makes one; refused so none reaches a file).
+    #[error(
+        "{dir}: the {map} map holds a non-finite value at texel {index} (allowed: finite values)"
+    )]
+    NotFinite {
+        /// The output folder.
+        dir: String,
+        /// The map.
+        map: &'static str,
+        /// The texel's index (row-major).
+        index: usize,
+    },
     /// A file of the output could not be written.
     #[error("{path}: {cause}")]
     Io {
@@ -79,6 +91,35 @@ impl FittedMaps {
             beta: f.iter().map(|t| t.beta).collect(),
             residual: f.iter().map(|t| t.residual).collect(),
             used: f.iter().map(|t| t.used).collect(),
+        }
+    }
+
+    /// Refuses maps holding a NaN or an infinity (the error names the map and texel).
+    pub fn check_finite(&self, dir: &Path) -> Result<(), MapsError> {
+        let vectors = [
+            ("diffuse", &self.diffuse),
+            ("fiber_color", &self.fiber_color),
+            ("fiber_axis", &self.fiber_axis),
+        ];
+        let scalars = [
+            ("highlight_width", &self.beta),
+            ("residual", &self.residual),
+        ];
+        let bad = vectors
+            .iter()
+            .find_map(|(m, v)| v.iter().position(|c| !c.is_finite()).map(|i| (*m, i)))
+            .or_else(|| {
+                scalars
+                    .iter()
+                    .find_map(|(m, v)| v.iter().position(|c| !c.is_finite()).map(|i| (*m, i)))
+            });
+        match bad {
+            Some((map, index)) => Err(MapsError::NotFinite {
+                dir: dir.display().to_string(),
+                map,
+                index,
+            }),
+            None => Ok(()),
         }
     }
 
@@ -154,6 +195,7 @@ pub fn write_maps(
         path: dir.display().to_string(),
         cause,
     })?;
+    maps.check_finite(dir)?;
     let _lock = FolderLock::try_new(dir, LockMode::Exclusive)?;
     let (w, h) = (maps.width as u32, maps.height as u32);
     let mut staged = stage_board_pngs(dir, &maps.board())?;
