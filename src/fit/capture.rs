@@ -91,6 +91,19 @@ impl FilmCamera {
         Some((0.5 * (x * h + w), 0.5 * (h - y * h)))
     }
 
+    /// The ray (origin, unit direction) through film point (x, y) in pixels: the inverse of
+    /// [`FilmCamera::project`].
+    pub fn ray(&self, x: f32, y: f32) -> (Vec3, Vec3) {
+        let (w, h) = (self.width as f32, self.height as f32);
+        let (nx, ny) = ((2.0 * x - w) / h, (h - 2.0 * y) / h);
+        let side = self.right * nx * self.scale + self.up * ny * self.scale;
+        if self.orthographic {
+            (self.eye + side, self.forward)
+        } else {
+            (self.eye, (self.forward + side).normalize())
+        }
+    }
+
     /// The unit direction from `p` towards the camera.
     pub fn view_dir(&self, p: Vec3) -> Vec3 {
         if self.orthographic {
@@ -125,6 +138,16 @@ impl BoardPlane {
         let u = ((col as f32 + 0.5) / w as f32 - 0.5) * self.size[0];
         let v = (0.5 - (row as f32 + 0.5) / h as f32) * self.size[1];
         self.origin + u * self.x + v * self.y
+    }
+
+    /// Where the ray (`origin`, `dir`) meets the board's face, if it does, from its front.
+    pub fn hit(&self, origin: Vec3, dir: Vec3) -> Option<Vec3> {
+        let den = dir.dot(self.z);
+        let t = (self.origin - origin).dot(self.z) / den;
+        let p = origin + t * dir;
+        let l = self.local(p - self.origin);
+        let inside = l.x.abs() <= 0.5 * self.size[0] && l.y.abs() <= 0.5 * self.size[1];
+        (den < 0.0 && t > 0.0 && inside).then_some(p)
     }
 
     /// World direction `d` in the board frame.
