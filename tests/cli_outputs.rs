@@ -203,7 +203,7 @@ fn installed_binary_runs_built_in_scenes_and_validate_from_any_folder() {
     // 5 s has loaded them (the full run takes minutes; it is stopped there). The cases' contents
     // are checked by the unit test of `validate::bsdf::load_suite` on the embedded file.
     let mut child = Command::new(env!("CARGO_BIN_EXE_xylem"))
-        .args(["validate", "bsdf", "--reduce", "100", "--no-report"])
+        .args(["validate", "bsdf", "--reduce", "20", "--no-report"])
         .current_dir(tmp.path())
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::piped())

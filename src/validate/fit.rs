@@ -573,7 +573,8 @@ fn side_by_side(truth: &MeasuredBoard, fitted: &FittedMaps) -> crate::picture::c
 
 /// Runs the round trips of every board (EXR and camera PNG), the curves over frames, arcs and
 /// noise, and returns validation/FIT.md's Markdown and whether every goal was met. Plots go to
-/// `dir/plots/`, the captures to `work`.
+/// `dir/plots/` with the README's figure ([`README_FIGURE`]), the captures to `work`; nothing
+/// is written anywhere else.
 pub fn run_report(
     base: &Path,
     dir: &Path,
@@ -660,7 +661,7 @@ pub fn run_report(
         noise_curve.push((name, nc));
     }
     progress("re-render");
-    readme_figure(base, work, spec)?;
+    readme_figure(base, work, spec, &plots.join(README_FIGURE))?;
     let mut md = format!(
         "# Fit validation: per-texel fibre-BSDF parameters measured back from light sweeps\n\n\
          Written by `cargo run --release -- validate fit` (src/validate/fit.rs; derivations in \
@@ -756,13 +757,24 @@ pub fn run_report(
             name.replace(' ', "_")
         );
     }
+    md += &format!(
+        "## The README's figure\n\nThe measured maple crop rendered (light 20° from the zenith along the grain), its fitted maps (diffuse, fibre colour, axis) and the fit re-rendered under the same light.\n\n![measured maple, fitted maps, re-rendered fit](plots/{README_FIGURE})\n"
+    );
     Ok((md, all_ok))
 }
 
-/// notes/images/fit_maple.png: the measured maple crop rendered (light 20° from the zenith along
-/// the grain), its fitted maps (diffuse, fibre colour ×3, fibre axis), and the fitted maps
-/// re-rendered through the `measured` material under the same light.
-pub fn readme_figure(base: &Path, work: &Path, spec: &SweepSpec) -> Result<(), String> {
+/// The README's figure of the fit, written beside the report's plots (`plots/fit_maple.png`).
+pub const README_FIGURE: &str = "fit_maple.png";
+
+/// The README's figure, written to `path`: the measured maple crop rendered (light 20° from the
+/// zenith along the grain), its fitted maps (diffuse, fibre colour ×3, fibre axis), and the
+/// fitted maps re-rendered through the `measured` material under the same light.
+pub fn readme_figure(
+    base: &Path,
+    work: &Path,
+    spec: &SweepSpec,
+    path: &Path,
+) -> Result<(), String> {
     use crate::picture::contact::{contact_sheet_rows, Rgb8};
     let w = work.join("readme");
     let source = Source::Measured {
@@ -832,7 +844,6 @@ pub fn readme_figure(base: &Path, work: &Path, spec: &SweepSpec) -> Result<(), S
     .map(|s| s.to_string())
     .collect();
     let sheet = contact_sheet_rows(&thumbs, &labels, 5, 4);
-    let path = base.join("notes/images/fit_maple.png");
-    crate::picture::png::write_png_rgb8(&path, sheet.width, sheet.height, &sheet.data)
+    crate::picture::png::write_png_rgb8(path, sheet.width, sheet.height, &sheet.data)
         .map_err(|e| format!("{}: {e}", path.display()))
 }
