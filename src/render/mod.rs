@@ -174,9 +174,11 @@ pub const TILE: u32 = 16;
 /// let out = xylem::render::render(&loaded.scene, &loaded.settings, &Default::default())?;
 /// assert_eq!(out.image.beauty.len(), 32 * 24);
 /// // Beauty with alpha, the AOV layers and the settings in the header:
-/// let dir = tempfile::tempdir()?;
+/// let dir = std::env::temp_dir().join(format!("xylem-doc-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
 /// let meta = loaded.settings.exr_meta(&loaded.name, "scenes/sweep_board.toml", &loaded.scene.camera);
-/// xylem::render::image_io::write_image_exr(&dir.path().join("board.exr"), &out.image, &meta)?;
+/// xylem::render::image_io::write_image_exr(&dir.join("board.exr"), &out.image, &meta)?;
+/// # std::fs::remove_dir_all(&dir)?;
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn render(
