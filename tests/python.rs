@@ -347,3 +347,55 @@ fn readme_python_snippets_run() {
         );
     }
 }
+
+/// Ctrl-C stops a Python render or sweep within moments and raises KeyboardInterrupt, after
+/// which numpy works (issue 26: the render ran on, and the first numpy call after it raised
+/// PanicException). The SIGINT is real, sent by a timer thread 1 s into a render of minutes.
+#[test]
+fn ctrl_c_stops_a_python_render() {
+    let venv = venv();
+    let site = stage_package(&root().join("target/python-test-ctrl-c"));
+    let work = tempfile::tempdir().unwrap();
+    let script = r#"
+import os, signal, threading, time
+import numpy as np, xylem
+for name, call in [("render", lambda: xylem.render("sweep_board", spp=1024, res=(512, 512))),
+                   ("sweep", lambda: xylem.sweep("sweep_board", frames=48, spp=256))]:
+    threading.Timer(1.0, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+    start = time.time()
+    try:
+        call()
+        raise SystemExit(f"{name}: not interrupted")
+    except KeyboardInterrupt:
+        took = time.time() - start
+    assert took < 8, (name, took)
+    assert np.arange(4).sum() == 6
+    print(name, "stopped after", round(took, 2), "s")
+"#;
+    let mut child = Command::new(venv.join("bin/python"))
+        .arg("-c")
+        .arg(script)
+        .env("PYTHONPATH", &site)
+        .current_dir(work.path())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed().as_secs() > 60 {
+            child.kill().unwrap();
+            panic!("Ctrl-C did not stop the render within 60 s");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let out = child.wait_with_output().unwrap();
+    let said = String::from_utf8_lossy(&out.stdout);
+    eprintln!("{said}");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(said.contains("render stopped") && said.contains("sweep stopped"));
+}
