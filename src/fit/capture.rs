@@ -263,7 +263,7 @@ impl Capture {
             })?;
         let m: Manifest = serde_json::from_str(&text).map_err(|e| CaptureError::Parse {
             path: path.clone(),
-            cause: e.to_string(),
+            cause: crate::jsonpath::describe(&text, &e),
         })?;
         Capture::from_manifest(dir, &m)
     }
