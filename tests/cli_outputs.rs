@@ -226,3 +226,33 @@ fn installed_binary_runs_built_in_scenes_and_validate_from_any_folder() {
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("nope.toml"));
 }
+
+/// A scene whose name is not ASCII gives an EXR whose header text is ASCII (`\u{f1}` escapes):
+/// OpenEXR names no encoding, and its Python bindings refused the Latin-1 bytes written before.
+#[test]
+fn a_non_ascii_scene_name_gives_an_ascii_exr_header() {
+    let tmp = tempfile::tempdir().unwrap();
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene = std::fs::read_to_string(repo.join("scenes/cornell_box.toml")).unwrap();
+    std::fs::write(tmp.path().join("ñandú_木.toml"), scene).unwrap();
+    let o = xylem(
+        &[
+            "render",
+            "ñandú_木.toml",
+            "--res",
+            "8x8",
+            "--spp",
+            "1",
+            "--quiet",
+            "--out",
+            "o",
+        ],
+        tmp.path(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let h = header(&tmp.path().join("o/ñandú_木.exr"));
+    for (k, v) in &h {
+        assert!(v.is_ascii() && k.is_ascii(), "{k} = {v:?}");
+    }
+    assert_eq!(text(&h, "scene"), "\\u{f1}and\\u{fa}_\\u{6728}");
+}
