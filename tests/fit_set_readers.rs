@@ -6,18 +6,8 @@
 #[path = "common/capture.rs"]
 mod common_capture;
 
-use common_capture::small_capture;
+use common_capture::{small_capture, xylem};
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn xylem(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_xylem"))
-        .args(args)
-        .current_dir(dir)
-        .env("RUST_BACKTRACE", "0")
-        .output()
-        .unwrap()
-}
 
 #[test]
 fn maps_of_an_incomplete_or_mixed_fit_are_refused() {

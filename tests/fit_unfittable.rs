@@ -6,19 +6,9 @@
 #[path = "common/capture.rs"]
 mod common_capture;
 
-use common_capture::small_capture as capture;
+use common_capture::{small_capture as capture, xylem};
 use std::path::Path;
-use std::process::{Command, Output};
 use xylem::render::image_io::{write_exr_layers, ExrLayer};
-
-fn xylem(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_xylem"))
-        .args(args)
-        .current_dir(dir)
-        .env("RUST_BACKTRACE", "0")
-        .output()
-        .unwrap()
-}
 
 fn edit(cap: &Path, f: impl Fn(&mut serde_json::Value)) {
     let m = cap.join("manifest.json");

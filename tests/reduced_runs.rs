@@ -5,17 +5,11 @@
 //! names no output is refused instead of overwriting the committed full results; `--reduce`
 //! refuses values at which the chi-square check is no longer valid.
 
-use std::path::Path;
-use std::process::{Command, Output};
+#[path = "common/capture.rs"]
+mod common_capture;
 
-fn xylem(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_xylem"))
-        .args(args)
-        .current_dir(dir)
-        .env("RUST_BACKTRACE", "0")
-        .output()
-        .unwrap()
-}
+use common_capture::xylem;
+use std::path::Path;
 
 /// Every file under `dir`, relative, sorted.
 fn files(dir: &Path) -> Vec<String> {
