@@ -602,7 +602,7 @@ fn checks(preset: &str) -> Vec<Check> {
             fact: "ray fleck on the quartersawn face: ≥ 10 % of the face, flecks ≥ 10 mm tall",
             measure: fleck_figures,
             holds: |f| f[0] >= 0.10 && f[1] >= 10.0,
-            control: Control::Edit("short_rays", &[("height = 25.0", "height = 6.0")]),
+            control: Control::Edit("short_rays", &[("height = 30.0", "height = 6.0")]),
         },
         // African mahogany.
         Check {

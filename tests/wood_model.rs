@@ -500,6 +500,40 @@ fn fibre_wander_angles_have_the_derived_std_and_correlation_lengths() {
     }
 }
 
+/// A wander scale whose tangential tilt has its own length along the grain (`tangential_along`,
+/// fibres bent round rays): each angle decorrelates to 1/e at its own length (±0.05); the
+/// control is the tangential angle at the radial one's 5 mm, which must have lost far more.
+#[test]
+fn tangential_wander_has_its_own_length_along_the_grain() {
+    let text = plain_with_wander(
+        "radial = 0.0\ntangential = 0.0\nalong = 5.0\nacross = 1.0\n\
+         [fibre_wander.fine]\nradial = 3.0\ntangential = 2.0\nalong = 5.0\nacross = 1.0\n\
+         tangential_along = 1.5",
+    );
+    let v = WoodVolume::new(wood::WoodParams::from_toml_str(&text, "t").unwrap(), 7).unwrap();
+    let mut rng = xylem::math::Pcg32::new(4, 0);
+    let (mut r0, mut t0, mut r5, mut t15, mut t5) = (vec![], vec![], vec![], vec![], vec![]);
+    for _ in 0..20_000 {
+        let r = 100.0 + 40.0 * rng.next_f32();
+        let a = std::f32::consts::TAU * rng.next_f32();
+        let p = Vec3::new(r * a.cos(), r * a.sin(), 3000.0 * rng.next_f32());
+        let (ar, at) = tilts(&v, p);
+        r0.push(ar);
+        t0.push(at);
+        r5.push(tilts(&v, p + Vec3::Z * 5.0).0);
+        t15.push(tilts(&v, p + Vec3::Z * 1.5).1);
+        t5.push(tilts(&v, p + Vec3::Z * 5.0).1);
+    }
+    let e = (-1.0f64).exp();
+    let (cr, ct, control) = (corr(&r0, &r5), corr(&t0, &t15), corr(&t0, &t5));
+    println!(
+        "radial at 5 mm {cr:.3}, tangential at 1.5 mm {ct:.3} (1/e = {e:.3}); control {control:.3}"
+    );
+    assert!((cr - e).abs() < 0.05, "radial: {cr}");
+    assert!((ct - e).abs() < 0.05, "tangential: {ct}");
+    assert!(control < 0.1, "tangential at 5 mm: {control}");
+}
+
 /// On a sampled board (390² texels over 97.5 mm, flat-sawn 120 mm from the pith, seed 7) the
 /// measured dip is the radial tilt and the in-plane angle the tangential one: their standard
 /// deviations are the parameters within 10 % (the dip's is ≈ 1 % lower in theory, since the face
@@ -684,4 +718,79 @@ fn bad_texture_parameters_name_file_field_and_range() {
             .to_string();
         assert!(err.contains("bad.toml") && err.contains(range), "{err}");
     }
+}
+
+/// Wavy ray sheets (`[rays] wander`, notes/wood.md §9d): on a radial face 100–160 mm from the
+/// pith and 300 mm along the trunk (0.2 mm texels), white-oak-like rays (0.4 mm wide) as flat
+/// sheets show one smooth fleck per ray; wavy sheets (0.12 mm over 12 mm) break them into ragged
+/// pieces: at least 1.5× the flecks (4-connected, ≥ 20 texels; seed 3: 7 flat, 12 wavy).
+/// `wander = 0` is bit-for-bit the paper's flat sheets (the control).
+#[test]
+fn wavy_rays_give_ragged_flecks() {
+    let text = |wander: &str| {
+        format!(
+            "[rings]\nwidth = 2.0\nproportions = [0.5, 0.3, 0.15, 0.05]\n\
+             [color]\nearlywood = [0.5, 0.37, 0.2]\nlatewood = [0.4, 0.28, 0.14]\n\
+             [rays]\nwidth = 0.4\nheight = 30.0\nlength = 40.0\ndensity = 0.3\n\
+             sharpness = 0.15\n{wander}\n"
+        )
+    };
+    let vol = |w: &str| {
+        WoodVolume::new(wood::WoodParams::from_toml_str(&text(w), "t").unwrap(), 3).unwrap()
+    };
+    let (na, nb) = (300, 1500);
+    let on = |v: &WoodVolume| -> Vec<bool> {
+        (0..na * nb)
+            .map(|i| {
+                let p = Vec3::new(100.0 + 0.2 * (i % na) as f32, 0.0, 0.2 * (i / na) as f32);
+                v.eval(p, Needs::COLOR_FIBERS).ray_mask > 0.5
+            })
+            .collect()
+    };
+    // 4-connected components of fleck texels, at least 20 texels.
+    let pieces = |m: &[bool]| {
+        let mut seen = vec![false; m.len()];
+        let mut count = 0;
+        for start in 0..m.len() {
+            if seen[start] || !m[start] {
+                continue;
+            }
+            let (mut stack, mut size) = (vec![start], 0);
+            seen[start] = true;
+            while let Some(i) = stack.pop() {
+                size += 1;
+                let (a, b) = (i % na, i / na);
+                let next = [
+                    (a > 0).then(|| i - 1),
+                    (a + 1 < na).then(|| i + 1),
+                    (b > 0).then(|| i - na),
+                    (b + 1 < nb).then(|| i + na),
+                ];
+                for j in next.into_iter().flatten() {
+                    if !seen[j] && m[j] {
+                        seen[j] = true;
+                        stack.push(j);
+                    }
+                }
+            }
+            count += usize::from(size >= 20);
+        }
+        count
+    };
+    let (flat, wavy) = (
+        on(&vol("")),
+        on(&vol("wander = 0.12\nwander_length = 12.0")),
+    );
+    assert_eq!(
+        flat,
+        on(&vol("wander = 0.0")),
+        "wander = 0 must be the flat sheets"
+    );
+    let (ff, fw) = (pieces(&flat), pieces(&wavy));
+    println!("flecks: flat {ff}, wavy {fw}");
+    assert!(ff >= 5, "too few flat flecks to judge: {ff}");
+    assert!(
+        fw as f64 >= 1.5 * ff as f64,
+        "wavy {fw} flecks against flat {ff}"
+    );
 }

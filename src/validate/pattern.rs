@@ -261,8 +261,10 @@ fn spectrum_slope(lines: &[Vec<f64>], pitch: f64, band: (f64, f64)) -> Option<f6
 /// outer product of the luminance gradient (central differences) smoothed by a Gaussian of
 /// [`TENSOR_SIGMA_MM`]. Returns (mean coherence (λ1−λ2)/(λ1+λ2) over the texels with any
 /// gradient, |angle| in degrees between the grain and the mean orientation of the structure,
-/// i.e. the direction across the dominant gradient of the region's summed tensor).
-fn structure_tensor(g: &Grid, pitch: f64) -> (Option<f64>, Option<f64>) {
+/// i.e. the direction across the dominant gradient of the region's summed tensor). The grain is
+/// the direction `grain_deg` from the grid's along axis (towards +c): the fibres', not the
+/// image's, since a photographed board is rarely square to its fibres.
+fn structure_tensor(g: &Grid, pitch: f64, grain_deg: f64) -> (Option<f64>, Option<f64>) {
     if g.na < 3 || g.nc < 3 {
         return (None, None);
     }
@@ -297,13 +299,13 @@ fn structure_tensor(g: &Grid, pitch: f64) -> (Option<f64>, Option<f64>) {
         gc.iter().map(|x| x * x).sum::<f64>(),
         ga.iter().zip(&gc).map(|(x, y)| x * y).sum::<f64>(),
     );
-    let angle = (saa + scc > 0.0).then(|| {
-        // The dominant gradient's angle from the grain; the structure runs at right angles to it.
-        let gradient = 0.5 * (2.0 * sac).atan2(saa - scc).to_degrees();
-        let s = gradient + 90.0;
-        let s = if s > 90.0 { s - 180.0 } else { s };
-        s.abs()
-    });
+    let angle = (saa + scc > 0.0)
+        .then(|| {
+            // The dominant gradient's angle from the grain; the structure runs at right angles to it.
+            let gradient = 0.5 * (2.0 * sac).atan2(saa - scc).to_degrees();
+            (gradient + 90.0 - grain_deg + 90.0).rem_euclid(180.0) - 90.0
+        })
+        .map(f64::abs);
     (coherence, angle)
 }
 
@@ -486,7 +488,14 @@ fn region_statistics(
     let inplane = Grid::new(maps, region, |i| maps.in_plane_deg(i));
     let length = |g: &Grid, along: bool| correlation_length(&g.lines(along)).map(|k| k * pitch);
     let slope = |along: bool| spectrum_slope(&lum.lines(along), pitch, SPECTRUM_BAND);
-    let (coherence, orientation) = structure_tensor(&lum, pitch);
+    // The region's grain: its median fibre direction in the face, in the grid's frame (rows run
+    // down, the stored in-plane angle counts towards image up, so the sign flips).
+    let grain_deg = if inplane.v.is_empty() {
+        0.0
+    } else {
+        -quantile(&inplane.v, 0.5)
+    };
+    let (coherence, orientation) = structure_tensor(&lum, pitch, grain_deg);
     let (elongation, fraction) = dark_features(&lum, pitch);
     let (ring_cv, transition) = rings(&lum, pitch);
     let values = [
@@ -723,6 +732,24 @@ mod tests {
         let coherence = stat(&white, PATTERN_STATISTICS[4]).unwrap();
         println!("white-noise coherence {coherence:.4}");
         assert!((0.07..0.16).contains(&coherence), "{coherence}");
+    }
+
+    /// A photographed board turned against its fibres: the oblique stripes of
+    /// [`stripes_are_coherent_and_white_noise_is_not`] with fibres running along them (in-plane
+    /// −30°: stored y points up, the rows run down) are at 0° to the grain; the negative control,
+    /// fibres along the image axis, reads 30°.
+    #[test]
+    fn orientation_is_measured_from_the_fibres_not_the_image_axes() {
+        let (s, c) = (30f64.to_radians().sin(), 30f64.to_radians().cos());
+        let mut turned = board(
+            (128, 128),
+            |a, k| 0.5 + 0.2 * (std::f64::consts::TAU * (k as f64 * c - a as f64 * s) / 10.0).sin(),
+            |_, _| 0.0,
+        );
+        close(stat(&turned, PATTERN_STATISTICS[5]), 30.0, 1.0);
+        let fibre = Vec3::new(c as f32, -s as f32, 0.0);
+        turned.board.fiber_axis.iter_mut().for_each(|u| *u = fibre);
+        close(stat(&turned, PATTERN_STATISTICS[5]), 0.0, 1.0);
     }
 
     /// Dark ellipses of semi-axes 12 texels along and 3 across on a pale ground: elongation 4, and

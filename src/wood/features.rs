@@ -255,10 +255,13 @@ pub struct Rays {
     pub width: f32,
     /// Mean of [`Rays::mask`]: strength · min(1, density · bump_kernel_mean(s)).
     pub mean_mask: f32,
+    /// Sideways displacement of the ray sheets (mm along θ̂), if they wander.
+    wander: Option<SeededSparse>,
 }
 
 impl Rays {
-    pub fn new(p: &RayParams, seed: u32) -> Self {
+    /// `seeds`: the rays', then their waviness's.
+    pub fn new(p: &RayParams, seeds: [u32; 2]) -> Self {
         let env = Vec3::new(0.5 * p.length, 0.5 * p.width, 0.5 * p.height);
         Rays {
             // Arc cells wider than the ray: the search window along θ is set by the longest
@@ -271,17 +274,27 @@ impl Rays {
                     Vec3::new(env.x, RAY_ARC_CELLS * env.y, env.z),
                     Cells::Cylindrical,
                 ),
-                seed,
+                seeds[0],
             ),
             strength: p.strength,
             width: p.width,
             mean_mask: p.strength * (p.density * bump_kernel_mean(p.sharpness)).min(1.0),
+            wander: (p.wander > 0.0)
+                .then(|| grain_noise(p.wander, (p.wander_length, p.wander_length), 2.0, seeds[1])),
         }
     }
 
-    /// Ray mask in [0, strength] at `q`.
+    /// Ray mask in [0, strength] at `q`: the sheets looked up at q moved sideways (along θ̂) by
+    /// their waviness, so a flat face meets a wavy sheet where it is within half a width.
     #[inline]
     pub fn mask(&self, q: Vec3) -> f32 {
+        let q = match &self.wander {
+            Some(w) => {
+                let frame = crate::field::cylinder_frame(q);
+                q + w.eval_oriented_with::<false>(q, &frame, 1, 1.0).0 * frame.t
+            }
+            None => q,
+        };
         self.noise.eval(q).min(1.0) * self.strength
     }
 }
@@ -322,12 +335,19 @@ impl FibreWander {
         }
     }
 
-    /// The two angles' noises of one scale.
+    /// The two angles' noises of one scale (the tangential one along its own length if given).
     fn scale(p: &WanderScale, seeds: [u32; 2]) -> [Option<SeededSparse>; 2] {
-        let noise = |deg: f32, seed: u32| {
-            (deg > 0.0).then(|| grain_noise(deg.to_radians(), (p.along, p.across), p.density, seed))
+        let noise = |deg: f32, along: f32, seed: u32| {
+            (deg > 0.0).then(|| grain_noise(deg.to_radians(), (along, p.across), p.density, seed))
         };
-        [noise(p.radial, seeds[0]), noise(p.tangential, seeds[1])]
+        [
+            noise(p.radial, p.along, seeds[0]),
+            noise(
+                p.tangential,
+                p.tangential_along.unwrap_or(p.along),
+                seeds[1],
+            ),
+        ]
     }
 
     /// The two tilt angles (radians) at `q`: towards r̂ and towards θ̂, kernels along `cyl`

@@ -230,6 +230,19 @@ pub struct RayParams {
     /// Largest ray mask (blend weight of the ray-fibre BSDF), in [0, 1].
     #[serde(default = "one")]
     pub strength: f32,
+    /// Standard deviation of the rays' sideways (θ) waviness, mm (0: flat radial sheets). Rays
+    /// follow the wandering fibres round them, so a sheet a few tenths of a millimetre thick
+    /// weaves in and out of a quartersawn face: the fleck is the ragged patch where it lies in
+    /// the face, not the whole kernel's ellipse (notes/wood.md §9d).
+    #[serde(default)]
+    pub wander: f32,
+    /// Correlation length (1/e) of that waviness, mm.
+    #[serde(default = "ray_wander_length")]
+    pub wander_length: f32,
+}
+
+fn ray_wander_length() -> f32 {
+    4.0
 }
 
 /// Beer's-law colour (§6.1.8, eq. 25): the earlywood (g = 0) and latewood (g = 1) colours fix σℓ₀
@@ -326,6 +339,13 @@ pub struct WanderScale {
     /// Mean number of kernels overlapping a point.
     #[serde(default = "two")]
     pub density: f32,
+    /// Correlation length along the grain of the tangential tilt alone, mm (default: `along`):
+    /// at the cell scale the two tilts have different causes — fibres bend tangentially round
+    /// the rays, whose height sets the length, and radially round vessels and growth
+    /// irregularities (Hoadley, "Understanding Wood", ch. 2: fibres part round the ray spindles
+    /// seen on a tangential face).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tangential_along: Option<f32>,
 }
 
 impl FibreWanderParams {
@@ -337,6 +357,7 @@ impl FibreWanderParams {
             along: self.along,
             across: self.across,
             density: self.density,
+            tangential_along: None,
         }
     }
 }
@@ -451,6 +472,9 @@ impl Checker<'_> {
         self.range(&format!("{name}.tangential"), w.tangential, 0.0, 20.0)?;
         self.range(&format!("{name}.along"), w.along, 0.05, 1000.0)?;
         self.range(&format!("{name}.across"), w.across, 0.02, 1000.0)?;
+        if let Some(l) = w.tangential_along {
+            self.range(&format!("{name}.tangential_along"), l, 0.05, 1000.0)?;
+        }
         self.range(&format!("{name}.density"), w.density, 0.25, 16.0)
     }
     fn texture(&self, name: &str, t: &TextureParams) -> Result<(), WoodError> {
@@ -565,6 +589,8 @@ impl WoodParams {
             c.positive("rays.density", r.density, 16.0)?;
             c.range("rays.sharpness", r.sharpness, 0.0, 100.0)?;
             c.range("rays.strength", r.strength, 0.0, 1.0)?;
+            c.range("rays.wander", r.wander, 0.0, 10.0)?;
+            c.range("rays.wander_length", r.wander_length, 0.05, 1000.0)?;
         }
         for (name, col) in [
             ("color.earlywood", self.color.earlywood),

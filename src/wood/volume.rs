@@ -80,6 +80,7 @@ mod salt {
     pub const TEXTURE: [u32; 2] = [13, 14];
     pub const KNOTS: u64 = 0x6b6e_6f74;
     pub const EYES: u64 = 0x6579_6573;
+    pub const RAY_WANDER: u32 = 15;
 }
 
 /// What `eval` computes at the distorted point before deciding what else it needs.
@@ -164,7 +165,7 @@ impl WoodVolume {
             .rays
             .as_ref()
             .filter(|r| r.strength > 0.0)
-            .map(|r| Rays::new(r, sub_seed(seed, salt::RAYS)));
+            .map(|r| Rays::new(r, [salt::RAYS, salt::RAY_WANDER].map(|s| sub_seed(seed, s))));
         let knots = p
             .knots
             .as_ref()
