@@ -359,6 +359,9 @@ fn ctrl_c_stops_a_python_render() {
     let script = r#"
 import os, signal, threading, time
 import numpy as np, xylem
+# As an interactive Python has it: a shell starts background jobs with SIGINT ignored, and
+# Python then leaves it ignored.
+signal.signal(signal.SIGINT, signal.default_int_handler)
 for name, call in [("render", lambda: xylem.render("sweep_board", spp=1024, res=(512, 512))),
                    ("sweep", lambda: xylem.sweep("sweep_board", frames=48, spp=256))]:
     threading.Timer(1.0, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
