@@ -3,8 +3,8 @@
 //!
 //! `cargo run --release --example eval_bsdf`
 
-use glam::Vec3;
 use xylem::bsdf::{Bsdf, WoodBsdf, WoodBsdfParams};
+use xylem::math::Vec3;
 
 fn main() -> Result<(), xylem::bsdf::BsdfError> {
     // Fibres along x lying in the surface, β = 8°, a smooth finish of index 1.5.

@@ -14,6 +14,7 @@ pub mod builtin;
 pub mod cli;
 pub mod field;
 pub mod fit;
+pub mod jsonpath;
 pub mod material;
 pub mod math;
 pub mod noise;

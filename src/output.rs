@@ -346,6 +346,30 @@ pub fn verify_set(dir: &Path, record: &str) -> Result<(), String> {
     Ok(())
 }
 
+/// Checks the file `name` in `dir` against the set record `record` there: `Ok(true)` where the
+/// record lists it with its size and CRC-32, `Ok(false)` where the record does not list it,
+/// and an error naming both where the record is unreadable or lists another file (another
+/// run's, or one changed since).
+pub fn check_member(dir: &Path, record: &str, name: &str) -> Result<bool, String> {
+    let path = dir.join(record);
+    let files = record_files(&path)?;
+    let Some(entry) = files
+        .iter()
+        .find(|f| f.get("name").and_then(|n| n.as_str()) == Some(name))
+    else {
+        return Ok(false);
+    };
+    let (_, same) = member_status(dir, entry)?;
+    if same {
+        Ok(true)
+    } else {
+        Err(format!(
+            "not the file {} lists (another run's, or changed since)",
+            path.display()
+        ))
+    }
+}
+
 /// Removes `path` if it exists (a stale output that must not outlive the run replacing it).
 pub fn remove_if_present(path: &Path) -> io::Result<()> {
     match std::fs::remove_file(path) {

@@ -16,6 +16,11 @@ pub trait Progress: Sync {
     fn update(&self, done: u64, total: u64, message: &str);
     /// The run ended: called once, after the last [`Progress::update`].
     fn finish(&self) {}
+    /// True when the caller wants the run to stop (Ctrl-C in Python): a render checks it
+    /// before each tile and ends with `RenderError::Stopped`.
+    fn stop(&self) -> bool {
+        false
+    }
 }
 
 /// Reports nothing: the default of [`crate::render::RunOptions`] and [`crate::fit::FitOptions`].

@@ -4,21 +4,13 @@
 //! Fixed seeds.
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
+#[path = "common/capture.rs"]
+mod common_capture;
+
+use common_capture::small_capture as capture;
 use std::path::Path;
-use std::process::Command;
 use xylem::fit::{fit, Capture, FitOptions};
 use xylem::math::Pcg32;
-
-/// A 3-frame-per-arc capture of the built-in fit scene at 1 spp.
-fn capture(dir: &Path) {
-    let o = Command::new(env!("CARGO_BIN_EXE_xylem"))
-        .args(["sweep", "fit_maple_sweep", "--frames", "3", "--spp", "1"])
-        .args(["--quiet", "--out", "cap"])
-        .current_dir(dir)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-}
 
 /// Opens and fits (4×4 texels) the capture in `dir`: Ok, or the error's message.
 fn open_and_fit(dir: &Path) -> Result<(), String> {
@@ -73,6 +65,23 @@ fn leaves(v: &serde_json::Value, at: String, out: &mut Vec<String>) {
     }
 }
 
+/// A JSON pointer (`/frames/3/intensity/0`) as the field path errors name
+/// (`frames[3].intensity[0]`).
+fn dotted(pointer: &str) -> String {
+    let mut out = String::new();
+    for part in pointer.split('/').skip(1) {
+        if part.parse::<usize>().is_ok() {
+            out += &format!("[{part}]");
+        } else {
+            if !out.is_empty() {
+                out.push('.');
+            }
+            out += part;
+        }
+    }
+    out
+}
+
 #[test]
 fn mutated_captures_give_errors_naming_the_file_never_panics() {
     let tmp = tempfile::tempdir().unwrap();
@@ -86,13 +95,26 @@ fn mutated_captures_give_errors_naming_the_file_never_panics() {
     leaves(&value, String::new(), &mut paths);
     let mut rng = Pcg32::new(26, 1);
     // Values: a random leaf replaced by a hostile value.
+    let mut typed = 0;
     for t in 0..60 {
         let mut v = value.clone();
         let p = &paths[rng.next_u32() as usize % paths.len()];
         *v.pointer_mut(p).unwrap() = hostile(rng.next_u32());
         std::fs::write(&manifest, v.to_string()).unwrap();
         check(&dir, &format!("value {t}: {p}"));
+        // A type error names the field (`frames[3].intensity[0]`), not only line and column.
+        if let Err(e) = open_and_fit(&dir) {
+            if e.contains("invalid type") || e.contains("invalid length") {
+                let field = dotted(p);
+                assert!(
+                    e.contains(&format!("field `{field}")),
+                    "value {t}: {p}: {e}"
+                );
+                typed += 1;
+            }
+        }
     }
+    assert!(typed >= 10, "only {typed} type errors among 60 mutations");
     // Bytes: cut, or flipped.
     for t in 0..30 {
         let mut b = good.clone();

@@ -4,7 +4,11 @@
 //! scene are refused instead of blocking or reading forever, count options have ranges, and a
 //! slice never rewrites the manifest of a capture of other settings.
 
-use std::path::{Path, PathBuf};
+#[path = "common/capture.rs"]
+mod common_capture;
+
+use common_capture::small_capture as capture;
+use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
@@ -115,24 +119,6 @@ fn exr_declaring(n: i32) -> Vec<u8> {
     out.extend_from_slice(&le(&[0, 0, 0, 0, 64]));
     out.extend_from_slice(&[0; 64]);
     out
-}
-
-/// A small valid capture (the built-in fit scene, 3 frames of 1 spp).
-fn capture(dir: &Path) -> PathBuf {
-    let args = [
-        "sweep",
-        "fit_maple_sweep",
-        "--frames",
-        "3",
-        "--spp",
-        "1",
-        "--quiet",
-        "--out",
-        "cap",
-    ];
-    let o = xylem(&args, dir);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    dir.join("cap")
 }
 
 /// Points frames[0] of the capture's manifest at `image`.
@@ -311,4 +297,112 @@ fn a_reader_that_stops_early_ends_the_program_quietly() {
             o.status
         );
     }
+}
+
+/// A scene placing `shape` (TOML lines of one object) with a Lambertian material.
+fn scene_with(object: &str) -> String {
+    format!(
+        r#"[render]
+width = 8
+height = 8
+spp = 1
+[camera]
+eye = [0, 0, 5]
+target = [0, 0, 0]
+up = [0, 1, 0]
+fov_deg = 40
+[[lights]]
+name = "sun"
+type = "distant"
+direction = [0, 0, 1]
+irradiance = 1.0
+[materials.m]
+type = "lambertian"
+albedo = [0.5, 0.5, 0.5]
+[[objects]]
+name = "o"
+material = "m"
+{object}
+"#
+    )
+}
+
+#[test]
+fn meshes_and_shapes_are_checked_before_they_are_built() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let render = |scene: &str| {
+        let args = ["render", scene, "--quiet", "--out", "o"];
+        xylem(&args, dir)
+    };
+    // A NaN or out-of-range vertex is the file's fault, named, not the transform's (before:
+    // "field `objects[0].translate`: ... reaches inf mm").
+    std::fs::write(
+        dir.join("nan.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv nan 1 0\nf 1 2 3\nf 1 2 4\n",
+    )
+    .unwrap();
+    let text = scene_with("shape = \"mesh\"\nfile = \"nan.obj\"\ntranslate = [1, 0, 0]");
+    std::fs::write(dir.join("nan.toml"), text).unwrap();
+    assert_refused(
+        &render("nan.toml"),
+        &["objects[0].file", "nan.obj", "vertex 4 of 4 is (NaN, 1, 0)"],
+    );
+    let ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1e39 0 0\n0 1 0\n3 0 1 2\n";
+    std::fs::write(dir.join("inf.ply"), ply).unwrap();
+    let text = scene_with("shape = \"mesh\"\nfile = \"inf.ply\"");
+    std::fs::write(dir.join("inf.toml"), text).unwrap();
+    assert_refused(
+        &render("inf.toml"),
+        &["inf.ply", "vertex 2 of 3 is (inf, 0, 0)"],
+    );
+    // A 3 GiB OBJ (sparse: nothing to read) needs ~48 GiB to parse: refused before reading.
+    let big = std::fs::File::create(dir.join("big.obj")).unwrap();
+    big.set_len(3 << 30).unwrap();
+    let text = scene_with("shape = \"mesh\"\nfile = \"big.obj\"");
+    std::fs::write(dir.join("big.toml"), text).unwrap();
+    assert_refused(&render("big.toml"), &["big.obj", "needs about", "to read"]);
+    // A lathe of 200 000 profile points at 4096 segments: 1.6 G triangles, refused before
+    // its vertices are allocated.
+    let profile: Vec<String> = (0..200_000)
+        .map(|i| format!("[{}, {}]", 1.0 + 0.1 * (i % 5) as f32, i as f32 * 1e-3))
+        .collect();
+    let text = scene_with(&format!(
+        "shape = \"lathe\"\nsegments = 4096\nprofile = [{}]",
+        profile.join(", ")
+    ));
+    std::fs::write(dir.join("lathe.toml"), text).unwrap();
+    assert_refused(
+        &render("lathe.toml"),
+        &["objects[0].profile", "1638391808 triangles", "of memory"],
+    );
+}
+
+#[test]
+fn texture_memory_is_checked_before_a_pixel_is_computed() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    // 16384² as EXR: about 12 GiB, beyond the 4 GiB cap; before, the allocation aborted.
+    let o = xylem(
+        &["texture", "marble", "--res", "16384", "--out", "t.exr"],
+        dir,
+    );
+    assert_refused(&o, &["16384² texture EXR", "of memory", "lower --res"]);
+    let o = xylem(
+        &[
+            "texture",
+            "clouds",
+            "--animate",
+            "2",
+            "--frames",
+            "1000",
+            "--res",
+            "4096",
+            "--out",
+            "a.png",
+        ],
+        dir,
+    );
+    assert_refused(&o, &["1000 frames", "of memory"]);
+    assert!(!dir.join("t.exr").exists() && !dir.join("a.png").exists());
 }

@@ -772,11 +772,51 @@ fn image1<'py>(py: Python<'py>, w: u32, h: u32, v: Vec<f32>) -> PyResult<Bound<'
         .into_any())
 }
 
+/// A render's [`xylem::progress::Progress`] that asks it to stop once `flag` is set.
+struct StopFlag<'a>(&'a std::sync::atomic::AtomicBool);
+
+impl xylem::progress::Progress for StopFlag<'_> {
+    fn update(&self, _done: u64, _total: u64, _message: &str) {}
+    fn stop(&self) -> bool {
+        self.0.load(std::sync::atomic::Ordering::Relaxed)
+    }
+}
+
+/// Runs `f` with the GIL released on a helper thread while this (the main) thread checks
+/// Python's signals every 50 ms, since only the main thread can raise KeyboardInterrupt: on
+/// Ctrl-C the run is asked to stop ([`StopFlag`]), ends at its next tile, and the signal's
+/// exception is raised. A panic in the run becomes a RuntimeError, never a PanicException.
+fn interruptible<T: Send>(py: Python<'_>, f: impl FnOnce(&StopFlag) -> T + Send) -> PyResult<T> {
+    let flag = std::sync::atomic::AtomicBool::new(false);
+    let stop = StopFlag(&flag);
+    std::thread::scope(|scope| {
+        let run = scope.spawn(|| f(&stop));
+        let mut interrupted = None;
+        while !run.is_finished() {
+            py.allow_threads(|| std::thread::sleep(std::time::Duration::from_millis(50)));
+            if let Err(e) = py.check_signals() {
+                flag.store(true, std::sync::atomic::Ordering::Relaxed);
+                interrupted = Some(e);
+                break;
+            }
+        }
+        let out = py.allow_threads(|| run.join());
+        match (interrupted, out) {
+            (Some(e), _) => Err(e),
+            (None, Ok(v)) => Ok(v),
+            (None, Err(_)) => Err(pyo3::exceptions::PyRuntimeError::new_err(
+                "the render panicked (a bug: please report it with the scene)",
+            )),
+        }
+    })
+}
+
 /// `render(scene, spp=None, res=None, seed=None, threads=0)`: renders a scene file as
 /// `xylem render` does and returns a dict of (H, W[, 3]) float32 arrays, top row first: `beauty`
 /// (linear RGB), `std_error` (of each pixel's luminance), and the first-hit AOVs `albedo`,
 /// `normal`, `depth`, `fiber`, `ray_mask`, `growth_time`; plus `nonfinite` (samples dropped) and
-/// `seconds`. The GIL is released while rendering.
+/// `seconds`. The GIL is released while rendering; Ctrl-C stops it within a tile and raises
+/// KeyboardInterrupt.
 #[pyfunction]
 #[pyo3(signature = (scene, spp=None, res=None, seed=None, threads=0))]
 fn render<'py>(
@@ -789,13 +829,15 @@ fn render<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     check_threads(threads)?;
     let loaded = load_scene(scene, spp, res, seed)?;
-    let run = xylem::render::RunOptions {
-        threads,
-        ..Default::default()
-    };
-    let out = py
-        .allow_threads(|| xylem::render::render(&loaded.scene, &loaded.settings, &run))
-        .map_err(value_error)?;
+    let out = interruptible(py, |stop| {
+        let run = xylem::render::RunOptions {
+            threads,
+            progress: stop,
+            ..Default::default()
+        };
+        xylem::render::render(&loaded.scene, &loaded.settings, &run)
+    })?
+    .map_err(value_error)?;
     let img = &out.image;
     let (w, h) = (img.width, img.height);
     let d = PyDict::new(py);
@@ -818,7 +860,8 @@ fn render<'py>(
 /// `sweep(scene, frames=None, arc=None, spp=None, res=None, seed=None, threads=0)`: renders the
 /// light sweep of a scene's `[sweep]` table (with the per-sweep cache, as `xylem sweep` does)
 /// without writing files; `arc` = (from_deg, to_deg). Returns a dict: `frames` (F, H, W, 3),
-/// `std_error` (F, H, W), `light_deg` (F,), `seconds`. The GIL is released while rendering.
+/// `std_error` (F, H, W), `light_deg` (F,), `seconds`. The GIL is released while rendering;
+/// Ctrl-C stops it within a tile and raises KeyboardInterrupt.
 #[pyfunction]
 #[pyo3(signature = (scene, frames=None, arc=None, spp=None, res=None, seed=None, threads=0))]
 #[allow(clippy::too_many_arguments)]
@@ -836,23 +879,23 @@ fn sweep<'py>(
     let loaded = load_scene(scene, spp, res, seed)?;
     let (path, moving) =
         xylem::sweep::SweepPath::from_scene(&loaded, frames, arc).map_err(value_error)?;
-    let run = xylem::render::RunOptions {
-        threads,
-        ..Default::default()
-    };
     let total = path.arc.frames;
-    let r = py
-        .allow_threads(|| {
-            xylem::sweep::render_sweep(
-                &loaded.scene,
-                &loaded.settings,
-                &path,
-                moving,
-                0..total,
-                &run,
-            )
-        })
-        .map_err(value_error)?;
+    let r = interruptible(py, |stop| {
+        let run = xylem::render::RunOptions {
+            threads,
+            progress: stop,
+            ..Default::default()
+        };
+        xylem::sweep::render_sweep(
+            &loaded.scene,
+            &loaded.settings,
+            &path,
+            moving,
+            0..total,
+            &run,
+        )
+    })?
+    .map_err(value_error)?;
     let (w, h, f) = (r.width as usize, r.height as usize, r.frames.len());
     let beauty: Vec<f32> = r
         .frames

@@ -21,7 +21,7 @@ const MIN_ROUGHNESS: f32 = 1e-3;
 /// quadrature when η > 1).
 ///
 /// ```
-/// use glam::{Vec2, Vec3};
+/// use xylem::math::{Vec2, Vec3};
 /// use xylem::bsdf::{Bsdf, WoodBsdf, WoodBsdfParams};
 ///
 /// // Fibres along x in the surface, a smooth finish of index 1.5 (local frame: z = normal).

@@ -92,6 +92,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 
 /// Prints one board's fit.
 fn report(r: &serde_json::Value, out: &Path) {
+    if let Some(w) = r["warning"].as_str() {
+        eprintln!("warning: {w}");
+    }
     println!(
         "fitted {}x{} texels from {} frames in {:.2} s (+{:.2} s reading); median relative residual {:.4}; {} texels not fitted; maps in {}",
         r["texels"][0],

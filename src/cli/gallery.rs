@@ -15,18 +15,29 @@ use std::time::Instant;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Output folder (the README's images live in notes/gallery).
-    #[arg(long, default_value = "notes/gallery")]
-    out: PathBuf,
+    /// Output folder [default: notes/gallery, where the README's images live]; a reduced run
+    /// (`--frames` other than 12) must name it.
+    #[arg(long)]
+    out: Option<PathBuf>,
     /// Only these parts: scenes, presets, sweeps (default: all three).
     #[arg(long, value_parser = ["scenes", "presets", "sweeps"])]
     only: Vec<String>,
     /// Only these built-in scenes (file stems; default: all but the measured-board sweeps).
     #[arg(long)]
     scene: Vec<String>,
-    /// Frames of each sweep close-up.
-    #[arg(long, default_value_t = 12)]
+    /// Frames of each sweep close-up, 1 to 1000.
+    #[arg(long, default_value_t = FRAMES, value_parser = parse_frames)]
     frames: usize,
+}
+
+/// Frames of each sweep close-up in the README's gallery.
+const FRAMES: usize = 12;
+
+fn parse_frames(s: &str) -> Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(n) if (1..=1000).contains(&n) => Ok(n),
+        _ => Err(format!("`{s}`: allowed 1 to 1000 frames")),
+    }
 }
 
 /// The built-in scenes the gallery shows (scenes/NAME.toml), hero renders first.
@@ -57,17 +68,19 @@ const CLOSE_FOV_DEG: f64 = 18.0;
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let part = |p: &str| args.only.is_empty() || args.only.iter().any(|o| o == p);
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating {}", args.out.display()))?;
-    let _lock = crate::output::FolderLock::try_new(&args.out, crate::output::LockMode::Exclusive)?;
+    let reduced =
+        (args.frames != FRAMES && part("sweeps")).then(|| format!("--frames {}", args.frames));
+    let out = crate::cli::output_path(args.out.clone(), "notes/gallery", "--out", reduced)?;
+    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    let _lock = crate::output::FolderLock::try_new(&out, crate::output::LockMode::Exclusive)?;
     let start = Instant::now();
     let mut ok = true;
     if part("scenes") {
-        ok &= scenes(&args.out.join("scenes"), &args.scene)?;
+        ok &= scenes(&out.join("scenes"), &args.scene)?;
     }
     if part("presets") {
         super::preset::gallery(
-            &args.out.join("presets"),
+            &out.join("presets"),
             (480, 240),
             16,
             &[-40.0, 0.0, 40.0],
@@ -76,7 +89,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         )?;
     }
     if part("sweeps") {
-        sweeps(&args.out.join("sweeps"), args.frames)?;
+        sweeps(&out.join("sweeps"), args.frames)?;
     }
     println!("gallery done in {:.0} s", start.elapsed().as_secs_f64());
     Ok(if ok {

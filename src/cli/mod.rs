@@ -140,3 +140,24 @@ fn error_chain(e: &anyhow::Error) -> String {
     }
     msg
 }
+
+/// Where a run writes: `given`, else `default` (a committed full result) — unless the run is
+/// reduced (`reduced` says how, e.g. `--reduce 20`), which must name its output itself so that
+/// reduced numbers never overwrite the full ones.
+pub(crate) fn output_path(
+    given: Option<std::path::PathBuf>,
+    default: &str,
+    option: &str,
+    reduced: Option<String>,
+) -> anyhow::Result<std::path::PathBuf> {
+    match (given, reduced) {
+        (Some(p), _) => Ok(p),
+        (None, None) => Ok(default.into()),
+        (None, Some(how)) => anyhow::bail!(
+            "{how} is a reduced run: it would overwrite the full results in {default}; name where it should write with {option} (e.g. {option} /tmp/xylem-reduced/{})",
+            std::path::Path::new(default)
+                .file_name()
+                .map_or(String::new(), |n| n.to_string_lossy().into_owned())
+        ),
+    }
+}

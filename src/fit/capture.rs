@@ -91,6 +91,19 @@ impl FilmCamera {
         Some((0.5 * (x * h + w), 0.5 * (h - y * h)))
     }
 
+    /// The ray (origin, unit direction) through film point (x, y) in pixels: the inverse of
+    /// [`FilmCamera::project`].
+    pub fn ray(&self, x: f32, y: f32) -> (Vec3, Vec3) {
+        let (w, h) = (self.width as f32, self.height as f32);
+        let (nx, ny) = ((2.0 * x - w) / h, (h - 2.0 * y) / h);
+        let side = self.right * nx * self.scale + self.up * ny * self.scale;
+        if self.orthographic {
+            (self.eye + side, self.forward)
+        } else {
+            (self.eye, (self.forward + side).normalize())
+        }
+    }
+
     /// The unit direction from `p` towards the camera.
     pub fn view_dir(&self, p: Vec3) -> Vec3 {
         if self.orthographic {
@@ -125,6 +138,16 @@ impl BoardPlane {
         let u = ((col as f32 + 0.5) / w as f32 - 0.5) * self.size[0];
         let v = (0.5 - (row as f32 + 0.5) / h as f32) * self.size[1];
         self.origin + u * self.x + v * self.y
+    }
+
+    /// Where the ray (`origin`, `dir`) meets the board's face, if it does, from its front.
+    pub fn hit(&self, origin: Vec3, dir: Vec3) -> Option<Vec3> {
+        let den = dir.dot(self.z);
+        let t = (self.origin - origin).dot(self.z) / den;
+        let p = origin + t * dir;
+        let l = self.local(p - self.origin);
+        let inside = l.x.abs() <= 0.5 * self.size[0] && l.y.abs() <= 0.5 * self.size[1];
+        (den < 0.0 && t > 0.0 && inside).then_some(p)
     }
 
     /// World direction `d` in the board frame.
@@ -240,7 +263,7 @@ impl Capture {
             })?;
         let m: Manifest = serde_json::from_str(&text).map_err(|e| CaptureError::Parse {
             path: path.clone(),
-            cause: e.to_string(),
+            cause: crate::jsonpath::describe(&text, &e),
         })?;
         Capture::from_manifest(dir, &m)
     }
@@ -284,6 +307,22 @@ impl Capture {
             unit("camera.up", c.up)?,
             unit("camera.forward", c.forward)?,
         );
+        // A camera whose axes are not orthogonal projects the board onto a line (a 1×23 map).
+        for (field, a, b, an) in [
+            ("camera.up", up, right, "camera.right"),
+            ("camera.forward", forward, right, "camera.right"),
+            ("camera.forward", forward, up, "camera.up"),
+        ] {
+            if a.dot(b).abs() > 1e-3 {
+                return Err(bad(
+                    field,
+                    format!(
+                        "{a} is {:.2}° from {an} {b} (allowed: perpendicular, within 0.06°)",
+                        a.dot(b).clamp(-1.0, 1.0).acos().to_degrees()
+                    ),
+                ));
+            }
+        }
         if !vec3(c.eye).is_finite() {
             return Err(bad("camera.eye", "must be finite".into()));
         }
@@ -369,6 +408,14 @@ impl Capture {
                 ))
             }
         };
+        if let Some(clip) = m.clip {
+            if !(clip.is_finite() && clip > 0.0) {
+                return Err(bad(
+                    "clip",
+                    format!("{clip} (allowed finite and > 0: a pixel at or above the clip level counts as clipped, so 0 or less would clip every pixel)"),
+                ));
+            }
+        }
         if m.frames.is_empty() {
             return Err(bad("frames", "empty (allowed one or more frames)".into()));
         }

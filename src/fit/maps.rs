@@ -10,7 +10,7 @@
 use super::model::TexelFit;
 use crate::material::MeasuredBoard;
 use crate::output::{FolderLock, LockError, LockMode, Staged};
-use crate::picture::png::stage_png_rgb8;
+use crate::picture::png::{stage_png_rgb8, stage_png_rgb8_text};
 use crate::picture::ImageError;
 use crate::render::image_io::{stage_exr_layers, ExrCompression, ExrLayer};
 use glam::Vec3;
@@ -25,6 +25,18 @@ pub enum MapsError {
     /// The output folder's lock could not be taken.
     #[error(transparent)]
     Lock(#[from] LockError),
+    /// A map holds a NaN or an infinity (no fit makes one; refused so none reaches a file).
+    #[error(
+        "{dir}: the {map} map holds a non-finite value at texel {index} (allowed: finite values)"
+    )]
+    NotFinite {
+        /// The output folder.
+        dir: String,
+        /// The map.
+        map: &'static str,
+        /// The texel's index (row-major).
+        index: usize,
+    },
     /// A file of the output could not be written.
     #[error("{path}: {cause}")]
     Io {
@@ -82,6 +94,35 @@ impl FittedMaps {
         }
     }
 
+    /// Refuses maps holding a NaN or an infinity (the error names the map and texel).
+    pub fn check_finite(&self, dir: &Path) -> Result<(), MapsError> {
+        let vectors = [
+            ("diffuse", &self.diffuse),
+            ("fiber_color", &self.fiber_color),
+            ("fiber_axis", &self.fiber_axis),
+        ];
+        let scalars = [
+            ("highlight_width", &self.beta),
+            ("residual", &self.residual),
+        ];
+        let bad = vectors
+            .iter()
+            .find_map(|(m, v)| v.iter().position(|c| !c.is_finite()).map(|i| (*m, i)))
+            .or_else(|| {
+                scalars
+                    .iter()
+                    .find_map(|(m, v)| v.iter().position(|c| !c.is_finite()).map(|i| (*m, i)))
+            });
+        match bad {
+            Some((map, index)) => Err(MapsError::NotFinite {
+                dir: dir.display().to_string(),
+                map,
+                index,
+            }),
+            None => Ok(()),
+        }
+    }
+
     /// The maps as a measured board (fibre colour as stored: k_f itself, for the default scale).
     pub fn board(&self) -> MeasuredBoard {
         MeasuredBoard {
@@ -103,21 +144,29 @@ fn rgb8(v: &[Vec3], f: impl Fn(Vec3) -> Vec3) -> Vec<u8> {
     v.iter().flat_map(|c| f(*c).to_array()).map(byte).collect()
 }
 
+/// The `tEXt` chunk (`Software`) that marks a PNG map written by `xylem fit`: a reader of such
+/// a map requires the fit's record `fit.json` beside it (`material::measured`), so the maps of
+/// a fit killed while committing are never read as a complete set.
+pub const FIT_PNG_MARK: (&str, &str) = ("Software", "xylem fit");
+
 /// Stages the PNG maps of `board` in the `measured` encoding into `dir` (β map if it has one).
 pub fn stage_board_pngs(dir: &Path, board: &MeasuredBoard) -> Result<Vec<Staged>, MapsError> {
+    stage_board_pngs_text(dir, board, &[])
+}
+
+/// [`stage_board_pngs`] with `tEXt` chunks in every map.
+fn stage_board_pngs_text(
+    dir: &Path,
+    board: &MeasuredBoard,
+    text: &[(&str, &str)],
+) -> Result<Vec<Staged>, MapsError> {
     let (w, h) = (board.width, board.height);
+    let png = |name: &str, bytes: &[u8]| stage_png_rgb8_text(&dir.join(name), w, h, bytes, text);
     let mut staged = vec![
-        stage_png_rgb8(&dir.join("diffuse.png"), w, h, &rgb8(&board.diffuse, |c| c))?,
-        stage_png_rgb8(
-            &dir.join("fiber_color.png"),
-            w,
-            h,
-            &rgb8(&board.fiber_color, |c| c),
-        )?,
-        stage_png_rgb8(
-            &dir.join("fiber_axis.png"),
-            w,
-            h,
+        png("diffuse.png", &rgb8(&board.diffuse, |c| c))?,
+        png("fiber_color.png", &rgb8(&board.fiber_color, |c| c))?,
+        png(
+            "fiber_axis.png",
             &rgb8(&board.fiber_axis, |u| 0.5 * (u + Vec3::ONE)),
         )?,
     ];
@@ -127,12 +176,7 @@ pub fn stage_board_pngs(dir: &Path, board: &MeasuredBoard) -> Result<Vec<Staged>
             .iter()
             .flat_map(|b| [byte(b.to_degrees() / 90.0).max(1); 3])
             .collect();
-        staged.push(stage_png_rgb8(
-            &dir.join("highlight_width.png"),
-            w,
-            h,
-            &bytes,
-        )?);
+        staged.push(png("highlight_width.png", &bytes)?);
     }
     Ok(staged)
 }
@@ -154,9 +198,10 @@ pub fn write_maps(
         path: dir.display().to_string(),
         cause,
     })?;
+    maps.check_finite(dir)?;
     let _lock = FolderLock::try_new(dir, LockMode::Exclusive)?;
     let (w, h) = (maps.width as u32, maps.height as u32);
-    let mut staged = stage_board_pngs(dir, &maps.board())?;
+    let mut staged = stage_board_pngs_text(dir, &maps.board(), &[FIT_PNG_MARK])?;
     let grey: Vec<u8> = maps
         .residual
         .iter()

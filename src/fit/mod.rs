@@ -80,9 +80,137 @@ pub enum FitError {
         /// rayon's error.
         cause: String,
     },
+    /// No texel has the 8 usable frames a fit needs: the capture cannot be fitted.
+    #[error(
+        "{path}: no texel of the {w}x{h} map could be fitted (each needs 8 usable frames): {cause}"
+    )]
+    Unfittable {
+        /// The manifest.
+        path: String,
+        /// Map width (texels).
+        w: usize,
+        /// Map height (texels).
+        h: usize,
+        /// Why the samples were rejected, with the fields to check.
+        cause: String,
+    },
     /// The maps could not be written.
     #[error(transparent)]
     Output(#[from] maps::MapsError),
+}
+
+/// The largest reflectance factor (pixel value over irradiance: a BRDF × cos θ) a sample may
+/// have, a million times a white diffuse surface's 1/π. A brighter sample comes from a frame
+/// or an intensity that does not match the light (a frame of 3e38, an intensity 10⁻³⁰ too
+/// small), and its square would overflow the fit's f32 sums into a NaN.
+pub const MAX_REFLECTANCE_FACTOR: f32 = 1e6 / std::f32::consts::PI;
+
+/// The least cosine between the face's normal and the light or the view for a sample to count
+/// (about 1.1° above the face): grazing samples carry no usable shading.
+pub const MIN_COS: f32 = 0.02;
+
+/// Samples (texel × frame) the fit did not use, by cause; `fit.json` reports them, and they
+/// name the cause when no texel could be fitted.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Rejections {
+    /// Samples used.
+    pub used: u64,
+    /// Clipped (at or above `clip`, or the top code of a PNG), missing or not finite.
+    pub clipped: u64,
+    /// Pixel value over irradiance above [`MAX_REFLECTANCE_FACTOR`].
+    pub too_bright: u64,
+    /// The light at most [`MIN_COS`] above the face, or behind it.
+    pub light_grazing: u64,
+    /// The camera at most [`MIN_COS`] above the face, or behind it.
+    pub view_grazing: u64,
+    /// The light's irradiance at the texel not a positive normal float in every channel.
+    pub no_light: u64,
+    /// The finish's mirror glint of a sphere light.
+    pub glint: u64,
+}
+
+/// What became of one sample (see [`Rejections`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Cause {
+    Used,
+    Clipped,
+    TooBright,
+    LightGrazing,
+    ViewGrazing,
+    NoLight,
+    Glint,
+}
+
+impl Rejections {
+    fn count(&mut self, c: Cause) {
+        *match c {
+            Cause::Used => &mut self.used,
+            Cause::Clipped => &mut self.clipped,
+            Cause::TooBright => &mut self.too_bright,
+            Cause::LightGrazing => &mut self.light_grazing,
+            Cause::ViewGrazing => &mut self.view_grazing,
+            Cause::NoLight => &mut self.no_light,
+            Cause::Glint => &mut self.glint,
+        } += 1;
+    }
+
+    fn add(&mut self, o: &Rejections) {
+        self.used += o.used;
+        self.clipped += o.clipped;
+        self.too_bright += o.too_bright;
+        self.light_grazing += o.light_grazing;
+        self.view_grazing += o.view_grazing;
+        self.no_light += o.no_light;
+        self.glint += o.glint;
+    }
+
+    /// The counts by cause, as `fit.json` reports them.
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "used": self.used,
+            "clipped_or_not_finite": self.clipped,
+            "too_bright": self.too_bright,
+            "light_grazing": self.light_grazing,
+            "view_grazing": self.view_grazing,
+            "no_irradiance": self.no_light,
+            "glint": self.glint,
+        })
+    }
+
+    /// The causes that rejected samples, most first, each with the fields to check.
+    pub fn describe(&self, capture: &Capture) -> String {
+        let clip = capture
+            .clip
+            .map_or("none".to_string(), |c| format!("{c:e}"));
+        let mut causes = [
+            (self.view_grazing, format!("the camera sees the face edge-on or from behind (within {:.1}° of its plane; fields `camera` and `board`)", MIN_COS.asin().to_degrees())),
+            (self.light_grazing, format!("the light is never more than {:.1}° above the face (fields `frames[].position`, `frames[].direction`, `board`)", MIN_COS.asin().to_degrees())),
+            (self.no_light, "no irradiance reaches the board (field `frames[].intensity`: every channel must be positive and large enough to divide by)".to_string()),
+            (self.clipped, format!("the pixels are clipped, missing or not finite (field `clip` = {clip}, or the frame images)")),
+            (self.too_bright, format!("pixel value over the light's irradiance exceeds {MAX_REFLECTANCE_FACTOR:.3e}, a million times a white diffuse surface: the frames do not match field `frames[].intensity`")),
+            (self.glint, "every usable sample is the finish's mirror glint of the sphere light (field `frames[].radius`)".to_string()),
+        ];
+        causes.sort_by(|a, b| b.0.cmp(&a.0));
+        let total = self.used
+            + self.clipped
+            + self.too_bright
+            + self.light_grazing
+            + self.view_grazing
+            + self.no_light
+            + self.glint;
+        let mut parts: Vec<String> = causes
+            .iter()
+            .filter(|c| c.0 > 0)
+            .map(|(n, why)| format!("{n} of {total} samples: {why}"))
+            .collect();
+        if self.used > 0 {
+            parts.push(format!(
+                "{} of {total} samples usable, too few at any one texel",
+                self.used
+            ));
+        }
+        parts.join("; ")
+    }
 }
 
 /// How to fit.
@@ -152,6 +280,49 @@ pub struct FitStats {
     pub frames: usize,
     /// Texels with fewer than 8 usable frames, left unfitted (residual 1).
     pub texels_failed: usize,
+    /// Samples (texel × frame) used and rejected, by cause.
+    pub samples: Rejections,
+}
+
+/// Refuses a board the camera sees only edge-on or from behind at every texel, before any
+/// frame is read (no sample of it could be used).
+fn check_view(capture: &Capture, w: usize, h: usize) -> Result<(), FitError> {
+    let (cam, board) = (&capture.camera, &capture.board);
+    let corners = [
+        (0, 0),
+        (w - 1, 0),
+        (0, h - 1),
+        (w - 1, h - 1),
+        (w / 2, h / 2),
+    ];
+    let seen = corners.iter().any(|&(c, r)| {
+        let p = board.texel_point(c, r, w, h);
+        board.local(cam.view_dir(p)).z > MIN_COS
+    });
+    if seen {
+        return Ok(());
+    }
+    let p = board.texel_point(w / 2, h / 2, w, h);
+    let angle = board
+        .local(cam.view_dir(p))
+        .z
+        .clamp(-1.0, 1.0)
+        .acos()
+        .to_degrees();
+    let samples = Rejections {
+        view_grazing: (w * h * capture.frames.len()) as u64,
+        ..Rejections::default()
+    };
+    Err(FitError::Unfittable {
+        path: capture.manifest_path.display().to_string(),
+        w,
+        h,
+        cause: format!(
+            "{} (the view is {angle:.1}° from the face's normal at its centre; allowed under {:.1}°)",
+            samples.describe(capture),
+            MIN_COS.acos().to_degrees()
+        ),
+    })
 }
 
 /// Why a capture folder could not be fitted into maps ([`fit_folder`]).
@@ -188,11 +359,23 @@ pub fn fit_folder(
         "arcs_azimuth_deg": capture.arc_azimuths(),
         "eta": capture.board.eta,
         "texels_not_fitted": stats.texels_failed,
+        "samples": stats.samples.to_json(),
         "median_relative_residual": median,
         "read_seconds": stats.read_time.as_secs_f64(),
         "fit_seconds": stats.fit_time.as_secs_f64(),
     });
     write_maps(out, &maps, &report)?;
+    let mut report = report;
+    if 2 * stats.texels_failed > maps.width * maps.height {
+        // Not in fit.json: a caller's note on this run, printed by `xylem fit`.
+        report["warning"] = format!(
+            "{} of {} texels not fitted (black in the maps, residual 1): {}",
+            stats.texels_failed,
+            maps.width * maps.height,
+            stats.samples.describe(&capture)
+        )
+        .into();
+    }
     Ok(report)
 }
 
@@ -229,6 +412,7 @@ pub fn fit(capture: &Capture, opts: &FitOptions) -> Result<(FittedMaps, FitStats
             have: Bytes(have),
         });
     }
+    check_view(capture, w, h)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.threads)
         .build()
@@ -294,7 +478,7 @@ fn fit_in_pool(
     let done = AtomicU64::new(0);
     let start = Instant::now();
     let eta = board.eta;
-    let fits: Vec<Option<TexelFit>> = (0..n)
+    let fits: Vec<(Option<TexelFit>, Rejections)> = (0..n)
         .into_par_iter()
         .map_init(
             || (Scratch::default(), TexelData::default()),
@@ -305,17 +489,30 @@ fn fit_in_pool(
                 d.wi.clear();
                 d.z.clear();
                 d.w.clear();
+                let mut why = Rejections::default();
                 for (k, f) in capture.frames.iter().enumerate() {
                     let (l, irr) = f.light_at(p);
                     let wi = board.local(l);
-                    let y = samples[k][i];
-                    let ok = y.is_finite()
-                        && wi.z > 0.02
-                        && d.wo.z > 0.02
-                        && irr.min_element() > 0.0
-                        && !f.glint(p, wo_world, board.z);
+                    let z = samples[k][i] / irr;
+                    let cause = if d.wo.z <= MIN_COS {
+                        Cause::ViewGrazing
+                    } else if wi.z <= MIN_COS {
+                        Cause::LightGrazing
+                    } else if irr.min_element() < f32::MIN_POSITIVE || !irr.is_finite() {
+                        Cause::NoLight
+                    } else if !samples[k][i].is_finite() {
+                        Cause::Clipped
+                    } else if !z.is_finite() || z.max_element() > MAX_REFLECTANCE_FACTOR {
+                        Cause::TooBright
+                    } else if f.glint(p, wo_world, board.z) {
+                        Cause::Glint
+                    } else {
+                        Cause::Used
+                    };
+                    why.count(cause);
+                    let ok = cause == Cause::Used;
                     d.wi.push(wi);
-                    d.z.push(if ok { y / irr } else { Vec3::ZERO });
+                    d.z.push(if ok { z } else { Vec3::ZERO });
                     d.w.push(if ok { 1.0 } else { 0.0 });
                 }
                 if i % 256 == 0 {
@@ -323,12 +520,25 @@ fn fit_in_pool(
                     let d = done.fetch_add(step, Ordering::Relaxed) + step;
                     opts.progress.update(d, n as u64, "");
                 }
-                fit_texel(d, eta, scratch)
+                (fit_texel(d, eta, scratch), why)
             },
         )
         .collect();
     opts.progress.finish();
+    let mut why = Rejections::default();
+    for (_, r) in &fits {
+        why.add(r);
+    }
+    let fits: Vec<Option<TexelFit>> = fits.into_iter().map(|(f, _)| f).collect();
     let failed = fits.iter().filter(|f| f.is_none()).count();
+    if failed == n {
+        return Err(FitError::Unfittable {
+            path: capture.manifest_path.display().to_string(),
+            w,
+            h,
+            cause: why.describe(capture),
+        });
+    }
     let maps = FittedMaps::from_fits(w, h, &fits);
     Ok((
         maps,
@@ -337,6 +547,7 @@ fn fit_in_pool(
             fit_time: start.elapsed(),
             frames: capture.frames.len(),
             texels_failed: failed,
+            samples: why,
         },
     ))
 }

@@ -389,14 +389,21 @@ pub fn fit_texel(d: &mut TexelData, eta: f32, s: &mut Scratch) -> Option<TexelFi
     if u.x < 0.0 || (u.x == 0.0 && u.y < 0.0) {
         u = -u;
     }
-    Some(TexelFit {
+    let fit = TexelFit {
         diffuse: prob.unit.diffuse_from_effective(rho_eff).min(Vec3::ONE),
         fiber_color: kf.min(Vec3::ONE),
         axis: u,
         beta: p[2].exp(),
         residual: (cost / zz.max(1e-30)).sqrt(),
         used: d.w.iter().filter(|w| **w > 0.0).count() as u32,
-    })
+    };
+    // An overflow anywhere leaves the texel unfitted rather than a NaN in a map or fit.json.
+    let finite = fit.diffuse.is_finite()
+        && fit.fiber_color.is_finite()
+        && fit.axis.is_finite()
+        && fit.beta.is_finite()
+        && fit.residual.is_finite();
+    finite.then_some(fit)
 }
 
 #[cfg(test)]

@@ -10,7 +10,7 @@
 use super::face::{bilinear_taps, face_shading, FaceRect, FaceTexel};
 use super::{MaterialHit, Shading};
 use crate::bsdf::FinishModel;
-use crate::picture::png::{decode_png, open_png};
+use crate::picture::png::{decode_png, decode_png_text, open_png};
 use glam::{Vec2, Vec3};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -153,7 +153,12 @@ fn read_png8(field: &'static str, path: &Path) -> Result<Rgb8, MeasuredError> {
     let expand = png::Transformations::EXPAND;
     let (info, buf) = match crate::builtin::stand_in(path) {
         Some((_, bytes)) => decode_png(path, bytes, expand, 3),
-        None => decode_png(path, open_png(path).map_err(fail)?, expand, 3),
+        None => {
+            let (info, buf, text) =
+                decode_png_text(path, open_png(path).map_err(fail)?, expand, 3).map_err(fail)?;
+            check_fit_record(path, &text).map_err(fail)?;
+            Ok((info, buf))
+        }
     }
     .map_err(fail)?;
     if info.bit_depth != png::BitDepth::Eight {
@@ -168,6 +173,30 @@ fn read_png8(field: &'static str, path: &Path) -> Result<Rgb8, MeasuredError> {
         })
         .collect();
     Ok((info.width, info.height, texels))
+}
+
+/// A map beside a fit's record (`fit.json`) must be the file it lists, and a map `xylem fit`
+/// wrote (its `Software` text chunk) must have that record beside it: a fit killed while
+/// committing leaves maps without a record, never a set of two runs read as one.
+fn check_fit_record(path: &Path, text: &[(String, String)]) -> Result<(), String> {
+    use crate::fit::maps::{FIT_PNG_MARK, FIT_RECORD};
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+    let by_fit = (text.iter()).any(|(k, v)| k == FIT_PNG_MARK.0 && v == FIT_PNG_MARK.1);
+    let record = dir.join(FIT_RECORD);
+    if std::fs::symlink_metadata(&record).is_err() {
+        return match by_fit {
+            true => Err(format!("written by `xylem fit`, but {} is missing: an incomplete fit (its record is written last); fit again", record.display())),
+            false => Ok(()),
+        };
+    }
+    match crate::output::check_member(dir, FIT_RECORD, name)? {
+        false if by_fit => Err(format!(
+            "written by `xylem fit`, but not listed in {}: another fit's map",
+            record.display()
+        )),
+        _ => Ok(()),
+    }
 }
 
 impl MeasuredBoard {

@@ -45,9 +45,39 @@ pub fn encode_png_rgb8(
     rgb: &[u8],
     tag: PngTag,
 ) -> Result<(), png::EncodingError> {
-    let mut w = encoder(out, width, height, tag).write_header()?;
+    encode_png_rgb8_text(out, width, height, rgb, tag, &[])
+}
+
+/// [`encode_png_rgb8`] with `tEXt` chunks (keyword, Latin-1 text), e.g. who wrote the file.
+pub fn encode_png_rgb8_text(
+    out: impl std::io::Write,
+    width: u32,
+    height: u32,
+    rgb: &[u8],
+    tag: PngTag,
+    text: &[(&str, &str)],
+) -> Result<(), png::EncodingError> {
+    let mut enc = encoder(out, width, height, tag);
+    for (k, v) in text {
+        enc.add_text_chunk(k.to_string(), v.to_string())?;
+    }
+    let mut w = enc.write_header()?;
     w.write_image_data(rgb)?;
     w.finish()
+}
+
+/// An sRGB-tagged PNG with `tEXt` chunks, staged beside `path` to [`commit`] later.
+pub fn stage_png_rgb8_text(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgb: &[u8],
+    text: &[(&str, &str)],
+) -> Result<Staged, ImageError> {
+    check_rgb8(path, width, height, rgb)?;
+    stage(path, |out| {
+        encode_png_rgb8_text(out, width, height, rgb, PngTag::Srgb, text).map_err(png_error(path))
+    })
 }
 
 /// Checks that `rgb` holds `width × height` RGB pixels, naming `path` if not.
@@ -291,6 +321,19 @@ pub fn decode_png(
     transformations: png::Transformations,
     extra_bytes_per_pixel: u64,
 ) -> Result<(png::OutputInfo, Vec<u8>), String> {
+    decode_png_text(path, input, transformations, extra_bytes_per_pixel).map(|(i, b, _)| (i, b))
+}
+
+/// A PNG's `tEXt` chunks: (keyword, text).
+pub type PngText = Vec<(String, String)>;
+
+/// [`decode_png`] with the `tEXt` chunks read before the image data.
+pub fn decode_png_text(
+    path: &Path,
+    input: impl std::io::Read,
+    transformations: png::Transformations,
+    extra_bytes_per_pixel: u64,
+) -> Result<(png::OutputInfo, Vec<u8>, PngText), String> {
     let limits = png::Limits {
         bytes: PNG_DECODER_BYTES,
     };
@@ -298,6 +341,9 @@ pub fn decode_png(
     dec.set_transformations(transformations);
     let mut reader = dec.read_info().map_err(|e| e.to_string())?;
     let (w, h) = (reader.info().width, reader.info().height);
+    let text: PngText = (reader.info().uncompressed_latin1_text.iter())
+        .map(|t| (t.keyword.clone(), t.text.clone()))
+        .collect();
     let (color, depth) = reader.output_color_type();
     let sample_bytes = if depth == png::BitDepth::Sixteen {
         2
@@ -315,7 +361,7 @@ pub fn decode_png(
     let mut buf = vec![0; reader.output_buffer_size()];
     let info = reader.next_frame(&mut buf).map_err(|e| e.to_string())?;
     buf.truncate(info.buffer_size());
-    Ok((info, buf))
+    Ok((info, buf, text))
 }
 
 /// Opens `path` for [`decode_png`] (a regular file of at most

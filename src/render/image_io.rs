@@ -208,13 +208,19 @@ fn sort_header_attributes(bytes: &mut [u8]) -> Result<(), String> {
 /// Text attributes of an EXR header, (name, value): e.g. `("spp", "64")`.
 pub type ExrMeta<'a> = &'a [(&'a str, String)];
 
-/// An EXR text attribute: OpenEXR text is 8-bit (Latin-1 here); other characters become `?`.
+/// An EXR text attribute in printable ASCII, every other character escaped as `\u{f1}`:
+/// OpenEXR stores bytes with no encoding named, and its Python bindings refuse non-UTF-8 ones
+/// (a Latin-1 `ñ`), so only ASCII reads the same everywhere; the escape keeps the name.
 fn exr_text(s: &str) -> exr::prelude::Text {
-    let latin1: String = s
-        .chars()
-        .map(|c| if (c as u32) < 256 { c } else { '?' })
-        .collect();
-    exr::prelude::Text::new_or_panic(latin1)
+    let mut ascii = String::with_capacity(s.len());
+    for c in s.chars() {
+        if c.is_ascii() && !c.is_ascii_control() {
+            ascii.push(c);
+        } else {
+            ascii += &format!("\\u{{{:x}}}", c as u32);
+        }
+    }
+    exr::prelude::Text::new_or_panic(ascii)
 }
 
 /// Writes a rendered image as EXR: beauty `R G B A` (alpha = the fraction of the pixel's camera
@@ -452,7 +458,8 @@ mod tests {
         let get = |k: &str| text.iter().find(|(n, _)| n == k).unwrap().1.clone();
         assert_eq!(get("software"), version);
         assert_eq!(get("spp"), "64");
-        assert_eq!(get("scene"), "board ? ø");
+        // Printable ASCII, everything else escaped (OpenEXR names no encoding).
+        assert_eq!(get("scene"), "board \\u{2013} \\u{f8}");
     }
 
     /// Every compression xylem offers; the match fails to compile when one is added and not

@@ -150,6 +150,14 @@ pub enum RenderError {
         /// rayon's message.
         message: String,
     },
+    /// The caller asked the run to stop ([`crate::progress::Progress::stop`]).
+    #[error("stopped before the render finished ({done} of {total} tiles)")]
+    Stopped {
+        /// Tiles finished.
+        done: u64,
+        /// Tiles in the render.
+        total: u64,
+    },
     /// An image with no pixels.
     #[error("image size {width}x{height} is empty")]
     EmptyImage {
@@ -174,9 +182,11 @@ pub const TILE: u32 = 16;
 /// let out = xylem::render::render(&loaded.scene, &loaded.settings, &Default::default())?;
 /// assert_eq!(out.image.beauty.len(), 32 * 24);
 /// // Beauty with alpha, the AOV layers and the settings in the header:
-/// let dir = tempfile::tempdir()?;
+/// let dir = std::env::temp_dir().join(format!("xylem-doc-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
 /// let meta = loaded.settings.exr_meta(&loaded.name, "scenes/sweep_board.toml", &loaded.scene.camera);
-/// xylem::render::image_io::write_image_exr(&dir.path().join("board.exr"), &out.image, &meta)?;
+/// xylem::render::image_io::write_image_exr(&dir.join("board.exr"), &out.image, &meta)?;
+/// # std::fs::remove_dir_all(&dir)?;
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn render(
@@ -279,21 +289,33 @@ pub fn render_frames(
     let tiles_done = AtomicU64::new(0);
     let total_rays = AtomicU64::new(0);
     let start = Instant::now();
-    let results: Vec<(UVec2, TileFrames)> = pool.install(|| {
+    let stopped = std::sync::atomic::AtomicBool::new(false);
+    let results: Vec<Option<(UVec2, TileFrames)>> = pool.install(|| {
         tiles
             .par_iter()
             .map(|&origin| {
+                if stopped.load(Ordering::Relaxed) || run.progress.stop() {
+                    stopped.store(true, Ordering::Relaxed);
+                    return None;
+                }
                 let tile = render_tile(scene, lights, &shadow, settings, origin);
                 let total = total_rays.fetch_add(tile.rays, Ordering::Relaxed) + tile.rays;
                 let secs = start.elapsed().as_secs_f64().max(1e-9);
                 let done = tiles_done.fetch_add(1, Ordering::Relaxed) + 1;
                 let rate = format!("{:.2} Mrays/s", total as f64 / secs / 1e6);
                 run.progress.update(done, n_tiles, &rate);
-                (origin, tile)
+                Some((origin, tile))
             })
             .collect()
     });
     run.progress.finish();
+    if stopped.into_inner() {
+        return Err(RenderError::Stopped {
+            done: tiles_done.into_inner(),
+            total: n_tiles,
+        });
+    }
+    let results = results.into_iter().flatten();
     let n = (w * h) as usize;
     let mut frames: Vec<FrameImage> = (0..lights.len())
         .map(|_| FrameImage {

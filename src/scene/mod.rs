@@ -1021,6 +1021,24 @@ impl Builder<'_> {
                     self.range(&f("profile"), q[0], 0.0, 1e9)?;
                     self.range(&f("profile"), q[1], -1e9, 1e9)?;
                 }
+                // Its triangle count is known before it is built: a long profile at 4096
+                // segments is billions of triangles, refused before a vertex is allocated.
+                let triangles = 2 * (p.len() as u64 - 1) * segments as u64;
+                let bytes = crate::render::resources::BUILD_BYTES_PER_TRIANGLE;
+                crate::render::resources::Resources {
+                    what: format!(
+                        "{} ({} profile points × {segments} segments = {triangles} triangles)",
+                        f("profile"),
+                        p.len()
+                    ),
+                    memory: triangles * bytes,
+                    disk: 0,
+                }
+                .check(self.base, self.ignore_limits)
+                .map_err(|source| SceneError::Resources {
+                    path: self.path.to_string(),
+                    source,
+                })?;
                 let pts: Vec<Vec2> = p.iter().map(|q| Vec2::new(q[0], q[1])).collect();
                 shapes::make_lathe(&pts, segments)
             }

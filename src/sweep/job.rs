@@ -329,7 +329,7 @@ fn check_same_sweep(dir: &Path, ours: &Manifest) -> Result<(), SweepError> {
             format!("{}, other lights or camera pose", summary(&m))
         }
         Ok(m) => summary(&m),
-        Err(e) => format!("unreadable: {e}"),
+        Err(e) => format!("unreadable: {}", crate::jsonpath::describe(&text, &e)),
     };
     Err(SweepError::OtherSweep {
         path: file.display().to_string(),

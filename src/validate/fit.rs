@@ -370,15 +370,49 @@ pub fn fit_and_compare(
     ))
 }
 
+/// How the simulated camera of [`to_camera_frames`] sets its one exposure for the sweep.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Exposure {
+    /// The brightest pixel of the wood at 90 % of full scale, the finish's mirror glint of the
+    /// sphere light left out (the fit's own glint mask, `CaptureFrame::glint`) and let clip,
+    /// as a photographer meters on the subject.
+    Wood,
+    /// The brightest pixel of the sweep at 90 % of full scale. On a board wider than about
+    /// 24 mm that pixel is the glint, far brighter than the wood, which the 8-bit frames then hold in a few codes
+    /// (kept to show why: tests/fit_roundtrip.rs).
+    BrightestPixel,
+}
+
+/// The brightest value (any channel) of the frames' pixels that see the board outside the
+/// glint of that frame's light.
+fn wood_peak(src: &Path, frames: &[(usize, usize, Vec<Vec3>)]) -> Result<f32, String> {
+    let capture = Capture::open(src).map_err(|e| e.to_string())?;
+    let (cam, board) = (&capture.camera, &capture.board);
+    let mut peak = 0.0f32;
+    for (f, (w, _, px)) in capture.frames.iter().zip(frames) {
+        for (i, p) in px.iter().enumerate() {
+            let (x, y) = ((i % w) as f32 + 0.5, (i / w) as f32 + 0.5);
+            let (o, d) = cam.ray(x, y);
+            let Some(q) = board.hit(o, d) else { continue };
+            if !f.glint(q, cam.view_dir(q), board.z) && p.is_finite() {
+                peak = peak.max(p.max_element());
+            }
+        }
+    }
+    Ok(peak)
+}
+
 /// The camera version of a rendered capture (notes/fit.md §5): every frame scaled by one
-/// exposure (the brightest pixel of the sweep at 90 % of full scale), Poisson shot noise for
-/// `full_well` electrons at full scale (Gaussian approximation, seeded; `None`: none), encoded
-/// as 8-bit sRGB PNG; the manifest's intensities scaled by the same exposure.
+/// exposure (`exposure`: the brightest wood pixel at 90 % of full scale, glint left to clip),
+/// Poisson shot noise for `full_well` electrons at full scale (Gaussian approximation, seeded;
+/// `None`: none), encoded as 8-bit sRGB PNG; the manifest's intensities scaled by the same
+/// exposure.
 pub fn to_camera_frames(
     src: &Path,
     dst: &Path,
     full_well: Option<f32>,
     seed: u64,
+    exposure: Exposure,
 ) -> Result<(), String> {
     std::fs::create_dir_all(dst).map_err(|e| format!("{}: {e}", dst.display()))?;
     let text =
@@ -389,10 +423,13 @@ pub fn to_camera_frames(
         .iter()
         .map(|f| read_exr_rgb(&src.join(&f.image)).map_err(|e| e.to_string()))
         .collect::<Result<_, _>>()?;
-    let peak = frames
-        .iter()
-        .flat_map(|f| f.2.iter().map(|p| p.max_element()))
-        .fold(0.0f32, f32::max);
+    let peak = match exposure {
+        Exposure::Wood => wood_peak(src, &frames)?,
+        Exposure::BrightestPixel => frames
+            .iter()
+            .flat_map(|f| f.2.iter().map(|p| p.max_element()))
+            .fold(0.0f32, f32::max),
+    };
     let exposure = 0.9 / peak.max(1e-12);
     let enc = Srgb8::new();
     for (k, (f, (w, h, px))) in m.frames.iter_mut().zip(&frames).enumerate() {
@@ -536,7 +573,8 @@ fn side_by_side(truth: &MeasuredBoard, fitted: &FittedMaps) -> crate::picture::c
 
 /// Runs the round trips of every board (EXR and camera PNG), the curves over frames, arcs and
 /// noise, and returns validation/FIT.md's Markdown and whether every goal was met. Plots go to
-/// `dir/plots/`, the captures to `work`.
+/// `dir/plots/` with the README's figure ([`README_FIGURE`]), the captures to `work`; nothing
+/// is written anywhere else.
 pub fn run_report(
     base: &Path,
     dir: &Path,
@@ -586,7 +624,7 @@ pub fn run_report(
         )
         .map_err(|e| e.to_string())?;
         let png = w.join("camera");
-        to_camera_frames(&rt.sweep_dir, &png, Some(FULL_WELL), 17)?;
+        to_camera_frames(&rt.sweep_dir, &png, Some(FULL_WELL), 17, Exposure::Wood)?;
         let (e, _, t) = fit_and_compare(&png, None, true, &rt)?;
         let ok = e.meets(&GOALS);
         all_ok &= ok;
@@ -616,14 +654,14 @@ pub fn run_report(
         let mut nc = Vec::new();
         for fw in [16000.0f32, 4000.0, 1000.0, 250.0] {
             let d = w.join(format!("noise{fw}"));
-            to_camera_frames(&rt.sweep_dir, &d, Some(fw), 23)?;
+            to_camera_frames(&rt.sweep_dir, &d, Some(fw), 23, Exposure::Wood)?;
             let (e, _, _) = fit_and_compare(&d, None, true, &rt)?;
             nc.push((fw as f64, e));
         }
         noise_curve.push((name, nc));
     }
     progress("re-render");
-    readme_figure(base, work, spec)?;
+    readme_figure(base, work, spec, &plots.join(README_FIGURE))?;
     let mut md = format!(
         "# Fit validation: per-texel fibre-BSDF parameters measured back from light sweeps\n\n\
          Written by `cargo run --release -- validate fit` (src/validate/fit.rs; derivations in \
@@ -635,8 +673,8 @@ pub fn run_report(
          500 mm (its solid angle is the renderer's noise), orthographic camera straight down, \
          {px}×{px} pixels per texel. `xylem sweep`'s job writes the frames and the manifest; \
          `xylem fit`'s code fits them; every error is against the maps the renderer read. The \
-         camera capture is the same sweep as 8-bit sRGB PNGs exposed so the brightest pixel is \
-         at 90 % of full scale, with Poisson shot noise of {fw} electrons at full scale.\n\n\
+         camera capture is the same sweep as 8-bit sRGB PNGs exposed so the brightest pixel of \
+         the wood is at 90 % of full scale (the finish's mirror glint of the light left to clip), with Poisson shot noise of {fw} electrons at full scale.\n\n\
          Goals (issue 13): fibre-axis angle median ≤ 2°, p90 ≤ 5°; diffuse relative error \
          median ≤ 3 %; fibre colour ≤ 10 %; β ≤ 15 %.\n\n",
         n = spec.texels,
@@ -719,13 +757,24 @@ pub fn run_report(
             name.replace(' ', "_")
         );
     }
+    md += &format!(
+        "## The README's figure\n\nThe measured maple crop rendered (light 20° from the zenith along the grain), its fitted maps (diffuse, fibre colour, axis) and the fit re-rendered under the same light.\n\n![measured maple, fitted maps, re-rendered fit](plots/{README_FIGURE})\n"
+    );
     Ok((md, all_ok))
 }
 
-/// notes/images/fit_maple.png: the measured maple crop rendered (light 20° from the zenith along
-/// the grain), its fitted maps (diffuse, fibre colour ×3, fibre axis), and the fitted maps
-/// re-rendered through the `measured` material under the same light.
-pub fn readme_figure(base: &Path, work: &Path, spec: &SweepSpec) -> Result<(), String> {
+/// The README's figure of the fit, written beside the report's plots (`plots/fit_maple.png`).
+pub const README_FIGURE: &str = "fit_maple.png";
+
+/// The README's figure, written to `path`: the measured maple crop rendered (light 20° from the
+/// zenith along the grain), its fitted maps (diffuse, fibre colour ×3, fibre axis), and the
+/// fitted maps re-rendered through the `measured` material under the same light.
+pub fn readme_figure(
+    base: &Path,
+    work: &Path,
+    spec: &SweepSpec,
+    path: &Path,
+) -> Result<(), String> {
     use crate::picture::contact::{contact_sheet_rows, Rgb8};
     let w = work.join("readme");
     let source = Source::Measured {
@@ -795,7 +844,6 @@ pub fn readme_figure(base: &Path, work: &Path, spec: &SweepSpec) -> Result<(), S
     .map(|s| s.to_string())
     .collect();
     let sheet = contact_sheet_rows(&thumbs, &labels, 5, 4);
-    let path = base.join("notes/images/fit_maple.png");
-    crate::picture::png::write_png_rgb8(&path, sheet.width, sheet.height, &sheet.data)
+    crate::picture::png::write_png_rgb8(path, sheet.width, sheet.height, &sheet.data)
         .map_err(|e| format!("{}: {e}", path.display()))
 }

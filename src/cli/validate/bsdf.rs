@@ -18,7 +18,9 @@ pub struct Args {
     /// Also write every measured number as JSON here.
     #[arg(long)]
     json: Option<PathBuf>,
-    /// Divide every sample count by this factor (a quick look; the defaults are the real check).
+    /// Divide every sample count by this factor (a quick look; the defaults are the real
+    /// check): 1 up to where the chi-square test keeps 10 samples per histogram cell on average
+    /// (24 for the committed cases). A reduced run must name its --report (or give --no-report).
     #[arg(long)]
     reduce: Option<u32>,
     /// Do not touch the report or write plots.
@@ -29,15 +31,33 @@ pub struct Args {
     from_json: Option<PathBuf>,
 }
 
+/// The largest `--reduce` at which the chi-square test keeps 10 samples per histogram cell on
+/// average (Pearson's statistic is chi-square distributed only with enough per cell; pooling
+/// cells under `chi2_min_expected` is not enough below that: measured, a correct sampler failed
+/// at 50 with the committed cases and passed at 10 and 20).
+fn max_reduce(s: &crate::validate::bsdf::Settings) -> u32 {
+    let cells = 10 * s.chi2_theta_bins as u64 * s.chi2_phi_bins as u64;
+    (s.chi2_samples as u64 / cells.max(1)).clamp(1, u32::MAX as u64) as u32
+}
+
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let cases = args
         .cases
         .unwrap_or_else(|| PathBuf::from("validation/bsdf_cases.toml"));
-    let report = args
-        .report
-        .unwrap_or_else(|| PathBuf::from("validation/REPORT.md"));
     let mut suite = load_suite(&cases).context("loading the BSDF validation cases")?;
-    if let Some(k) = args.reduce.filter(|&k| k > 1) {
+    let reduce = args.reduce.unwrap_or(1);
+    let most = max_reduce(&suite.settings);
+    anyhow::ensure!(
+        (1..=most).contains(&reduce),
+        "--reduce {reduce}: allowed 1 to {most} for {}: the chi-square test needs 10 samples per histogram cell on average (chi2_samples {} / reduce ≥ 10 × {}×{} cells); with fewer its statistic is no longer chi-square distributed and a correct sampler fails (at 50: p = 1.1e-5)",
+        cases.display(),
+        suite.settings.chi2_samples,
+        suite.settings.chi2_theta_bins,
+        suite.settings.chi2_phi_bins,
+    );
+    let reduced = (reduce > 1 && !args.no_report).then(|| format!("--reduce {reduce}"));
+    let report = crate::cli::output_path(args.report, "validation/REPORT.md", "--report", reduced)?;
+    if let Some(k) = Some(reduce).filter(|&k| k > 1) {
         let s = &mut suite.settings;
         s.furnace_samples = (s.furnace_samples / k).max(1000);
         s.chi2_samples = (s.chi2_samples / k).max(10_000);

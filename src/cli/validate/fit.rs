@@ -1,5 +1,5 @@
 //! `xylem validate fit`: round trips of known boards through sweep and fit; writes
-//! validation/FIT.md with its plots. Exits non-zero when a goal is missed.
+//! validation/FIT.md (or --report) with its plots and figure beside it. Exits non-zero when a goal is missed.
 
 use crate::validate::fit::{run_report, SweepSpec};
 use anyhow::Context;
@@ -8,24 +8,26 @@ use std::process::ExitCode;
 
 #[derive(clap::Args, Debug, Default)]
 pub struct Args {
-    /// Report to write [default: validation/FIT.md]; plots go beside it in plots/.
+    /// Report to write [default: validation/FIT.md]; its plots and the README's figure
+    /// (`fit_maple.png`) go beside it in plots/, nothing anywhere else. A reduced run
+    /// (`--texels` other than 64) must name it.
     #[arg(long)]
     report: Option<PathBuf>,
-    /// Texels along each side of every board (default 64).
+    /// Texels along each side of every board, 4 to 390 (default 64, the full validation).
     #[arg(long)]
     texels: Option<usize>,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let report = args
-        .report
-        .unwrap_or_else(|| PathBuf::from("validation/FIT.md"));
-    let dir = report.parent().map(Path::to_path_buf).unwrap_or_default();
     let mut spec = SweepSpec::full();
     if let Some(n) = args.texels {
         anyhow::ensure!((4..=390).contains(&n), "--texels {n}: allowed 4 to 390");
         spec.texels = n;
     }
+    let reduced =
+        (spec.texels != SweepSpec::full().texels).then(|| format!("--texels {}", spec.texels));
+    let report = crate::cli::output_path(args.report, "validation/FIT.md", "--report", reduced)?;
+    let dir = report.parent().map(Path::to_path_buf).unwrap_or_default();
     let work = tempfile::tempdir().context("creating a temporary folder for the captures")?;
     let bar = indicatif::ProgressBar::new(4).with_style(
         indicatif::ProgressStyle::with_template("validate fit {bar:40} {pos}/{len} {msg}")
