@@ -24,7 +24,7 @@ use glam::Vec3;
 /// Immutable after construction, so it is `Send + Sync` and `eval` allocates nothing.
 ///
 /// ```
-/// use glam::Vec3;
+/// use xylem::math::Vec3;
 /// use xylem::wood::{preset, Needs, WoodVolume};
 ///
 /// // A built-in species preset, tree seed 7; points are tree space in mm (pith along z).
