@@ -154,7 +154,7 @@ pub(crate) fn output_path(
         (Some(p), _) => Ok(p),
         (None, None) => Ok(default.into()),
         (None, Some(how)) => anyhow::bail!(
-            "{how} is a reduced run: it would overwrite the full results in {default}; name where it should write with {option} (e.g. {option} /tmp/xylem-reduced/{})",
+            "{how} is a reduced run: it would overwrite the full results in {default}; name where it should write with {option} (e.g. {option} out/reduced/{})",
             std::path::Path::new(default)
                 .file_name()
                 .map_or(String::new(), |n| n.to_string_lossy().into_owned())

@@ -352,7 +352,7 @@ pub fn fit_folder(
     let mut res: Vec<f32> = maps.residual.clone();
     res.sort_by(f32::total_cmp);
     let median = res.get(res.len() / 2).copied().unwrap_or(f32::NAN);
-    let report = serde_json::json!({
+    let mut report = serde_json::json!({
         "sweep": sweep.display().to_string(),
         "texels": [maps.width, maps.height],
         "frames": stats.frames,
@@ -365,7 +365,6 @@ pub fn fit_folder(
         "fit_seconds": stats.fit_time.as_secs_f64(),
     });
     write_maps(out, &maps, &report)?;
-    let mut report = report;
     if 2 * stats.texels_failed > maps.width * maps.height {
         // Not in fit.json: a caller's note on this run, printed by `xylem fit`.
         report["warning"] = format!(

@@ -1,7 +1,7 @@
 # Shared by the figure scripts of notes/cluster.md: the binary, a work folder, and the board at
 # 256x256 (its region scaled to 256²) at the spp given.
 XYLEM=${XYLEM:-$PWD/target/release/xylem}
-WORK=${WORK:-/tmp/xylem-cluster-figures}
+WORK=${WORK:-$PWD/out/cluster-figures}
 ROOT=$PWD
 mkdir -p "$WORK"
 board256() { # board256 SPP -> path of the scene
