@@ -250,3 +250,43 @@ fn calibrated_presets_keep_the_pattern_rows_they_reach() {
         assert!(!lost.is_empty(), "{name}: the control passes every row");
     }
 }
+
+/// The fibre axis a preset's board map reports is that of the lobe that dominates its BSDF blend
+/// (notes/appearance.md §10), as a per-texel fit to a photographed board reports it: where the ray
+/// fibres' weight exceeds ½ (a quartersawn face through a ray), the axis is the ray's, radial, so
+/// it lies in the face across the grain. Control: the same rays at weight 0.45 never dominate,
+/// and no texel's axis leaves the grain by more than 45°.
+#[test]
+fn ray_texels_report_the_ray_axis_where_the_ray_lobe_dominates() {
+    let source = std::fs::read_to_string(base().join("scenes/presets/padauk.toml")).unwrap();
+    let start = source.find("[rays]").unwrap();
+    let end = start + source[start..].find("\n\n").unwrap();
+    let steep = |strength: f64| -> f64 {
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("rays_{strength}"));
+        std::fs::create_dir_all(&dir).unwrap();
+        let rays = format!(
+            "[rays]\nwidth = 0.05\nheight = 0.3\nlength = 3.0\ndensity = 0.1\nstrength = {strength}"
+        );
+        let text = format!("{}{}{}", &source[..start], rays, &source[end..]);
+        std::fs::write(dir.join("padauk.toml"), text).unwrap();
+        let maps = Subject::Preset {
+            name: "padauk".into(),
+            seed: 7,
+            dir: Some(dir),
+            ring_angle_deg: 90.0,
+        }
+        .maps(base())
+        .unwrap();
+        let n = maps.board.fiber_axis.len();
+        (0..n)
+            .filter(|&i| maps.in_plane_deg(i).abs() > 45.0)
+            .count() as f64
+            / n as f64
+    };
+    let (dominant, weak) = (steep(1.0), steep(0.45));
+    println!(
+        "texels more than 45° off the grain: rays at weight 1: {dominant:.4}, at 0.45: {weak:.4}"
+    );
+    assert!(dominant > 0.002, "{dominant}");
+    assert_eq!(weak, 0.0);
+}

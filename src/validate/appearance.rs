@@ -161,9 +161,14 @@ impl BoardMaps {
                 let t = volume.eval(q, needs);
                 board.diffuse.push(t.diffuse);
                 board.fiber_color.push(t.fiber_color);
+                let dominant = if t.ray_mask > 0.5 {
+                    t.ray_dir
+                } else {
+                    t.fiber_dir
+                };
                 board
                     .fiber_axis
-                    .push((j.transpose() * t.fiber_dir).normalize_or_zero());
+                    .push((j.transpose() * dominant).normalize_or_zero());
             }
         }
         BoardMaps {

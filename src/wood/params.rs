@@ -492,7 +492,7 @@ impl Checker<'_> {
         if !(1..=8).contains(&n.bands) {
             return Err(self.err(&format!("{name}.bands"), n.bands, "1..=8".into()));
         }
-        self.range(&format!("{name}.size_factor"), n.size_factor, 0.1, 0.9)?;
+        self.range(&format!("{name}.size_factor"), n.size_factor, 0.02, 0.9)?;
         self.range(&format!("{name}.dropoff"), n.dropoff, 0.0, 4.0)
     }
 }
