@@ -246,3 +246,69 @@ fn sweep_res_and_frame_headers() {
         "{e}"
     );
 }
+
+#[test]
+fn unwritable_output_folders_are_named_not_measured() {
+    let tmp = tempfile::tempdir().unwrap();
+    let small = ["--res", "8x6", "--spp", "1", "--quiet"];
+    // /proc is a read-only file system even for root: before, "needs about … but 0.0 MiB is
+    // available".
+    for cmd in [
+        &["render", "sweep_board"][..],
+        &["sweep", "sweep_board", "--frames", "2"][..],
+    ] {
+        let o = xylem(
+            &[cmd, &small[..], &["--out", "/proc/xylem-out"]].concat(),
+            tmp.path(),
+        );
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{e}");
+        assert!(
+            e.contains("cannot write into the output folder /proc/xylem-out"),
+            "{e}"
+        );
+        assert!(
+            e.contains("tried /proc, where it would be made") && e.contains("--out"),
+            "{e}"
+        );
+        assert!(!e.contains("MiB"), "{e}");
+    }
+    // A file where the folder should be.
+    std::fs::write(tmp.path().join("afile"), "x").unwrap();
+    let o = xylem(
+        &[
+            &["render", "sweep_board"][..],
+            &small[..],
+            &["--out", "afile"],
+        ]
+        .concat(),
+        tmp.path(),
+    );
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("cannot write into the output folder afile") && e.contains("is not a folder"),
+        "{e}"
+    );
+    // The control: a writable folder that does not exist yet is made and written, and the
+    // probe leaves nothing behind.
+    let o = xylem(
+        &[
+            &["render", "sweep_board"][..],
+            &small[..],
+            &["--out", "new/dir"],
+        ]
+        .concat(),
+        tmp.path(),
+    );
+    ok(&o);
+    let left: Vec<_> = std::fs::read_dir(tmp.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert!(
+        left.iter()
+            .all(|n| !n.to_string_lossy().contains("write-probe")),
+        "{left:?}"
+    );
+    assert!(tmp.path().join("new/dir/sweep_board.png").exists());
+}

@@ -65,7 +65,10 @@ pub fn main() -> ExitCode {
     // Output piped into a reader that stops early (`xylem … | head`) ends the program quietly
     // with SIGPIPE's usual status, as any Unix tool, instead of a panic on the failed print.
     // SAFETY: restores the default action of one signal.
-    unsafe { libc::signal(libc::SIGPIPE, libc::SIG_DFL) };
+    #[cfg(unix)]
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL)
+    };
     // A forced SIMD level with an unknown name is refused here, before any work.
     if let Err(e) = crate::simd::Simd::from_env() {
         eprintln!("error: {e}");
