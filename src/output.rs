@@ -55,7 +55,13 @@ impl Drop for Live {
 /// status still tells the signal). The handler only writes the signal's number to a pipe; a
 /// thread waiting on the pipe removes the files, holding the registry's lock so that no new
 /// temporary appears meanwhile, and re-raises the signal. For the `xylem` binary: a library
-/// embedder (Python) keeps its own signal handling.
+/// embedder (Python) keeps its own signal handling. Unix only: elsewhere a killed run's
+/// temporaries stay (they carry the `.xylem-tmp.` mark and are never taken for outputs).
+#[cfg(not(unix))]
+pub fn remove_temporaries_on_signal() {}
+
+/// See the non-Unix stand-in above for what this does.
+#[cfg(unix)]
 pub fn remove_temporaries_on_signal() {
     use std::sync::atomic::{AtomicI32, Ordering};
     static PIPE: AtomicI32 = AtomicI32::new(-1);
@@ -190,13 +196,22 @@ fn checksum(mut r: impl Read) -> io::Result<(u64, u32)> {
 /// What marks xylem's temporary names: `.NAME.xylem-tmp.HOST-PID-RANDOM.tmp`.
 const TMP_MARK: &str = ".xylem-tmp.";
 
-/// This host's name (`gethostname`), or `host` where unknown.
+/// This host's name (`gethostname`; `COMPUTERNAME` on Windows), or `host` where unknown.
 fn host() -> String {
-    let mut buf = [0u8; 256];
-    // SAFETY: `buf` is writable for its length; the name is NUL-terminated when it fits.
-    let ok = unsafe { libc::gethostname(buf.as_mut_ptr().cast(), buf.len()) } == 0;
-    let end = buf.iter().position(|&b| b == 0).unwrap_or(0);
-    let name = String::from_utf8_lossy(&buf[..end]).replace(['/', '-'], "_");
+    #[cfg(unix)]
+    let (ok, raw) = {
+        let mut buf = [0u8; 256];
+        // SAFETY: `buf` is writable for its length; the name is NUL-terminated when it fits.
+        let ok = unsafe { libc::gethostname(buf.as_mut_ptr().cast(), buf.len()) } == 0;
+        let end = buf.iter().position(|&b| b == 0).unwrap_or(0);
+        (ok, String::from_utf8_lossy(&buf[..end]).into_owned())
+    };
+    #[cfg(not(unix))]
+    let (ok, raw) = match std::env::var("COMPUTERNAME") {
+        Ok(n) => (true, n),
+        Err(_) => (false, String::new()),
+    };
+    let name = raw.replace(['/', '-'], "_");
     if ok && !name.is_empty() {
         name
     } else {
@@ -204,7 +219,15 @@ fn host() -> String {
     }
 }
 
+/// Whether process `pid` of this host is alive; without `kill(pid, 0)` (not Unix) every process
+/// counts as alive, so no temporary is ever taken from a live run.
+#[cfg(not(unix))]
+fn alive(_pid: i32) -> bool {
+    true
+}
+
 /// Whether process `pid` of this host is alive (`kill(pid, 0)`: no such process means dead).
+#[cfg(unix)]
 fn alive(pid: i32) -> bool {
     // SAFETY: signal 0 only checks for the process.
     let r = unsafe { libc::kill(pid, 0) };

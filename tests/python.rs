@@ -216,7 +216,7 @@ fn render_case() -> Value {
     })
 }
 
-/// The package as pip would install it: python/xylem/*.py and the extension module that this
+/// The package as pip would install it: python/xylem/*.py, *.pyi, py.typed and the extension module that this
 /// `cargo test` built (the `_xylem` example, from python/src/lib.rs) in target/python-test/site.
 fn stage_package(dir: &Path) -> PathBuf {
     let exe = std::env::current_exe().expect("test binary path");
@@ -236,7 +236,9 @@ fn stage_package(dir: &Path) -> PathBuf {
     std::fs::create_dir_all(&pkg).unwrap();
     for entry in std::fs::read_dir(root().join("python/xylem")).unwrap() {
         let p = entry.unwrap().path();
-        if p.extension().is_some_and(|e| e == "py") {
+        // Sources, type stubs and the PEP 561 marker, as the wheel carries them.
+        let name = p.file_name().unwrap().to_string_lossy();
+        if p.extension().is_some_and(|e| e == "py" || e == "pyi") || name == "py.typed" {
             std::fs::copy(&p, pkg.join(p.file_name().unwrap())).unwrap();
         }
     }

@@ -41,6 +41,12 @@ fn validate_fit_writes_only_beside_its_report() {
     // Exit 0 (goals met) or 1 (a goal missed at 8 texels), never an error about a path.
     assert!(matches!(o.status.code(), Some(0 | 1)), "{e}");
     assert!(!e.contains("error"), "{e}");
+    // Progress on stderr although it is not a terminal (issue 30: minutes of silence before):
+    // a first line, then one per board with its count.
+    assert!(e.contains("validate fit: 4 boards to run"), "{e}");
+    for k in 1..=4 {
+        assert!(e.contains(&format!("validate fit: {k}/4 boards, ")), "{e}");
+    }
     let got = files(dir);
     assert!(got.iter().all(|f| f.starts_with("r/")), "{got:?}");
     for f in ["r/FIT.md", "r/plots/fit_maple.png", "r/plots/fit_noise.png"] {

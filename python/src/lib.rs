@@ -1,24 +1,32 @@
 //! Python bindings of xylem (PyO3 + numpy), the native module `xylem._xylem` behind the `xylem`
-//! package: the finished-wood BSDF, the wood volume, a wood surface (volume + finish + tree
-//! placement, shaded in world space as the renderer shades a hit), and renders and light sweeps
-//! of scene files as numpy arrays. Every number comes from the xylem library; these functions
-//! only move arrays in and out, release the GIL while computing, and turn the library's typed
-//! errors into Python exceptions (`ValueError` for values out of range, `OSError` for files).
+//! package (distributed as `xylem-wood`): the finished-wood BSDF, the wood volume, a wood surface
+//! (volume + finish + tree placement, shaded in world space as the renderer shades a hit), and
+//! scenes (from files or Python dicts) rendered and light-swept into numpy arrays. Every number
+//! comes from the xylem library; these functions only move arrays in and out (broadcasting over
+//! leading dimensions as numpy does, `batch`), release the GIL while computing, and turn the
+//! library's typed errors into Python exceptions (`ValueError` for values out of range or not
+//! finite, `OSError` for files).
 
+mod batch;
+
+use batch::{Arg, Broadcast};
 use glam::{Mat3, Vec2, Vec3};
-use numpy::{AllowTypeChange, PyArray1, PyArray2, PyArrayLikeDyn, PyArrayMethods};
+use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
 use std::path::PathBuf;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 use xylem::bsdf::{Bsdf, BsdfSample, WoodBsdfParams};
 use xylem::material::{Cutting, Material, MaterialHit, Placement, ShadingSwitches, WoodMaterial};
 use xylem::wood::{Needs, WoodError, WoodTexel};
 
 /// Below this many items a call runs on the calling thread (rayon's start-up is not worth it).
 const PARALLEL_FROM: usize = 4096;
+
+/// An array argument: anything `numpy.asarray` turns into numbers (`batch`).
+type ArrayIn<'py> = Bound<'py, PyAny>;
 
 fn value_error(e: impl std::fmt::Display) -> PyErr {
     PyValueError::new_err(e.to_string())
@@ -44,98 +52,31 @@ fn map_indices<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T
     }
 }
 
-/// An array-like of 3-vectors: shape (3,) (one vector) or (N, 3).
-fn vec3_rows(name: &str, a: &PyArrayLikeDyn<'_, f32, AllowTypeChange>) -> PyResult<Vec<Vec3>> {
-    let v = a.as_array();
-    let shape = v.shape().to_vec();
-    let ok = match shape.as_slice() {
-        [3] | [_, 3] => true,
-        _ => false,
-    };
-    if !ok {
-        return Err(value_error(format!(
-            "{name}: shape {shape:?}, expected (3,) or (N, 3)"
-        )));
-    }
-    let flat: Vec<f32> = v.iter().copied().collect();
-    Ok(flat
-        .chunks_exact(3)
-        .map(|c| Vec3::new(c[0], c[1], c[2]))
-        .collect())
-}
-
-/// An array-like of scalars: shape () (one value) or (N,).
-fn scalars(name: &str, a: &PyArrayLikeDyn<'_, f32, AllowTypeChange>) -> PyResult<Vec<f32>> {
-    let v = a.as_array();
-    if v.ndim() > 1 {
-        return Err(value_error(format!(
-            "{name}: shape {:?}, expected () or (N,)",
-            v.shape()
-        )));
-    }
-    Ok(v.iter().copied().collect())
-}
-
-/// An array-like of 2-vectors: shape (2,) or (N, 2).
-fn vec2_rows(name: &str, a: &PyArrayLikeDyn<'_, f32, AllowTypeChange>) -> PyResult<Vec<Vec2>> {
-    let v = a.as_array();
-    let shape = v.shape().to_vec();
-    if !matches!(shape.as_slice(), [2] | [_, 2]) {
-        return Err(value_error(format!(
-            "{name}: shape {shape:?}, expected (2,) or (N, 2)"
-        )));
-    }
-    let flat: Vec<f32> = v.iter().copied().collect();
-    Ok(flat
-        .chunks_exact(2)
-        .map(|c| Vec2::new(c[0], c[1]))
-        .collect())
-}
-
-/// The arguments of a `sample` call: directions `wo`, lobe numbers `uc` and 2D numbers `u`.
-type SampleInputs = (Vec<Vec3>, Vec<f32>, Vec<Vec2>);
-
-fn sample_inputs(
-    wo: &PyArrayLikeDyn<'_, f32, AllowTypeChange>,
-    uc: &PyArrayLikeDyn<'_, f32, AllowTypeChange>,
-    u: &PyArrayLikeDyn<'_, f32, AllowTypeChange>,
-) -> PyResult<SampleInputs> {
-    Ok((vec3_rows("wo", wo)?, scalars("uc", uc)?, vec2_rows("u", u)?))
-}
-
-/// The common length of arrays that broadcast: each has length 1 or N.
-fn broadcast(lens: &[(&str, usize)]) -> PyResult<usize> {
-    let n = lens.iter().map(|l| l.1).max().unwrap_or(1);
-    for (name, len) in lens {
-        if *len != 1 && *len != n {
-            let all: Vec<String> = lens.iter().map(|(k, l)| format!("{k}: {l}")).collect();
-            return Err(value_error(format!(
-                "{name} has {len} rows; every argument needs 1 or {n} rows ({})",
-                all.join(", ")
-            )));
-        }
-        if *len == 0 {
-            return Err(value_error(format!("{name} is empty")));
-        }
-    }
-    Ok(n)
-}
-
-/// Element i of a broadcast array.
-#[inline]
-fn at<T: Copy>(v: &[T], i: usize) -> T {
-    if v.len() == 1 {
-        v[0]
-    } else {
-        v[i]
-    }
-}
-
-fn vec3_array<'py>(py: Python<'py>, v: &[Vec3]) -> PyResult<Bound<'py, PyArray2<f32>>> {
+/// An array of 3-vectors with leading shape `shape`, as shape (*shape, 3).
+fn vec3_out<'py>(py: Python<'py>, v: &[Vec3], shape: &[usize]) -> PyResult<Bound<'py, PyAny>> {
     let flat: Vec<f32> = v.iter().flat_map(|c| c.to_array()).collect();
-    PyArray1::from_vec(py, flat).reshape([v.len(), 3])
+    let mut s = shape.to_vec();
+    s.push(3);
+    Ok(PyArray1::from_vec(py, flat).reshape(s)?.into_any())
 }
 
+/// An array of scalars (f32 or bool) with shape `shape`.
+fn out<'py, T: numpy::Element>(
+    py: Python<'py>,
+    v: Vec<T>,
+    shape: &[usize],
+) -> PyResult<Bound<'py, PyAny>> {
+    Ok(PyArray1::from_vec(py, v)
+        .reshape(shape.to_vec())?
+        .into_any())
+}
+
+/// `(a, b, c)` with each number as Python reads it back exactly (f32's shortest round trip).
+fn tuple3(v: Vec3) -> String {
+    format!("({:?}, {:?}, {:?})", v.x, v.y, v.z)
+}
+
+/// The fields of `WoodBsdfParams`, in the order the constructor documents them.
 const BSDF_FIELDS: [&str; 8] = [
     "diffuse",
     "fiber_color",
@@ -148,8 +89,9 @@ const BSDF_FIELDS: [&str; 8] = [
 ];
 
 /// Per-shading-point BSDF parameters from a dict of fields, each a scalar / 3-vector or an array
-/// with one row per shading point; missing fields take `WoodBsdfParams::default()`.
-fn bsdf_params(fields: &Bound<'_, PyDict>) -> PyResult<Vec<WoodBsdfParams>> {
+/// of them over any leading shape (broadcast together); missing fields take
+/// `WoodBsdfParams::default()`. Returns the parameters, flat, and their leading shape.
+fn bsdf_params(fields: &Bound<'_, PyDict>) -> PyResult<(Vec<WoodBsdfParams>, Vec<usize>)> {
     for key in fields.keys() {
         let k: String = key.extract()?;
         if !BSDF_FIELDS.contains(&k.as_str()) {
@@ -160,22 +102,18 @@ fn bsdf_params(fields: &Bound<'_, PyDict>) -> PyResult<Vec<WoodBsdfParams>> {
         }
     }
     let d = WoodBsdfParams::default();
-    let get3 = |name: &str, default: Vec3| -> PyResult<Vec<Vec3>> {
+    let get3 = |name: &str, default: Vec3| -> PyResult<Arg<Vec3>> {
+        let field = format!("WoodBsdfParams.{name}");
         match fields.get_item(name)? {
-            Some(v) => vec3_rows(
-                &format!("WoodBsdfParams.{name}"),
-                &v.extract::<PyArrayLikeDyn<f32, AllowTypeChange>>()?,
-            ),
-            None => Ok(vec![default]),
+            Some(v) => batch::vec3(&field, &v),
+            None => Ok(Arg::one(default)),
         }
     };
-    let get1 = |name: &str, default: f32| -> PyResult<Vec<f32>> {
+    let get1 = |name: &str, default: f32| -> PyResult<Arg<f32>> {
+        let field = format!("WoodBsdfParams.{name}");
         match fields.get_item(name)? {
-            Some(v) => scalars(
-                &format!("WoodBsdfParams.{name}"),
-                &v.extract::<PyArrayLikeDyn<f32, AllowTypeChange>>()?,
-            ),
-            None => Ok(vec![default]),
+            Some(v) => batch::scalar(&field, &v),
+            None => Ok(Arg::one(default)),
         }
     };
     let (diffuse, fiber_color) = (
@@ -188,77 +126,117 @@ fn bsdf_params(fields: &Bound<'_, PyDict>) -> PyResult<Vec<WoodBsdfParams>> {
         get1("highlight_width", d.highlight_width)?,
     );
     let (eta, roughness) = (get1("eta", d.eta)?, get1("roughness", d.roughness)?);
-    let n = broadcast(&[
-        ("diffuse", diffuse.len()),
-        ("fiber_color", fiber_color.len()),
-        ("fiber_dir", fiber_dir.len()),
-        ("ray_dir", ray_dir.len()),
-        ("ray_mask", ray_mask.len()),
-        ("highlight_width", width.len()),
-        ("eta", eta.len()),
-        ("roughness", roughness.len()),
+    let b = Broadcast::new(&[
+        ("diffuse", &diffuse.lead),
+        ("fiber_color", &fiber_color.lead),
+        ("fiber_dir", &fiber_dir.lead),
+        ("ray_dir", &ray_dir.lead),
+        ("ray_mask", &ray_mask.lead),
+        ("highlight_width", &width.lead),
+        ("eta", &eta.lead),
+        ("roughness", &roughness.lead),
     ])?;
-    Ok((0..n)
+    let m = &b.maps;
+    let params = (0..b.len)
         .map(|i| WoodBsdfParams {
-            diffuse: at(&diffuse, i),
-            fiber_color: at(&fiber_color, i),
-            fiber_dir: at(&fiber_dir, i),
-            ray_dir: at(&ray_dir, i),
-            ray_mask: at(&ray_mask, i),
-            highlight_width: at(&width, i),
-            eta: at(&eta, i),
-            roughness: at(&roughness, i),
+            diffuse: diffuse.data[m[0].get(i)],
+            fiber_color: fiber_color.data[m[1].get(i)],
+            fiber_dir: fiber_dir.data[m[2].get(i)],
+            ray_dir: ray_dir.data[m[3].get(i)],
+            ray_mask: ray_mask.data[m[4].get(i)],
+            highlight_width: width.data[m[5].get(i)],
+            eta: eta.data[m[6].get(i)],
+            roughness: roughness.data[m[7].get(i)],
         })
-        .collect())
+        .collect();
+    Ok((params, b.shape))
 }
 
-/// Sample results as a dict of arrays: `wi` (N, 3), `f` (N, 3), `pdf` (N,), `is_delta` (N,),
-/// `valid` (N,); rows where sampling failed have `valid` false and zeros elsewhere.
-fn sample_dict<'py>(py: Python<'py>, s: &[Option<BsdfSample>]) -> PyResult<Bound<'py, PyDict>> {
+/// Sample results as a dict of arrays over the leading shape `shape`: `wi` (..., 3), `f` (...,
+/// 3), `pdf`, `is_delta`, `valid` (...); where sampling failed `valid` is false and the rest zero.
+fn sample_dict<'py>(
+    py: Python<'py>,
+    s: &[Option<BsdfSample>],
+    shape: &[usize],
+) -> PyResult<Bound<'py, PyDict>> {
     let get = |f: &dyn Fn(&BsdfSample) -> Vec3| -> Vec<Vec3> {
         s.iter().map(|x| x.as_ref().map_or(Vec3::ZERO, f)).collect()
     };
     let d = PyDict::new(py);
-    d.set_item("wi", vec3_array(py, &get(&|x| x.wi))?)?;
-    d.set_item("f", vec3_array(py, &get(&|x| x.f))?)?;
+    d.set_item("wi", vec3_out(py, &get(&|x| x.wi), shape)?)?;
+    d.set_item("f", vec3_out(py, &get(&|x| x.f), shape)?)?;
     let pdf: Vec<f32> = s.iter().map(|x| x.map_or(0.0, |x| x.pdf)).collect();
-    d.set_item("pdf", PyArray1::from_vec(py, pdf))?;
+    d.set_item("pdf", out(py, pdf, shape)?)?;
     let delta: Vec<bool> = s.iter().map(|x| x.is_some_and(|x| x.is_delta)).collect();
-    d.set_item("is_delta", PyArray1::from_vec(py, delta))?;
+    d.set_item("is_delta", out(py, delta, shape)?)?;
     let valid: Vec<bool> = s.iter().map(|x| x.is_some()).collect();
-    d.set_item("valid", PyArray1::from_vec(py, valid))?;
+    d.set_item("valid", out(py, valid, shape)?)?;
     Ok(d)
 }
 
-/// xylem's finished-wood BSDF (Marschner et al. 2005) for one or N shading points, in the local
-/// shading frame (z = normal, unit directions pointing away from the surface). `eval` is f
-/// without the cosine; `pdf` is per unit solid angle.
+/// The inputs of a `sample` call: directions `wo`, lobe numbers `uc` and 2D numbers `u`.
+fn sample_args(wo: &ArrayIn, uc: &ArrayIn, u: &ArrayIn) -> PyResult<SampleArgs> {
+    Ok((
+        batch::vec3("wo", wo)?,
+        batch::scalar("uc", uc)?,
+        batch::vec2("u", u)?,
+    ))
+}
+
+type SampleArgs = (Arg<Vec3>, Arg<f32>, Arg<Vec2>);
+
+/// xylem's finished-wood BSDF (Marschner et al. 2005) at one shading point or an array of them,
+/// in the local shading frame (z = normal, unit directions pointing away from the surface).
+///
+/// Fields (a dict `params` and keywords merge, keywords winning; each missing field takes the
+/// default of Rust's `WoodBsdfParams::default()`):
+///
+/// - `diffuse`: Lambertian substrate albedo, linear RGB in [0, 1] (3-vector or (..., 3))
+/// - `fiber_color`: fibre highlight colour k_f, linear RGB >= 0 (3-vector or (..., 3))
+/// - `fiber_dir`: fibre axis, unit vector in the local frame (3-vector or (..., 3))
+/// - `ray_dir`: ray-cell axis, unit vector in the local frame (3-vector or (..., 3))
+/// - `ray_mask`: blend towards the ray fibres, [0, 1] (scalar or (...))
+/// - `highlight_width`: the fibre lobe's width beta in radians (scalar or (...))
+/// - `eta`: refractive index of the finish, [1, 4]; 1 is unfinished (scalar or (...))
+/// - `roughness`: GGX roughness of the finish, [0, 1]; 0 is a smooth finish (scalar or (...))
+///
+/// Arrays broadcast over their leading dimensions as numpy does; the result's `shape` is their
+/// broadcast. `eval(wo, wi)` is f without the cosine, `pdf(wo, wi)` per unit solid angle,
+/// `sample(wo, uc, u)` importance-samples wi; directions broadcast against the shading points.
+/// Non-finite values raise ValueError naming the field and the element.
 #[pyclass(module = "xylem", name = "WoodBsdf", frozen)]
 struct PyWoodBsdf {
     bsdfs: Vec<xylem::bsdf::WoodBsdf>,
+    shape: Vec<usize>,
 }
 
 impl PyWoodBsdf {
-    /// `f(bsdf, wo, wi)` at every row of the broadcast (bsdf, wo, wi), GIL released.
+    /// `f(bsdf, wo, wi)` at every element of the broadcast (bsdf, wo, wi), GIL released.
     fn at_pairs<T: Send>(
         &self,
         py: Python<'_>,
-        wo: &PyArrayLikeDyn<'_, f32, AllowTypeChange>,
-        wi: &PyArrayLikeDyn<'_, f32, AllowTypeChange>,
+        wo: &ArrayIn,
+        wi: &ArrayIn,
         f: impl Fn(&xylem::bsdf::WoodBsdf, Vec3, Vec3) -> T + Sync + Send,
-    ) -> PyResult<Vec<T>> {
-        let (wo, wi) = (vec3_rows("wo", wo)?, vec3_rows("wi", wi)?);
-        let b = &self.bsdfs;
-        let n = broadcast(&[("bsdf", b.len()), ("wo", wo.len()), ("wi", wi.len())])?;
-        Ok(py.allow_threads(|| map_indices(n, |i| f(&at(b, i), at(&wo, i), at(&wi, i)))))
+    ) -> PyResult<(Vec<T>, Vec<usize>)> {
+        let (wo, wi) = (batch::vec3("wo", wo)?, batch::vec3("wi", wi)?);
+        let b = Broadcast::new(&[("bsdf", &self.shape), ("wo", &wo.lead), ("wi", &wi.lead)])?;
+        let (bs, m) = (&self.bsdfs, &b.maps);
+        let v = py.allow_threads(|| {
+            map_indices(b.len, |i| {
+                f(&bs[m[0].get(i)], wo.data[m[1].get(i)], wi.data[m[2].get(i)])
+            })
+        });
+        Ok((v, b.shape))
     }
 }
 
 #[pymethods]
 impl PyWoodBsdf {
-    /// `WoodBsdf(params=None, **fields)`: fields `diffuse`, `fiber_color`, `fiber_dir`,
-    /// `ray_dir` (3-vectors or (N, 3)), `ray_mask`, `highlight_width` (radians), `eta`,
-    /// `roughness` (scalars or (N,)); a dict and keywords merge, keywords winning.
+    /// The fields of the constructor, in order.
+    #[classattr]
+    const FIELDS: [&'static str; 8] = BSDF_FIELDS;
+
     #[new]
     #[pyo3(signature = (params=None, **fields))]
     fn new(
@@ -273,76 +251,162 @@ impl PyWoodBsdf {
         if let Some(f) = fields {
             all.update(f.as_mapping())?;
         }
-        let params = bsdf_params(&all)?;
+        let (params, shape) = bsdf_params(&all)?;
         let bsdfs = params
             .iter()
             .enumerate()
             .map(|(i, p)| {
                 xylem::bsdf::WoodBsdf::new(*p).map_err(|e| {
-                    if params.len() > 1 {
-                        value_error(format!("{e} (shading point {i})"))
-                    } else {
+                    if shape.is_empty() {
                         value_error(e)
+                    } else {
+                        value_error(format!(
+                            "{e} (shading point {})",
+                            batch::index_str(&shape, i)
+                        ))
                     }
                 })
             })
             .collect::<PyResult<Vec<_>>>()?;
-        Ok(PyWoodBsdf { bsdfs })
+        Ok(PyWoodBsdf { bsdfs, shape })
     }
 
-    /// Number of shading points.
+    /// Number of shading points (the product of `shape`).
     fn __len__(&self) -> usize {
         self.bsdfs.len()
     }
 
-    /// True where the BSDF has a delta lobe (a smooth finish), shape (N,).
-    fn has_delta<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
-        PyArray1::from_vec(py, self.bsdfs.iter().map(|b| b.has_delta()).collect())
+    /// The shading points' shape: () for one, else the fields' broadcast leading shape.
+    #[getter]
+    fn shape<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        pyo3::types::PyTuple::new(py, &self.shape)
     }
 
-    /// f(wo, wi) without the cosine, shape (N, 3).
+    /// The fields as a dict of arrays of this BSDF's shape (3-vectors with a trailing axis 3).
+    fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let p: Vec<WoodBsdfParams> = self.bsdfs.iter().map(|b| *b.params()).collect();
+        params_dict(py, &p, &self.shape)
+    }
+
+    fn __repr__(&self) -> String {
+        let p = self.bsdfs.first().map(|b| *b.params());
+        match (self.shape.is_empty(), p) {
+            (true, Some(p)) => format!(
+                "WoodBsdf(diffuse={}, fiber_color={}, fiber_dir={}, ray_dir={}, ray_mask={:?}, \
+                 highlight_width={:?}, eta={:?}, roughness={:?})",
+                tuple3(p.diffuse),
+                tuple3(p.fiber_color),
+                tuple3(p.fiber_dir),
+                tuple3(p.ray_dir),
+                p.ray_mask,
+                p.highlight_width,
+                p.eta,
+                p.roughness
+            ),
+            _ => format!(
+                "<WoodBsdf of shape {}: {} shading points>",
+                batch::shape_str(&self.shape),
+                self.bsdfs.len()
+            ),
+        }
+    }
+
+    /// True where the BSDF has a delta lobe (a smooth finish), of this BSDF's shape.
+    fn has_delta<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let v = self.bsdfs.iter().map(|b| b.has_delta()).collect();
+        out(py, v, &self.shape)
+    }
+
+    /// f(wo, wi) without the cosine, shape (..., 3): wo, wi (..., 3) broadcast with the BSDF.
     fn eval<'py>(
         &self,
         py: Python<'py>,
-        wo: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
-        wi: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
-    ) -> PyResult<Bound<'py, PyArray2<f32>>> {
-        let f = self.at_pairs(py, &wo, &wi, |b, o, i| b.eval(o, i))?;
-        vec3_array(py, &f)
+        wo: ArrayIn<'py>,
+        wi: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (f, shape) = self.at_pairs(py, &wo, &wi, |b, o, i| b.eval(o, i))?;
+        vec3_out(py, &f, &shape)
     }
 
-    /// The sampling density of `sample` per unit solid angle, shape (N,).
+    /// The sampling density of `sample` per unit solid angle, shape (...).
     fn pdf<'py>(
         &self,
         py: Python<'py>,
-        wo: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
-        wi: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
-    ) -> PyResult<Bound<'py, PyArray1<f32>>> {
-        let p = self.at_pairs(py, &wo, &wi, |b, o, i| b.pdf(o, i))?;
-        Ok(PyArray1::from_vec(py, p))
+        wo: ArrayIn<'py>,
+        wi: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (p, shape) = self.at_pairs(py, &wo, &wi, |b, o, i| b.pdf(o, i))?;
+        out(py, p, &shape)
     }
 
-    /// Importance-samples wi given wo and uniform numbers `uc` (N,) (lobe choice) and `u`
-    /// (N, 2); returns a dict `wi`, `f`, `pdf`, `is_delta`, `valid`.
+    /// Importance-samples wi given wo (..., 3) and uniform numbers `uc` (...) (lobe choice) and
+    /// `u` (..., 2); returns a dict `wi`, `f`, `pdf`, `is_delta`, `valid` over the broadcast.
     fn sample<'py>(
         &self,
         py: Python<'py>,
-        wo: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
-        uc: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
-        u: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
+        wo: ArrayIn<'py>,
+        uc: ArrayIn<'py>,
+        u: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let (wo, uc, u) = sample_inputs(&wo, &uc, &u)?;
-        let n = broadcast(&[
-            ("bsdf", self.bsdfs.len()),
-            ("wo", wo.len()),
-            ("uc", uc.len()),
-            ("u", u.len()),
+        let (wo, uc, u) = sample_args(&wo, &uc, &u)?;
+        let b = Broadcast::new(&[
+            ("bsdf", &self.shape),
+            ("wo", &wo.lead),
+            ("uc", &uc.lead),
+            ("u", &u.lead),
         ])?;
-        let b = &self.bsdfs;
+        let (bs, m) = (&self.bsdfs, &b.maps);
         let s = py.allow_threads(|| {
-            map_indices(n, |i| at(b, i).sample(at(&wo, i), at(&uc, i), at(&u, i)))
+            map_indices(b.len, |i| {
+                bs[m[0].get(i)].sample(
+                    wo.data[m[1].get(i)],
+                    uc.data[m[2].get(i)],
+                    u.data[m[3].get(i)],
+                )
+            })
         });
-        sample_dict(py, &s)
+        sample_dict(py, &s, &b.shape)
+    }
+}
+
+/// The `WoodBsdf` fields of `p` as a dict of arrays over the leading shape `shape`.
+fn params_dict<'py>(
+    py: Python<'py>,
+    p: &[WoodBsdfParams],
+    shape: &[usize],
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let col = |f: fn(&WoodBsdfParams) -> Vec3| -> Vec<Vec3> { p.iter().map(f).collect() };
+    let one = |f: fn(&WoodBsdfParams) -> f32| -> Vec<f32> { p.iter().map(f).collect() };
+    d.set_item("diffuse", vec3_out(py, &col(|p| p.diffuse), shape)?)?;
+    d.set_item("fiber_color", vec3_out(py, &col(|p| p.fiber_color), shape)?)?;
+    d.set_item("fiber_dir", vec3_out(py, &col(|p| p.fiber_dir), shape)?)?;
+    d.set_item("ray_dir", vec3_out(py, &col(|p| p.ray_dir), shape)?)?;
+    d.set_item("ray_mask", out(py, one(|p| p.ray_mask), shape)?)?;
+    d.set_item(
+        "highlight_width",
+        out(py, one(|p| p.highlight_width), shape)?,
+    )?;
+    d.set_item("eta", out(py, one(|p| p.eta), shape)?)?;
+    d.set_item("roughness", out(py, one(|p| p.roughness), shape)?)?;
+    Ok(d)
+}
+/// Where a volume's parameters came from: a built-in preset or a preset file.
+#[derive(Clone)]
+enum Source {
+    Preset(String),
+    File(PathBuf),
+}
+
+impl Source {
+    /// `'red_oak'` or `preset_file='woods/oak.toml'`, as the constructors take them.
+    fn repr(&self) -> String {
+        match self {
+            Source::Preset(n) => format!("{n:?}").replace('"', "'"),
+            Source::File(f) => {
+                format!("preset_file={:?}", f.display().to_string()).replace('"', "'")
+            }
+        }
     }
 }
 
@@ -350,13 +414,19 @@ impl PyWoodBsdf {
 fn wood_params(
     preset: Option<String>,
     preset_file: Option<PathBuf>,
-) -> PyResult<xylem::wood::WoodParams> {
+) -> PyResult<(xylem::wood::WoodParams, Source)> {
     match (preset, preset_file) {
-        (Some(name), None) => xylem::wood::preset(&name).map_err(wood_error),
-        (None, Some(file)) => xylem::scene::read_preset_file(&file).map_err(|e| match e {
-            e @ xylem::scene::PresetFileError::Read(_) => PyOSError::new_err(e.to_string()),
-            xylem::scene::PresetFileError::Wood(w) => wood_error(w),
-        }),
+        (Some(name), None) => {
+            let p = xylem::wood::preset(&name).map_err(wood_error)?;
+            Ok((p, Source::Preset(name)))
+        }
+        (None, Some(file)) => {
+            let p = xylem::scene::read_preset_file(&file).map_err(|e| match e {
+                e @ xylem::scene::PresetFileError::Read(_) => PyOSError::new_err(e.to_string()),
+                xylem::scene::PresetFileError::Wood(w) => wood_error(w),
+            })?;
+            Ok((p, Source::File(file)))
+        }
         _ => Err(value_error(format!(
             "give exactly one of `preset` (one of: {}) or `preset_file`",
             xylem::wood::PRESET_NAMES.join(", ")
@@ -391,94 +461,138 @@ fn parse_needs(needs: &Bound<'_, PyAny>) -> PyResult<Needs> {
     Ok(out)
 }
 
-/// The named arrays of texels that `needs` asked for (and the growth time, always computed).
-fn texel_dict<'py>(py: Python<'py>, t: &[WoodTexel], needs: Needs) -> PyResult<Bound<'py, PyDict>> {
+/// The named arrays of texels that `needs` asked for (and the growth time, always computed),
+/// over the points' leading shape.
+fn texel_dict<'py>(
+    py: Python<'py>,
+    t: &[WoodTexel],
+    needs: Needs,
+    shape: &[usize],
+) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     let v3 = |f: fn(&WoodTexel) -> Vec3| -> Vec<Vec3> { t.iter().map(f).collect() };
     let v1 = |f: fn(&WoodTexel) -> f32| -> Vec<f32> { t.iter().map(f).collect() };
-    d.set_item("growth_time", PyArray1::from_vec(py, v1(|x| x.growth_time)))?;
+    d.set_item("growth_time", out(py, v1(|x| x.growth_time), shape)?)?;
     if needs.color {
-        d.set_item("diffuse", vec3_array(py, &v3(|x| x.diffuse))?)?;
-        d.set_item("fiber_color", vec3_array(py, &v3(|x| x.fiber_color))?)?;
+        d.set_item("diffuse", vec3_out(py, &v3(|x| x.diffuse), shape)?)?;
+        d.set_item("fiber_color", vec3_out(py, &v3(|x| x.fiber_color), shape)?)?;
     }
     if needs.color || needs.bump {
-        d.set_item("pore_mask", PyArray1::from_vec(py, v1(|x| x.pore_mask)))?;
+        d.set_item("pore_mask", out(py, v1(|x| x.pore_mask), shape)?)?;
     }
     if needs.fibers {
-        d.set_item("fiber_dir", vec3_array(py, &v3(|x| x.fiber_dir))?)?;
-        d.set_item("ray_dir", vec3_array(py, &v3(|x| x.ray_dir))?)?;
-        d.set_item("ray_mask", PyArray1::from_vec(py, v1(|x| x.ray_mask)))?;
+        d.set_item("fiber_dir", vec3_out(py, &v3(|x| x.fiber_dir), shape)?)?;
+        d.set_item("ray_dir", vec3_out(py, &v3(|x| x.ray_dir), shape)?)?;
+        d.set_item("ray_mask", out(py, v1(|x| x.ray_mask), shape)?)?;
         d.set_item(
             "highlight_width",
-            PyArray1::from_vec(py, v1(|x| x.highlight_width)),
+            out(py, v1(|x| x.highlight_width), shape)?,
         )?;
     }
     if needs.bump {
-        d.set_item("bump", PyArray1::from_vec(py, v1(|x| x.bump)))?;
-        d.set_item("bump_grad", vec3_array(py, &v3(|x| x.bump_grad))?)?;
+        d.set_item("bump", out(py, v1(|x| x.bump), shape)?)?;
+        d.set_item("bump_grad", vec3_out(py, &v3(|x| x.bump_grad), shape)?)?;
     }
     Ok(d)
 }
 
 /// The procedural solid wood of a species preset (Liu et al. 2016) in tree space (mm, pith
 /// along +z).
+///
+/// Constructor fields:
+///
+/// - `preset`: a built-in preset name (`xylem.PRESETS`), or
+/// - `preset_file`: a preset TOML file (keyword; give exactly one of the two)
+/// - `seed`: the tree (keyword, a whole number >= 0; default 0)
+///
+/// `eval(points, needs="all")` takes tree-space points in mm of shape (..., 3).
 #[pyclass(module = "xylem", name = "WoodVolume", frozen)]
 struct PyWoodVolume {
     volume: Arc<xylem::wood::WoodVolume>,
+    source: Source,
 }
 
 #[pymethods]
 impl PyWoodVolume {
-    /// `WoodVolume(preset=None, *, preset_file=None, seed=0)`: a built-in preset by name or a
-    /// preset TOML file, and the seed that selects the tree.
     #[new]
     #[pyo3(signature = (preset=None, *, preset_file=None, seed=0))]
     fn new(preset: Option<String>, preset_file: Option<PathBuf>, seed: u64) -> PyResult<Self> {
-        let params = wood_params(preset, preset_file)?;
+        let (params, source) = wood_params(preset, preset_file)?;
         let volume = xylem::wood::WoodVolume::new(params, seed).map_err(wood_error)?;
         Ok(PyWoodVolume {
             volume: Arc::new(volume),
+            source,
         })
     }
 
+    /// The seed that selects the tree.
     #[getter]
     fn seed(&self) -> u64 {
         self.volume.seed()
     }
 
-    /// Texels at `points` (N, 3) tree-space mm; `needs` is "color", "fibers", "bump", "all" (the
-    /// default) or a list / comma-separated string of them. Returns a dict of arrays: always `growth_time`;
-    /// with color `diffuse`, `fiber_color`, `pore_mask`; with fibers `fiber_dir`, `ray_dir`,
-    /// `ray_mask`, `highlight_width` (radians); with bump `pore_mask`, `bump`, `bump_grad`.
+    fn __repr__(&self) -> String {
+        format!(
+            "WoodVolume({}, seed={})",
+            self.source.repr(),
+            self.volume.seed()
+        )
+    }
+
+    /// Texels at `points` (..., 3), tree-space mm; `needs` is "color", "fibers", "bump", "all" (the
+    /// default) or a list / comma-separated string of them. Returns a dict of arrays over the
+    /// points' leading shape: always `growth_time`; with color `diffuse`, `fiber_color`,
+    /// `pore_mask`; with fibers `fiber_dir`, `ray_dir`, `ray_mask`, `highlight_width` (radians);
+    /// with bump `pore_mask`, `bump`, `bump_grad`.
     #[pyo3(signature = (points, needs=None))]
     fn eval<'py>(
         &self,
         py: Python<'py>,
-        points: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
+        points: ArrayIn<'py>,
         needs: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let points = vec3_rows("points", &points)?;
+        let points = batch::vec3("points", &points)?;
         let needs = needs.map_or(Ok(Needs::ALL), parse_needs)?;
         let v = &self.volume;
+        let p = &points.data;
         let texels = py.allow_threads(|| {
             let chunk = 1024;
-            let mut out = vec![WoodTexel::default(); points.len()];
+            let mut out = vec![WoodTexel::default(); p.len()];
             out.par_chunks_mut(chunk)
-                .zip(points.par_chunks(chunk))
+                .zip(p.par_chunks(chunk))
                 .for_each(|(o, p)| v.eval_many(p, needs, o));
             out
         });
-        texel_dict(py, &texels, needs)
+        texel_dict(py, &texels, needs, &points.lead)
     }
 }
 
 /// A wood surface as the renderer shades it: the volume under a finish, placed in the tree by a
-/// solid cutting in world space (`p_tree = origin + scale · Rz(rotation) · A · p`, A turning
-/// `axis` onto the pith). Methods take world-space points, shading normals and directions.
+/// solid cutting in world space (`p_tree = origin + scale * Rz(rotation) * A * p`, A turning
+/// `axis` onto the pith). Methods take world-space points `p`, shading normals `n` and
+/// directions, each of shape (..., 3) (broadcast as numpy does), and the sample numbers `uc`
+/// (...) and `u` (..., 2).
+///
+/// Constructor fields:
+///
+/// - `preset`: a built-in preset name (`xylem.PRESETS`), or
+/// - `preset_file`: a preset TOML file (keyword; give exactly one of the two)
+/// - `seed`: the tree (whole number >= 0; default 0)
+/// - `eta`: refractive index of the finish, [1, 4] (default 1.5; 1 is unfinished)
+/// - `roughness`: GGX roughness of the finish, [0, 1] (default 0, a smooth finish)
+/// - `origin`: the tree point (mm) at the world origin, 3 finite numbers (default (0, 0, 0))
+/// - `axis`: the world direction of the pith, non-zero (default (0, 0, 1))
+/// - `rotation_deg`: rotation about the pith, degrees (default 0)
+/// - `scale`: tree mm per world unit, [1e-6, 1e6] (default 1: a scene in mm)
 #[pyclass(module = "xylem", name = "WoodSurface", frozen)]
 struct PyWoodSurface {
     material: Material,
     placement: Placement,
+    source: Source,
+    seed: u64,
+    finish: (f32, f32),
+    axis: Vec3,
+    rotation_deg: f32,
 }
 
 impl PyWoodSurface {
@@ -504,38 +618,45 @@ impl PyWoodSurface {
         self.material.shade(&hit)
     }
 
-    /// `f(bsdf, wo, wi)` in xylem's local frame at every row of (p, n, wo, wi), world inputs.
+    /// `f(bsdf, wo, wi)` in xylem's local frame at every element of the broadcast (p, n, wo,
+    /// wi), world inputs.
     fn at_pairs<T: Send>(
         &self,
         py: Python<'_>,
-        [p, n, wo, wi]: [&PyArrayLikeDyn<'_, f32, AllowTypeChange>; 4],
+        [p, n, wo, wi]: [&ArrayIn; 4],
         f: impl Fn(&xylem::material::SurfaceBsdf, Vec3, Vec3) -> T + Sync + Send,
-    ) -> PyResult<Vec<T>> {
-        let (p, nn) = (vec3_rows("p", p)?, vec3_rows("n", n)?);
-        let (wo, wi) = (vec3_rows("wo", wo)?, vec3_rows("wi", wi)?);
-        let count = broadcast(&[
-            ("p", p.len()),
-            ("n", nn.len()),
-            ("wo", wo.len()),
-            ("wi", wi.len()),
+    ) -> PyResult<(Vec<T>, Vec<usize>)> {
+        let (p, nn) = (batch::vec3("p", p)?, batch::vec3("n", n)?);
+        let (wo, wi) = (batch::vec3("wo", wo)?, batch::vec3("wi", wi)?);
+        let b = Broadcast::new(&[
+            ("p", &p.lead),
+            ("n", &nn.lead),
+            ("wo", &wo.lead),
+            ("wi", &wi.lead),
         ])?;
-        Ok(py.allow_threads(|| {
-            map_indices(count, |i| {
-                let s = self.shade_one(at(&p, i), at(&nn, i));
+        let m = &b.maps;
+        let v = py.allow_threads(|| {
+            map_indices(b.len, |i| {
+                let s = self.shade_one(p.data[m[0].get(i)], nn.data[m[1].get(i)]);
                 let to_local = |d: Vec3| s.frame.to_local(d);
-                f(&s.bsdf, to_local(at(&wo, i)), to_local(at(&wi, i)))
+                f(
+                    &s.bsdf,
+                    to_local(wo.data[m[2].get(i)]),
+                    to_local(wi.data[m[3].get(i)]),
+                )
             })
-        }))
+        });
+        Ok((v, b.shape))
     }
 }
 
 #[pymethods]
 impl PyWoodSurface {
-    /// `WoodSurface(preset=None, *, preset_file=None, seed=0, eta=1.5, roughness=0.0,
-    /// origin=(0, 0, 0), axis=(0, 0, 1), rotation_deg=0.0, scale=1.0)`.
     #[new]
     #[pyo3(signature = (preset=None, *, preset_file=None, seed=0, eta=1.5, roughness=0.0,
-        origin=[0.0, 0.0, 0.0], axis=[0.0, 0.0, 1.0], rotation_deg=0.0, scale=1.0))]
+        origin=[0.0, 0.0, 0.0], axis=[0.0, 0.0, 1.0], rotation_deg=0.0, scale=1.0),
+        text_signature = "(preset=None, *, preset_file=None, seed=0, eta=1.5, roughness=0.0, \
+            origin=(0.0, 0.0, 0.0), axis=(0.0, 0.0, 1.0), rotation_deg=0.0, scale=1.0)")]
     #[allow(clippy::too_many_arguments)]
     fn new(
         preset: Option<String>,
@@ -570,7 +691,7 @@ impl PyWoodSurface {
         if !origin.is_finite() || !rotation_deg.is_finite() {
             return Err(value_error("origin and rotation_deg must be finite"));
         }
-        let params = wood_params(preset, preset_file)?;
+        let (params, source) = wood_params(preset, preset_file)?;
         let volume = xylem::wood::WoodVolume::new(params, seed).map_err(wood_error)?;
         Ok(PyWoodSurface {
             material: Material::Wood(Box::new(WoodMaterial {
@@ -589,23 +710,45 @@ impl PyWoodSurface {
                 world_space: true,
                 tilt: Default::default(),
             },
+            source,
+            seed,
+            finish: (eta, roughness),
+            axis,
+            rotation_deg,
         })
     }
 
-    /// The BSDF parameters at world points `p` (N, 3) with shading normals `n` (N, 3), in the
+    fn __repr__(&self) -> String {
+        let p = &self.placement;
+        format!(
+            "WoodSurface({}, seed={}, eta={:?}, roughness={:?}, origin={}, axis={}, \
+             rotation_deg={:?}, scale={:?})",
+            self.source.repr(),
+            self.seed,
+            self.finish.0,
+            self.finish.1,
+            tuple3(p.origin),
+            tuple3(self.axis),
+            self.rotation_deg,
+            p.scale
+        )
+    }
+
+    /// The BSDF parameters at world points `p` (..., 3) with shading normals `n` (..., 3), in the
     /// shading frame xylem builds there (z = n, x along the fibre's surface projection): a dict
-    /// of the `WoodBsdf` fields and `frame` (N, 3, 3), rows s, t, n in world space.
+    /// of the `WoodBsdf` fields and `frame` (..., 3, 3), rows s, t, n in world space.
     fn shade<'py>(
         &self,
         py: Python<'py>,
-        p: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
-        n: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
+        p: ArrayIn<'py>,
+        n: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let (p, nn) = (vec3_rows("p", &p)?, vec3_rows("n", &n)?);
-        let count = broadcast(&[("p", p.len()), ("n", nn.len())])?;
+        let (p, nn) = (batch::vec3("p", &p)?, batch::vec3("n", &n)?);
+        let b = Broadcast::new(&[("p", &p.lead), ("n", &nn.lead)])?;
+        let m = &b.maps;
         let shaded = py.allow_threads(|| {
-            map_indices(count, |i| {
-                let s = self.shade_one(at(&p, i), at(&nn, i));
+            map_indices(b.len, |i| {
+                let s = self.shade_one(p.data[m[0].get(i)], nn.data[m[1].get(i)]);
                 let params = match s.bsdf {
                     xylem::material::SurfaceBsdf::Wood(b) => *b.params(),
                     // A texel the BSDF rejected falls back to a Lambertian of its colour.
@@ -618,98 +761,83 @@ impl PyWoodSurface {
                 (params, s.frame)
             })
         });
-        let d = PyDict::new(py);
-        let col = |f: fn(&WoodBsdfParams) -> Vec3| -> Vec<Vec3> {
-            shaded.iter().map(|(p, _)| f(p)).collect()
-        };
-        let one = |f: fn(&WoodBsdfParams) -> f32| -> Vec<f32> {
-            shaded.iter().map(|(p, _)| f(p)).collect()
-        };
-        d.set_item("diffuse", vec3_array(py, &col(|p| p.diffuse))?)?;
-        d.set_item("fiber_color", vec3_array(py, &col(|p| p.fiber_color))?)?;
-        d.set_item("fiber_dir", vec3_array(py, &col(|p| p.fiber_dir))?)?;
-        d.set_item("ray_dir", vec3_array(py, &col(|p| p.ray_dir))?)?;
-        d.set_item("ray_mask", PyArray1::from_vec(py, one(|p| p.ray_mask)))?;
-        d.set_item(
-            "highlight_width",
-            PyArray1::from_vec(py, one(|p| p.highlight_width)),
-        )?;
-        d.set_item("eta", PyArray1::from_vec(py, one(|p| p.eta)))?;
-        d.set_item("roughness", PyArray1::from_vec(py, one(|p| p.roughness)))?;
+        let params: Vec<WoodBsdfParams> = shaded.iter().map(|x| x.0).collect();
+        let d = params_dict(py, &params, &b.shape)?;
         let frames: Vec<f32> = shaded
             .iter()
             .flat_map(|(_, f)| [f.s.to_array(), f.t.to_array(), f.n.to_array()])
             .flatten()
             .collect();
-        d.set_item(
-            "frame",
-            PyArray1::from_vec(py, frames).reshape([count, 3, 3])?,
-        )?;
+        d.set_item("frame", out(py, frames, &b.with(&[3, 3]))?)?;
         Ok(d)
     }
 
     /// f(wo, wi) without the cosine at world points `p` with shading normals `n`; `wo`, `wi` are
-    /// world-space unit directions away from the surface. Shape (N, 3).
+    /// world-space unit directions away from the surface. Shape (..., 3).
     fn eval<'py>(
         &self,
         py: Python<'py>,
-        p: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
-        n: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
-        wo: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
-        wi: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
-    ) -> PyResult<Bound<'py, PyArray2<f32>>> {
-        let f = self.at_pairs(py, [&p, &n, &wo, &wi], |b, o, i| b.eval(o, i))?;
-        vec3_array(py, &f)
+        p: ArrayIn<'py>,
+        n: ArrayIn<'py>,
+        wo: ArrayIn<'py>,
+        wi: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (f, shape) = self.at_pairs(py, [&p, &n, &wo, &wi], |b, o, i| b.eval(o, i))?;
+        vec3_out(py, &f, &shape)
     }
 
-    /// The sampling density per unit solid angle of world direction `wi`, shape (N,).
+    /// The sampling density per unit solid angle of world direction `wi`, shape (...).
     fn pdf<'py>(
         &self,
         py: Python<'py>,
-        p: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
-        n: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
-        wo: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
-        wi: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
-    ) -> PyResult<Bound<'py, PyArray1<f32>>> {
-        let pdf = self.at_pairs(py, [&p, &n, &wo, &wi], |b, o, i| b.pdf(o, i))?;
-        Ok(PyArray1::from_vec(py, pdf))
+        p: ArrayIn<'py>,
+        n: ArrayIn<'py>,
+        wo: ArrayIn<'py>,
+        wi: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (pdf, shape) = self.at_pairs(py, [&p, &n, &wo, &wi], |b, o, i| b.pdf(o, i))?;
+        out(py, pdf, &shape)
     }
 
     /// Samples a world direction `wi` given `wo`; as `WoodBsdf.sample`, with `wi` in world space.
     fn sample<'py>(
         &self,
         py: Python<'py>,
-        p: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
-        n: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
-        wo: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
-        uc: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
-        u: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
+        p: ArrayIn<'py>,
+        n: ArrayIn<'py>,
+        wo: ArrayIn<'py>,
+        uc: ArrayIn<'py>,
+        u: ArrayIn<'py>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let (p, nn) = (vec3_rows("p", &p)?, vec3_rows("n", &n)?);
-        let (wo, uc, u) = sample_inputs(&wo, &uc, &u)?;
-        let count = broadcast(&[
-            ("p", p.len()),
-            ("n", nn.len()),
-            ("wo", wo.len()),
-            ("uc", uc.len()),
-            ("u", u.len()),
+        let (p, nn) = (batch::vec3("p", &p)?, batch::vec3("n", &n)?);
+        let (wo, uc, u) = sample_args(&wo, &uc, &u)?;
+        let b = Broadcast::new(&[
+            ("p", &p.lead),
+            ("n", &nn.lead),
+            ("wo", &wo.lead),
+            ("uc", &uc.lead),
+            ("u", &u.lead),
         ])?;
+        let m = &b.maps;
         let s = py.allow_threads(|| {
-            map_indices(count, |i| {
-                let s = self.shade_one(at(&p, i), at(&nn, i));
+            map_indices(b.len, |i| {
+                let s = self.shade_one(p.data[m[0].get(i)], nn.data[m[1].get(i)]);
                 let frame = s.frame;
                 s.bsdf
-                    .sample(frame.to_local(at(&wo, i)), at(&uc, i), at(&u, i))
+                    .sample(
+                        frame.to_local(wo.data[m[2].get(i)]),
+                        uc.data[m[3].get(i)],
+                        u.data[m[4].get(i)],
+                    )
                     .map(|x| BsdfSample {
                         wi: frame.to_world(x.wi),
                         ..x
                     })
             })
         });
-        sample_dict(py, &s)
+        sample_dict(py, &s, &b.shape)
     }
 }
-
 /// `threads`: 0 (all cores) up to 16 per core, as `--threads`.
 fn check_threads(threads: usize) -> PyResult<()> {
     use xylem::render::resources::{check_threads, ResourceError};
@@ -721,55 +849,262 @@ fn check_threads(threads: usize) -> PyResult<()> {
     })
 }
 
-/// A scene file loaded with the overrides of `xylem render` (`spp`, `res` = (width, height),
-/// `seed`).
-fn load_scene(
-    scene: PathBuf,
-    spp: Option<u32>,
-    res: Option<(u32, u32)>,
-    seed: Option<u64>,
-) -> PyResult<xylem::scene::LoadedScene> {
-    let mut loaded = xylem::scene::load(&scene).map_err(|e| match e {
+fn scene_error(e: xylem::scene::SceneError) -> PyErr {
+    match e {
         xylem::scene::SceneError::Io { .. } | xylem::scene::SceneError::Input(_) => {
             PyOSError::new_err(e.to_string())
         }
         other => value_error(other),
-    })?;
-    if let Some(spp) = spp {
-        if !(1..=1_000_000).contains(&spp) {
+    }
+}
+
+/// A Python value as a TOML value: dict → table, list / tuple / numpy array → array, bool, int,
+/// float, str, numpy scalars and `os.PathLike` (a path string); `at` names the key for errors.
+fn toml_value(v: &Bound<'_, PyAny>, at: &str) -> PyResult<toml::Value> {
+    use pyo3::types::{PyBool, PyFloat, PyInt, PyList, PyString, PyTuple};
+    if let Ok(d) = v.downcast::<PyDict>() {
+        let mut t = toml::Table::new();
+        for (k, x) in d.iter() {
+            let key: String = k.extract().map_err(|_| {
+                value_error(format!("scene dict: a key in `{at}` is not a string: {k}"))
+            })?;
+            let here = if at.is_empty() {
+                key.clone()
+            } else {
+                format!("{at}.{key}")
+            };
+            t.insert(key, toml_value(&x, &here)?);
+        }
+        return Ok(toml::Value::Table(t));
+    }
+    if v.is_instance_of::<PyBool>() {
+        return Ok(toml::Value::Boolean(v.extract()?));
+    }
+    if v.is_instance_of::<PyInt>() {
+        return Ok(toml::Value::Integer(v.extract().map_err(|_| {
+            value_error(format!("scene dict: `{at}` = {v}: out of the 64-bit range"))
+        })?));
+    }
+    if v.is_instance_of::<PyFloat>() {
+        let x: f64 = v.extract()?;
+        if !x.is_finite() {
             return Err(value_error(format!(
-                "spp = {spp}: out of range (allowed 1 to 1000000 samples per pixel)"
+                "scene dict: `{at}` = {x}: must be finite"
             )));
         }
-        loaded.settings.spp = spp;
+        return Ok(toml::Value::Float(x));
     }
-    if let Some(seed) = seed {
-        loaded.settings.seed = seed;
+    if v.is_instance_of::<PyString>() {
+        return Ok(toml::Value::String(v.extract()?));
     }
-    if let Some((w, h)) = res {
-        for (name, v) in [("width", w), ("height", h)] {
-            if !(1..=16384).contains(&v) {
+    if v.is_instance_of::<PyList>() || v.is_instance_of::<PyTuple>() {
+        let items = v
+            .try_iter()?
+            .enumerate()
+            .map(|(i, x)| toml_value(&x?, &format!("{at}[{i}]")))
+            .collect::<PyResult<Vec<_>>>()?;
+        return Ok(toml::Value::Array(items));
+    }
+    if v.hasattr("__fspath__")? {
+        let p: PathBuf = v.extract()?;
+        return Ok(toml::Value::String(p.display().to_string()));
+    }
+    // numpy arrays and scalars: their Python equivalents.
+    if v.hasattr("tolist")? {
+        return toml_value(&v.call_method0("tolist")?, at);
+    }
+    Err(value_error(format!(
+        "scene dict: `{at}` = {}: a {} is not a scene value (use dicts, lists, numbers, \
+         strings and booleans, as in a scene file)",
+        v.repr()?,
+        v.get_type().name()?
+    )))
+}
+
+/// A loaded scene, ready to render many times (as `mitsuba.load_dict` gives). Made by
+/// `xylem.load_file(path)` or `xylem.load_dict(dict)`; `render` and `sweep` take it in place
+/// of a file. Renders of one Scene from several threads run one after the other.
+#[pyclass(module = "xylem", name = "Scene", frozen)]
+struct PyScene {
+    loaded: Mutex<xylem::scene::LoadedScene>,
+    /// The file, or `<dict>`.
+    origin: String,
+}
+
+impl PyScene {
+    fn new(loaded: xylem::scene::LoadedScene, origin: String) -> Self {
+        PyScene {
+            loaded: Mutex::new(loaded),
+            origin,
+        }
+    }
+
+    /// The scene locked for this thread; other threads' renders of it are waited for with the
+    /// GIL released.
+    fn lock(
+        &self,
+        py: Python<'_>,
+    ) -> PyResult<std::sync::MutexGuard<'_, xylem::scene::LoadedScene>> {
+        loop {
+            match self.loaded.try_lock() {
+                Ok(g) => return Ok(g),
+                Err(std::sync::TryLockError::WouldBlock) => {
+                    py.allow_threads(|| std::thread::sleep(std::time::Duration::from_millis(5)));
+                    py.check_signals()?;
+                }
+                Err(std::sync::TryLockError::Poisoned(p)) => return Ok(p.into_inner()),
+            }
+        }
+    }
+}
+
+#[pymethods]
+impl PyScene {
+    /// The scene's name (the file stem, or `name` of `load_dict`).
+    #[getter]
+    fn name(&self, py: Python<'_>) -> PyResult<String> {
+        Ok(self.lock(py)?.name.clone())
+    }
+
+    /// (width, height) of the camera's image.
+    #[getter]
+    fn res(&self, py: Python<'_>) -> PyResult<(u32, u32)> {
+        let s = self.lock(py)?;
+        Ok((s.scene.camera.width, s.scene.camera.height))
+    }
+
+    /// Samples per pixel of the scene's `[render]` table.
+    #[getter]
+    fn spp(&self, py: Python<'_>) -> PyResult<u32> {
+        Ok(self.lock(py)?.settings.spp)
+    }
+
+    /// Non-fatal problems found while loading (e.g. degenerate triangles dropped).
+    #[getter]
+    fn warnings(&self, py: Python<'_>) -> PyResult<Vec<String>> {
+        Ok(self.lock(py)?.warnings.clone())
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        let s = self.lock(py)?;
+        Ok(format!(
+            "<xylem.Scene '{}' from {}: {}x{}, {} spp, {} lights, {} materials{}>",
+            s.name,
+            self.origin,
+            s.scene.camera.width,
+            s.scene.camera.height,
+            s.settings.spp,
+            s.scene.lights.len(),
+            s.scene.materials.len(),
+            if s.sweep.is_some() { ", [sweep]" } else { "" }
+        ))
+    }
+}
+
+/// `load_file(path)`: reads and builds a scene file (or a built-in scene by name) once, for
+/// many renders.
+#[pyfunction]
+fn load_file(scene: PathBuf) -> PyResult<PyScene> {
+    let loaded = xylem::scene::load(&scene).map_err(scene_error)?;
+    Ok(PyScene::new(loaded, scene.display().to_string()))
+}
+
+/// `load_dict(scene, *, name="scene", base=None)`: builds a scene from a dict with the keys and
+/// values of a scene file (scenes/README.md: `camera`, `render`, `materials`, `objects`,
+/// `lights`, `sweep`, ...); relative files (meshes, maps) resolve against `base` (default: the
+/// current folder). Errors name
+/// the field as for a file, with `<dict>` as the file.
+#[pyfunction]
+#[pyo3(signature = (scene, *, name="scene", base=None))]
+fn load_dict(scene: &Bound<'_, PyDict>, name: &str, base: Option<PathBuf>) -> PyResult<PyScene> {
+    let base = base.unwrap_or_else(|| PathBuf::from("."));
+    let value = toml_value(scene.as_any(), "")?;
+    let text = toml::to_string(&value).map_err(|e| value_error(format!("scene dict: {e}")))?;
+    let loaded = xylem::scene::from_str(&text, "<dict>", &base, name).map_err(scene_error)?;
+    Ok(PyScene::new(loaded, "<dict>".into()))
+}
+
+/// `spp`, `res` = (width, height) and `seed` of `xylem render`, checked.
+struct Overrides {
+    spp: Option<u32>,
+    res: Option<(u32, u32)>,
+    seed: Option<u64>,
+}
+
+impl Overrides {
+    fn check(&self) -> PyResult<()> {
+        if let Some(spp) = self.spp {
+            if !(1..=1_000_000).contains(&spp) {
                 return Err(value_error(format!(
-                    "res {name} = {v}: must be a whole number in 1..=16384"
+                    "spp = {spp}: out of range (allowed 1 to 1000000 samples per pixel)"
                 )));
             }
         }
-        loaded.scene.camera = loaded.scene.camera.with_resolution(w, h);
+        if let Some((w, h)) = self.res {
+            for (name, v) in [("width", w), ("height", h)] {
+                if !(1..=16384).contains(&v) {
+                    return Err(value_error(format!(
+                        "res {name} = {v}: must be a whole number in 1..=16384"
+                    )));
+                }
+            }
+        }
+        Ok(())
     }
-    Ok(loaded)
+}
+
+/// Runs `f` on the scene `scene` (a `Scene`, a dict or a file path) with the overrides
+/// applied; a `Scene`'s own settings are restored afterwards.
+fn with_scene<T>(
+    py: Python<'_>,
+    scene: &Bound<'_, PyAny>,
+    o: &Overrides,
+    f: impl FnOnce(&xylem::scene::LoadedScene) -> PyResult<T>,
+) -> PyResult<T> {
+    o.check()?;
+    let apply = |loaded: &mut xylem::scene::LoadedScene| -> PyResult<T> {
+        let (settings, camera) = (loaded.settings, loaded.scene.camera);
+        if let Some(spp) = o.spp {
+            loaded.settings.spp = spp;
+        }
+        if let Some(seed) = o.seed {
+            loaded.settings.seed = seed;
+        }
+        if let Some((w, h)) = o.res {
+            loaded.scene.camera = camera.with_resolution(w, h);
+        }
+        let r = f(loaded);
+        (loaded.settings, loaded.scene.camera) = (settings, camera);
+        r
+    };
+    if let Ok(s) = scene.downcast::<PyScene>() {
+        let mut guard = s.get().lock(py)?;
+        return apply(&mut guard);
+    }
+    let mut loaded = if let Ok(d) = scene.downcast::<PyDict>() {
+        load_dict(d, "scene", None)?
+            .loaded
+            .into_inner()
+            .map_err(|_| value_error("scene dict: unusable"))?
+    } else {
+        let path: PathBuf = scene.extract().map_err(|_| {
+            pyo3::exceptions::PyTypeError::new_err(format!(
+                "scene: expected a file path, a built-in scene name, a dict or an xylem.Scene, not {}",
+                scene.get_type().name().map_or("?".into(), |n| n.to_string())
+            ))
+        })?;
+        xylem::scene::load(&path).map_err(scene_error)?
+    };
+    apply(&mut loaded)
 }
 
 /// Reshapes a row-major image of 3-vectors to (H, W, 3).
 fn image3<'py>(py: Python<'py>, w: u32, h: u32, v: &[Vec3]) -> PyResult<Bound<'py, PyAny>> {
-    Ok(vec3_array(py, v)?
-        .reshape([h as usize, w as usize, 3])?
-        .into_any())
+    vec3_out(py, v, &[h as usize, w as usize])
 }
 
 fn image1<'py>(py: Python<'py>, w: u32, h: u32, v: Vec<f32>) -> PyResult<Bound<'py, PyAny>> {
-    Ok(PyArray1::from_vec(py, v)
-        .reshape([h as usize, w as usize])?
-        .into_any())
+    out(py, v, &[h as usize, w as usize])
 }
 
 /// A render's [`xylem::progress::Progress`] that asks it to stop once `flag` is set.
@@ -811,8 +1146,8 @@ fn interruptible<T: Send>(py: Python<'_>, f: impl FnOnce(&StopFlag) -> T + Send)
     })
 }
 
-/// `render(scene, spp=None, res=None, seed=None, threads=0)`: renders a scene file as
-/// `xylem render` does and returns a dict of (H, W[, 3]) float32 arrays, top row first: `beauty`
+/// `render(scene, spp=None, res=None, seed=None, threads=0)`: renders a scene (a file path, a
+/// built-in scene name, a dict as `load_dict` takes, or a `Scene`) as `xylem render` does and returns a dict of (H, W[, 3]) float32 arrays, top row first: `beauty`
 /// (linear RGB), `std_error` (of each pixel's luminance), and the first-hit AOVs `albedo`,
 /// `normal`, `depth`, `fiber`, `ray_mask`, `growth_time`; plus `nonfinite` (samples dropped) and
 /// `seconds`. The GIL is released while rendering; Ctrl-C stops it within a tile and raises
@@ -821,21 +1156,23 @@ fn interruptible<T: Send>(py: Python<'_>, f: impl FnOnce(&StopFlag) -> T + Send)
 #[pyo3(signature = (scene, spp=None, res=None, seed=None, threads=0))]
 fn render<'py>(
     py: Python<'py>,
-    scene: PathBuf,
+    scene: &Bound<'py, PyAny>,
     spp: Option<u32>,
     res: Option<(u32, u32)>,
     seed: Option<u64>,
     threads: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
     check_threads(threads)?;
-    let loaded = load_scene(scene, spp, res, seed)?;
-    let out = interruptible(py, |stop| {
-        let run = xylem::render::RunOptions {
-            threads,
-            progress: stop,
-            ..Default::default()
-        };
-        xylem::render::render(&loaded.scene, &loaded.settings, &run)
+    let o = Overrides { spp, res, seed };
+    let out = with_scene(py, scene, &o, |loaded| {
+        interruptible(py, |stop| {
+            let run = xylem::render::RunOptions {
+                threads,
+                progress: stop,
+                ..Default::default()
+            };
+            xylem::render::render(&loaded.scene, &loaded.settings, &run)
+        })
     })?
     .map_err(value_error)?;
     let img = &out.image;
@@ -858,7 +1195,7 @@ fn render<'py>(
 }
 
 /// `sweep(scene, frames=None, arc=None, spp=None, res=None, seed=None, threads=0)`: renders the
-/// light sweep of a scene's `[sweep]` table (with the per-sweep cache, as `xylem sweep` does)
+/// light sweep of a scene's (a path, a name, a dict or a `Scene`, as `render` takes) `[sweep]` table (with the per-sweep cache, as `xylem sweep` does)
 /// without writing files; `arc` = (from_deg, to_deg). Returns a dict: `frames` (F, H, W, 3),
 /// `std_error` (F, H, W), `light_deg` (F,), `seconds`. The GIL is released while rendering;
 /// Ctrl-C stops it within a tile and raises KeyboardInterrupt.
@@ -867,7 +1204,7 @@ fn render<'py>(
 #[allow(clippy::too_many_arguments)]
 fn sweep<'py>(
     py: Python<'py>,
-    scene: PathBuf,
+    scene: &Bound<'py, PyAny>,
     frames: Option<usize>,
     arc: Option<(f32, f32)>,
     spp: Option<u32>,
@@ -876,26 +1213,30 @@ fn sweep<'py>(
     threads: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
     check_threads(threads)?;
-    let loaded = load_scene(scene, spp, res, seed)?;
-    let (path, moving) =
-        xylem::sweep::SweepPath::from_scene(&loaded, frames, arc).map_err(value_error)?;
-    let total = path.arc.frames;
-    let r = interruptible(py, |stop| {
-        let run = xylem::render::RunOptions {
-            threads,
-            progress: stop,
-            ..Default::default()
-        };
-        xylem::sweep::render_sweep(
-            &loaded.scene,
-            &loaded.settings,
-            &path,
-            moving,
-            0..total,
-            &run,
-        )
-    })?
-    .map_err(value_error)?;
+    let o = Overrides { spp, res, seed };
+    let (r, deg) = with_scene(py, scene, &o, |loaded| {
+        let (path, moving) =
+            xylem::sweep::SweepPath::from_scene(loaded, frames, arc).map_err(value_error)?;
+        let total = path.arc.frames;
+        let r = interruptible(py, |stop| {
+            let run = xylem::render::RunOptions {
+                threads,
+                progress: stop,
+                ..Default::default()
+            };
+            xylem::sweep::render_sweep(
+                &loaded.scene,
+                &loaded.settings,
+                &path,
+                moving,
+                0..total,
+                &run,
+            )
+        })?
+        .map_err(value_error)?;
+        let deg: Vec<f32> = (0..r.frames.len()).map(|k| path.light_deg(k)).collect();
+        Ok((r, deg))
+    })?;
     let (w, h, f) = (r.width as usize, r.height as usize, r.frames.len());
     let beauty: Vec<f32> = r
         .frames
@@ -907,7 +1248,6 @@ fn sweep<'py>(
         .iter()
         .flat_map(|fr| fr.std_error.clone())
         .collect();
-    let deg: Vec<f32> = (0..f).map(|k| path.light_deg(k)).collect();
     let d = PyDict::new(py);
     d.set_item(
         "frames",
@@ -954,6 +1294,10 @@ fn _xylem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyWoodBsdf>()?;
     m.add_class::<PyWoodVolume>()?;
     m.add_class::<PyWoodSurface>()?;
+    m.add_class::<PyScene>()?;
+    m.add_function(wrap_pyfunction!(load_file, m)?)?;
+    m.add_function(wrap_pyfunction!(load_dict, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_function(wrap_pyfunction!(render, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(fit, m)?)?;

@@ -174,7 +174,8 @@ def test_render_matches_xylem(root):
     n_x, n_m = 4096, 128
     x = xylem.render(scene, spp=n_x)
     xy, se_xy = luminance(x["beauty"].astype(np.float64)), x["std_error"].astype(np.float64)
-    img = np.array(mi.render(mitsuba_board(root, n_m, 1)), dtype=np.float64)
+    with xylem.mitsuba.evaluated():
+        img = np.array(mi.render(mitsuba_board(root, n_m, 1)), dtype=np.float64)
     assert img.shape == (24, 32, 3)
     z = z_scores(xy, se_xy, n_x, img, n_m)
     npx = z.size
@@ -197,17 +198,108 @@ def test_render_matches_xylem(root):
 def test_scalar_variant_renders():
     """The plugin in the scalar variant renders a (tiny) image of the board."""
     use("scalar_rgb")
+    scene = small_scene(6, 4)
+    img = np.array(mi.render(scene))
+    assert img.shape == (4, 6, 3) and np.isfinite(img).all() and img.mean() > 1e-3
+
+
+FLAGS = ("SymbolicLoops", "SymbolicCalls", "SymbolicConditionals")
+
+
+def flags():
+    return {f: dr.flag(getattr(dr.JitFlag, f)) for f in FLAGS}
+
+
+def small_scene(width=8, height=6):
+    """The board under a distant light, seen from above (a few pixels)."""
     T = mi.ScalarTransform4f
-    scene = mi.load_dict({
+    return mi.load_dict({
         "type": "scene",
         "integrator": {"type": "direct"},
         "sensor": {"type": "perspective", "fov": 30.0,
                    "to_world": T().look_at(origin=[0, -120, 160], target=[0, 0, 0], up=[0, 0, 1]),
-                   "film": {"type": "hdrfilm", "width": 6, "height": 4, "pixel_format": "rgb"},
+                   "film": {"type": "hdrfilm", "width": width, "height": height, "pixel_format": "rgb"},
                    "sampler": {"type": "independent", "sample_count": 2}},
         "light": {"type": "directional", "direction": [0, 0, -1], "irradiance": 3.0},
         "board": {"type": "rectangle", "to_world": T().scale([300.0, 300.0, 1.0]),
                   "bsdf": dict(BOARD)},
     })
-    img = np.array(mi.render(scene))
-    assert img.shape == (4, 6, 3) and np.isfinite(img).all() and img.mean() > 1e-3
+
+
+def test_register_changes_no_global_flag():
+    """register() leaves Dr.Jit's symbolic modes as they were (issue 30: it turned them off for
+    the whole process, 2.3x slower renders elsewhere); evaluated() turns them off for its
+    block only and restores them, also after an exception."""
+    mi.set_variant("llvm_ad_rgb")
+    before = flags()
+    assert all(before.values()), before      # Dr.Jit's defaults: symbolic
+    xylem.mitsuba.register()
+    assert flags() == before
+    with xylem.mitsuba.evaluated():
+        assert not any(flags().values())
+    assert flags() == before
+    with pytest.raises(KeyError):
+        with xylem.mitsuba.evaluated():
+            raise KeyError("x")
+    assert flags() == before
+
+
+def test_symbolic_scope_is_an_explicit_error():
+    use("llvm_ad_rgb")
+    scene = small_scene()
+    with pytest.raises(Exception) as raised:
+        mi.render(scene)
+    # Mitsuba wraps it ("error while performing a custom differentiable operation"): the
+    # plugin's own error is in the chain.
+    chain, e = [], raised.value
+    while e is not None:
+        chain.append(f"{type(e).__name__}: {e}")
+        e = e.__cause__ or e.__context__
+    assert any("symbolic Dr.Jit scope" in c and "xylem.mitsuba.evaluated" in c for c in chain), chain
+    # The control: the same render inside evaluated() works.
+    with xylem.mitsuba.evaluated():
+        img = np.array(mi.render(scene))
+    assert img.shape == (6, 8, 3) and np.isfinite(img).all() and img.mean() > 1e-3
+
+
+def one_hit():
+    """One hit on the board (LLVM variant): the interaction, a light direction, a context."""
+    si = dr.zeros(mi.SurfaceInteraction3f, 1)
+    si.p = mi.Point3f(10, 5, 0)
+    si.sh_frame = mi.Frame3f(mi.Vector3f(0, 0, 1))
+    si.wi = mi.Vector3f(0.3, 0.0, 0.954)
+    return si, mi.Vector3f(-0.4, 0.1, 0.911), mi.BSDFContext()
+
+
+def test_gradients_are_refused_not_wrong():
+    """Under AD the plugin raises instead of returning derivatives that miss the BSDF's own
+    (issue 30: -0.067 against -0.369 by finite differences)."""
+    use("llvm_ad_rgb")
+    bsdf = mi.load_dict(BOARD)
+    si, wo, ctx = one_hit()
+    assert np.array(bsdf.eval(ctx, si, wo)).max() > 0      # no gradients: fine
+    dr.enable_grad(wo)
+    for call in [lambda: bsdf.eval(ctx, si, wo), lambda: bsdf.pdf(ctx, si, wo)]:
+        with pytest.raises(NotImplementedError, match="not differentiable"):
+            call()
+    dr.enable_grad(si.wi)
+    with pytest.raises(NotImplementedError, match="not differentiable"):
+        bsdf.sample(ctx, si, mi.Float(0.5), mi.Point2f(0.3, 0.6))
+
+
+def test_parameters_are_traversable():
+    use("llvm_ad_rgb")
+    bsdf = mi.load_dict(BOARD)
+    params = mi.traverse(bsdf)
+    assert {"eta", "roughness", "seed"} <= set(params.keys()), params
+    assert float(params["roughness"][0]) == 0.25 and float(params["eta"][0]) == 1.5
+    si, wo, ctx = one_hit()
+    before = np.array(bsdf.eval(ctx, si, wo)).ravel()
+    params["roughness"] = 0.6
+    params.update()
+    after = np.array(bsdf.eval(ctx, si, wo)).ravel()
+    want = xylem.WoodSurface("african_mahogany", seed=7, eta=1.5, roughness=0.6,
+                             origin=(0, 120, 0), axis=(1, 0, 0), rotation_deg=20.0).eval(
+        [10, 5, 0], [0, 0, 1], [0.3, 0.0, 0.954], [-0.4, 0.1, 0.911]) * 0.911
+    np.testing.assert_allclose(after, want, rtol=1e-4)
+    assert not np.allclose(before, after)

@@ -8,19 +8,39 @@ Thin bindings of the Rust library (every number comes from it):
   (N, 3) array of tree-space points (mm), returning named arrays;
 - ``WoodSurface(preset, ...)``: the volume under a finish placed in the tree, shaded in world
   space as xylem's renderer shades a hit (what the Mitsuba 3 plugin calls);
-- ``render(scene, spp=..., res=...)`` and ``sweep(scene, ...)``: scene files rendered to numpy
-  images, the GIL released while rendering;
+- ``load_file(path)`` / ``load_dict(dict)``: a scene loaded once (``Scene``), from a file or from
+  a dict with the keys of a scene file (as ``mitsuba.load_dict``);
+- ``render(scene, spp=..., res=...)`` and ``sweep(scene, ...)``: a scene (file, built-in name,
+  dict or ``Scene``) rendered to numpy images, the GIL released while rendering;
 - ``fit(capture, out, texels=None, threads=0)``: one board's capture folder fitted into maps in
   ``out`` (as ``xylem fit``), returning the report; many boards fit in parallel with a Dask
   pool (python/examples/fit_boards_dask.py).
 
+Array arguments broadcast over their leading dimensions as numpy does (an ``(H, W, 3)`` grid of
+directions gives ``(H, W, 3)`` values; an empty batch gives empty results), and every input must
+be finite (NaN or infinity raises ``ValueError`` naming the argument and the element).
+
 ``xylem.mitsuba.register()`` registers the ``xylem_wood`` BSDF with Mitsuba 3.
+
+Distributed on PyPI as ``xylem-wood`` (the name ``xylem`` there is an unrelated project); the
+import name is ``xylem``.
 """
 
 import json as _json
 
 from . import _xylem
-from ._xylem import PRESETS, WoodBsdf, WoodSurface, WoodVolume, render, sweep
+from ._xylem import (
+    PRESETS,
+    Scene,
+    WoodBsdf,
+    WoodSurface,
+    WoodVolume,
+    __version__,
+    load_dict,
+    load_file,
+    render,
+    sweep,
+)
 
 
 def fit(capture, out, texels=None, threads=0):
@@ -33,4 +53,16 @@ def fit(capture, out, texels=None, threads=0):
     return _json.loads(_xylem.fit(str(capture), str(out), texels, threads))
 
 
-__all__ = ["PRESETS", "WoodBsdf", "WoodSurface", "WoodVolume", "fit", "render", "sweep"]
+__all__ = [
+    "PRESETS",
+    "Scene",
+    "WoodBsdf",
+    "WoodSurface",
+    "WoodVolume",
+    "__version__",
+    "fit",
+    "load_dict",
+    "load_file",
+    "render",
+    "sweep",
+]

@@ -22,10 +22,19 @@ so cosines are the same in both frames. Mitsuba's ``si.wi`` is xylem's ``wo`` (t
 viewer) and Mitsuba's ``wo`` is xylem's ``wi`` (towards the light). Mitsuba's ``eval`` includes
 the cosine foreshortening, xylem's does not; ``sample`` returns the weight f cos / pdf.
 
-In the LLVM (JIT) variants the plugin reads its inputs into numpy, so Dr.Jit's symbolic loops
-and calls must be off (``register()`` turns them off): rendering then runs in evaluated
-(wavefront) mode.
+In the LLVM (JIT) variants the plugin reads its inputs into numpy, so Dr.Jit's symbolic loops,
+calls and conditionals must be off while it renders: render inside ``with
+xylem.mitsuba.evaluated():``, which turns them off for the block and restores them after
+(rendering then runs in evaluated, wavefront mode). ``register()`` changes no global state; a
+plugin call in a symbolic scope raises an error saying so instead.
+
+The plugin is not differentiable (its inputs go through numpy): a call whose inputs carry
+gradients (``dr.grad_enabled``) raises ``NotImplementedError`` rather than returning values
+whose derivatives would be silently wrong. ``mi.traverse`` shows ``eta``, ``roughness`` and
+``seed`` (non-differentiable); changing them and calling ``params.update()`` rebuilds the wood.
 """
+
+import contextlib
 
 import numpy as np
 
@@ -54,19 +63,31 @@ def _vector(props, name, default):
     return tuple(float(x) for x in parts)
 
 
+_SYMBOLIC = ("SymbolicLoops", "SymbolicCalls", "SymbolicConditionals")
+
+
+@contextlib.contextmanager
+def evaluated():
+    """Dr.Jit's symbolic loops, calls and conditionals off inside the block, as the plugin
+    needs in JIT variants (``with xylem.mitsuba.evaluated(): image = mi.render(scene)``); the
+    flags are restored when the block ends, also on an exception."""
+    import drjit as dr
+
+    with contextlib.ExitStack() as stack:
+        for name in _SYMBOLIC:
+            stack.enter_context(dr.scoped_set_flag(getattr(dr.JitFlag, name), False))
+        yield
+
+
 def register():
-    """Registers the ``xylem_wood`` BSDF with Mitsuba 3 (a variant must be set first)."""
+    """Registers the ``xylem_wood`` BSDF with Mitsuba 3 (a variant must be set first). Changes
+    no Dr.Jit flag: render JIT variants inside ``evaluated()``."""
     global _REGISTERED
     import drjit as dr
     import mitsuba as mi
 
     if mi.variant() is None:
         raise RuntimeError("xylem.mitsuba.register(): call mitsuba.set_variant(...) first")
-    if not mi.variant().startswith("scalar"):
-        # The plugin's methods read their inputs into numpy: symbolic tracing cannot.
-        dr.set_flag(dr.JitFlag.SymbolicLoops, False)
-        dr.set_flag(dr.JitFlag.SymbolicCalls, False)
-        dr.set_flag(dr.JitFlag.SymbolicConditionals, False)
     mi.register_bsdf("xylem_wood", lambda props: _make(mi, dr, props))
     _REGISTERED = True
 
@@ -110,18 +131,22 @@ def _bsdf_class(mi, dr):
             )
             self.eta = float(props.get("eta", 1.5))
             self.roughness = float(props.get("roughness", 0.0))
-            self.surface = WoodSurface(
-                preset,
+            self.seed = int(props.get("seed", 0))
+            self._wood = dict(
                 preset_file=preset_file,
-                seed=int(props.get("seed", 0)),
-                eta=self.eta,
-                roughness=self.roughness,
                 origin=_vector(props, "origin", (0, 0, 0)),
                 axis=_vector(props, "axis", (0, 0, 1)),
                 rotation_deg=float(props.get("rotation_deg", 0.0)),
                 scale=float(props.get("scale", 1.0)),
             )
+            self._preset = preset
+            self._build()
             self.name = preset if preset is not None else preset_file
+
+        def _build(self):
+            """The WoodSurface and the lobes of the current eta, roughness and seed."""
+            self.surface = WoodSurface(self._preset, seed=self.seed, eta=self.eta,
+                                       roughness=self.roughness, **self._wood)
             smooth = self.eta > 1.0 and self.roughness < 1e-3
             lobes = (
                 mi.BSDFFlags.DiffuseReflection
@@ -145,11 +170,27 @@ def _bsdf_class(mi, dr):
             n = dr.select(unset, mi.Vector3f(0, 0, 1), n)
             return mi.Frame3f(s, t, n)
 
+        def _check(self, *values):
+            """Refuses what the plugin cannot do right: a symbolic scope (it reads its inputs
+            into numpy) and inputs that carry gradients (it is not differentiable)."""
+            if not scalar and dr.flag(dr.JitFlag.SymbolicScope):
+                raise RuntimeError(
+                    "xylem_wood reads its inputs into numpy and cannot run in a symbolic "
+                    "Dr.Jit scope: render inside `with xylem.mitsuba.evaluated():`"
+                )
+            if any(dr.grad_enabled(v) for v in values):
+                raise NotImplementedError(
+                    "xylem_wood is not differentiable (its inputs go through numpy, so "
+                    "derivatives would be wrong): use it in primal renders only, with no "
+                    "gradients enabled on the geometry, the sensor or the directions"
+                )
+
         def _inputs(self, si):
             frame = self._frame(si)
             return frame, to_np3(si.p), to_np3(frame.n), to_np3(frame.to_world(si.wi))
 
         def eval(self, ctx, si, wo, active=True):
+            self._check(si.p, si.wi, si.sh_frame.n, wo)
             frame, p, n, wo_x = self._inputs(si)
             wi_x = to_np3(frame.to_world(wo))
             f = from_np3(mi.Color3f, self.surface.eval(p, n, wo_x, wi_x))
@@ -158,6 +199,7 @@ def _bsdf_class(mi, dr):
             return dr.select(ok, f * cos_o, 0.0)
 
         def pdf(self, ctx, si, wo, active=True):
+            self._check(si.p, si.wi, si.sh_frame.n, wo)
             frame, p, n, wo_x = self._inputs(si)
             wi_x = to_np3(frame.to_world(wo))
             pdf = from_np1(self.surface.pdf(p, n, wo_x, wi_x))
@@ -168,6 +210,7 @@ def _bsdf_class(mi, dr):
             return self.eval(ctx, si, wo, active), self.pdf(ctx, si, wo, active)
 
         def sample(self, ctx, si, sample1, sample2, active=True):
+            self._check(si.p, si.wi, si.sh_frame.n)
             frame, p, n, wo_x = self._inputs(si)
             s = self.surface.sample(p, n, wo_x, to_np1(sample1), to_np3_2(sample2))
             bs = dr.zeros(mi.BSDFSample3f, dr.width(sample1))
@@ -190,7 +233,21 @@ def _bsdf_class(mi, dr):
             return bs, dr.select(ok, weight, 0.0)
 
         def traverse(self, callback):
-            pass
+            # Dr.Jit values (params.update() assigns them in place); none is differentiable
+            # (see the module). The scalar variant's are plain numbers: listed, not settable.
+            self._params = {"eta": mi.Float(self.eta), "roughness": mi.Float(self.roughness),
+                            "seed": mi.UInt32(self.seed)}
+            for name, value in self._params.items():
+                callback.put(name, value, mi.ParamFlags.NonDifferentiable)
+
+        def parameters_changed(self, keys=None):
+            if not hasattr(self, "_params"):  # never traversed: nothing can have changed
+                return
+            first = lambda v: np.array(v).ravel()[0]
+            self.eta = float(first(self._params["eta"]))
+            self.roughness = float(first(self._params["roughness"]))
+            self.seed = int(first(self._params["seed"]))
+            self._build()
 
         def to_string(self):
             return (

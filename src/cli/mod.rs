@@ -6,6 +6,7 @@ use std::process::ExitCode;
 
 mod bake;
 mod bench;
+mod docs;
 mod fit;
 mod gallery;
 mod preset;
@@ -22,7 +23,7 @@ mod validate;
     version,
     about = "Wood-appearance simulator: fibre BSDF, procedural solid wood, light sweeps"
 )]
-struct Cli {
+pub(crate) struct Cli {
     #[command(subcommand)]
     command: Command,
 }
@@ -50,6 +51,10 @@ enum Command {
     Bake(bake::Args),
     /// Fit per-texel fibre-BSDF maps (measured-material encoding) to a light sweep.
     Fit(fit::Args),
+    /// Print a shell completion script (bash, zsh, fish, elvish, powershell).
+    Completions(docs::CompletionsArgs),
+    /// Print the man page, or write every subcommand's into a folder (--out DIR).
+    Man(docs::ManArgs),
 }
 
 /// Entry point of the binary: runs the subcommand and turns an error into a message and exit code 1.
@@ -60,7 +65,10 @@ pub fn main() -> ExitCode {
     // Output piped into a reader that stops early (`xylem … | head`) ends the program quietly
     // with SIGPIPE's usual status, as any Unix tool, instead of a panic on the failed print.
     // SAFETY: restores the default action of one signal.
-    unsafe { libc::signal(libc::SIGPIPE, libc::SIG_DFL) };
+    #[cfg(unix)]
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL)
+    };
     // A forced SIMD level with an unknown name is refused here, before any work.
     if let Err(e) = crate::simd::Simd::from_env() {
         eprintln!("error: {e}");
@@ -77,6 +85,8 @@ pub fn main() -> ExitCode {
         Command::Tradeoff(a) => tradeoff::run(a),
         Command::Bake(a) => bake::run(a),
         Command::Fit(a) => fit::run(a),
+        Command::Completions(a) => docs::completions(a),
+        Command::Man(a) => docs::man(a),
     };
     match result {
         Ok(code) => code,

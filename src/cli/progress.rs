@@ -57,3 +57,64 @@ impl Progress for Bar {
         self.bar().finish_and_clear();
     }
 }
+
+/// The steps of a long command (`xylem validate ...`): a bar on a terminal; elsewhere (a log
+/// file, CI, a pipe, where indicatif draws nothing) one line per step on stderr,
+/// `validate sweep: 3/6 steps, highlight tracking (12.4 s)`, and a first line when it starts,
+/// so a run of minutes never looks hung.
+pub(crate) struct Steps {
+    bar: ProgressBar,
+    what: String,
+    unit: String,
+    lines: bool,
+    start: std::time::Instant,
+}
+
+impl Steps {
+    /// `total` steps of `unit` (e.g. "cases") for `what` (e.g. "validate bsdf").
+    pub(crate) fn new(what: &str, total: u64, unit: &str) -> Self {
+        use std::io::IsTerminal;
+        let lines = !std::io::stderr().is_terminal();
+        let bar = if lines {
+            eprintln!("{what}: {total} {unit} to run");
+            ProgressBar::hidden()
+        } else {
+            ProgressBar::new(total).with_style(
+                ProgressStyle::with_template(&format!(
+                    "{what} {{bar:40}} {{pos}}/{{len}} {unit}, {{elapsed}} (eta {{eta}}) {{msg}}"
+                ))
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+            )
+        };
+        bar.set_length(total);
+        Steps {
+            bar,
+            what: what.to_string(),
+            unit: unit.to_string(),
+            lines,
+            start: std::time::Instant::now(),
+        }
+    }
+
+    /// One step done (`name` says which; may be empty).
+    pub(crate) fn step(&self, name: &str) {
+        self.bar.set_message(name.to_string());
+        self.bar.inc(1);
+        if self.lines {
+            let sep = if name.is_empty() { "" } else { ", " };
+            eprintln!(
+                "{}: {}/{} {}{sep}{name} ({:.1} s)",
+                self.what,
+                self.bar.position(),
+                self.bar.length().unwrap_or(0),
+                self.unit,
+                self.start.elapsed().as_secs_f64()
+            );
+        }
+    }
+
+    /// Clears the bar (the lines stay).
+    pub(crate) fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
+}

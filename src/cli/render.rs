@@ -30,6 +30,10 @@ pub struct Args {
     /// Render even when the memory or disk estimate exceeds what the machine has.
     #[arg(long)]
     ignore_limits: bool,
+    /// Also write a JSON summary of the run to FILE (`-`: print it on stdout instead of the
+    /// text lines): scene, settings, camera, time, rays, outputs, image statistics.
+    #[arg(long, value_name = "FILE")]
+    json: Option<PathBuf>,
 }
 
 /// Parses `WxH` with both in 1..=16384.
@@ -91,28 +95,90 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let out = crate::render::render(&loaded.scene, &loaded.settings, &run)?;
     let exr = args.out.join(format!("{}.exr", loaded.name));
     let png = args.out.join(format!("{}.png", loaded.name));
-    let meta = loaded.settings.exr_meta(
-        &loaded.name,
-        &args.scene.display().to_string(),
-        &loaded.scene.camera,
-    );
+    let meta = meta_pairs(&loaded, &args.scene);
     write_outputs(&out.image, &exr, &png, loaded.exposure, &meta)?;
     let secs = out.elapsed.as_secs_f64();
-    println!(
-        "rendered {} in {:.2} s: {:.2} Mrays/s ({} rays)",
-        loaded.name,
-        secs,
-        out.rays as f64 / secs.max(1e-9) / 1e6,
-        out.rays
-    );
+    let to_stdout = args.json.as_deref() == Some(Path::new("-"));
+    if !to_stdout {
+        println!(
+            "rendered {} in {:.2} s: {:.2} Mrays/s ({} rays)",
+            loaded.name,
+            secs,
+            out.rays as f64 / secs.max(1e-9) / 1e6,
+            out.rays
+        );
+    }
     if out.image.nonfinite > 0 {
         eprintln!(
             "warning: {} non-finite samples were dropped (counted as zero)",
             out.image.nonfinite
         );
     }
+    if let Some(file) = &args.json {
+        let summary = summary(&loaded, &args.scene, &out, &meta, [&exr, &png]);
+        let text = serde_json::to_string_pretty(&summary)? + "\n";
+        if to_stdout {
+            print!("{text}");
+            return Ok(ExitCode::SUCCESS);
+        }
+        crate::output::write_atomic(file, text.as_bytes())
+            .with_context(|| format!("cannot write the JSON summary {}", file.display()))?;
+        println!("wrote {}", file.display());
+    }
     println!("wrote {} and {}", exr.display(), png.display());
     Ok(ExitCode::SUCCESS)
+}
+
+/// The EXR header's description of the render (scene, file, spp, seed, integrator, camera).
+fn meta_pairs(loaded: &crate::scene::LoadedScene, scene: &Path) -> Vec<(&'static str, String)> {
+    loaded.settings.exr_meta(
+        &loaded.name,
+        &scene.display().to_string(),
+        &loaded.scene.camera,
+    )
+}
+
+/// `render --json`: what was rendered, how, how long it took, what was written and the image's
+/// mean and peak (linear RGB) and its dropped samples.
+fn summary(
+    loaded: &crate::scene::LoadedScene,
+    scene: &Path,
+    out: &crate::render::RenderOutput,
+    meta: &[(&'static str, String)],
+    files: [&Path; 2],
+) -> serde_json::Value {
+    let img = &out.image;
+    let n = img.beauty.len().max(1) as f64;
+    let mean = img
+        .beauty
+        .iter()
+        .fold([0f64; 3], |a, c| {
+            [a[0] + c.x as f64, a[1] + c.y as f64, a[2] + c.z as f64]
+        })
+        .map(|x| x / n);
+    let peak = img.beauty.iter().fold(0f32, |m, c| m.max(c.max_element()));
+    let secs = out.elapsed.as_secs_f64();
+    let cam = &loaded.scene.camera;
+    serde_json::json!({
+        "xylem": env!("CARGO_PKG_VERSION"),
+        "scene": loaded.name,
+        "scene_file": scene.display().to_string(),
+        "width": cam.width,
+        "height": cam.height,
+        "spp": loaded.settings.spp,
+        "seed": loaded.settings.seed,
+        "integrator": loaded.settings.integrator.to_string(),
+        "camera": meta.iter().find(|m| m.0 == "camera").map(|m| m.1.clone()),
+        "lights": loaded.scene.lights.len(),
+        "triangles": loaded.scene.accel.triangle_count(),
+        "seconds": secs,
+        "rays": out.rays,
+        "mrays_per_s": out.rays as f64 / secs.max(1e-9) / 1e6,
+        "nonfinite_samples": img.nonfinite,
+        "mean_rgb": mean,
+        "peak": peak,
+        "outputs": files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>(),
+    })
 }
 
 /// Writes the EXR and the PNG as one pair: both are encoded to temporary files first, then, under

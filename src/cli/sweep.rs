@@ -27,6 +27,9 @@ pub struct Args {
     /// Samples per pixel, 1 to 1000000 (overrides the scene\'s render.spp).
     #[arg(long, value_parser = super::parse_spp)]
     pub spp: Option<u32>,
+    /// Image size WxH, 1 to 16384 each (overrides render.width / render.height), e.g. 256x192.
+    #[arg(long, value_parser = super::render::parse_res)]
+    pub res: Option<(u32, u32)>,
     /// Speed/accuracy preset measured in validation/TRADEOFF.md (spp and wood-model knobs);
     /// `--spp` still overrides its sample count.
     #[arg(long, value_enum)]
@@ -41,7 +44,7 @@ pub struct Args {
     #[arg(long)]
     pub quiet: bool,
     /// Assemble contact sheet, animated PNG, CSV and viewer from the frames already in DIR.
-    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "frames", "arc", "frames_range", "spp", "naive", "quality", "memory", "emit_openjd"])]
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "frames", "arc", "frames_range", "spp", "res", "naive", "quality", "memory", "emit_openjd"])]
     pub assemble: Option<PathBuf>,
     /// Compression of each frame's EXR: `rle` is fast, `zip` gives files ≈ 20 % smaller for
     /// ≈ 50 ms more CPU per 512×384 frame (notes/sweep.md), `none` writes raw floats.
@@ -85,6 +88,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     if let Some(spp) = args.spp {
         loaded.settings.spp = spp;
+    }
+    if let Some((w, h)) = args.res {
+        loaded.scene.camera = loaded.scene.camera.with_resolution(w, h);
     }
     let arc = args
         .arc
@@ -189,6 +195,7 @@ fn emit_openjd(
     };
     add("--arc", args.arc.clone());
     add("--spp", args.spp.map(|n| n.to_string()));
+    add("--res", args.res.map(|(w, h)| format!("{w}x{h}")));
     add("--quality", args.quality.map(|q| q.to_string()));
     add("--memory", args.memory.map(|m| m.to_string()));
     add(

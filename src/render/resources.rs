@@ -38,6 +38,15 @@ pub enum ResourceError {
         /// The largest allowed.
         max: usize,
     },
+    /// The output folder (or, where it does not exist yet, the nearest folder above it) cannot
+    /// be written: a read-only file system, no permission, not a folder.
+    #[error("cannot write into the output folder {path}: {cause}; choose another with --out")]
+    Unwritable {
+        /// The output folder as given.
+        path: String,
+        /// Why (the operating system's error, and which existing folder was tried).
+        cause: String,
+    },
     /// An input file that is not a regular file or is too large to read.
     #[error("{path}: {message}")]
     Input {
@@ -151,9 +160,14 @@ impl Resources {
         }
     }
 
-    /// Refuses when the estimate exceeds the available memory or the free space of the file
-    /// system holding `out` (unless `ignore`); unknown amounts are not checked.
+    /// Refuses, for a run that writes files (`disk > 0`), an output folder `out` that cannot be
+    /// written ([`check_writable`], even with `ignore`), then, unless `ignore`, an estimate above
+    /// the available memory or the free space of the file system holding `out`; unknown amounts
+    /// are not checked.
     pub fn check(&self, out: &Path, ignore: bool) -> Result<(), ResourceError> {
+        if self.disk > 0 {
+            check_writable(out)?;
+        }
         if ignore {
             return Ok(());
         }
@@ -195,11 +209,53 @@ pub fn check_threads(threads: usize) -> Result<(), ResourceError> {
     Ok(())
 }
 
+/// Refuses an output folder that cannot be written, before anything is rendered: `out` itself
+/// where it exists, else the nearest existing folder above it (where `out` would be made), is
+/// probed by creating and removing a temporary file in it. (Before, a read-only file system
+/// such as /proc reported "needs … but 0.0 MiB is available".)
+pub fn check_writable(out: &Path) -> Result<(), ResourceError> {
+    let unwritable = |cause: String| ResourceError::Unwritable {
+        path: out.display().to_string(),
+        cause,
+    };
+    let abs = std::path::absolute(out).map_err(|e| unwritable(e.to_string()))?;
+    let Some(existing) = abs.ancestors().find(|p| p.exists()) else {
+        return Err(unwritable("no part of the path exists".into()));
+    };
+    let tried = if existing == abs {
+        String::new()
+    } else {
+        format!(
+            " (it does not exist yet; tried {}, where it would be made)",
+            existing.display()
+        )
+    };
+    if !existing.is_dir() {
+        return Err(unwritable(format!(
+            "{} is not a folder{tried}",
+            existing.display()
+        )));
+    }
+    tempfile::Builder::new()
+        .prefix(".xylem-write-probe")
+        .tempfile_in(existing)
+        .map(drop)
+        .map_err(|e| unwritable(format!("{e}{tried}")))
+}
+
 /// Memory available to this process: `MemAvailable` of /proc/meminfo, lowered to the cgroup's
-/// remaining allowance (`memory.max − memory.current`) where one is set, and to the address
-/// space left under `ulimit -v` (`RLIMIT_AS − VmSize`) where one is set. None where unknown.
+/// remaining allowance (`memory.max − memory.current`) where one is set, and (on Unix) to the
+/// address space left under `ulimit -v` (`RLIMIT_AS − VmSize`) where one is set. None where
+/// unknown: on systems without /proc/meminfo (macOS, Windows) the memory is not checked.
 pub fn available_memory() -> Option<u64> {
     let have = available_system_memory()?;
+    Some(have.min(address_space_left().unwrap_or(u64::MAX)))
+}
+
+/// The address space left under `ulimit -v` (`RLIMIT_AS − VmSize`); None where there is no
+/// limit or no such notion.
+#[cfg(unix)]
+fn address_space_left() -> Option<u64> {
     let mut lim = libc::rlimit {
         rlim_cur: 0,
         rlim_max: 0,
@@ -208,14 +264,19 @@ pub fn available_memory() -> Option<u64> {
     if unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut lim) } != 0
         || lim.rlim_cur == libc::RLIM_INFINITY
     {
-        return Some(have);
+        return None;
     }
     let status = std::fs::read_to_string("/proc/self/status").ok();
     let vm_kib: u64 = (status.as_deref())
         .and_then(|s| s.lines().find_map(|l| l.strip_prefix("VmSize:")))
         .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
         .unwrap_or(0);
-    Some(have.min((lim.rlim_cur as u64).saturating_sub(vm_kib * 1024)))
+    Some((lim.rlim_cur as u64).saturating_sub(vm_kib * 1024))
+}
+
+#[cfg(not(unix))]
+fn address_space_left() -> Option<u64> {
+    None
 }
 
 /// [`available_memory`] before the address-space limit.
@@ -241,18 +302,12 @@ fn available_system_memory() -> Option<u64> {
 }
 
 /// Free space (for unprivileged users) on the file system that holds `dir` or, when it does not
-/// exist yet, its nearest existing ancestor. None where unknown.
+/// exist yet, its nearest existing ancestor (the `fs4` crate: statvfs on Unix,
+/// GetDiskFreeSpaceExW on Windows). None where unknown.
 pub fn available_disk(dir: &Path) -> Option<u64> {
-    use std::os::unix::ffi::OsStrExt;
     let abs = std::path::absolute(dir).ok()?;
     let existing = abs.ancestors().find(|p| p.exists())?;
-    let c = std::ffi::CString::new(existing.as_os_str().as_bytes()).ok()?;
-    let mut st: libc::statvfs = unsafe { std::mem::zeroed() };
-    // SAFETY: `c` is a valid NUL-terminated path and `st` a writable statvfs.
-    if unsafe { libc::statvfs(c.as_ptr(), &mut st) } != 0 {
-        return None;
-    }
-    Some(st.f_bavail as u64 * st.f_frsize as u64)
+    fs4::available_space(existing).ok()
 }
 
 /// Opens an input file, refusing what is not a regular file (a FIFO, a device such as
@@ -260,30 +315,23 @@ pub fn available_disk(dir: &Path) -> Option<u64> {
 /// non-blocking, so a FIFO without a writer is refused at once instead of waiting, and its type
 /// and size are checked on the opened handle, so nothing can be swapped in between.
 pub fn open_regular(path: &Path, max: u64) -> Result<std::fs::File, ResourceError> {
-    use std::os::unix::fs::{FileTypeExt, OpenOptionsExt};
     let input = |message: String| ResourceError::Input {
         path: path.display().to_string(),
         message,
     };
-    let file = std::fs::OpenOptions::new()
-        .read(true)
-        .custom_flags(libc::O_NONBLOCK)
-        .open(path)
-        .map_err(|e| input(e.to_string()))?;
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, libc::O_NONBLOCK);
+    let file = options.open(path).map_err(|e| input(e.to_string()))?;
     let meta = file.metadata().map_err(|e| input(e.to_string()))?;
     let t = meta.file_type();
     let kind = if t.is_file() {
         None
     } else if t.is_dir() {
         Some("a folder")
-    } else if t.is_fifo() {
-        Some("a FIFO")
-    } else if t.is_char_device() || t.is_block_device() {
-        Some("a device")
-    } else if t.is_socket() {
-        Some("a socket")
     } else {
-        Some("a special file")
+        Some(special_kind(&t))
     };
     if let Some(kind) = kind {
         return Err(input(format!(
@@ -298,6 +346,26 @@ pub fn open_regular(path: &Path, max: u64) -> Result<std::fs::File, ResourceErro
         )));
     }
     Ok(file)
+}
+
+/// What a file that is neither a regular file nor a folder is.
+#[cfg(unix)]
+fn special_kind(t: &std::fs::FileType) -> &'static str {
+    use std::os::unix::fs::FileTypeExt;
+    if t.is_fifo() {
+        "a FIFO"
+    } else if t.is_char_device() || t.is_block_device() {
+        "a device"
+    } else if t.is_socket() {
+        "a socket"
+    } else {
+        "a special file"
+    }
+}
+
+#[cfg(not(unix))]
+fn special_kind(_: &std::fs::FileType) -> &'static str {
+    "a special file"
 }
 
 /// Reads an input file whole through [`open_regular`] (regular files of at most `max` bytes).

@@ -145,6 +145,11 @@ pub const AOV_FILE: &str = "aov.exr";
 /// is killed. The job that renders frame 0 also writes the AOVs every frame shares into
 /// [`AOV_FILE`] (the camera and geometry do not move). `render` holds frames `range` of the
 /// sweep `path`.
+///
+/// Each frame's EXR header carries one attribute, `sweep_frame` (one, because the exr crate
+/// writes several in hash-map order and frames must be byte-stable): the frame, the light's
+/// angle, azimuth, direction and position on the arc, then `header` (the render's spp, seed,
+/// integrator and camera, [`frame_header`]).
 #[allow(clippy::too_many_arguments)]
 pub fn write_frames(
     dir: &Path,
@@ -156,6 +161,7 @@ pub fn write_frames(
     regions: &[Region],
     compression: ExrCompression,
     settings: &SweepSettings,
+    header: &str,
 ) -> Result<(), SweepError> {
     let (w, h) = (render.width, render.height);
     if range.start == 0 && !render.frames.is_empty() {
@@ -178,9 +184,23 @@ pub fn write_frames(
             ];
             // One attribute: the exr crate writes its extra attributes in hash-map order, which
             // differs run to run, and frames must be byte-stable (tests/robustness.rs).
+            let (to, at) = (
+                path.direction(index),
+                path.pivot + path.radius * path.direction(index),
+            );
             let meta = [(
                 "sweep_frame",
-                format!("frame {index} of {total}, light at {light_deg} deg"),
+                format!(
+                    "frame {index} of {total}, light at {light_deg} deg, azimuth {} deg, \
+                     direction ({}, {}, {}), position ({}, {}, {}) mm; {header}",
+                    path.azimuth_deg(index),
+                    to.x,
+                    to.y,
+                    to.z,
+                    at.x,
+                    at.y,
+                    at.z
+                ),
             )];
             let exr = stage_exr_layers(
                 &dir.join(format!("{stem}.exr")),
@@ -200,6 +220,44 @@ pub fn write_frames(
             write_record(dir, &rec)?;
             Ok(())
         })
+}
+
+/// What every frame of a sweep shares, for its EXR header: the moving light (its name and
+/// kind, the arc's pivot and radius), spp, seed, integrator and the camera (as
+/// [`RenderSettings::exr_meta`](crate::render::RenderSettings::exr_meta) words it).
+pub fn frame_header(loaded: &LoadedScene, path: &SweepPath, moving: usize) -> String {
+    let light = loaded
+        .light_names
+        .get(moving)
+        .cloned()
+        .flatten()
+        .unwrap_or_else(|| format!("lights[{moving}]"));
+    use crate::render::Light;
+    let kind = match loaded.scene.lights.get(moving) {
+        Some(Light::Point(_)) => "point",
+        Some(Light::Spot(_)) => "spot",
+        Some(Light::Distant(_)) => "distant",
+        Some(Light::Rect(_)) => "rect",
+        Some(Light::Sphere(_)) => "sphere",
+        Some(Light::Environment(_)) => "environment",
+        None => "?",
+    };
+    let p = path.pivot;
+    let meta = loaded
+        .settings
+        .exr_meta(&loaded.name, &loaded.name, &loaded.scene.camera);
+    let field = |k: &str| meta.iter().find(|m| m.0 == k).map_or("", |m| m.1.as_str());
+    format!(
+        "moving light {light} ({kind}) about pivot ({}, {}, {}) mm at radius {} mm; {} spp, seed {}, integrator {}; camera {}",
+        p.x,
+        p.y,
+        p.z,
+        path.radius,
+        field("spp"),
+        field("seed"),
+        field("integrator"),
+        field("camera")
+    )
 }
 
 /// Runs a sweep job on a loaded scene. A whole sweep holds its output folder alone, clears what
@@ -251,6 +309,7 @@ pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepE
         provenance: job.provenance.clone(),
     };
     let regions = scene_regions(loaded);
+    let header = frame_header(loaded, &path, moving);
     let (mut render_time, mut n_batches) = (Duration::ZERO, 0);
     // Each batch is written before the next is rendered, so only one batch is ever held.
     for frames in batches(range.clone(), batch) {
@@ -274,6 +333,7 @@ pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepE
             &regions,
             job.exr,
             &settings,
+            &header,
         )?;
         release_freed_memory();
     }

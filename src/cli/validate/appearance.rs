@@ -99,13 +99,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let report = args.report.unwrap_or_else(|| PathBuf::from(default_report));
     let dir = report.parent().map(Path::to_path_buf).unwrap_or_default();
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-    let bar = indicatif::ProgressBar::new(pairs.len() as u64 + if builtin { 3 } else { 0 })
-        .with_style(
-            indicatif::ProgressStyle::with_template(
-                "validate appearance {bar:40} {pos}/{len} {msg}",
-            )
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
+    let steps = pairs.len() as u64 + if builtin { 3 } else { 0 };
+    let bar = crate::cli::progress::Steps::new("validate appearance", steps, "steps");
     let (md, ok) = run_report(
         Path::new("."),
         args.presets.as_deref(),
@@ -113,13 +108,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         SweepSettings::FULL,
         &pairs,
         builtin,
-        &|name| {
-            bar.set_message(name.to_string());
-            bar.inc(1);
-        },
+        &|name| bar.step(name),
     )
     .map_err(anyhow::Error::msg)?;
-    bar.finish_and_clear();
+    bar.finish();
     super::finish_report(&report, &md, ok)
 }
 

@@ -72,14 +72,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         let text = crate::render::resources::read_text_bounded(path, 16 << 20, "JSON text")?;
         serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))?
     } else {
-        let bar = indicatif::ProgressBar::new(suite.cases.len() as u64).with_style(
-            indicatif::ProgressStyle::with_template(
-                "validate bsdf {bar:40} {pos}/{len} cases, {elapsed} (eta {eta})",
-            )
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        let r = run_suite(&suite, &|| bar.inc(1));
-        bar.finish_and_clear();
+        let n = suite.cases.len() as u64;
+        let bar = crate::cli::progress::Steps::new("validate bsdf", n, "cases");
+        let r = run_suite(&suite, &|| bar.step(""));
+        bar.finish();
         r
     };
 

@@ -29,15 +29,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let report = crate::cli::output_path(args.report, "validation/FIT.md", "--report", reduced)?;
     let dir = report.parent().map(Path::to_path_buf).unwrap_or_default();
     let work = tempfile::tempdir().context("creating a temporary folder for the captures")?;
-    let bar = indicatif::ProgressBar::new(4).with_style(
-        indicatif::ProgressStyle::with_template("validate fit {bar:40} {pos}/{len} {msg}")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
+    let bar = crate::cli::progress::Steps::new("validate fit", 4, "boards");
     let (md, ok) = run_report(Path::new("."), &dir, work.path(), &spec, &|name| {
-        bar.set_message(name.to_string());
-        bar.inc(1);
+        bar.step(name)
     })
     .map_err(anyhow::Error::msg)?;
-    bar.finish_and_clear();
+    bar.finish();
     super::finish_report(&report, &md, ok)
 }

@@ -26,16 +26,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .unwrap_or_else(|| PathBuf::from("validation/REPORT.md"));
     let dir = report.parent().map(|p| p.to_path_buf()).unwrap_or_default();
     let run = crate::render::RunOptions::default();
-    let bar = indicatif::ProgressBar::new(6).with_style(
-        indicatif::ProgressStyle::with_template("validate sweep {bar:40} {pos}/{len} {msg}")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
+    let bar = crate::cli::progress::Steps::new("validate sweep", 6, "checks");
     let plots = (!args.no_report).then_some(dir.as_path());
-    let checks = run_checks(plots, &run, &|name| {
-        bar.set_message(name.to_string());
-        bar.inc(1);
-    })?;
-    bar.finish_and_clear();
+    let checks = run_checks(plots, &run, &|name| bar.step(name))?;
+    bar.finish();
     println!("{:<70} {:<6} measured", "check", "result");
     for c in &checks {
         println!(
