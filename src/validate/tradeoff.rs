@@ -45,7 +45,8 @@ fn debug_name<T: std::fmt::Debug, S: serde::Serializer>(v: &T, s: S) -> Result<S
 }
 
 impl Knobs {
-    /// Today's default model (what a scene renders with when no knob is set) at `spp`.
+    /// The default model (what a scene renders with when no knob is set, footprint
+    /// band-limiting on since issue 28) at `spp`.
     pub const fn full(spp: u32) -> Knobs {
         Knobs {
             spp,
@@ -54,17 +55,20 @@ impl Knobs {
             pores_and_rays: true,
             jacobian: JacobianModel::Simplified,
             finish: FinishModel::ClosedForm,
-            footprint_filter: false,
+            footprint_filter: true,
             baked_res: None,
             baked_fibers: BakedFibers::Anisotropy,
         }
     }
 
     /// The most accurate setting of every knob at `spp`: the reference the others are measured
-    /// against (the exact Jacobian instead of the simplified default).
+    /// against (the exact Jacobian instead of the simplified default, and the wood
+    /// point-sampled, so that its pixels converge to the pixel filter's average of the
+    /// unfiltered wood rather than to the footprint-blurred one).
     pub const fn reference(spp: u32) -> Knobs {
         Knobs {
             jacobian: JacobianModel::Exact,
+            footprint_filter: false,
             ..Knobs::full(spp)
         }
     }
@@ -386,9 +390,9 @@ pub fn settings() -> Vec<(String, String, Knobs)> {
     for spp in [1, 4, 16, 64] {
         v.push((
             "footprint band-limit".into(),
-            format!("on, {spp} spp"),
+            format!("off, {spp} spp"),
             Knobs {
-                footprint_filter: true,
+                footprint_filter: false,
                 ..Knobs::full(spp)
             },
         ));
