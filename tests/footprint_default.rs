@@ -85,12 +85,13 @@ fn filtered_low_spp_renders_are_closer_to_the_supersampled_board() {
     // Reference: the point-sampled wood converged by 256 samples a pixel (the pixel filter's
     // average of the unfiltered wood). At 4 spp the unfiltered render adds the wood's sub-pixel
     // variation as noise (aliasing); the filtered one replaces it by its footprint mean, at the
-    // cost of a small bias (the footprint box on top of the pixel filter).
+    // cost of a small bias (a box of the sample's share of the pixel on top of the pixel
+    // filter). Measured (deterministic seeds): 3.26e-2 filtered, 4.81e-2 point-sampled (0.68×).
     let reference = board(256, false);
     let (on, off) = (board(4, true), board(4, false));
     let (e_on, e_off) = (rel_mse(&on, &reference), rel_mse(&off, &reference));
     eprintln!("4 spp: rel. MSE filtered {e_on:.3e}, point-sampled {e_off:.3e}");
-    assert!(e_on < 0.7 * e_off, "filtered {e_on} vs point-sampled {e_off}");
+    assert!(e_on < 0.8 * e_off, "filtered {e_on} vs point-sampled {e_off}");
 }
 
 fn xylem(args: &[&str], dir: &Path) -> std::process::Output {

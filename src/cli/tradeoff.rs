@@ -2,7 +2,9 @@
 //! writes validation/TRADEOFF.md with an error-against-time plot.
 
 use crate::picture::plot::{line_plot, PlotOptions, Series};
-use crate::validate::tradeoff::{relative_mse, render_with, settings, ssim, Knobs, Measurement};
+use crate::validate::tradeoff::{
+    relative_mse, render_with, settings, ssim, weak_reference, Knobs, Measurement,
+};
 use anyhow::Context;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -33,6 +35,10 @@ pub struct Args {
     /// Worker threads (0 = all cores; at most 16 per core).
     #[arg(long, default_value_t = 0, value_parser = super::parse_threads)]
     pub threads: usize,
+    /// Measure even with a reference under 4× the highest measured spp (the report then says
+    /// so at its top; without this flag such a run is refused).
+    #[arg(long)]
+    pub allow_weak_reference: bool,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -46,6 +52,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         "--reference-spp must be at least 1"
     );
     let all = settings();
+    let max_spp = all.iter().map(|(_, _, k)| k.spp).max().unwrap_or(1);
+    let weak = weak_reference(args.reference_spp, max_spp);
+    if let Some(why) = &weak {
+        anyhow::ensure!(
+            args.allow_weak_reference,
+            "{why} (or pass --allow-weak-reference to measure anyway)"
+        );
+        eprintln!("warning: {why}");
+    }
     let probe = crate::scene::load(&args.scene)?;
     let (w0, h0) = (probe.scene.camera.width, probe.scene.camera.height);
     let (w, h) = (
@@ -147,7 +162,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .unwrap_or_else(|| "tradeoff".into());
     let plot_rel = format!("plots/{stem}_error_vs_time.png");
     write_plot(&dir.join(&plot_rel), &rows)?;
-    let md = markdown(&name, &args, (w, h), ref_secs, &rows, &plot_rel);
+    let mut md = markdown(&name, &args, (w, h), ref_secs, &rows, &plot_rel);
+    if let Some(why) = &weak {
+        // Right under the title, before any number.
+        let at = md.find("\n\n").map_or(0, |i| i + 2);
+        md.insert_str(at, &format!("> **Weak reference**: {why}.\n\n"));
+    }
     crate::sweep::sequence::write_text_atomic(&args.out, &md)?;
     for r in &rows {
         println!(

@@ -407,6 +407,26 @@ pub fn settings() -> Vec<(String, String, Knobs)> {
     v
 }
 
+/// The least reference sample count, as a multiple of the highest measured one, that `xylem
+/// tradeoff` accepts without `--allow-weak-reference`: the reference's own noise variance is
+/// then ≤ ¼ of the noisiest row's lowest, so a row cannot score better than it is by matching the
+/// reference's noise (with a 16-spp reference the 16-spp row scored SSIM 1.0000, same seeds).
+pub const MIN_REFERENCE_FACTOR: u32 = 4;
+
+/// Why a reference of `reference_spp` is too weak to score rows of up to `max_spp` samples
+/// (below [`MIN_REFERENCE_FACTOR`] × `max_spp`), or `None`.
+pub fn weak_reference(reference_spp: u32, max_spp: u32) -> Option<String> {
+    let need = MIN_REFERENCE_FACTOR.saturating_mul(max_spp);
+    (reference_spp < need).then(|| {
+        format!(
+            "--reference-spp {reference_spp} is under {MIN_REFERENCE_FACTOR}× the highest \
+             measured {max_spp} spp: rows near it are scored against a reference about as noisy \
+             as they are (a row at the reference's spp and seeds matches it exactly); use \
+             --reference-spp {need} or more"
+        )
+    })
+}
+
 /// Renders the scene (its own lights, as built) with `knobs`; returns the beauty, the render
 /// seconds and the seconds spent applying the knobs.
 pub fn render_with(
