@@ -3,7 +3,7 @@
 
 use crate::picture::plot::{line_plot, PlotOptions, Series};
 use crate::validate::tradeoff::{
-    relative_mse, render_with, settings, ssim, weak_reference, Knobs, Measurement,
+    median_range, relative_mse, render_with, settings, ssim, weak_reference, Knobs, Measurement,
 };
 use anyhow::Context;
 use std::path::{Path, PathBuf};
@@ -39,6 +39,11 @@ pub struct Args {
     /// so at its top; without this flag such a run is refused).
     #[arg(long)]
     pub allow_weak_reference: bool,
+    /// Times each setting is rendered for its timing, 1 to 20, in rounds over all settings (so
+    /// that a change in the machine's load falls on every setting alike); the report gives the
+    /// median and the range.
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=20))]
+    pub repeats: u32,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -93,14 +98,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         threads: args.threads,
         ..Default::default()
     };
-    let bar = indicatif::ProgressBar::new(all.len() as u64 + 1).with_style(
+    let bar = indicatif::ProgressBar::new(all.len() as u64 * args.repeats as u64 + 1).with_style(
         indicatif::ProgressStyle::with_template("tradeoff {bar:40} {pos}/{len} {msg}")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
     bar.set_message(format!("reference, {} spp", args.reference_spp));
-    let (reference, ref_secs, _) = render_with(&base, &Knobs::reference(args.reference_spp), &run)
+    let reference_render = render_with(&base, &Knobs::reference(args.reference_spp), &run)
         .map_err(anyhow::Error::msg)
         .context("reference render")?;
+    let (reference, ref_secs) = (reference_render.image, reference_render.seconds);
     bar.inc(1);
     let save = |name: &str, img: &[glam::Vec3]| -> anyhow::Result<()> {
         if let Some(dir) = &args.images {
@@ -123,16 +129,21 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let mut rows = Vec::new();
     // The reference model at each measured spp (same seeds), rendered once per spp.
     let mut same_spp: Vec<(u32, Vec<glam::Vec3>)> = Vec::new();
-    for (knob, setting, knobs) in all {
+    // Wall and CPU seconds of every render of each setting, over the rounds.
+    let mut times: Vec<(Vec<f64>, Vec<f64>)> = vec![(Vec::new(), Vec::new()); all.len()];
+    for (i, (knob, setting, knobs)) in all.iter().cloned().enumerate() {
         bar.set_message(setting.clone());
-        let (img, secs, prep) = render_with(&base, &knobs, &run)
+        let r = render_with(&base, &knobs, &run)
             .map_err(anyhow::Error::msg)
             .with_context(|| format!("render with {setting}"))?;
+        let (img, prep) = (r.image, r.prep_seconds);
+        times[i].0.push(r.seconds);
+        times[i].1.push(r.cpu_seconds);
         if !same_spp.iter().any(|(s, _)| *s == knobs.spp) {
-            let (r, _, _) = render_with(&base, &Knobs::reference(knobs.spp), &run)
+            let r = render_with(&base, &Knobs::reference(knobs.spp), &run)
                 .map_err(anyhow::Error::msg)
                 .with_context(|| format!("reference model at {} spp", knobs.spp))?;
-            same_spp.push((knobs.spp, r));
+            same_spp.push((knobs.spp, r.image));
         }
         save(&format!("{knob} {setting}"), &img)?;
         let model_ref = &same_spp
@@ -144,7 +155,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             knob,
             setting,
             knobs,
-            seconds: secs,
+            seconds: f64::NAN,
+            cpu_seconds: f64::NAN,
+            cpu_min: f64::NAN,
+            cpu_max: f64::NAN,
+            repeats: args.repeats,
             prep_seconds: prep,
             relative_mse: relative_mse(&img, &reference),
             ssim: ssim(&img, &reference, w as usize, h as usize, exposure),
@@ -152,6 +167,22 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             model_ssim: ssim(&img, model_ref, w as usize, h as usize, exposure),
         });
         bar.inc(1);
+    }
+    // The timing repeats, interleaved: every setting once per round.
+    for round in 1..args.repeats {
+        for (i, (_, setting, knobs)) in all.iter().enumerate() {
+            bar.set_message(format!("timing round {}: {setting}", round + 1));
+            let r = render_with(&base, knobs, &run)
+                .map_err(anyhow::Error::msg)
+                .with_context(|| format!("render with {setting}"))?;
+            times[i].0.push(r.seconds);
+            times[i].1.push(r.cpu_seconds);
+            bar.inc(1);
+        }
+    }
+    for (row, (wall, cpu)) in rows.iter_mut().zip(&times) {
+        row.seconds = median_range(wall).0;
+        (row.cpu_seconds, row.cpu_min, row.cpu_max) = median_range(cpu);
     }
     bar.finish_and_clear();
     let dir = args.out.parent().map(Path::to_path_buf).unwrap_or_default();
@@ -171,8 +202,8 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     crate::sweep::sequence::write_text_atomic(&args.out, &md)?;
     for r in &rows {
         println!(
-            "{:<20} {:<28} {:>8.3} s (+{:.3} s)  rel. MSE {:>10.3e}  SSIM {:.4}  model {:>10.3e} {:.4}",
-            r.knob, r.setting, r.seconds, r.prep_seconds, r.relative_mse, r.ssim, r.model_mse, r.model_ssim
+            "{:<20} {:<28} {:>8.3} s CPU ({:.3}–{:.3}), {:.3} s wall (+{:.3} s)  rel. MSE {:>10.3e}  SSIM {:.4}  model {:>10.3e} {:.4}",
+            r.knob, r.setting, r.cpu_seconds, r.cpu_min, r.cpu_max, r.seconds, r.prep_seconds, r.relative_mse, r.ssim, r.model_mse, r.model_ssim
         );
     }
     println!("report: {}", args.out.display());
@@ -217,7 +248,7 @@ fn write_plot(path: &Path, rows: &[Measurement]) -> anyhow::Result<()> {
             points: rows
                 .iter()
                 .filter(|r| r.knob == *name)
-                .map(|r| (r.seconds, r.relative_mse))
+                .map(|r| (r.cpu_seconds, r.relative_mse))
                 .collect(),
             color: COLOURS[k % COLOURS.len()].0,
             markers: true,
@@ -247,12 +278,14 @@ const PRESET_KNOBS: [&str; 4] = [
     "finish",
 ];
 
-/// The cheapest measured setting (render plus preparation time) among [`PRESET_KNOBS`] whose
+/// The cheapest measured setting (median render CPU seconds plus preparation time) among [`PRESET_KNOBS`] whose
 /// SSIM reaches `min_ssim`.
 fn cheapest(rows: &[Measurement], min_ssim: f64) -> Option<&Measurement> {
     rows.iter()
         .filter(|r| PRESET_KNOBS.contains(&r.knob.as_str()) && r.ssim >= min_ssim)
-        .min_by(|a, b| (a.seconds + a.prep_seconds).total_cmp(&(b.seconds + b.prep_seconds)))
+        .min_by(|a, b| {
+            (a.cpu_seconds + a.prep_seconds).total_cmp(&(b.cpu_seconds + b.prep_seconds))
+        })
 }
 
 fn markdown(
@@ -269,8 +302,10 @@ fn markdown(
          with the most accurate setting of every knob, the wood point-sampled, took \
          {ref_secs:.2} s). Error against the \
          reference: relative MSE (Σ|x − r|² / Σ|r|² over RGB) and mean SSIM (Wang et al. 2004, \
-         8×8 windows, stride 4, on sRGB luminance). Times are wall clock on a shared machine \
-         (other jobs running), so compare them within this table only. Model knobs are measured \
+         8×8 windows, stride 4, on sRGB luminance). Times are the median (and range) of {} \
+         renders of each setting, taken in rounds over all settings so that a change of the \
+         machine's load falls on every row alike, in CPU seconds of the process (all threads; \
+         the recommendations use these), with the wall-clock median beside them. Model knobs are measured \
          at 16 spp (the footprint band-limit, on by default, switched off at 1 to 64), so their \
          error includes the noise of \
          the same spp in the first table's rows; the \
@@ -294,15 +329,19 @@ fn markdown(
         } else {
             args.threads.to_string()
         },
-        args.reference_spp
+        args.reference_spp,
+        args.repeats
     );
-    s += "| knob | setting | time (s) | prep (s) | relative MSE | SSIM | model rel. MSE | model SSIM |\n\
-          | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+    s += "| knob | setting | CPU (s), median | CPU range (s) | wall (s) | prep (s) | relative MSE | SSIM | model rel. MSE | model SSIM |\n\
+          | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
     for r in rows {
         s += &format!(
-            "| {} | {} | {:.3} | {:.3} | {:.3e} | {:.4} | {:.3e} | {:.4} |\n",
+            "| {} | {} | {:.3} | {:.3}–{:.3} | {:.3} | {:.3} | {:.3e} | {:.4} | {:.3e} | {:.4} |\n",
             r.knob,
             r.setting,
+            r.cpu_seconds,
+            r.cpu_min,
+            r.cpu_max,
             r.seconds,
             r.prep_seconds,
             r.relative_mse,
@@ -317,10 +356,10 @@ fn markdown(
         .map(|(k, name)| format!("{} {name}", COLOURS[k % COLOURS.len()].1))
         .collect();
     s += &format!(
-        "\n![relative MSE (vertical, log) against render time in seconds (horizontal, log), one \
+        "\n![relative MSE (vertical, log) against median render CPU seconds (horizontal, log), one \
          colour per knob: {}]({plot})\n\n## Recommended settings\n\n\
          Chosen among the knobs that keep any scene's look ({}): the cheapest measured setting \
-         (render plus preparation time) reaching each SSIM threshold.\n\n",
+         (median render CPU seconds plus preparation time) reaching each SSIM threshold.\n\n",
         legend.join(", "),
         PRESET_KNOBS.join(", ")
     );
@@ -328,8 +367,8 @@ fn markdown(
         match cheapest(rows, t) {
             Some(r) => {
                 s += &format!(
-                    "- **{label}** (cheapest with SSIM ≥ {t}): {} {} — {:.3} s, SSIM {:.4}\n",
-                    r.knob, r.setting, r.seconds, r.ssim
+                    "- **{label}** (cheapest with SSIM ≥ {t}): {} {} — {:.3} CPU s, SSIM {:.4}\n",
+                    r.knob, r.setting, r.cpu_seconds, r.ssim
                 )
             }
             None => s += &format!("- **{label}**: no measured setting reaches SSIM ≥ {t}\n"),
