@@ -158,3 +158,37 @@ fn wide_footprints_give_the_mean_ring_colour() {
     let err = (wide - want).abs().max_element();
     assert!(err < 0.003, "wide footprint {wide} vs {want}");
 }
+
+#[test]
+fn ray_fleck_stays_on_a_quartersawn_face_and_fades_on_a_flat_sawn_one() {
+    // Quartersawn white oak's rays are sheets 0.4 mm thick with normal θ̂: a quartersawn face
+    // (normal θ̂) lies in them and shows broad flecks, which a footprint of three ray widths
+    // must keep; a flat-sawn face (normal r̂) cuts them in 0.4 mm lines, which it fades to the
+    // mean (the negative control: the same footprint, the other face).
+    let vol = WoodVolume::new(preset("quartersawn_white_oak").unwrap(), 3).unwrap();
+    let width = vol.params().rays.as_ref().unwrap().width;
+    let mut rng = Pcg32::new(9, 9);
+    let spread = |normal_of: &dyn Fn(Vec3) -> Vec3, rng: &mut Pcg32| -> f32 {
+        let masks: Vec<f32> = (0..2000)
+            .map(|_| {
+                let c = Vec3::new(
+                    60.0 + 60.0 * rng.next_f32(),
+                    2.0 * rng.next_f32(),
+                    200.0 * rng.next_f32(),
+                );
+                let fp = Footprint {
+                    width: 3.0 * width,
+                    normal: normal_of(c),
+                };
+                vol.eval_footprint(c, Needs::ALL, fp).ray_mask
+            })
+            .collect();
+        let mean = masks.iter().sum::<f32>() / masks.len() as f32;
+        (masks.iter().map(|m| (m - mean).powi(2)).sum::<f32>() / masks.len() as f32).sqrt()
+    };
+    let theta = |c: Vec3| Vec3::new(-c.y, c.x, 0.0).normalize();
+    let radial = |c: Vec3| Vec3::new(c.x, c.y, 0.0).normalize();
+    let (quarter, flat) = (spread(&theta, &mut rng), spread(&radial, &mut rng));
+    assert!(quarter > 0.05, "quartersawn fleck faded: std {quarter}");
+    assert!(flat < 1e-4, "flat-sawn ray lines kept: std {flat}");
+}

@@ -253,6 +253,9 @@ pub struct Rays {
     strength: f32,
     /// Ray width (its narrowest extent), mm.
     pub width: f32,
+    /// The smaller of the ray's other extents (length along r̂, height along ẑ), mm: the widest
+    /// its trace on a face can be.
+    pub trace_limit: f32,
     /// Mean of [`Rays::mask`]: strength · min(1, density · bump_kernel_mean(s)).
     pub mean_mask: f32,
     /// Sideways displacement of the ray sheets (mm along θ̂), if they wander.
@@ -278,6 +281,7 @@ impl Rays {
             ),
             strength: p.strength,
             width: p.width,
+            trace_limit: p.length.min(p.height),
             mean_mask: p.strength * (p.density * bump_kernel_mean(p.sharpness)).min(1.0),
             wander: (p.wander > 0.0)
                 .then(|| grain_noise(p.wander, (p.wander_length, p.wander_length), 2.0, seeds[1])),

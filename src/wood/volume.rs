@@ -511,7 +511,18 @@ impl WoodVolume {
         }
         if want_rays {
             let rays = self.rays.as_ref().expect("checked");
-            let w = footprint_weight(rays.width, footprint);
+            // A ray is a sheet `width` thick with normal θ̂: a face with normal n cuts it in a
+            // trace width / |θ̂ × n| wide (at most the sheet's other extents), so on a
+            // quartersawn face (n ≈ θ̂) the fleck is broad and stays; on a flat-sawn face it is a
+            // thin line that fades like a pore. Unknown face: the width itself.
+            let trace = if fp.normal == Vec3::ZERO {
+                rays.width
+            } else {
+                let theta = Vec3::new(-q.y, q.x, 0.0).normalize_or_zero();
+                let sin = (1.0 - theta.dot(fp.normal).powi(2)).max(0.0).sqrt();
+                (rays.width / sin.max(1e-6)).min(rays.trace_limit).max(rays.width)
+            };
+            let w = footprint_weight(trace, footprint);
             texel.ray_mask = if w >= 1.0 {
                 rays.mask(q)
             } else if w <= 0.0 {
