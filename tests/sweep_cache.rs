@@ -301,7 +301,7 @@ fn batch_culled_shadow_segments_are_unoccluded() {
     let (mut n_culled, mut n_kept) = (0, 0);
     for y in 0..scene.camera.height {
         for x in 0..scene.camera.width {
-            let Some(sp) = primary_sample(scene, glam::UVec2::new(x, y), 0, 3).point else {
+            let Some(sp) = primary_sample(scene, glam::UVec2::new(x, y), 0, 3, 1.0).point else {
                 continue;
             };
             let centers: [Vec<f32>; 3] = [

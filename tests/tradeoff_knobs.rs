@@ -188,9 +188,14 @@ fn exact_jacobian_is_closer_to_finite_differences_of_the_lookup_point() {
     assert!(err_e < 0.8 * err_s, "exact {err_e} vs simplified {err_s}");
 }
 
-/// The narrowest feature of a preset (mm): pore diameter, ray width, finest distortion band.
+/// The narrowest feature of a preset (mm): pore diameter, ray width, finest distortion band, and
+/// a tenth of the shorter ring transition, below which the rings are point-sampled (issue 28;
+/// the growth wave and noise and the distortion steepen the time gradient over 1/width, by
+/// less than 20× in every preset).
 fn smallest_feature(p: &WoodParams) -> f32 {
-    let mut d = f32::INFINITY;
+    let [_, rise, _, fall] = p.rings.proportions;
+    let sum: f32 = p.rings.proportions.iter().sum();
+    let mut d = 0.1 * rise.min(fall) / sum * p.rings.width / 20.0;
     if let Some(x) = &p.pores {
         d = d.min(2.0 * x.radius);
     }

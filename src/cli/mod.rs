@@ -125,6 +125,41 @@ pub(crate) fn parse_spp(s: &str) -> Result<u32, String> {
     }
 }
 
+/// Parses `on` / `off` (also `true` / `false`).
+pub(crate) fn parse_on_off(s: &str) -> Result<bool, String> {
+    match s.trim() {
+        "on" | "true" => Ok(true),
+        "off" | "false" => Ok(false),
+        _ => Err(format!("`{s}`: expected on or off")),
+    }
+}
+
+/// The command line's settings over a loaded scene, applied in one order by every command that
+/// renders a scene (`render`, `sweep`): the `--quality` preset first (its spp and wood-model
+/// knobs, `validate::tradeoff::Quality::knobs`), then `--spp` and `--footprint-filter`, which
+/// override the preset and the scene file.
+pub(crate) fn apply_scene_overrides(
+    loaded: &mut crate::scene::LoadedScene,
+    quality: Option<crate::validate::tradeoff::Quality>,
+    spp: Option<u32>,
+    footprint_filter: Option<bool>,
+) -> anyhow::Result<()> {
+    use anyhow::Context;
+    if let Some(q) = quality {
+        crate::validate::tradeoff::apply(loaded, &q.knobs())
+            .with_context(|| format!("applying --quality {q}"))?;
+    }
+    if let Some(spp) = spp {
+        loaded.settings.spp = spp;
+    }
+    if let Some(on) = footprint_filter {
+        for m in &mut loaded.scene.materials {
+            m.set_footprint_filter(on);
+        }
+    }
+    Ok(())
+}
+
 /// The largest `--exposure` magnitude in stops: ±30 stops scales by 2^±30 ≈ 10^±9, beyond
 /// which every pixel of any image is black or white.
 pub(crate) const MAX_EXPOSURE_STOPS: f32 = 30.0;

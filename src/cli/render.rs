@@ -21,6 +21,14 @@ pub struct Args {
     /// Worker threads (0 = all cores; at most 16 per core).
     #[arg(long, default_value_t = 0, value_parser = super::parse_threads)]
     threads: usize,
+    /// Speed/accuracy preset measured in validation/TRADEOFF.md (spp and wood-model knobs, as
+    /// `sweep --quality`); `--spp` and `--footprint-filter` still override it.
+    #[arg(long, value_enum)]
+    quality: Option<crate::validate::tradeoff::Quality>,
+    /// Band-limit wood by the pixel footprint, `on` or `off` (overrides render.footprint_filter,
+    /// default on).
+    #[arg(long, value_name = "on|off", value_parser = super::parse_on_off)]
+    footprint_filter: Option<bool>,
     /// Random seed (overrides render.seed).
     #[arg(long)]
     seed: Option<u64>,
@@ -60,9 +68,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     for w in &loaded.warnings {
         eprintln!("warning: {w}");
     }
-    if let Some(spp) = args.spp {
-        loaded.settings.spp = spp;
-    }
+    super::apply_scene_overrides(&mut loaded, args.quality, args.spp, args.footprint_filter)?;
     if let Some(seed) = args.seed {
         loaded.settings.seed = seed;
     }

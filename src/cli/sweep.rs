@@ -82,13 +82,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     for w in &loaded.warnings {
         eprintln!("warning: {w}");
     }
-    if let Some(q) = args.quality {
-        crate::validate::tradeoff::apply(&mut loaded, &q.knobs())
-            .with_context(|| format!("applying --quality {q}"))?;
-    }
-    if let Some(spp) = args.spp {
-        loaded.settings.spp = spp;
-    }
+    super::apply_scene_overrides(&mut loaded, args.quality, args.spp, None)?;
     if let Some((w, h)) = args.res {
         loaded.scene.camera = loaded.scene.camera.with_resolution(w, h);
     }

@@ -2,7 +2,9 @@
 //! writes validation/TRADEOFF.md with an error-against-time plot.
 
 use crate::picture::plot::{line_plot, PlotOptions, Series};
-use crate::validate::tradeoff::{relative_mse, render_with, settings, ssim, Knobs, Measurement};
+use crate::validate::tradeoff::{
+    median_range, relative_mse, render_with, settings, ssim, weak_reference, Knobs, Measurement,
+};
 use anyhow::Context;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -33,6 +35,15 @@ pub struct Args {
     /// Worker threads (0 = all cores; at most 16 per core).
     #[arg(long, default_value_t = 0, value_parser = super::parse_threads)]
     pub threads: usize,
+    /// Measure even with a reference under 4× the highest measured spp (the report then says
+    /// so at its top; without this flag such a run is refused).
+    #[arg(long)]
+    pub allow_weak_reference: bool,
+    /// Times each setting is rendered for its timing, 1 to 20, in rounds over all settings (so
+    /// that a change in the machine's load falls on every setting alike); the report gives the
+    /// median and the range.
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=20))]
+    pub repeats: u32,
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
@@ -45,6 +56,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         args.reference_spp >= 1,
         "--reference-spp must be at least 1"
     );
+    let all = settings();
+    let max_spp = all.iter().map(|(_, _, k)| k.spp).max().unwrap_or(1);
+    let weak = weak_reference(args.reference_spp, max_spp);
+    if let Some(why) = &weak {
+        anyhow::ensure!(
+            args.allow_weak_reference,
+            "{why} (or pass --allow-weak-reference to measure anyway)"
+        );
+        eprintln!("warning: {why}");
+    }
     let probe = crate::scene::load(&args.scene)?;
     let (w0, h0) = (probe.scene.camera.width, probe.scene.camera.height);
     let (w, h) = (
@@ -77,15 +98,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         threads: args.threads,
         ..Default::default()
     };
-    let all = settings();
-    let bar = indicatif::ProgressBar::new(all.len() as u64 + 1).with_style(
+    let bar = indicatif::ProgressBar::new(all.len() as u64 * args.repeats as u64 + 1).with_style(
         indicatif::ProgressStyle::with_template("tradeoff {bar:40} {pos}/{len} {msg}")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
     bar.set_message(format!("reference, {} spp", args.reference_spp));
-    let (reference, ref_secs, _) = render_with(&base, &Knobs::reference(args.reference_spp), &run)
+    let reference_render = render_with(&base, &Knobs::reference(args.reference_spp), &run)
         .map_err(anyhow::Error::msg)
         .context("reference render")?;
+    let (reference, ref_secs) = (reference_render.image, reference_render.seconds);
     bar.inc(1);
     let save = |name: &str, img: &[glam::Vec3]| -> anyhow::Result<()> {
         if let Some(dir) = &args.images {
@@ -108,16 +129,21 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let mut rows = Vec::new();
     // The reference model at each measured spp (same seeds), rendered once per spp.
     let mut same_spp: Vec<(u32, Vec<glam::Vec3>)> = Vec::new();
-    for (knob, setting, knobs) in all {
+    // Wall and CPU seconds of every render of each setting, over the rounds.
+    let mut times: Vec<(Vec<f64>, Vec<f64>)> = vec![(Vec::new(), Vec::new()); all.len()];
+    for (i, (knob, setting, knobs)) in all.iter().cloned().enumerate() {
         bar.set_message(setting.clone());
-        let (img, secs, prep) = render_with(&base, &knobs, &run)
+        let r = render_with(&base, &knobs, &run)
             .map_err(anyhow::Error::msg)
             .with_context(|| format!("render with {setting}"))?;
+        let (img, prep) = (r.image, r.prep_seconds);
+        times[i].0.push(r.seconds);
+        times[i].1.push(r.cpu_seconds);
         if !same_spp.iter().any(|(s, _)| *s == knobs.spp) {
-            let (r, _, _) = render_with(&base, &Knobs::reference(knobs.spp), &run)
+            let r = render_with(&base, &Knobs::reference(knobs.spp), &run)
                 .map_err(anyhow::Error::msg)
                 .with_context(|| format!("reference model at {} spp", knobs.spp))?;
-            same_spp.push((knobs.spp, r));
+            same_spp.push((knobs.spp, r.image));
         }
         save(&format!("{knob} {setting}"), &img)?;
         let model_ref = &same_spp
@@ -129,7 +155,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             knob,
             setting,
             knobs,
-            seconds: secs,
+            seconds: f64::NAN,
+            cpu_seconds: f64::NAN,
+            cpu_min: f64::NAN,
+            cpu_max: f64::NAN,
+            repeats: args.repeats,
             prep_seconds: prep,
             relative_mse: relative_mse(&img, &reference),
             ssim: ssim(&img, &reference, w as usize, h as usize, exposure),
@@ -137,6 +167,22 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             model_ssim: ssim(&img, model_ref, w as usize, h as usize, exposure),
         });
         bar.inc(1);
+    }
+    // The timing repeats, interleaved: every setting once per round.
+    for round in 1..args.repeats {
+        for (i, (_, setting, knobs)) in all.iter().enumerate() {
+            bar.set_message(format!("timing round {}: {setting}", round + 1));
+            let r = render_with(&base, knobs, &run)
+                .map_err(anyhow::Error::msg)
+                .with_context(|| format!("render with {setting}"))?;
+            times[i].0.push(r.seconds);
+            times[i].1.push(r.cpu_seconds);
+            bar.inc(1);
+        }
+    }
+    for (row, (wall, cpu)) in rows.iter_mut().zip(&times) {
+        row.seconds = median_range(wall).0;
+        (row.cpu_seconds, row.cpu_min, row.cpu_max) = median_range(cpu);
     }
     bar.finish_and_clear();
     let dir = args.out.parent().map(Path::to_path_buf).unwrap_or_default();
@@ -147,12 +193,17 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .unwrap_or_else(|| "tradeoff".into());
     let plot_rel = format!("plots/{stem}_error_vs_time.png");
     write_plot(&dir.join(&plot_rel), &rows)?;
-    let md = markdown(&name, &args, (w, h), ref_secs, &rows, &plot_rel);
+    let mut md = markdown(&name, &args, (w, h), ref_secs, &rows, &plot_rel);
+    if let Some(why) = &weak {
+        // Right under the title, before any number.
+        let at = md.find("\n\n").map_or(0, |i| i + 2);
+        md.insert_str(at, &format!("> **Weak reference**: {why}.\n\n"));
+    }
     crate::sweep::sequence::write_text_atomic(&args.out, &md)?;
     for r in &rows {
         println!(
-            "{:<20} {:<28} {:>8.3} s (+{:.3} s)  rel. MSE {:>10.3e}  SSIM {:.4}  model {:>10.3e} {:.4}",
-            r.knob, r.setting, r.seconds, r.prep_seconds, r.relative_mse, r.ssim, r.model_mse, r.model_ssim
+            "{:<20} {:<28} {:>8.3} s CPU ({:.3}–{:.3}), {:.3} s wall (+{:.3} s)  rel. MSE {:>10.3e}  SSIM {:.4}  model {:>10.3e} {:.4}",
+            r.knob, r.setting, r.cpu_seconds, r.cpu_min, r.cpu_max, r.seconds, r.prep_seconds, r.relative_mse, r.ssim, r.model_mse, r.model_ssim
         );
     }
     println!("report: {}", args.out.display());
@@ -197,7 +248,7 @@ fn write_plot(path: &Path, rows: &[Measurement]) -> anyhow::Result<()> {
             points: rows
                 .iter()
                 .filter(|r| r.knob == *name)
-                .map(|r| (r.seconds, r.relative_mse))
+                .map(|r| (r.cpu_seconds, r.relative_mse))
                 .collect(),
             color: COLOURS[k % COLOURS.len()].0,
             markers: true,
@@ -227,12 +278,14 @@ const PRESET_KNOBS: [&str; 4] = [
     "finish",
 ];
 
-/// The cheapest measured setting (render plus preparation time) among [`PRESET_KNOBS`] whose
+/// The cheapest measured setting (median render CPU seconds plus preparation time) among [`PRESET_KNOBS`] whose
 /// SSIM reaches `min_ssim`.
 fn cheapest(rows: &[Measurement], min_ssim: f64) -> Option<&Measurement> {
     rows.iter()
         .filter(|r| PRESET_KNOBS.contains(&r.knob.as_str()) && r.ssim >= min_ssim)
-        .min_by(|a, b| (a.seconds + a.prep_seconds).total_cmp(&(b.seconds + b.prep_seconds)))
+        .min_by(|a, b| {
+            (a.cpu_seconds + a.prep_seconds).total_cmp(&(b.cpu_seconds + b.prep_seconds))
+        })
 }
 
 fn markdown(
@@ -246,11 +299,15 @@ fn markdown(
     let mut s = format!(
         "# Speed against accuracy: `{name}`{}\n\nRegenerated by `xylem tradeoff {} --width {}{}` \
          ({w}×{h} pixels, one frame with the scene's own lights, {} threads; a reference of {} spp \
-         with the most accurate setting of every knob took {ref_secs:.2} s). Error against the \
+         with the most accurate setting of every knob, the wood point-sampled, took \
+         {ref_secs:.2} s). Error against the \
          reference: relative MSE (Σ|x − r|² / Σ|r|² over RGB) and mean SSIM (Wang et al. 2004, \
-         8×8 windows, stride 4, on sRGB luminance). Times are wall clock on a shared machine \
-         (other jobs running), so compare them within this table only. Model knobs are measured \
-         at 16 spp (the footprint band-limit at 1 to 64), so their error includes the noise of \
+         8×8 windows, stride 4, on sRGB luminance). Times are the median (and range) of {} \
+         renders of each setting, taken in rounds over all settings so that a change of the \
+         machine's load falls on every row alike, in CPU seconds of the process (all threads; \
+         the recommendations use these), with the wall-clock median beside them. Model knobs are measured \
+         at 16 spp (the footprint band-limit, on by default, switched off at 1 to 64), so their \
+         error includes the noise of \
          the same spp in the first table's rows; the \
          *model* columns compare each render with the reference model rendered at the same spp \
          with the same seeds, which cancels most of that shared noise and leaves what the knob \
@@ -272,15 +329,19 @@ fn markdown(
         } else {
             args.threads.to_string()
         },
-        args.reference_spp
+        args.reference_spp,
+        args.repeats
     );
-    s += "| knob | setting | time (s) | prep (s) | relative MSE | SSIM | model rel. MSE | model SSIM |\n\
-          | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+    s += "| knob | setting | CPU (s), median | CPU range (s) | wall (s) | prep (s) | relative MSE | SSIM | model rel. MSE | model SSIM |\n\
+          | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
     for r in rows {
         s += &format!(
-            "| {} | {} | {:.3} | {:.3} | {:.3e} | {:.4} | {:.3e} | {:.4} |\n",
+            "| {} | {} | {:.3} | {:.3}–{:.3} | {:.3} | {:.3} | {:.3e} | {:.4} | {:.3e} | {:.4} |\n",
             r.knob,
             r.setting,
+            r.cpu_seconds,
+            r.cpu_min,
+            r.cpu_max,
             r.seconds,
             r.prep_seconds,
             r.relative_mse,
@@ -295,10 +356,10 @@ fn markdown(
         .map(|(k, name)| format!("{} {name}", COLOURS[k % COLOURS.len()].1))
         .collect();
     s += &format!(
-        "\n![relative MSE (vertical, log) against render time in seconds (horizontal, log), one \
+        "\n![relative MSE (vertical, log) against median render CPU seconds (horizontal, log), one \
          colour per knob: {}]({plot})\n\n## Recommended settings\n\n\
          Chosen among the knobs that keep any scene's look ({}): the cheapest measured setting \
-         (render plus preparation time) reaching each SSIM threshold.\n\n",
+         (median render CPU seconds plus preparation time) reaching each SSIM threshold.\n\n",
         legend.join(", "),
         PRESET_KNOBS.join(", ")
     );
@@ -306,15 +367,15 @@ fn markdown(
         match cheapest(rows, t) {
             Some(r) => {
                 s += &format!(
-                    "- **{label}** (cheapest with SSIM ≥ {t}): {} {} — {:.3} s, SSIM {:.4}\n",
-                    r.knob, r.setting, r.seconds, r.ssim
+                    "- **{label}** (cheapest with SSIM ≥ {t}): {} {} — {:.3} CPU s, SSIM {:.4}\n",
+                    r.knob, r.setting, r.cpu_seconds, r.ssim
                 )
             }
             None => s += &format!("- **{label}**: no measured setting reaches SSIM ≥ {t}\n"),
         }
     }
-    s += "\n`--quality draft|default|final` (on `xylem sweep`) applies the presets of \
-          `Quality::knobs` in `src/sweep/tradeoff.rs`, fixed from this table (rows `--quality` \
-          above); rerunning on another scene or machine may recommend others.\n";
+    s += "\n`--quality draft|default|final` (on `xylem render` and `xylem sweep`) applies the \
+          presets of `Quality::knobs` in `src/validate/tradeoff.rs`, fixed from this table (rows \
+          `--quality` above); rerunning on another scene or machine may recommend others.\n";
     s
 }

@@ -24,7 +24,7 @@ use crate::bsdf::{
     Bsdf, BsdfSample, FinishModel, Glass, Lambertian, Mirror, WoodBsdf, WoodBsdfParams,
 };
 use crate::math::Frame;
-use crate::wood::{Needs, WoodVolume};
+use crate::wood::{Footprint, Needs, WoodVolume};
 use glam::{Mat3, Vec2, Vec3};
 use std::sync::Arc;
 
@@ -210,16 +210,38 @@ pub struct WoodMaterial {
 }
 
 /// Speed/accuracy switches of a wood material, measured by `xylem tradeoff`
-/// (validation/TRADEOFF.md). `Default` is the full model.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+/// (validation/TRADEOFF.md). `Default` is what a scene renders with: the full finish, the wood
+/// band-limited by the pixel footprint (issue 28; a scene's `[render] footprint_filter = false`
+/// or `xylem render --footprint-filter off` point-samples it).
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ShadingSwitches {
     /// Internal reflections under the finish: closed-form series or one pass.
     pub finish: FinishModel,
-    /// Band-limit the wood by the pixel footprint (`WoodVolume::eval_filtered`).
+    /// Band-limit the wood by the pixel footprint (`WoodVolume::eval_footprint`): rings and
+    /// their colour box-filtered, finer features faded to their means.
     pub footprint_filter: bool,
 }
 
+impl Default for ShadingSwitches {
+    fn default() -> Self {
+        ShadingSwitches {
+            finish: FinishModel::default(),
+            footprint_filter: true,
+        }
+    }
+}
+
 impl Material {
+    /// Switches footprint band-limiting on or off for a wood material (procedural or baked);
+    /// other materials have nothing to filter.
+    pub fn set_footprint_filter(&mut self, on: bool) {
+        match self {
+            Material::Wood(w) => w.switches.footprint_filter = on,
+            Material::BakedWood(b) => b.switches.footprint_filter = on,
+            _ => {}
+        }
+    }
+
     /// True for a mirror or glass: every lobe of its BSDF is a delta lobe.
     pub fn is_delta(&self) -> bool {
         match self {
@@ -359,10 +381,15 @@ impl WoodMaterial {
         };
         let (p_tree, j) = place.to_tree(p, n);
         let texel = if self.switches.footprint_filter && hit.footprint > 0.0 {
-            // World mm → placement units (|det|^⅓ of the placement → world map) → tree mm.
+            // World mm → placement units (|det|^⅓ of the placement → world map) → tree mm; the
+            // surface's normal carried into the tree by J (a rotation), so that the rings are
+            // filtered only as much as this face shows them.
             let unit = to_world_dir.determinant().abs().cbrt().max(1e-12);
-            let footprint = hit.footprint / unit * place.scale;
-            self.volume.eval_filtered(p_tree, self.needs(), footprint)
+            let footprint = Footprint {
+                width: hit.footprint / unit * place.scale,
+                normal: (j * n).normalize_or_zero(),
+            };
+            self.volume.eval_footprint(p_tree, self.needs(), footprint)
         } else {
             self.volume.eval(p_tree, self.needs())
         };

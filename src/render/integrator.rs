@@ -107,8 +107,15 @@ fn splitmix64(x: u64) -> u64 {
     z ^ (z >> 31)
 }
 
-/// Builds the shading point of a hit seen along `ray`.
-pub fn shading_point(scene: &Scene, ray: &Ray, hit: &Hit, aov: Option<&mut Aov>) -> ShadingPoint {
+/// Builds the shading point of a hit seen along `ray`. `aov` is given at the camera's first hit,
+/// whose pixel footprint (times `footprint_scale`, [`footprint_scale`]) band-limits the textures.
+pub fn shading_point(
+    scene: &Scene,
+    ray: &Ray,
+    hit: &Hit,
+    aov: Option<&mut Aov>,
+    footprint_scale: f32,
+) -> ShadingPoint {
     let s = scene.accel.surface(ray, hit);
     let inst = &scene.accel.instances[s.instance as usize];
     let material = &scene.materials[inst.material as usize];
@@ -126,7 +133,8 @@ pub fn shading_point(scene: &Scene, ray: &Ray, hit: &Hit, aov: Option<&mut Aov>)
         // ellipse it makes on the surface, stretched by 1/cos, is taken at its geometric mean.
         footprint: match aov {
             Some(_) => {
-                scene.camera.pixel_footprint(ray, hit.t) / s.ng.dot(ray.d).abs().max(0.05).sqrt()
+                footprint_scale * scene.camera.pixel_footprint(ray, hit.t)
+                    / s.ng.dot(ray.d).abs().max(0.05).sqrt()
             }
             None => 0.0,
         },
@@ -165,8 +173,27 @@ pub fn shading_point(scene: &Scene, ray: &Ray, hit: &Hit, aov: Option<&mut Aov>)
     }
 }
 
-/// The light-independent part of sample `sample` of pixel `pixel`.
-pub fn primary_sample(scene: &Scene, pixel: UVec2, sample: u32, seed: u64) -> PrimarySample {
+/// The share of the pixel footprint each of `spp` camera samples band-limits its first hit by:
+/// max(1/8, 1/√spp), as pbrt-v4 scales its camera ray differentials (Pharr, Jakob, Humphreys,
+/// "Physically Based Rendering", 4th ed., §5.1.5 and `RayIntegrator::EvaluatePixelSample`):
+/// the samples of a pixel already average over it, so each one only needs to be band-limited to
+/// the spacing between samples, ≈ 1/√spp pixel; filtering each by the whole pixel would blur the
+/// converged image by a pixel-wide box on top of the reconstruction filter (on sweep_board at
+/// 16 spp: relative MSE against the 256-spp point-sampled reference 3.86·10⁻³ with the whole
+/// pixel, 3.60·10⁻³ unfiltered; notes/sweep.md "Footprint").
+pub fn footprint_scale(spp: u32) -> f32 {
+    (1.0 / (spp.max(1) as f32).sqrt()).max(0.125)
+}
+
+/// The light-independent part of sample `sample` of pixel `pixel`; first hits are band-limited
+/// by `footprint_scale` of the pixel footprint ([`footprint_scale`]).
+pub fn primary_sample(
+    scene: &Scene,
+    pixel: UVec2,
+    sample: u32,
+    seed: u64,
+    footprint_scale: f32,
+) -> PrimarySample {
     let cam = &scene.camera;
     let index = pixel.y as u64 * cam.width as u64 + pixel.x as u64;
     let (mut rng, _) = sample_rngs(seed, index, sample);
@@ -177,7 +204,13 @@ pub fn primary_sample(scene: &Scene, pixel: UVec2, sample: u32, seed: u64) -> Pr
         Some(hit) => PrimarySample {
             ray,
             t_hit: hit.t,
-            point: Some(shading_point(scene, &ray, &hit, Some(&mut aov))),
+            point: Some(shading_point(
+                scene,
+                &ray,
+                &hit,
+                Some(&mut aov),
+                footprint_scale,
+            )),
             aov,
         },
         None => PrimarySample {
@@ -721,7 +754,7 @@ pub(crate) fn radiance_frames(
             Some(h) if last => (t_hit, bounce) = (h.t, None),
             Some(h) => {
                 t_hit = h.t;
-                bounce = Some(shading_point(scene, &ray, &h, None));
+                bounce = Some(shading_point(scene, &ray, &h, None, 0.0));
             }
             None => (t_hit, bounce) = (f32::INFINITY, None),
         }

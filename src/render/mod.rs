@@ -437,12 +437,13 @@ fn render_tile_in(
     let mut radiance = vec![Vec3::ZERO; frames];
     let mut scratch = FramesScratch::default();
     let mut rays = RayCount::default();
+    let fp_scale = integrator::footprint_scale(settings.spp);
     for (i, pixel) in (origin.y..origin.y + th)
         .flat_map(|y| (origin.x..origin.x + tw).map(move |x| UVec2::new(x, y)))
         .enumerate()
     {
         for s in 0..settings.spp {
-            let ps = primary_sample(scene, pixel, s, settings.seed);
+            let ps = primary_sample(scene, pixel, s, settings.seed, fp_scale);
             rays.0 += 1;
             let mut rng = light_rng(scene, pixel, s, settings.seed);
             radiance_frames(

@@ -72,6 +72,9 @@ pub struct RenderTable {
     pub filter: FilterName,
     /// Filter radius in pixels (box: half-width).
     pub filter_radius: Option<f32>,
+    /// Band-limit wood by the pixel footprint (default true; false point-samples it, as
+    /// before issue 28; `xylem render --footprint-filter` overrides).
+    pub footprint_filter: bool,
 }
 
 impl Default for RenderTable {
@@ -86,6 +89,7 @@ impl Default for RenderTable {
             exposure: 0.0,
             filter: FilterName::Gaussian,
             filter_radius: None,
+            footprint_filter: true,
         }
     }
 }

@@ -365,7 +365,10 @@ impl Builder<'_> {
         };
         let camera = self.camera(&file.camera, width, height)?;
         let (lights, light_names) = self.lights(&file.lights)?;
-        let (materials, material_index) = self.materials(&file.materials)?;
+        let (mut materials, material_index) = self.materials(&file.materials)?;
+        for m in &mut materials {
+            m.set_footprint_filter(r.footprint_filter);
+        }
         let instances = self.objects(&file.objects, &material_index, &materials)?;
         if let Some(s) = &file.sweep {
             self.check_sweep(s, &light_names, width, height)?;

@@ -45,7 +45,8 @@ fn debug_name<T: std::fmt::Debug, S: serde::Serializer>(v: &T, s: S) -> Result<S
 }
 
 impl Knobs {
-    /// Today's default model (what a scene renders with when no knob is set) at `spp`.
+    /// The default model (what a scene renders with when no knob is set, footprint
+    /// band-limiting on since issue 28) at `spp`.
     pub const fn full(spp: u32) -> Knobs {
         Knobs {
             spp,
@@ -54,17 +55,20 @@ impl Knobs {
             pores_and_rays: true,
             jacobian: JacobianModel::Simplified,
             finish: FinishModel::ClosedForm,
-            footprint_filter: false,
+            footprint_filter: true,
             baked_res: None,
             baked_fibers: BakedFibers::Anisotropy,
         }
     }
 
     /// The most accurate setting of every knob at `spp`: the reference the others are measured
-    /// against (the exact Jacobian instead of the simplified default).
+    /// against (the exact Jacobian instead of the simplified default, and the wood
+    /// point-sampled, so that its pixels converge to the pixel filter's average of the
+    /// unfiltered wood rather than to the footprint-blurred one).
     pub const fn reference(spp: u32) -> Knobs {
         Knobs {
             jacobian: JacobianModel::Exact,
+            footprint_filter: false,
             ..Knobs::full(spp)
         }
     }
@@ -296,8 +300,17 @@ pub struct Measurement {
     pub setting: String,
     /// All knobs of the row.
     pub knobs: Knobs,
-    /// Render time.
+    /// Render time, wall clock: the median over the interleaved repeats.
     pub seconds: f64,
+    /// Render time in CPU seconds of the process (all threads; what the machine's other jobs do
+    /// not change, unlike wall clock): the median over the repeats, and its smallest and largest.
+    pub cpu_seconds: f64,
+    /// Smallest CPU seconds of the repeats.
+    pub cpu_min: f64,
+    /// Largest CPU seconds of the repeats.
+    pub cpu_max: f64,
+    /// Renders timed.
+    pub repeats: u32,
     /// Time to prepare the scene for these knobs (rebuilding volumes, baking maps).
     pub prep_seconds: f64,
     /// [`relative_mse`] against the reference render ([`Knobs::reference`] at `--reference-spp`).
@@ -386,9 +399,9 @@ pub fn settings() -> Vec<(String, String, Knobs)> {
     for spp in [1, 4, 16, 64] {
         v.push((
             "footprint band-limit".into(),
-            format!("on, {spp} spp"),
+            format!("off, {spp} spp"),
             Knobs {
-                footprint_filter: true,
+                footprint_filter: false,
                 ..Knobs::full(spp)
             },
         ));
@@ -403,19 +416,91 @@ pub fn settings() -> Vec<(String, String, Knobs)> {
     v
 }
 
-/// Renders the scene (its own lights, as built) with `knobs`; returns the beauty, the render
-/// seconds and the seconds spent applying the knobs.
+/// The least reference sample count, as a multiple of the highest measured one, that `xylem
+/// tradeoff` accepts without `--allow-weak-reference`: the reference's own noise variance is
+/// then ≤ ¼ of the noisiest row's lowest, so a row cannot score better than it is by matching the
+/// reference's noise (with a 16-spp reference the 16-spp row scored SSIM 1.0000, same seeds).
+pub const MIN_REFERENCE_FACTOR: u32 = 4;
+
+/// Why a reference of `reference_spp` is too weak to score rows of up to `max_spp` samples
+/// (below [`MIN_REFERENCE_FACTOR`] × `max_spp`), or `None`.
+pub fn weak_reference(reference_spp: u32, max_spp: u32) -> Option<String> {
+    let need = MIN_REFERENCE_FACTOR.saturating_mul(max_spp);
+    (reference_spp < need).then(|| {
+        format!(
+            "--reference-spp {reference_spp} is under {MIN_REFERENCE_FACTOR}× the highest \
+             measured {max_spp} spp: rows near it are scored against a reference about as noisy \
+             as they are (a row at the reference's spp and seeds matches it exactly); use \
+             --reference-spp {need} or more"
+        )
+    })
+}
+
+/// One render of [`render_with`].
+pub struct Rendered {
+    /// The beauty image.
+    pub image: Vec<glam::Vec3>,
+    /// Render time, wall clock.
+    pub seconds: f64,
+    /// Render time in CPU seconds of the process ([`process_cpu_seconds`]; the wall clock where
+    /// that is unavailable).
+    pub cpu_seconds: f64,
+    /// Wall-clock time spent applying the knobs.
+    pub prep_seconds: f64,
+}
+
+/// Renders the scene (its own lights, as built) with `knobs`.
 pub fn render_with(
     base: &dyn Fn() -> Result<LoadedScene, String>,
     knobs: &Knobs,
     run: &RunOptions,
-) -> Result<(Vec<glam::Vec3>, f64, f64), String> {
+) -> Result<Rendered, String> {
     let mut loaded = base()?;
     let prep = std::time::Instant::now();
     apply(&mut loaded, knobs).map_err(|e| e.to_string())?;
     let prep = prep.elapsed().as_secs_f64();
+    let cpu0 = process_cpu_seconds();
     let out = render(&loaded.scene, &loaded.settings, run).map_err(|e| e.to_string())?;
-    Ok((out.image.beauty, out.elapsed.as_secs_f64(), prep))
+    let seconds = out.elapsed.as_secs_f64();
+    let cpu_seconds = match (cpu0, process_cpu_seconds()) {
+        (Some(a), Some(b)) => b - a,
+        _ => seconds,
+    };
+    Ok(Rendered {
+        image: out.image.beauty,
+        seconds,
+        cpu_seconds,
+        prep_seconds: prep,
+    })
+}
+
+/// CPU seconds this process has run so far, user + system over all its threads (Linux:
+/// /proc/self/stat fields 14–15, clock ticks of 10 ms); `None` elsewhere. Unlike wall clock it
+/// does not grow while other jobs hold the cores (cache and SMT contention still show).
+pub fn process_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name, which is in parentheses and may hold spaces.
+    let rest = &stat[stat.rfind(')')? + 2..];
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = fields.get(11)?.parse::<f64>().ok()? + fields.get(12)?.parse::<f64>().ok()?;
+    Some(ticks / 100.0)
+}
+
+/// (median, smallest, largest) of `xs` (the median of an even count is the mean of the middle
+/// two); (NaN, NaN, NaN) when empty.
+pub fn median_range(xs: &[f64]) -> (f64, f64, f64) {
+    if xs.is_empty() {
+        return (f64::NAN, f64::NAN, f64::NAN);
+    }
+    let mut v = xs.to_vec();
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    let median = if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    };
+    (median, v[0], v[n - 1])
 }
 
 #[cfg(test)]
@@ -433,6 +518,20 @@ mod tests {
             assert_eq!(clap_name.as_deref(), Some(q.to_string().as_str()));
         }
         assert_eq!(Quality::value_variants().len(), 3);
+    }
+
+    #[test]
+    fn median_range_of_odd_and_even_counts() {
+        assert_eq!(median_range(&[3.0, 1.0, 2.0]), (2.0, 1.0, 3.0));
+        assert_eq!(median_range(&[4.0, 1.0, 2.0, 10.0]), (3.0, 1.0, 10.0));
+        assert!(median_range(&[]).0.is_nan());
+        // The process's CPU clock runs forward while it works.
+        let a = process_cpu_seconds().expect("Linux /proc/self/stat");
+        let mut x = 0u64;
+        while process_cpu_seconds().unwrap() < a + 0.05 {
+            x = x.wrapping_add(std::hint::black_box(1));
+        }
+        assert!(x > 0);
     }
 
     #[test]

@@ -51,6 +51,33 @@ impl BeerColor {
         (Vec3::new(r.0, g.0, b.0), Vec3::new(r.1, g.1, b.1))
     }
 
+    /// The absorbance per unit ring value g, k = σℓ_g, of the diffuse and of the fibre colour
+    /// (× the fibre saturation).
+    pub fn ring_scales(&self) -> [Vec3; 2] {
+        [self.ring, self.ring * self.fiber_saturation]
+    }
+
+    /// (diffuse, fibre) colours averaged over a window of the ring wave: with the pore, ray and
+    /// extra paths held, the absorbance is a₀ + k g (k of [`BeerColor::ring_scales`]), so Beer's
+    /// law averages to exp(−a₀) · E[exp(−k g)], which `mean_exp(i)` gives for `ring_scales()[i]`.
+    /// `None` where the clamp at zero absorbance would act (a negative path: the caller falls
+    /// back to the colour of the mean ring value).
+    pub fn ring_filtered_colors(
+        &self,
+        pore: f32,
+        ray: f32,
+        extra: f32,
+        mean_exp: impl Fn(usize) -> Vec3,
+    ) -> Option<(Vec3, Vec3)> {
+        let a0 = self.absorbance(0.0, pore, ray, extra);
+        if a0.min_element() < 0.0 || (a0 + self.ring).min_element() < 0.0 {
+            return None;
+        }
+        let diffuse = (-a0).exp() * mean_exp(0);
+        let fiber = (-a0 * self.fiber_saturation).exp() * mean_exp(1);
+        Some((diffuse, fiber))
+    }
+
     /// Channel `ch` (0 red, 1 green, 2 blue) of [`BeerColor::absorbance`]: one scalar expression,
     /// so a loop over many texels runs it in SIMD lanes.
     #[inline(always)]

@@ -181,18 +181,18 @@ impl Pores {
         }
     }
 
-    /// The mean of [`Pores::mask`] at growth-ring value `g`: every pore shrunk by
+    /// The mean of [`Pores::mask`] over a footprint whose ring values g have the means
+    /// `moments` = (E[g], E[g²], E[g³]) (at one g: (g, g², g³)). Every pore shrunk by
     /// size = 1 − porosity · g in all three axes about its own centre keeps its count, so by
-    /// Campbell's theorem the mean of the (unclamped) kernel sum scales by size³ (notes/noise.md);
-    /// the clamp at 1 only matters where pores overlap.
+    /// Campbell's theorem the mean of the (unclamped) kernel sum scales by size³ (notes/noise.md;
+    /// the clamp at 1 only matters where pores overlap), and size³ = (1 − ρg)³ is a cubic in g:
+    /// E[size³] = 1 − 3ρE[g] + 3ρ²E[g²] − ρ³E[g³] (the mean of a ring-porous wood's pores over
+    /// rings it cannot resolve; the mean size's cube would drop most of the earlywood vessels).
     #[inline]
-    pub fn mean_mask(&self, g: f32) -> f32 {
-        let size = 1.0 - self.ring_porosity * g;
-        if size <= 1e-3 {
-            0.0
-        } else {
-            self.mean_full * size.min(1.0).powi(3)
-        }
+    pub fn mean_mask_over(&self, moments: Vec3) -> f32 {
+        let r = self.ring_porosity;
+        let cube = 1.0 - 3.0 * r * moments.x + 3.0 * r * r * moments.y - r * r * r * moments.z;
+        self.mean_full * cube.clamp(0.0, 1.0)
     }
 
     /// Pore mask in [0, 1] and its gradient at `q` for growth-ring value `g`, kernels along `fiber`
@@ -253,6 +253,9 @@ pub struct Rays {
     strength: f32,
     /// Ray width (its narrowest extent), mm.
     pub width: f32,
+    /// The smaller of the ray's other extents (length along r̂, height along ẑ), mm: the widest
+    /// its trace on a face can be.
+    pub trace_limit: f32,
     /// Mean of [`Rays::mask`]: strength · min(1, density · bump_kernel_mean(s)).
     pub mean_mask: f32,
     /// Sideways displacement of the ray sheets (mm along θ̂), if they wander.
@@ -278,6 +281,7 @@ impl Rays {
             ),
             strength: p.strength,
             width: p.width,
+            trace_limit: p.length.min(p.height),
             mean_mask: p.strength * (p.density * bump_kernel_mean(p.sharpness)).min(1.0),
             wander: (p.wander > 0.0)
                 .then(|| grain_noise(p.wander, (p.wander_length, p.wander_length), 2.0, seeds[1])),
@@ -527,7 +531,7 @@ mod tests {
             shrunk += ms as f64;
         }
         let n = pts.len() as f64;
-        let expect = pores.mean_mask(g) as f64;
+        let expect = pores.mean_mask_over(Vec3::new(g, g * g, g * g * g)) as f64;
         let got = shrunk / n;
         assert!(full / n > 0.05, "full-size pores cover {}", full / n);
         assert!(

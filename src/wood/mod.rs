@@ -16,11 +16,11 @@ pub use board::*;
 pub use color::BeerColor;
 pub use error::WoodError;
 pub use eyes::{EyeSample, Eyes};
-pub use growth::{SmoothRectangleWave, SmoothTriangleWave};
+pub use growth::{RingExpTable, SmoothRectangleWave, SmoothTriangleWave};
 pub use knots::{smooth_min, KnotSample, Knots};
 pub use params::*;
 pub use preview::preview_color;
-pub use volume::WoodVolume;
+pub use volume::{Footprint, WoodVolume};
 
 use glam::Vec3;
 
