@@ -212,10 +212,10 @@ fn calibrated_presets_keep_the_pattern_rows_they_reach() {
             "padauk",
             "padauk",
             &[
-                "luminance correlation length along (mm)",
                 "luminance correlation length across (mm)",
-                "luminance spectrum slope along",
-                "orientation coherence",
+                "luminance spectrum slope across",
+                "mean orientation from grain (deg)",
+                "dark feature elongation (along/across)",
                 "dark feature area fraction",
                 "in-plane angle spread (deg)",
                 "dip correlation length along (mm)",
