@@ -252,6 +252,7 @@ fn write_plot(path: &Path, rows: &[Measurement]) -> anyhow::Result<()> {
                 .collect(),
             color: COLOURS[k % COLOURS.len()].0,
             markers: true,
+            label: name.to_string(),
         })
         .collect();
     let opts = PlotOptions {
@@ -259,6 +260,8 @@ fn write_plot(path: &Path, rows: &[Measurement]) -> anyhow::Result<()> {
         height: 300,
         log_x: true,
         log_y: true,
+        x_title: "cpu seconds",
+        y_title: "relative mse",
     };
     let img = line_plot(&series, &opts);
     if let Some(p) = path.parent() {

@@ -1,6 +1,7 @@
 //! Small line plots as images (validation figures, the error-against-time curve): axes, one
-//! polyline per series with optional point markers, the axis ranges printed at the corners.
-//! The captions live in the Markdown that embeds the plot.
+//! polyline per series with optional point markers, the axis ranges printed at the corners, the
+//! axis titles beside them and a legend of the labelled series in the top-right corner. Longer
+//! captions live in the Markdown that embeds the plot.
 
 use super::contact::{draw_label, Rgb8};
 
@@ -13,6 +14,8 @@ pub struct Series {
     pub color: [u8; 3],
     /// Draw a small square on every point (for measurements, not sampled curves).
     pub markers: bool,
+    /// Legend entry ("" for none: guides, reference lines).
+    pub label: String,
 }
 
 /// Plot size and axis scaling.
@@ -26,6 +29,10 @@ pub struct PlotOptions {
     pub log_x: bool,
     /// Logarithmic y axis (points with y ≤ 0 are left out).
     pub log_y: bool,
+    /// Title of the x axis, printed at the bottom between the range labels ("" for none).
+    pub x_title: &'static str,
+    /// Title of the y axis, printed at the top beside the largest value ("" for none).
+    pub y_title: &'static str,
 }
 
 impl Default for PlotOptions {
@@ -35,6 +42,8 @@ impl Default for PlotOptions {
             height: 240,
             log_x: false,
             log_y: false,
+            x_title: "",
+            y_title: "",
         }
     }
 }
@@ -164,6 +173,34 @@ pub fn line_plot(series: &[Series], opts: &PlotOptions) -> Rgb8 {
         bottom as u32 - 8,
         1,
     );
+    let text_width = |t: &str| 4 * t.chars().count() as u32 + 1;
+    if !opts.x_title.is_empty() {
+        let x = (w / 2).saturating_sub(text_width(opts.x_title) / 2);
+        draw_label(&mut img, opts.x_title, x, h - 8, 1);
+    }
+    let y_max = number_label(un(y1, opts.log_y));
+    if !opts.y_title.is_empty() {
+        draw_label(
+            &mut img,
+            opts.y_title,
+            left as u32 + 6 + text_width(&y_max),
+            2,
+            1,
+        );
+    }
+    // Legend: a swatch and the label per labelled series, right-aligned, top down.
+    let mut row = top as u32 + 2;
+    for s in series.iter().filter(|s| !s.label.is_empty()) {
+        let tw = text_width(&s.label);
+        let x = (right as u32).saturating_sub(tw + 8);
+        for dy in 1..6 {
+            for dx in 0..5 {
+                set(&mut img, (x + dx) as i64, (row + dy) as i64, s.color);
+            }
+        }
+        draw_label(&mut img, &s.label, x + 7, row, 1);
+        row += 8;
+    }
     img
 }
 
@@ -206,6 +243,7 @@ mod tests {
             points: vec![(0.0, 0.0), (1.0, 1.0)],
             color: [255, 0, 0],
             markers: false,
+            label: String::new(),
         };
         let img = line_plot(&[s], &PlotOptions::default());
         let red = |x: u32, y: u32| {
@@ -227,6 +265,7 @@ mod tests {
         let s = Series {
             points: vec![(0.0, 1.0), (1.0, f64::NAN), (10.0, 1e-3), (100.0, -1.0)],
             color: [0, 0, 255],
+            label: String::new(),
             markers: true,
         };
         let opts = PlotOptions {
@@ -238,5 +277,40 @@ mod tests {
         assert_eq!(img.data.len(), (img.width * img.height * 3) as usize);
         assert_eq!(number_label(1e-3), "1e-3");
         assert_eq!(number_label(-60.0), "-60");
+    }
+
+    /// A labelled series gets a swatch of its colour in the top-right legend and axis titles are
+    /// drawn; the same plot without label or titles (the control) has neither.
+    #[test]
+    fn legend_and_axis_titles_are_drawn_only_when_given() {
+        let plot = |label: &str, titles: bool| {
+            let s = Series {
+                points: vec![(0.0, 0.0), (1.0, 0.0)],
+                color: [0, 160, 0],
+                markers: false,
+                label: label.into(),
+            };
+            let opts = PlotOptions {
+                x_title: if titles { "cpu s" } else { "" },
+                y_title: if titles { "rel mse" } else { "" },
+                ..PlotOptions::default()
+            };
+            line_plot(&[s], &opts)
+        };
+        let count = |img: &Rgb8, c: [u8; 3], xs: std::ops::Range<u32>, ys: std::ops::Range<u32>| {
+            ys.flat_map(|y| xs.clone().map(move |x| (x, y)))
+                .filter(|&(x, y)| {
+                    let i = (y * img.width + x) as usize * 3;
+                    img.data[i..i + 3] == c
+                })
+                .count()
+        };
+        let (with, without) = (plot("model", true), plot("", false));
+        let (w, h) = (with.width, with.height);
+        let legend = |img: &Rgb8| count(img, [0, 160, 0], w - 60..w, 0..30);
+        assert_eq!(legend(&with), 25, "one 5 × 5 swatch");
+        assert_eq!(legend(&without), 0);
+        let black = |img: &Rgb8| count(img, [0, 0, 0], w / 2 - 12..w / 2 + 12, h - 8..h - 1);
+        assert!(black(&with) > 10 && black(&without) == 0);
     }
 }

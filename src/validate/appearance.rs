@@ -993,6 +993,9 @@ fn series(points: Vec<(f64, f64)>, k: usize) -> Series {
         points,
         color: PALETTE[k],
         markers: false,
+        label: ["preset", "measured"]
+            .get(k)
+            .map_or(String::new(), |s| s.to_string()),
     }
 }
 

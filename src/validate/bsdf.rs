@@ -1308,6 +1308,7 @@ pub fn write_polar_plot(spec: &CaseSpec, path: &Path) -> Result<(), PolarPlotErr
             .collect(),
         color: [190, 190, 190],
         markers: false,
+        label: String::new(),
     }];
     for (k, c) in curves.iter().enumerate() {
         let max = c
@@ -1319,6 +1320,7 @@ pub fn write_polar_plot(spec: &CaseSpec, path: &Path) -> Result<(), PolarPlotErr
             points: c.iter().map(|(x, y)| (x / max, y / max)).collect(),
             color: PALETTE[k % PALETTE.len()],
             markers: false,
+            label: format!("{}°", [0, 30, 60, 80][k]),
         });
     }
     let img = line_plot(

@@ -719,10 +719,11 @@ pub fn run_report(
         let series: Vec<Series> = c
             .iter()
             .enumerate()
-            .map(|(i, (_, pts))| Series {
+            .map(|(i, (name, pts))| Series {
                 points: pts.iter().map(|(x, e)| (*x, e.axis_p90_deg)).collect(),
                 color: PALETTE[i % PALETTE.len()],
                 markers: true,
+                label: name.to_string(),
             })
             .collect();
         plot_png(&plots, file, &series, log_x)

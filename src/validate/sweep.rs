@@ -311,15 +311,22 @@ pub fn highlight_tracking(
                 .collect(),
             color: PALETTE[0],
             markers: false,
+            label: "pixel".into(),
         }];
         if let Some(p) = predicted {
             series.push(Series {
                 points: vec![(p as f64, 0.0), (p as f64, top)],
                 color: PALETTE[1],
                 markers: false,
+                label: "predicted peak".into(),
             });
         }
-        write_plot(dir, &rel, &series, &PlotOptions::default())?;
+        let opts = PlotOptions {
+            x_title: "light angle °",
+            y_title: "radiance",
+            ..PlotOptions::default()
+        };
+        write_plot(dir, &rel, &series, &opts)?;
         plot = Some(rel);
     }
     Ok(CheckOutcome {
@@ -495,9 +502,15 @@ pub fn mahogany_stripes(
                     .collect(),
                 color: PALETTE[k],
                 markers: false,
+                label: format!("stripe {}", ["a", "b"][k]),
             })
             .collect();
-        write_plot(dir, &rel, &series, &PlotOptions::default())?;
+        let opts = PlotOptions {
+            x_title: "light angle °",
+            y_title: "radiance",
+            ..PlotOptions::default()
+        };
+        write_plot(dir, &rel, &series, &opts)?;
         plot = Some(rel);
     }
     Ok(CheckOutcome {
@@ -566,8 +579,14 @@ pub fn curly_maple_bands(
                 .collect(),
             color: PALETTE[2],
             markers: true,
+            label: String::new(),
         };
-        write_plot(dir, &rel, &[s], &PlotOptions::default())?;
+        let opts = PlotOptions {
+            x_title: "frame",
+            y_title: "peak position",
+            ..PlotOptions::default()
+        };
+        write_plot(dir, &rel, &[s], &opts)?;
         plot = Some(rel);
     }
     Ok(CheckOutcome {
