@@ -1180,15 +1180,25 @@ fn pair_section(r: &PairReport, dir: &Path, sweep: SweepSettings) -> Result<Stri
     let dips =
         |m: &BoardMaps| -> Vec<f64> { (0..m.board.diffuse.len()).map(|i| m.dip_deg(i)).collect() };
     // Preset (blue) against measured (red), one plot per statistic.
-    let compare = |name: &str, preset: Vec<(f64, f64)>, measured: Vec<(f64, f64)>| {
-        let plot = line_plot(
-            &[series(preset, 0), series(measured, 1)],
-            &PlotOptions::default(),
-        );
+    let compare = |name: &str,
+                   (x_title, y_title): (&'static str, &'static str),
+                   preset: Vec<(f64, f64)>,
+                   measured: Vec<(f64, f64)>| {
+        let opts = PlotOptions {
+            x_title,
+            y_title,
+            ..PlotOptions::default()
+        };
+        let plot = line_plot(&[series(preset, 0), series(measured, 1)], &opts);
         write_png(dir, &format!("plots/appearance_{tag}_{name}.png"), &plot)
     };
     let dip_hist = |m: &BoardMaps| histogram(&dips(m), -20.0, 20.0, 80);
-    compare("dips", dip_hist(&r.preset_maps), dip_hist(&r.measured_maps))?;
+    compare(
+        "dips",
+        ("fibre dip °", "share"),
+        dip_hist(&r.preset_maps),
+        dip_hist(&r.measured_maps),
+    )?;
     let profile = |m: &BoardMaps| -> Vec<(f64, f64)> {
         let p = m.dip_profile(0..m.grain_dims().1);
         let n = p.len() as f64;
@@ -1199,11 +1209,17 @@ fn pair_section(r: &PairReport, dir: &Path, sweep: SweepSettings) -> Result<Stri
     };
     compare(
         "dip_profile",
+        ("position along the grain", "mean dip °"),
         profile(&r.preset_maps),
         profile(&r.measured_maps),
     )?;
     let chat = |s: &SweepLuminance| histogram(&s.chatoyance(), 1.0, 12.0, 88);
-    compare("chatoyance", chat(&r.preset_sweep), chat(&r.measured_sweep))?;
+    compare(
+        "chatoyance",
+        ("max over min", "share"),
+        chat(&r.preset_sweep),
+        chat(&r.measured_sweep),
+    )?;
     write_png(
         dir,
         &format!("plots/appearance_{tag}_frames.png"),
