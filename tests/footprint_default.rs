@@ -4,8 +4,11 @@
 //! Each assertion fails on the code before issue 28 (filter off by default, no such field or
 //! option).
 
+#[path = "common/capture.rs"]
+mod common_capture;
+
+use common_capture::xylem;
 use std::path::Path;
-use std::process::Command;
 use xylem::material::{Material, ShadingSwitches};
 use xylem::math::Vec3;
 use xylem::render::{render, RunOptions};
@@ -95,14 +98,6 @@ fn filtered_low_spp_renders_are_closer_to_the_supersampled_board() {
         e_on < 0.8 * e_off,
         "filtered {e_on} vs point-sampled {e_off}"
     );
-}
-
-fn xylem(args: &[&str], dir: &Path) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_xylem"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap()
 }
 
 #[test]
