@@ -1,4 +1,4 @@
-"""Shared fixtures: the Rust reference numbers that tests/python.rs writes before running pytest."""
+"""Shared fixtures: the Rust reference numbers that crates/xylem-cli/tests/python.rs writes before running pytest."""
 
 import json
 import os

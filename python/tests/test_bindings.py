@@ -1,5 +1,5 @@
 """The bindings give the Rust library's numbers: every value is compared with what
-tests/python.rs computed by calling the library directly (float32, bit for bit)."""
+crates/xylem-cli/tests/python.rs computed by calling the library directly (float32, bit for bit)."""
 
 import numpy as np
 import pytest

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Dask against Ray: three captures of the built-in fit scene fitted (64x64 texels) on a local
 # pool of 2 one-thread workers. Needs a Python with the staged xylem package on PYTHONPATH
-# (tests/python.rs stages it in target/python-test/site) and `pip install "dask[distributed]" ray`.
+# (crates/xylem-cli/tests/python.rs stages it in target/python-test/site) and `pip install "dask[distributed]" ray`.
 set -eu
 . "$(dirname "$0")/common.sh"
 PY=${PY:-python3}

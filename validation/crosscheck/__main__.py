@@ -3,7 +3,7 @@ Mitsuba 3 on the same scenes (validation/CROSSCHECK.md says what is compared and
 
 --small   low resolution, few samples, every case at one depth, plus the negative controls;
           exit status 0 only if every case agrees and every negative control is detected
-          (tests/crosscheck.rs runs it in `cargo test --release`).
+          (crates/xylem-cli/tests/crosscheck.rs runs it in `cargo test --release`).
 --full    every case at xylem depths 1, 2 and 8; writes validation/CROSSCHECK.md and the
           pictures in validation/plots/crosscheck/.
 --timing  Mitsuba's speed and error on the Lambertian Cornell box (`xylem bench render` runs it
@@ -107,7 +107,7 @@ def markdown(rows, controls, mode, args, wall):
         "",
         "Made by `target/python-venv/bin/python -m validation.crosscheck --full` (the method: "
         "validation/crosscheck/; the small version runs in `cargo test --release` as "
-        "tests/crosscheck.rs). Do not edit by hand.",
+        "crates/xylem-cli/tests/crosscheck.rs). Do not edit by hand.",
         "",
         f"- Mitsuba {args.mitsuba_version} (`{args.variant}`), Dr.Jit {args.drjit_version}; "
         f"xylem `{os.path.relpath(args.xylem, ROOT)}`; {args.threads} threads each; "

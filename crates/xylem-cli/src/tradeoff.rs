@@ -1,0 +1,384 @@
+//! `xylem tradeoff SCENE.toml`: measures every speed/accuracy knob against a reference render and
+//! writes validation/TRADEOFF.md with an error-against-time plot.
+
+use anyhow::Context;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use xylem::picture::plot::{line_plot, PlotOptions, Series};
+use xylem_lab::tradeoff::{
+    median_range, relative_mse, render_with, settings, ssim, weak_reference, Knobs, Measurement,
+};
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Scene file (TOML).
+    pub scene: PathBuf,
+    /// Image width for the measurements, 8 to 4096 (the height keeps the scene's aspect ratio).
+    #[arg(long, default_value_t = 160)]
+    pub width: u32,
+    /// Samples per pixel of the reference render (full model), 1 to 1000000.
+    #[arg(long, default_value_t = 256, value_parser = super::parse_spp)]
+    pub reference_spp: u32,
+    /// Report to write.
+    #[arg(long, default_value = "validation/TRADEOFF.md")]
+    pub out: PathBuf,
+    /// Also write every number as JSON here.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Replace the preset of every wood material of the scene by this one (e.g. curly_maple, to
+    /// measure the distortion knobs on a strongly figured wood).
+    #[arg(long)]
+    pub preset: Option<String>,
+    /// Also write every render (reference and each row) as a PNG into this folder.
+    #[arg(long)]
+    pub images: Option<PathBuf>,
+    /// Worker threads (0 = all cores; at most 16 per core).
+    #[arg(long, default_value_t = 0, value_parser = super::parse_threads)]
+    pub threads: usize,
+    /// Measure even with a reference under 4× the highest measured spp (the report then says
+    /// so at its top; without this flag such a run is refused).
+    #[arg(long)]
+    pub allow_weak_reference: bool,
+    /// Times each setting is rendered for its timing, 1 to 20, in rounds over all settings (so
+    /// that a change in the machine's load falls on every setting alike); the report gives the
+    /// median and the range.
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=20))]
+    pub repeats: u32,
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    anyhow::ensure!(
+        (8..=4096).contains(&args.width),
+        "--width {}: allowed 8 to 4096",
+        args.width
+    );
+    anyhow::ensure!(
+        args.reference_spp >= 1,
+        "--reference-spp must be at least 1"
+    );
+    let all = settings();
+    let max_spp = all.iter().map(|(_, _, k)| k.spp).max().unwrap_or(1);
+    let weak = weak_reference(args.reference_spp, max_spp);
+    if let Some(why) = &weak {
+        anyhow::ensure!(
+            args.allow_weak_reference,
+            "{why} (or pass --allow-weak-reference to measure anyway)"
+        );
+        eprintln!("warning: {why}");
+    }
+    let probe = xylem::scene::load(&args.scene)?;
+    let (w0, h0) = (probe.scene.camera.width, probe.scene.camera.height);
+    let (w, h) = (
+        args.width,
+        ((args.width as f32 * h0 as f32 / w0 as f32).round() as u32).max(1),
+    );
+    let exposure = probe.exposure;
+    let name = probe.name.clone();
+    drop(probe);
+    let preset = match &args.preset {
+        Some(p) => Some(xylem::wood::preset(p).with_context(|| format!("--preset {p}"))?),
+        None => None,
+    };
+    let scene_path = args.scene.clone();
+    let base = move || -> Result<xylem::scene::LoadedScene, String> {
+        let mut l = xylem::scene::load(&scene_path).map_err(|e| e.to_string())?;
+        l.scene.camera = l.scene.camera.with_resolution(w, h);
+        if let Some(params) = &preset {
+            for m in &mut l.scene.materials {
+                if let xylem::material::Material::Wood(wm) = m {
+                    let v = xylem::wood::WoodVolume::new(params.clone(), wm.volume.seed())
+                        .map_err(|e| e.to_string())?;
+                    wm.volume = std::sync::Arc::new(v);
+                }
+            }
+        }
+        Ok(l)
+    };
+    let run = xylem::render::RunOptions {
+        threads: args.threads,
+        ..Default::default()
+    };
+    let bar = indicatif::ProgressBar::new(all.len() as u64 * args.repeats as u64 + 1).with_style(
+        indicatif::ProgressStyle::with_template("tradeoff {bar:40} {pos}/{len} {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar.set_message(format!("reference, {} spp", args.reference_spp));
+    let reference_render = render_with(&base, &Knobs::reference(args.reference_spp), &run)
+        .map_err(anyhow::Error::msg)
+        .context("reference render")?;
+    let (reference, ref_secs) = (reference_render.image, reference_render.seconds);
+    bar.inc(1);
+    let save = |name: &str, img: &[glam::Vec3]| -> anyhow::Result<()> {
+        if let Some(dir) = &args.images {
+            std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+            let file: String = name
+                .chars()
+                .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+                .collect();
+            xylem::picture::png::write_png_linear(
+                &dir.join(format!("{file}.png")),
+                w,
+                h,
+                img,
+                exposure,
+            )?;
+        }
+        Ok(())
+    };
+    save("reference", &reference)?;
+    let mut rows = Vec::new();
+    // The reference model at each measured spp (same seeds), rendered once per spp.
+    let mut same_spp: Vec<(u32, Vec<glam::Vec3>)> = Vec::new();
+    // Wall and CPU seconds of every render of each setting, over the rounds.
+    let mut times: Vec<(Vec<f64>, Vec<f64>)> = vec![(Vec::new(), Vec::new()); all.len()];
+    for (i, (knob, setting, knobs)) in all.iter().cloned().enumerate() {
+        bar.set_message(setting.clone());
+        let r = render_with(&base, &knobs, &run)
+            .map_err(anyhow::Error::msg)
+            .with_context(|| format!("render with {setting}"))?;
+        let (img, prep) = (r.image, r.prep_seconds);
+        times[i].0.push(r.seconds);
+        times[i].1.push(r.cpu_seconds);
+        if !same_spp.iter().any(|(s, _)| *s == knobs.spp) {
+            let r = render_with(&base, &Knobs::reference(knobs.spp), &run)
+                .map_err(anyhow::Error::msg)
+                .with_context(|| format!("reference model at {} spp", knobs.spp))?;
+            same_spp.push((knobs.spp, r.image));
+        }
+        save(&format!("{knob} {setting}"), &img)?;
+        let model_ref = &same_spp
+            .iter()
+            .find(|(s, _)| *s == knobs.spp)
+            .expect("pushed")
+            .1;
+        rows.push(Measurement {
+            knob,
+            setting,
+            knobs,
+            seconds: f64::NAN,
+            cpu_seconds: f64::NAN,
+            cpu_min: f64::NAN,
+            cpu_max: f64::NAN,
+            repeats: args.repeats,
+            prep_seconds: prep,
+            relative_mse: relative_mse(&img, &reference),
+            ssim: ssim(&img, &reference, w as usize, h as usize, exposure),
+            model_mse: relative_mse(&img, model_ref),
+            model_ssim: ssim(&img, model_ref, w as usize, h as usize, exposure),
+        });
+        bar.inc(1);
+    }
+    // The timing repeats, interleaved: every setting once per round.
+    for round in 1..args.repeats {
+        for (i, (_, setting, knobs)) in all.iter().enumerate() {
+            bar.set_message(format!("timing round {}: {setting}", round + 1));
+            let r = render_with(&base, knobs, &run)
+                .map_err(anyhow::Error::msg)
+                .with_context(|| format!("render with {setting}"))?;
+            times[i].0.push(r.seconds);
+            times[i].1.push(r.cpu_seconds);
+            bar.inc(1);
+        }
+    }
+    for (row, (wall, cpu)) in rows.iter_mut().zip(&times) {
+        row.seconds = median_range(wall).0;
+        (row.cpu_seconds, row.cpu_min, row.cpu_max) = median_range(cpu);
+    }
+    bar.finish_and_clear();
+    let dir = args.out.parent().map(Path::to_path_buf).unwrap_or_default();
+    let stem = args
+        .out
+        .file_stem()
+        .map(|s| s.to_string_lossy().to_lowercase())
+        .unwrap_or_else(|| "tradeoff".into());
+    let plot_rel = format!("plots/{stem}_error_vs_time.png");
+    write_plot(&dir.join(&plot_rel), &rows)?;
+    let mut md = markdown(&name, &args, (w, h), ref_secs, &rows, &plot_rel);
+    if let Some(why) = &weak {
+        // Right under the title, before any number.
+        let at = md.find("\n\n").map_or(0, |i| i + 2);
+        md.insert_str(at, &format!("> **Weak reference**: {why}.\n\n"));
+    }
+    xylem::sweep::sequence::write_text_atomic(&args.out, &md)?;
+    for r in &rows {
+        println!(
+            "{:<20} {:<28} {:>8.3} s CPU ({:.3}–{:.3}), {:.3} s wall (+{:.3} s)  rel. MSE {:>10.3e}  SSIM {:.4}  model {:>10.3e} {:.4}",
+            r.knob, r.setting, r.cpu_seconds, r.cpu_min, r.cpu_max, r.seconds, r.prep_seconds, r.relative_mse, r.ssim, r.model_mse, r.model_ssim
+        );
+    }
+    println!("report: {}", args.out.display());
+    if let Some(p) = &args.json {
+        let text = serde_json::to_string_pretty(&rows)?;
+        xylem::sweep::sequence::write_text_atomic(p, &text)?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// One colour per knob (the plot's series, in the table's order), with its name for the legend.
+const COLOURS: [([u8; 3], &str); 10] = [
+    ([31, 119, 180], "blue"),
+    ([214, 39, 40], "red"),
+    ([44, 160, 44], "green"),
+    ([255, 127, 14], "orange"),
+    ([148, 103, 189], "purple"),
+    ([23, 190, 207], "cyan"),
+    ([140, 86, 75], "brown"),
+    ([227, 119, 194], "pink"),
+    ([127, 127, 127], "grey"),
+    ([188, 189, 34], "olive"),
+];
+
+/// The knobs in the table's order.
+fn knob_names(rows: &[Measurement]) -> Vec<&str> {
+    let mut knobs: Vec<&str> = Vec::new();
+    for r in rows {
+        if !knobs.contains(&r.knob.as_str()) {
+            knobs.push(&r.knob);
+        }
+    }
+    knobs
+}
+
+fn write_plot(path: &Path, rows: &[Measurement]) -> anyhow::Result<()> {
+    let knobs = knob_names(rows);
+    let series: Vec<Series> = knobs
+        .iter()
+        .enumerate()
+        .map(|(k, name)| Series {
+            points: rows
+                .iter()
+                .filter(|r| r.knob == *name)
+                .map(|r| (r.cpu_seconds, r.relative_mse))
+                .collect(),
+            color: COLOURS[k % COLOURS.len()].0,
+            markers: true,
+            label: name.to_string(),
+        })
+        .collect();
+    let opts = PlotOptions {
+        width: 560,
+        height: 300,
+        log_x: true,
+        log_y: true,
+        x_title: "cpu seconds",
+        y_title: "relative mse",
+    };
+    let img = line_plot(&series, &opts);
+    if let Some(p) = path.parent() {
+        std::fs::create_dir_all(p)?;
+    }
+    xylem::picture::png::write_png_rgb8(path, img.width, img.height, &img.data)?;
+    Ok(())
+}
+
+/// Knobs that keep the scene's look for any scene (noise bands, impulse density and dropping
+/// pores change the wood itself; baking needs one flat object per material), so the presets are
+/// chosen among these.
+const PRESET_KNOBS: [&str; 4] = [
+    "samples per pixel",
+    "footprint band-limit",
+    "distortion Jacobian",
+    "finish",
+];
+
+/// The cheapest measured setting (median render CPU seconds plus preparation time) among [`PRESET_KNOBS`] whose
+/// SSIM reaches `min_ssim`.
+fn cheapest(rows: &[Measurement], min_ssim: f64) -> Option<&Measurement> {
+    rows.iter()
+        .filter(|r| PRESET_KNOBS.contains(&r.knob.as_str()) && r.ssim >= min_ssim)
+        .min_by(|a, b| {
+            (a.cpu_seconds + a.prep_seconds).total_cmp(&(b.cpu_seconds + b.prep_seconds))
+        })
+}
+
+fn markdown(
+    name: &str,
+    args: &Args,
+    (w, h): (u32, u32),
+    ref_secs: f64,
+    rows: &[Measurement],
+    plot: &str,
+) -> String {
+    let mut s = format!(
+        "# Speed against accuracy: `{name}`{}\n\nRegenerated by `xylem tradeoff {} --width {}{}` \
+         ({w}×{h} pixels, one frame with the scene's own lights, {} threads; a reference of {} spp \
+         with the most accurate setting of every knob, the wood point-sampled, took \
+         {ref_secs:.2} s). Error against the \
+         reference: relative MSE (Σ|x − r|² / Σ|r|² over RGB) and mean SSIM (Wang et al. 2004, \
+         8×8 windows, stride 4, on sRGB luminance). Times are the median (and range) of {} \
+         renders of each setting, taken in rounds over all settings so that a change of the \
+         machine's load falls on every row alike, in CPU seconds of the process (all threads; \
+         the recommendations use these), with the wall-clock median beside them. Model knobs are measured \
+         at 16 spp (the footprint band-limit, on by default, switched off at 1 to 64), so their \
+         error includes the noise of \
+         the same spp in the first table's rows; the \
+         *model* columns compare each render with the reference model rendered at the same spp \
+         with the same seeds, which cancels most of that shared noise and leaves what the knob \
+         itself changes. Every row but the reference uses the simplified Jacobian (today's \
+         default) unless it says otherwise. *prep* is the time to apply the knobs before \
+         rendering (rebuilding the volume; baking the maps), paid once per scene.\n\n",
+        args.preset
+            .as_ref()
+            .map(|p| format!(" with {p}"))
+            .unwrap_or_default(),
+        args.scene.display(),
+        args.width,
+        args.preset
+            .as_ref()
+            .map(|p| format!(" --preset {p}"))
+            .unwrap_or_default(),
+        if args.threads == 0 {
+            "all".to_string()
+        } else {
+            args.threads.to_string()
+        },
+        args.reference_spp,
+        args.repeats
+    );
+    s += "| knob | setting | CPU (s), median | CPU range (s) | wall (s) | prep (s) | relative MSE | SSIM | model rel. MSE | model SSIM |\n\
+          | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+    for r in rows {
+        s += &format!(
+            "| {} | {} | {:.3} | {:.3}–{:.3} | {:.3} | {:.3} | {:.3e} | {:.4} | {:.3e} | {:.4} |\n",
+            r.knob,
+            r.setting,
+            r.cpu_seconds,
+            r.cpu_min,
+            r.cpu_max,
+            r.seconds,
+            r.prep_seconds,
+            r.relative_mse,
+            r.ssim,
+            r.model_mse,
+            r.model_ssim
+        );
+    }
+    let legend: Vec<String> = knob_names(rows)
+        .iter()
+        .enumerate()
+        .map(|(k, name)| format!("{} {name}", COLOURS[k % COLOURS.len()].1))
+        .collect();
+    s += &format!(
+        "\n![relative MSE (vertical, log) against median render CPU seconds (horizontal, log), one \
+         colour per knob: {}]({plot})\n\n## Recommended settings\n\n\
+         Chosen among the knobs that keep any scene's look ({}): the cheapest measured setting \
+         (median render CPU seconds plus preparation time) reaching each SSIM threshold.\n\n",
+        legend.join(", "),
+        PRESET_KNOBS.join(", ")
+    );
+    for (label, t) in [("draft", 0.9), ("default", 0.97), ("final", 0.99)] {
+        match cheapest(rows, t) {
+            Some(r) => {
+                s += &format!(
+                    "- **{label}** (cheapest with SSIM ≥ {t}): {} {} — {:.3} CPU s, SSIM {:.4}\n",
+                    r.knob, r.setting, r.cpu_seconds, r.ssim
+                )
+            }
+            None => s += &format!("- **{label}**: no measured setting reaches SSIM ≥ {t}\n"),
+        }
+    }
+    s += "\n`--quality draft|default|final` (on `xylem render` and `xylem sweep`) applies the \
+          presets of `Quality::knobs` in `crates/xylem-lab/src/tradeoff.rs`, fixed from this table (rows \
+          `--quality` above); rerunning on another scene or machine may recommend others.\n";
+    s
+}

@@ -1,0 +1,58 @@
+//! `xylem validate sweep`: the light-sweep checks; rewrites the sweep section of
+//! validation/REPORT.md (with plots) and optionally writes every number as JSON. Exits non-zero
+//! when a check fails.
+
+use anyhow::Context;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use xylem_lab::sweep::{run_checks, to_markdown};
+
+#[derive(clap::Args, Debug, Default)]
+pub struct Args {
+    /// Report to update (only its sweep section) [default: validation/REPORT.md].
+    #[arg(long)]
+    report: Option<PathBuf>,
+    /// Also write every measured number as JSON here.
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Do not touch the report or write plots.
+    #[arg(long)]
+    no_report: bool,
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let report = args
+        .report
+        .unwrap_or_else(|| PathBuf::from("validation/REPORT.md"));
+    let dir = report.parent().map(|p| p.to_path_buf()).unwrap_or_default();
+    let run = xylem::render::RunOptions::default();
+    let bar = crate::progress::Steps::new("validate sweep", 6, "checks");
+    let plots = (!args.no_report).then_some(dir.as_path());
+    let checks = run_checks(plots, &run, &|name| bar.step(name))?;
+    bar.finish();
+    println!("{:<70} {:<6} measured", "check", "result");
+    for c in &checks {
+        println!(
+            "{:<70} {:<6} {}",
+            c.check,
+            if c.passed { "pass" } else { "FAIL" },
+            c.figure
+        );
+    }
+    if !args.no_report {
+        xylem_lab::update_report_section(&report, "sweep", &to_markdown(&checks))
+            .with_context(|| format!("writing {}", report.display()))?;
+        println!("report: {}", report.display());
+    }
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&checks)?;
+        let tmp = path.with_extension("json.partial");
+        std::fs::write(&tmp, text).with_context(|| format!("writing {}", tmp.display()))?;
+        std::fs::rename(&tmp, path).with_context(|| format!("writing {}", path.display()))?;
+    }
+    Ok(if checks.iter().all(|c| c.passed) {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
+}

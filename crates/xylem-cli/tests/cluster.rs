@@ -1,0 +1,313 @@
+//! Sweeps beyond one process and one memory (issue 31): frames streamed in batches that fit
+//! `--memory`, the Slurm recipe of notes/cluster.md run on a local cluster, and the Open Job
+//! Description template run with `openjd run`. Each farmed sweep must give the same files, byte
+//! for byte, as one process.
+
+#[allow(dead_code)] // only the venv of crates/xylem-cli/tests/common/python.rs is used here
+mod common;
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+use xylem::render::resources::Resources;
+
+fn repo() -> &'static Path {
+    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+}
+
+fn xylem(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_xylem"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("xylem runs")
+}
+
+fn ok(o: Output, what: &str) -> String {
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(o.status.success(), "{what} failed: {text}");
+    text
+}
+
+/// The built-in board scene at `w × h`, 1 spp, written into `dir` as board.toml.
+fn tiny_board(dir: &Path, w: u32, h: u32) -> PathBuf {
+    let text = std::fs::read_to_string(repo().join("scenes/sweep_board.toml")).unwrap();
+    let text = text
+        .replace("width = 512", &format!("width = {w}"))
+        .replace("height = 384", &format!("height = {h}"))
+        .replace("spp = 16", "spp = 1");
+    // The named regions are in pixels of the full-size image.
+    let text = &text[..text.find("[[sweep.regions]]").unwrap_or(text.len())];
+    let p = dir.join("board.toml");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// Every file of a folder (names and bytes), without the lock file of the folder lock.
+fn files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_file())
+        .map(|p| {
+            let name = p.file_name().unwrap().to_string_lossy().into_owned();
+            (name, std::fs::read(&p).unwrap())
+        })
+        .collect()
+}
+
+/// Asserts two sweep folders hold the same files with the same bytes.
+fn assert_same_files(a: &Path, b: &Path) {
+    let (fa, fb) = (files(a), files(b));
+    let names = |f: &BTreeMap<String, Vec<u8>>| f.keys().cloned().collect::<Vec<_>>();
+    assert_eq!(
+        names(&fa),
+        names(&fb),
+        "{} and {}",
+        a.display(),
+        b.display()
+    );
+    assert!(fa.contains_key("index.html") && fa.contains_key("aov.exr"));
+    for (name, bytes) in &fa {
+        assert!(
+            bytes == &fb[name],
+            "{name} differs between {} and {}",
+            a.display(),
+            b.display()
+        );
+    }
+}
+
+#[test]
+fn a_sweep_in_batches_writes_the_same_files_as_one_batch() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = tiny_board(dir.path(), 24, 16);
+    let s = scene.to_str().unwrap();
+    let one = ok(
+        xylem(dir.path(), &["sweep", s, "--frames", "10", "--out", "one"]),
+        "one batch",
+    );
+    assert!(one.contains("1 batch of up to 10"), "{one}");
+    // A budget of three frames (at the one thread asked for) cuts the sweep into 4 batches.
+    let budget =
+        Resources::sweep_fixed_bytes(24, 16, 1) + 3 * Resources::sweep_frame_bytes(24, 16, 1);
+    let budget = budget.to_string();
+    let args = ["--threads", "1", "--memory", &budget];
+    let many = ok(
+        xylem(
+            dir.path(),
+            &[&["sweep", s, "--frames", "10", "--out", "many"], &args[..]].concat(),
+        ),
+        "four batches",
+    );
+    assert!(many.contains("4 batches of up to 3"), "{many}");
+    assert_same_files(&dir.path().join("one"), &dir.path().join("many"));
+    // A budget below one frame is refused up front, naming the option and what one frame needs.
+    let o = xylem(dir.path(), &["sweep", s, "--memory", "1K", "--out", "no"]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && !e.contains("panicked"), "{e}");
+    assert!(
+        e.contains("--memory 1.0 KiB") || e.contains("--memory"),
+        "{e}"
+    );
+    assert!(
+        e.contains("too small for one frame of a 24x16 sweep"),
+        "{e}"
+    );
+    let o = xylem(dir.path(), &["sweep", s, "--memory", "12 parsecs"]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && e.contains("unknown unit"), "{e}");
+}
+
+#[test]
+fn the_memory_a_sweep_needs_does_not_grow_with_its_frames() {
+    // Batches of 48 frames: 48 frames and 100000 need the same memory (the disk still grows).
+    let short = Resources::sweep(512, 384, 48, 48, 2);
+    let long = Resources::sweep(512, 384, 100_000, 48, 2);
+    assert_eq!(short.memory, long.memory);
+    assert!(long.disk > 1000 * short.disk);
+    // The batch the default budget allows holds at least one frame of the largest image.
+    let per = xylem::sweep::batch::frames_per_batch(512, 384, 2, 1 << 30).unwrap();
+    assert!((100..2000).contains(&per), "{per} frames per GiB");
+}
+
+/// `sbatch`, or None (with the reason printed) where Slurm is not installed.
+fn slurm() -> Option<()> {
+    let found = Command::new("sbatch")
+        .arg("--version")
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success());
+    if !found {
+        println!("skipped: sbatch is not installed, so there is no Slurm cluster to submit to (Debian: apt-get install slurm-wlm munge, then tools/slurm-local/start.sh as root; .ci/run does both)");
+        return None;
+    }
+    let o = Command::new("bash")
+        .arg(repo().join("tools/slurm-local/start.sh"))
+        .output()
+        .unwrap();
+    ok(
+        o,
+        "tools/slurm-local/start.sh (bringing up the local Slurm cluster)",
+    );
+    Some(())
+}
+
+/// The state of Slurm job `id` (`COMPLETED`, `PENDING`, …).
+fn job_state(id: &str) -> String {
+    let o = Command::new("scontrol")
+        .args(["show", "job", "-o", id])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    (text.split_whitespace())
+        .find_map(|f| f.strip_prefix("JobState="))
+        .unwrap_or("UNKNOWN")
+        .to_string()
+}
+
+#[test]
+fn the_slurm_recipe_of_notes_cluster_md_matches_one_process() {
+    let notes = std::fs::read_to_string(repo().join("notes/cluster.md")).unwrap();
+    let tools = repo().join("tools/slurm-local");
+    // The notes give these two files verbatim: the recipe there is the one run here.
+    for f in ["submit.sh", "sweep_array.sbatch"] {
+        let text = std::fs::read_to_string(tools.join(f)).unwrap();
+        assert!(
+            notes.contains(&format!("```bash\n{text}```")),
+            "notes/cluster.md does not give tools/slurm-local/{f} verbatim"
+        );
+    }
+    if slurm().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let scene = tiny_board(dir.path(), 32, 32);
+    ok(
+        xylem(
+            dir.path(),
+            &[
+                "sweep",
+                scene.to_str().unwrap(),
+                "--frames",
+                "8",
+                "--out",
+                "single",
+                "--quiet",
+            ],
+        ),
+        "the single-process sweep",
+    );
+    let o = Command::new("bash")
+        .arg(tools.join("submit.sh"))
+        .env("XYLEM", env!("CARGO_BIN_EXE_xylem"))
+        .env("SCENE", &scene)
+        .env("FRAMES", "8")
+        .env("OUT", "out/farm")
+        .env("TASKS", "3")
+        .env("CPUS", "1")
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let ids = ok(o, "tools/slurm-local/submit.sh");
+    let ids: Vec<&str> = ids.split_whitespace().collect();
+    assert_eq!(ids.len(), 2, "submit.sh printed {ids:?}");
+    let start = Instant::now();
+    let logs = || {
+        let mut s = String::new();
+        for e in std::fs::read_dir(dir.path().join("logs"))
+            .into_iter()
+            .flatten()
+        {
+            let p = e.unwrap().path();
+            s += &format!(
+                "--- {}\n{}",
+                p.display(),
+                std::fs::read_to_string(&p).unwrap_or_default()
+            );
+        }
+        s
+    };
+    loop {
+        let state = job_state(ids[1]);
+        match state.as_str() {
+            "COMPLETED" => break,
+            "PENDING" | "RUNNING" | "CONFIGURING" | "COMPLETING" => {}
+            _ => panic!("the assembly job {} ended {state}:\n{}", ids[1], logs()),
+        }
+        if start.elapsed() > Duration::from_secs(240) {
+            let _ = Command::new("scancel").args(&ids).status();
+            panic!("the Slurm jobs did not finish in 240 s:\n{}", logs());
+        }
+        std::thread::sleep(Duration::from_millis(500));
+    }
+    println!(
+        "8 frames in 3 array tasks plus the assembly: {:.1} s on Slurm",
+        start.elapsed().as_secs_f64()
+    );
+    assert_same_files(&dir.path().join("single"), &dir.path().join("out/farm"));
+}
+
+#[test]
+fn the_openjd_template_checks_and_runs_to_the_same_files_as_one_process() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = tiny_board(dir.path(), 32, 32);
+    let s = scene.to_str().unwrap();
+    ok(
+        xylem(
+            dir.path(),
+            &["sweep", s, "--frames", "8", "--out", "single", "--quiet"],
+        ),
+        "the single-process sweep",
+    );
+    let emitted = ok(
+        xylem(
+            dir.path(),
+            &[
+                "sweep",
+                s,
+                "--frames",
+                "8",
+                "--out",
+                "farm",
+                "--emit-openjd",
+                "job",
+            ],
+        ),
+        "--emit-openjd",
+    );
+    assert!(emitted.contains("template.json"), "{emitted}");
+    assert!(!dir.path().join("farm").exists(), "--emit-openjd rendered");
+    let template = dir.path().join("job/template.json");
+    let text = std::fs::read_to_string(&template).unwrap();
+    assert!(text.contains("\"CHUNK[INT]\"") && text.contains("\"TASK_CHUNKING\""));
+    // openjd-cli from the test venv (python/requirements-test.txt pins it).
+    let openjd = common::python::venv().join("bin/openjd");
+    ok(
+        Command::new(&openjd)
+            .arg("check")
+            .arg(&template)
+            .output()
+            .unwrap(),
+        "openjd check",
+    );
+    // Chunks of 3 frames: 0-2, 3-5, 6-7, then the assembly.
+    let run = ok(
+        Command::new(&openjd)
+            .arg("run")
+            .arg(&template)
+            .args(["--job-param", "ChunkSize=3"])
+            .current_dir(dir.path())
+            .output()
+            .unwrap(),
+        "openjd run",
+    );
+    assert!(run.contains("Chunks run: 4"), "{run}");
+    assert_same_files(&dir.path().join("single"), &dir.path().join("farm"));
+}

@@ -1,0 +1,76 @@
+//! The Python side of the integration tests: the pinned virtual environment in
+//! target/python-venv and the libLLVM that Mitsuba's LLVM variants need. Shared by
+//! crates/xylem-cli/tests/python.rs and crates/xylem-cli/tests/crosscheck.rs.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn root() -> PathBuf {
+    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+}
+
+pub fn run(cmd: &mut Command, what: &str, hint: &str) {
+    let out = cmd
+        .output()
+        .unwrap_or_else(|e| panic!("{what}: cannot run {cmd:?}: {e}. {hint}"));
+    if !out.status.success() {
+        panic!(
+            "{what} failed ({}): {cmd:?}\n--- stdout\n{}\n--- stderr\n{}\n{hint}",
+            out.status,
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+}
+
+/// The virtual environment with the pinned test requirements, made once and reused while the
+/// requirements file is unchanged.
+pub fn venv() -> PathBuf {
+    let venv = root().join("target/python-venv");
+    let python = venv.join("bin/python");
+    if !python.exists() {
+        let base = std::env::var("XYLEM_PYTHON").unwrap_or_else(|_| "python3".into());
+        run(
+            Command::new(&base).args(["-m", "venv"]).arg(&venv),
+            "creating target/python-venv",
+            "Python 3.11+ with venv is needed (Debian: apt-get install python3 python3-venv; or set XYLEM_PYTHON)",
+        );
+    }
+    let req = root().join("python/requirements-test.txt");
+    let wanted = std::fs::read_to_string(&req).expect("python/requirements-test.txt");
+    let stamp = venv.join("xylem-requirements.txt");
+    if std::fs::read_to_string(&stamp).ok().as_deref() != Some(wanted.as_str()) {
+        run(
+            Command::new(&python)
+                .args([
+                    "-m",
+                    "pip",
+                    "install",
+                    "--quiet",
+                    "--disable-pip-version-check",
+                    "-r",
+                ])
+                .arg(&req),
+            "installing python/requirements-test.txt",
+            "pip needs the package index (PyPI) to install numpy, pytest and mitsuba",
+        );
+        std::fs::write(&stamp, wanted).unwrap();
+    }
+    venv
+}
+
+/// libLLVM for Dr.Jit's LLVM backend (Mitsuba's llvm_* variants).
+pub fn libllvm() -> Option<PathBuf> {
+    if let Ok(p) = std::env::var("DRJIT_LIBLLVM_PATH") {
+        return Some(PathBuf::from(p));
+    }
+    let dirs = [
+        "/usr/lib/x86_64-linux-gnu",
+        "/usr/lib/aarch64-linux-gnu",
+        "/usr/lib/llvm-19/lib",
+    ];
+    let names = ["libLLVM-19.so", "libLLVM.so.19.1", "libLLVM.so"];
+    dirs.iter()
+        .flat_map(|d| names.iter().map(move |n| Path::new(d).join(n)))
+        .find(|p| p.exists())
+}

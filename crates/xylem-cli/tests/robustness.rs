@@ -1,0 +1,719 @@
+//! Never panic, never corrupt (issue 15): the binary driven as a user would drive it — bad
+//! scenes, concurrent renders and sweep slices into one folder, the farm recipe of
+//! notes/cluster.md, runs killed at random points, mixed slices given to `--assemble`, and
+//! requests beyond the machine's resources. Every run is tiny (tens of pixels, 1 spp).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+use xylem::picture::png::read_png_rgb8;
+use xylem::picture::srgb::to_srgb8;
+use xylem::render::image_io::{read_exr_channels, read_exr_rgb};
+use xylem::sweep::sequence::{read_records, FrameRecord, CSV, VIEWER};
+
+fn xylem() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_xylem"));
+    c.env("RUST_BACKTRACE", "0");
+    c
+}
+
+fn run(args: &[&str]) -> Output {
+    xylem().args(args).output().expect("xylem runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn repo() -> &'static Path {
+    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+}
+
+/// The built-in board scene at `w × h`, 1 spp, with a `frames`-frame sweep, written into `dir`.
+fn tiny_board(dir: &Path, w: u32, h: u32, frames: usize) -> PathBuf {
+    let text = std::fs::read_to_string(repo().join("scenes/sweep_board.toml")).unwrap();
+    let text = text
+        .replace("width = 512", &format!("width = {w}"))
+        .replace("height = 384", &format!("height = {h}"))
+        .replace("spp = 16", "spp = 1")
+        .replace("frames = 48", &format!("frames = {frames}"));
+    assert!(text.contains(&format!("width = {w}")) && text.contains("spp = 1"));
+    // The named regions are in pixels of the full-size image.
+    let text = &text[..text.find("[[sweep.regions]]").unwrap_or(text.len())];
+    let p = dir.join("board.toml");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn assert_clean_error(o: &Output, needle: &str) {
+    let e = stderr(o);
+    assert!(!o.status.success(), "expected an error, got success: {e}");
+    assert!(!e.contains("panicked"), "panic: {e}");
+    assert!(e.contains(needle), "error does not name `{needle}`: {e}");
+}
+
+#[test]
+fn scenes_without_objects_or_with_far_objects_are_errors_not_panics() {
+    let dir = tempfile::tempdir().unwrap();
+    let board = std::fs::read_to_string(repo().join("scenes/sweep_board.toml")).unwrap();
+    // Cut before the first object: camera, lights and materials but no [[objects]].
+    let cut = &board[..board.find("[[objects]]").unwrap()];
+    let p = dir.path().join("cut.toml");
+    std::fs::write(&p, cut).unwrap();
+    let out = dir.path().join("out");
+    let o = run(&[
+        "render",
+        p.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_clean_error(&o, "objects");
+    let far = board.replacen(
+        "translate = [0.0, 0.0, 9.0]",
+        "translate = [1e38, 0.0, 0.0]",
+        1,
+    );
+    assert_ne!(far, board);
+    let p = dir.path().join("far.toml");
+    std::fs::write(&p, far).unwrap();
+    let o = run(&[
+        "render",
+        p.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_clean_error(&o, "objects[1].translate");
+    // A scene or mesh that is a device is refused before it is read.
+    let o = run(&["render", "/dev/zero", "--out", out.to_str().unwrap()]);
+    assert_clean_error(&o, "not a regular file");
+    let mesh = board.replacen(
+        "shape = \"box\"\nsize = [260.0, 110.0, 18.0]",
+        "shape = \"mesh\"\nfile = \"/dev/zero.obj\"",
+        1,
+    );
+    assert_ne!(mesh, board);
+    std::os::unix::fs::symlink("/dev/zero", dir.path().join("zero.obj")).unwrap();
+    let p = dir.path().join("mesh.toml");
+    std::fs::write(&p, mesh.replace("/dev/zero.obj", "zero.obj")).unwrap();
+    let o = run(&[
+        "render",
+        p.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_clean_error(&o, "not a regular file");
+}
+
+#[test]
+fn resources_beyond_the_machine_are_refused_up_front() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = tiny_board(dir.path(), 16, 12, 4);
+    let out = dir.path().join("out");
+    let s = scene.to_str().unwrap();
+    let o = run(&[
+        "render",
+        s,
+        "--threads",
+        "100000",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_clean_error(&o, "--threads 100000");
+    // 100000 frames of 512×384: streamed in batches within --memory, but ≈ 348 GiB of frame
+    // files on disk.
+    let board = repo().join("scenes/sweep_board.toml");
+    let start = Instant::now();
+    let o = run(&[
+        "sweep",
+        board.to_str().unwrap(),
+        "--frames",
+        "100000",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_clean_error(&o, "--ignore-limits");
+    assert!(start.elapsed() < Duration::from_secs(30), "refused late");
+    // The documented maximum resolution: refused when the estimate exceeds the memory here.
+    let need = xylem::render::resources::Resources::render(16384, 16384).memory;
+    // 16384² pixels hold at least the beauty, the standard error and the AOVs (16 floats).
+    assert!(need >= 16384 * 16384 * 16 * 4);
+    if xylem::render::resources::available_memory().is_some_and(|m| m < need) {
+        let o = run(&[
+            "render",
+            s,
+            "--res",
+            "16384x16384",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_clean_error(&o, "memory");
+    }
+}
+
+/// Checks that the render's PNG is the sRGB preview of its EXR (so both come from one run).
+fn assert_pair_matches(exr: &Path, png: &Path) {
+    let (w, h, px) = read_exr_rgb(exr).unwrap();
+    let img = read_png_rgb8(png).unwrap();
+    assert_eq!((img.width as usize, img.height as usize), (w, h));
+    assert!(
+        img.data == to_srgb8(&px, 0.0),
+        "{} is not the preview of {}",
+        png.display(),
+        exr.display()
+    );
+}
+
+fn leftovers(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".tmp") || n.ends_with(".partial"))
+        .collect()
+}
+
+#[test]
+fn two_renders_into_one_folder_leave_one_consistent_pair() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = tiny_board(dir.path(), 96, 64, 4);
+    let out = dir.path().join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    // Another run's temporary file under the old fixed name must not stop or harm this one.
+    std::fs::create_dir(out.join("board.exr.partial")).unwrap();
+    std::fs::create_dir(out.join("board.png.partial")).unwrap();
+    let o = run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for round in 0..3 {
+        let kids: Vec<_> = [1, 2]
+            .map(|seed: u32| {
+                xylem()
+                    .args([
+                        "render",
+                        scene.to_str().unwrap(),
+                        "--quiet",
+                        "--threads",
+                        "1",
+                    ])
+                    .args(["--seed", &(seed + 10 * round).to_string()])
+                    .args(["--out", out.to_str().unwrap()])
+                    .stderr(Stdio::piped())
+                    .stdout(Stdio::null())
+                    .spawn()
+                    .unwrap()
+            })
+            .into_iter()
+            .collect();
+        for k in kids {
+            let o = k.wait_with_output().unwrap();
+            assert!(o.status.success(), "{}", stderr(&o));
+        }
+        assert_pair_matches(&out.join("board.exr"), &out.join("board.png"));
+    }
+    let left: Vec<String> = leftovers(&out)
+        .into_iter()
+        .filter(|n| !n.ends_with(".partial"))
+        .collect();
+    assert!(left.is_empty(), "temporary files left: {left:?}");
+}
+
+/// What a folder must satisfy at any moment, even after a run was killed: every image under a
+/// final name decodes; every frame record describes the EXR and PNG beside it (their mean
+/// radiance); and a viewer is only present beside a complete, consistent sweep.
+fn assert_nothing_looks_complete_that_is_not(dir: &Path) {
+    if !dir.exists() {
+        return;
+    }
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        let name = p.file_name().unwrap().to_string_lossy().into_owned();
+        if name.starts_with('.') {
+            continue; // a temporary of a killed run: never under a final name
+        }
+        if name.ends_with(".png") {
+            read_png_rgb8(&p).unwrap_or_else(|e| panic!("{name}: {e}"));
+        } else if name.ends_with(".exr") {
+            read_exr_channels(&p).unwrap_or_else(|e| panic!("{name}: {e}"));
+        } else if name == "manifest.json" {
+            // The capture manifest for `xylem fit`, written atomically: it must parse whole.
+            let text = std::fs::read_to_string(&p).unwrap();
+            serde_json::from_str::<xylem::sweep::manifest::Manifest>(&text)
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
+        } else if name.ends_with(".json") {
+            let rec: FrameRecord =
+                serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
+            let exr = p.with_extension("exr");
+            let (_, _, px) = read_exr_rgb(&exr)
+                .unwrap_or_else(|e| panic!("{name} is there but its EXR is not: {e}"));
+            let n = px.len() as f64;
+            for c in 0..3 {
+                let mean = px.iter().map(|v| v[c] as f64).sum::<f64>() / n;
+                let want = rec.mean_rgb[c] as f64;
+                assert!(
+                    (mean - want).abs() <= 1e-5 * want.abs().max(1e-6),
+                    "{name} says mean {want} but its EXR has {mean}: they come from different runs"
+                );
+            }
+            let png = read_png_rgb8(&p.with_extension("png"))
+                .unwrap_or_else(|e| panic!("{name} is there but its PNG is not: {e}"));
+            assert!(png.data == to_srgb8(&px, 0.0), "{name}: PNG and EXR differ");
+        }
+    }
+    if dir.join(VIEWER).exists() {
+        let records = read_records(dir).expect("a viewer beside an incomplete sweep");
+        let csv = std::fs::read_to_string(dir.join(CSV)).expect("a viewer without its CSV");
+        assert_eq!(csv.lines().count(), records.len() + 1);
+    }
+}
+
+/// A deterministic stream of kill delays (xorshift64*, fixed seed).
+fn delays(n: usize, max: Duration, mut s: u64) -> Vec<Duration> {
+    (0..n)
+        .map(|_| {
+            s ^= s >> 12;
+            s ^= s << 25;
+            s ^= s >> 27;
+            let u = (s.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64;
+            max.mul_f64(u)
+        })
+        .collect()
+}
+
+#[test]
+fn sweeps_killed_at_random_points_leave_nothing_that_looks_complete() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = tiny_board(dir.path(), 40, 30, 9);
+    let out = dir.path().join("out");
+    let args = |frames: &str| {
+        let mut c = xylem();
+        c.args([
+            "sweep",
+            scene.to_str().unwrap(),
+            "--quiet",
+            "--frames",
+            frames,
+        ])
+        .args(["--out", out.to_str().unwrap()])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null());
+        c
+    };
+    // A complete earlier sweep of another frame count (so other light angles) in the folder.
+    let start = Instant::now();
+    assert!(args("5").status().unwrap().success());
+    let full = start.elapsed();
+    assert_nothing_looks_complete_that_is_not(&out);
+    for d in delays(10, full.mul_f64(1.5), 0x9e37_79b9_7f4a_7c15) {
+        let mut kid = args("9").spawn().unwrap();
+        std::thread::sleep(d);
+        let _ = kid.kill(); // SIGKILL
+        kid.wait().unwrap();
+        assert_nothing_looks_complete_that_is_not(&out);
+    }
+    assert!(args("9").status().unwrap().success());
+    assert_eq!(read_records(&out).unwrap().len(), 9);
+    assert_nothing_looks_complete_that_is_not(&out);
+}
+
+#[test]
+fn a_whole_sweep_refuses_a_folder_another_run_holds() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = tiny_board(dir.path(), 16, 12, 3);
+    let out = dir.path().join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    let held = xylem::output::FolderLock::try_new(&out, xylem::output::LockMode::Shared).unwrap();
+    let o = run(&[
+        "sweep",
+        scene.to_str().unwrap(),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_clean_error(&o, "in use by another xylem run");
+    drop(held);
+    // Once released the folder is free. A child forked by another test thread of this binary
+    // shares the lock's open file until it execs (flock locks belong to the open file), so a
+    // busy answer within that moment is retried; a lock that stays held fails all three tries.
+    let mut o = None;
+    for _ in 0..3 {
+        let r = run(&[
+            "sweep",
+            scene.to_str().unwrap(),
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let busy = stderr(&r).contains("in use by another xylem run");
+        o = Some(r);
+        if !busy {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(300));
+    }
+    let o = o.unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+#[test]
+fn assemble_refuses_slices_that_disagree_and_absurd_records() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = tiny_board(dir.path(), 16, 12, 4);
+    let out = dir.path().join("out");
+    let s = scene.to_str().unwrap();
+    let o_ = out.to_str().unwrap();
+    let slice = |range: &str, extra: &[&str]| {
+        let o = run(&[
+            &["sweep", s, "--quiet", "--out", o_, "--frames-range", range],
+            extra,
+        ]
+        .concat());
+        assert!(o.status.success(), "{}", stderr(&o));
+        // A slice never assembles, even when it completes the folder.
+        assert!(!out.join(VIEWER).exists());
+    };
+    slice("0..2", &[]);
+    slice("2..4", &["--spp", "2"]);
+    let o = run(&["sweep", "--assemble", o_]);
+    assert_clean_error(&o, "spp = ");
+    // A slice of another arc is refused before it renders: the folder's manifest is of the
+    // scene's arc (issue 26) ...
+    let o = run(&[
+        "sweep",
+        s,
+        "--quiet",
+        "--out",
+        o_,
+        "--frames-range",
+        "2..4",
+        "--arc",
+        "-30..30",
+    ]);
+    assert_clean_error(&o, "manifest.json");
+    // ... and where no manifest says so, `--assemble` refuses records of two arcs.
+    let manifest = out.join("manifest.json");
+    std::fs::remove_file(&manifest).unwrap();
+    slice("2..4", &["--arc", "-30..30"]);
+    let o = run(&["sweep", "--assemble", o_]);
+    assert_clean_error(&o, "arc_deg");
+    std::fs::remove_file(&manifest).unwrap();
+    slice("2..4", &[]);
+    let o = run(&["sweep", "--assemble", o_]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_nothing_looks_complete_that_is_not(&out);
+    // A duplicated record under another frame's name.
+    std::fs::copy(out.join("frame_0001.json"), out.join("frame_0002.json")).unwrap();
+    let o = run(&["sweep", "--assemble", o_]);
+    assert_clean_error(&o, "frame_0002.json");
+    slice("2..3", &[]);
+    // A record that claims 10¹² frames is refused at once, not allocated for.
+    let p = out.join("frame_0003.json");
+    let text = std::fs::read_to_string(&p).unwrap();
+    std::fs::write(
+        &p,
+        text.replace("\"frames\": 4", "\"frames\": 1000000000000"),
+    )
+    .unwrap();
+    let start = Instant::now();
+    let o = run(&["sweep", "--assemble", o_]);
+    assert_clean_error(&o, "1000000000000");
+    assert!(start.elapsed() < Duration::from_secs(20));
+    // --arc 1...2 is a syntax error, not 1 → 0.2.
+    let o = run(&["sweep", s, "--quiet", "--out", o_, "--arc", "1...2"]);
+    assert_clean_error(&o, "1...2");
+}
+
+#[test]
+fn sweep_frame_exrs_are_byte_stable_run_to_run() {
+    let dir = tempfile::tempdir().unwrap();
+    // 200×136 is 4×3 RLE tiles of 64², so the parallel compressor has chunks to reorder.
+    let scene = tiny_board(dir.path(), 200, 136, 3);
+    let outs = ["a", "b"].map(|n| dir.path().join(n));
+    for o in &outs {
+        let r = run(&[
+            "sweep",
+            scene.to_str().unwrap(),
+            "--quiet",
+            "--out",
+            o.to_str().unwrap(),
+        ]);
+        assert!(r.status.success(), "{}", stderr(&r));
+    }
+    for f in [
+        "frame_0000.exr",
+        "frame_0001.exr",
+        "frame_0002.exr",
+        "aov.exr",
+    ] {
+        let [a, b] = outs.clone().map(|o| std::fs::read(o.join(f)).unwrap());
+        assert!(a == b, "{f} differs between two identical runs");
+    }
+}
+
+/// The GNU parallel recipe of notes/cluster.md, run as written (from a folder where `scenes/`
+/// and `target/release/xylem` are this checkout's), then assembled.
+#[test]
+fn the_farm_recipe_of_notes_cluster_md_works_as_written() {
+    let notes = std::fs::read_to_string(repo().join("notes/cluster.md")).unwrap();
+    let section = &notes[notes.find("## GNU parallel").unwrap()..];
+    let block = &section[section.find("```bash\n").unwrap() + 8..];
+    let script = &block[..block.find("```").unwrap()];
+    assert!(script.contains("parallel") && script.contains("--assemble"));
+    let dir = tempfile::tempdir().unwrap();
+    std::os::unix::fs::symlink(repo().join("scenes"), dir.path().join("scenes")).unwrap();
+    std::fs::create_dir_all(dir.path().join("target/release")).unwrap();
+    std::os::unix::fs::symlink(
+        env!("CARGO_BIN_EXE_xylem"),
+        dir.path().join("target/release/xylem"),
+    )
+    .unwrap();
+    let has_parallel = Command::new("parallel")
+        .arg("--version")
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success());
+    let out = dir.path().join("out/sweep_board");
+    if has_parallel {
+        let o = Command::new("bash")
+            .args(["-euo", "pipefail", "-c", script])
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "the recipe failed: {}", stderr(&o));
+    } else {
+        println!("notice: GNU parallel is not installed; running the recipe's 8 slices as concurrent processes instead");
+        let kids: Vec<_> = (0..48)
+            .step_by(6)
+            .map(|a| {
+                Command::new("target/release/xylem")
+                    .args(["sweep", "scenes/sweep_board.toml", "--frames", "48"])
+                    .args(["--out", "out/sweep_board", "--quiet"])
+                    .args(["--frames-range", &format!("{a}..{}", a + 6)])
+                    .current_dir(dir.path())
+                    .stdout(Stdio::null())
+                    .stderr(Stdio::piped())
+                    .spawn()
+                    .unwrap()
+            })
+            .collect();
+        for k in kids {
+            let o = k.wait_with_output().unwrap();
+            assert!(o.status.success(), "a slice failed: {}", stderr(&o));
+        }
+        let o = Command::new("target/release/xylem")
+            .args(["sweep", "--assemble", "out/sweep_board"])
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    assert_eq!(read_records(&out).unwrap().len(), 48);
+    assert!(out.join(VIEWER).exists() && out.join("aov.exr").exists());
+    assert_nothing_looks_complete_that_is_not(&out);
+}
+
+#[test]
+fn objects_sharing_a_mesh_file_keep_their_own_smooth_setting() {
+    let dir = tempfile::tempdir().unwrap();
+    // One triangle with vertex normals.
+    let obj = "v 0 0 0\nv 10 0 0\nv 0 10 0\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\nf 1//1 2//2 3//3\n";
+    std::fs::write(dir.path().join("tri.obj"), obj).unwrap();
+    let board = std::fs::read_to_string(repo().join("scenes/sweep_board.toml")).unwrap();
+    let head = &board[..board.find("[[objects]]").unwrap()];
+    let text = format!(
+        "{head}[[objects]]\nshape = \"mesh\"\nfile = \"tri.obj\"\nmaterial = \"table\"\n\n\
+         [[objects]]\nshape = \"mesh\"\nfile = \"tri.obj\"\nsmooth = false\nmaterial = \"table\"\n"
+    );
+    let loaded = xylem::scene::from_str(&text, "two.toml", dir.path(), "two").unwrap();
+    let inst = &loaded.scene.accel.instances;
+    assert!(
+        inst[0].mesh.normals.is_some(),
+        "smooth = true (default) keeps the file's normals"
+    );
+    assert!(
+        inst[1].mesh.normals.is_none(),
+        "smooth = false on the second object was ignored"
+    );
+}
+
+#[test]
+fn an_os_error_is_printed_once_and_the_output_folder_is_checked_first() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = run(&["render", dir.path().join("missing.toml").to_str().unwrap()]);
+    assert_clean_error(&o, "missing.toml");
+    assert_eq!(stderr(&o).matches("os error").count(), 1, "{}", stderr(&o));
+    // An output folder that cannot exist is reported before rendering, not after.
+    let scene = tiny_board(dir.path(), 16, 12, 2);
+    std::fs::write(dir.path().join("file"), "").unwrap();
+    let bad_out = dir.path().join("file/out");
+    let o = run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--out",
+        bad_out.to_str().unwrap(),
+    ]);
+    assert_clean_error(&o, "output folder");
+    assert!(
+        !String::from_utf8_lossy(&o.stdout).contains("rendered"),
+        "rendered first"
+    );
+}
+
+#[test]
+fn a_far_eye_and_far_tree_origins_are_named_not_blamed_on_other_fields() {
+    let board = std::fs::read_to_string(repo().join("scenes/sweep_board.toml")).unwrap();
+    let load = |text: &str| {
+        xylem::scene::from_str(text, "far.toml", repo(), "far")
+            .err()
+            .map(|e| e.to_string())
+    };
+    let eye = board.replace("eye = [0.0, -250.0, 190.0]", "eye = [0.0, -1e30, 190.0]");
+    assert_ne!(eye, board);
+    let e = load(&eye).expect("a far eye is an error");
+    assert!(e.contains("camera.eye") && !e.contains("camera.up"), "{e}");
+    let tree = board
+        .lines()
+        .find(|l| l.starts_with("tree = "))
+        .expect("the board's tree line");
+    let origin = board.replace(
+        tree,
+        "tree = { origin = [0.0, 1e12, 0.0], axis = [1.0, 0.0, 0.0] }",
+    );
+    assert_ne!(origin, board);
+    let e = load(&origin).expect("a tree origin at 1e12 mm is an error");
+    assert!(e.contains("objects[1].tree.origin"), "{e}");
+    // A direction of huge components keeps its direction (it became a zero vector).
+    let key = board.replace(
+        "[sweep]\nframes = 48",
+        "[[lights]]\ntype = \"distant\"\ndirection = [3e19, 0.0, -3e19]\nirradiance = 1.0\n\n[sweep]\nframes = 48",
+    );
+    assert_ne!(key, board);
+    let loaded = xylem::scene::from_str(&key, "far.toml", repo(), "far").unwrap();
+    let dir = loaded.scene.lights.iter().find_map(|l| match l {
+        xylem::render::Light::Distant(xylem::render::DistantLight { direction, .. }) => {
+            Some(*direction)
+        }
+        _ => None,
+    });
+    let want = xylem::math::Vec3::new(1.0, 0.0, -1.0).normalize();
+    let got = dir.expect("the distant light");
+    // (Stored towards the light or away from it: either way along ±(1, 0, −1)/√2, not zero.)
+    assert!(got.dot(want).abs() > 1.0 - 1e-6, "{got} (want ±{want})");
+}
+
+/// Each case: a replacement in scenes/sweep_board.toml and the field its error must name.
+/// (On the old code: a type error in a tagged table named only its `[[lights]]` / `[materials.X]`
+/// header, a 4th number was dropped, an orthographic camera ignored `fov_deg`.)
+#[test]
+fn errors_name_the_field_inside_tables_and_arrays_have_exact_lengths() {
+    let board = std::fs::read_to_string(repo().join("scenes/sweep_board.toml")).unwrap();
+    let cases = [
+        (
+            "radiance = 4000.0",
+            "radiance = \"bright\"",
+            "lights[0].radiance",
+            "expected f32",
+        ),
+        ("radiance = 4000.0", "", "lights[0].radiance", "required"),
+        (
+            "type = \"sphere\"",
+            "type = \"spheer\"",
+            "lights[0].type",
+            "sphere",
+        ),
+        (
+            "albedo = [0.03, 0.03, 0.035]",
+            "albedo = \"dark\"",
+            "materials.table.albedo",
+            "sequence",
+        ),
+        (
+            "eta = 1.5 ",
+            "eta = \"glassy\" ",
+            "materials.board.eta",
+            "expected f32",
+        ),
+        (
+            "target = [0.0, 0.0, 5.0]",
+            "target = [0.0, 0.0, 5.0, 7.0]",
+            "target = [",
+            "3 numbers",
+        ),
+        (
+            "center = [250.0, 0.0, 433.0]",
+            "center = [250.0, 0.0, 433.0, 1.0]",
+            "lights[0].center",
+            "3 numbers",
+        ),
+        (
+            "arc_deg = [-60.0, 60.0]",
+            "arc_deg = [-60.0, 60.0, 0.0]",
+            "arc_deg",
+            "2 numbers",
+        ),
+        (
+            "projection = \"perspective\"",
+            "projection = \"orthographic\"\nwidth = 300.0",
+            "camera.fov_deg",
+            "perspective",
+        ),
+    ];
+    for (from, to, field, what) in cases {
+        let text = board.replacen(from, to, 1);
+        assert_ne!(text, board, "{from}");
+        let e = match xylem::scene::from_str(&text, "x.toml", repo(), "x") {
+            Ok(_) => panic!("{to:?} was accepted"),
+            Err(e) => e.to_string(),
+        };
+        assert!(
+            e.contains("x.toml") && e.contains(field) && e.contains(what),
+            "{to:?}: {e}"
+        );
+    }
+}
+
+#[test]
+fn messages_print_user_facing_names_not_rust_enum_variants() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = tiny_board(dir.path(), 8, 6, 2);
+    let text = std::fs::read_to_string(&scene).unwrap();
+    std::fs::write(
+        &scene,
+        text.replace(
+            "integrator = \"direct\"",
+            "integrator = \"path\"\nmax_depth = 5",
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let o = run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("path (max_depth 5)") && !e.contains("Path {"),
+        "{e}"
+    );
+    let o = run(&[
+        "texture",
+        "marble",
+        "--plane",
+        "xz",
+        "--res",
+        "8",
+        "--out",
+        dir.path().join("t.png").to_str().unwrap(),
+    ]);
+    let s = String::from_utf8_lossy(&o.stdout).to_string() + &stderr(&o);
+    assert!(o.status.success(), "{s}");
+    assert!(s.contains("plane xz") && !s.contains("Xz"), "{s}");
+}

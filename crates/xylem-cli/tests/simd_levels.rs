@@ -1,0 +1,94 @@
+//! `XYLEM_SIMD` forces every SIMD level in a whole run of the binary, and every level gives the
+//! scalar level's images bit for bit: a wood render (fibre BSDF, distortion and pore noise, the
+//! wide-BVH traversal of a mesh), a flat wood slice (the batched colour blocks) and an fBm slice
+//! (the gradient lane kernels). Every kernel promises the scalar values, so the expected image
+//! is the scalar run's. A level this CPU lacks is clamped down with a warning, never run; an
+//! unknown name is refused.
+
+use std::path::Path;
+use std::process::{Command, Output};
+use xylem::simd::Simd;
+
+fn xylem(level: &str, args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_xylem"))
+        .args(args)
+        .env("XYLEM_SIMD", level)
+        .current_dir(dir)
+        .output()
+        .unwrap()
+}
+
+/// Every channel of every output of one run at `level`, as bits (EXR headers hold timings).
+fn images(level: &str, dir: &Path) -> Vec<(String, Vec<u32>)> {
+    let scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenes/carved_bunny.toml"
+    );
+    let runs: [&[&str]; 3] = [
+        &[
+            "render", scene, "--res", "24x16", "--spp", "1", "--quiet", "--out", "r",
+        ],
+        &[
+            "texture",
+            "--preset",
+            "african_mahogany",
+            "--flat",
+            "--res",
+            "40",
+            "--out",
+            "wood.exr",
+        ],
+        &["texture", "fbm", "--res", "40", "--out", "fbm.exr"],
+    ];
+    let mut out = Vec::new();
+    for args in runs {
+        let o = xylem(level, args, dir);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{level} {args:?}: {stderr}");
+        let clamped = Simd::parse(level).unwrap() > Simd::detected();
+        assert_eq!(
+            stderr.contains(&format!("XYLEM_SIMD={level} needs CPU features")),
+            clamped,
+            "{level}: {stderr}"
+        );
+    }
+    for file in ["r/carved_bunny.exr", "wood.exr", "fbm.exr"] {
+        for (name, values) in xylem::render::image_io::read_exr_channels(&dir.join(file)).unwrap() {
+            out.push((
+                format!("{file} {name}"),
+                values.iter().map(|v| v.to_bits()).collect(),
+            ));
+        }
+    }
+    out
+}
+
+#[test]
+fn every_level_gives_the_scalar_images() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scalar = images("scalar", tmp.path());
+    assert!(scalar.len() > 10, "{} channels", scalar.len());
+    for level in Simd::ALL {
+        if level == Simd::Scalar {
+            continue;
+        }
+        let got = images(level.name(), tmp.path());
+        assert_eq!(got.len(), scalar.len());
+        for ((name, a), (_, b)) in got.iter().zip(&scalar) {
+            let differ = a.iter().zip(b).filter(|(x, y)| x != y).count();
+            assert_eq!(differ, 0, "{level:?}: {name}: {differ} values differ");
+        }
+    }
+}
+
+#[test]
+fn an_unknown_level_is_refused_by_name() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = xylem("avx512f", &["texture", "fbm", "--res", "8"], tmp.path());
+    assert!(!o.status.success());
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.contains("XYLEM_SIMD=\"avx512f\" is not one of scalar, sse2, avx2, avx512"),
+        "{stderr}"
+    );
+}

@@ -1,0 +1,6 @@
+//! Benchmark harnesses (behind `xylem bench` and crates/xylem-lab/benches/): the tracing benchmark against obvhs's
+//! own traversal and, with the feature `embree-anchor`, Embree 3.
+
+#[cfg(feature = "embree-anchor")]
+pub mod embree;
+pub mod trace;

@@ -1,0 +1,105 @@
+//! BSDFs in the local shading frame (z = shading normal, unit directions pointing away from
+//! the surface): the finished-wood BSDF of Marschner et al. 2005 and the simple BSDFs scenes need.
+
+mod fiber;
+pub mod fiber_albedo;
+mod fiber_albedo_table;
+mod fresnel;
+mod ggx;
+mod lambertian;
+pub mod layered_reference;
+pub mod rough_finish;
+mod rough_finish_table;
+pub mod rough_transmission;
+mod specular;
+mod wood;
+pub mod workload;
+
+pub use fiber::{erf_inv, gaussian, FiberAtWo, FiberAxis, FiberNormalization};
+pub use fresnel::{
+    fresnel_dielectric, fresnel_diffuse_reflectance, refract, refract_in, refract_out,
+};
+pub use ggx::Ggx;
+pub use lambertian::Lambertian;
+pub use specular::{Glass, Mirror};
+pub use wood::{FinishModel, WoodAtWo, WoodBsdf};
+
+use glam::{Vec2, Vec3};
+
+/// One importance sample of a BSDF. For a delta lobe `pdf` is the discrete lobe-selection
+/// probability and `f / pdf · |cos θi|` is the path weight.
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfSample {
+    /// Sampled incident direction (unit, shading frame).
+    pub wi: Vec3,
+    /// BSDF value f(wo, wi), without the cosine.
+    pub f: Vec3,
+    /// Solid-angle density of `wi`, or the lobe-selection probability for a delta lobe.
+    pub pdf: f32,
+    /// True when `wi` came from a delta lobe (`eval` and `pdf` do not see it).
+    pub is_delta: bool,
+}
+
+/// A BSDF: `eval` is f(wo, wi) without the cosine and without delta lobes; `pdf` is the density
+/// per unit solid angle that `sample` draws its non-delta directions from (0 for delta lobes).
+pub trait Bsdf {
+    /// f(wo, wi) without the cosine factor and without delta lobes (shading frame, z = normal).
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3;
+    /// Density per unit solid angle with which `sample` draws `wi` given `wo` (0 for delta lobes).
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32;
+    /// Draws `wi` for `wo` from the lobe chosen by `uc` and the 2D sample `u` (each in [0, 1));
+    /// `None` when no direction is produced (e.g. `wo` below the surface).
+    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample>;
+}
+
+/// A BSDF parameter outside its allowed range (or not finite).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum BsdfError {
+    /// A parameter is not finite or outside its range.
+    #[error("WoodBsdfParams.{field} = {value}: must be {range}")]
+    OutOfRange {
+        /// The parameter's field name in [`WoodBsdfParams`].
+        field: &'static str,
+        /// The value given.
+        value: String,
+        /// The allowed range, in words.
+        range: &'static str,
+    },
+}
+
+/// Parameters of the finished-wood BSDF (Marschner et al. 2005, §4; Liu et al. 2016, §6.3).
+/// Directions are in the local shading frame; angles in radians.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WoodBsdfParams {
+    /// Lambertian albedo of the wood substrate (under the finish).
+    pub diffuse: Vec3,
+    /// Fibre-lobe colour k_f, each channel in [0, 1].
+    pub fiber_color: Vec3,
+    /// Longitudinal fibre axis u (unit; may dip into the surface).
+    pub fiber_dir: Vec3,
+    /// Ray-fibre axis (unit), used where `ray_mask` > 0.
+    pub ray_dir: Vec3,
+    /// Blend weight of the ray-fibre BSDF, in [0, 1].
+    pub ray_mask: f32,
+    /// Gaussian width β of the fibre highlight, radians.
+    pub highlight_width: f32,
+    /// Refractive index of the finish; 1 means no finish.
+    pub eta: f32,
+    /// GGX roughness of the finish; 0 means smooth.
+    pub roughness: f32,
+}
+
+impl Default for WoodBsdfParams {
+    fn default() -> Self {
+        WoodBsdfParams {
+            diffuse: Vec3::new(0.45, 0.22, 0.10),
+            fiber_color: Vec3::new(0.6, 0.4, 0.25),
+            fiber_dir: Vec3::X,
+            ray_dir: Vec3::Z,
+            ray_mask: 0.0,
+            highlight_width: 8.0_f32.to_radians(),
+            eta: 1.5,
+            roughness: 0.0,
+        }
+    }
+}

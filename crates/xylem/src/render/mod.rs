@@ -1,0 +1,475 @@
+//! The BVH path tracer: camera, lights, meshes on an obvhs BVH, integrator, film with AOVs,
+//! EXR / PNG output and progress.
+//!
+//! [`render`] renders a [`Scene`] tile by tile on a rayon pool. Every pixel sample draws its
+//! random numbers from streams keyed by (seed, pixel, sample) only, so the image is bit-identical
+//! for any thread count.
+
+pub mod camera;
+pub mod film;
+pub mod frames;
+pub mod geometry;
+pub mod image_io;
+pub mod integrator;
+pub mod light;
+pub mod resources;
+pub mod wide_bvh;
+
+pub use camera::{Camera, Projection};
+pub use film::{Aov, Filter, Image, PixelSum, RadianceSum};
+pub use frames::LightFrames;
+pub use geometry::{Accel, Instance, Ray, Transform, TriMesh};
+pub use integrator::{
+    light_rng, primary_sample, sample_rngs, Integrator, PrimarySample, ShadingPoint,
+};
+pub use light::{
+    DistantLight, EnvMap, Environment, Light, PointLight, RectLight, SphereLight, SpotLight,
+};
+
+use crate::material::Material;
+use crate::progress::{NoProgress, Progress};
+use crate::simd::{simd_level, Simd};
+use glam::{UVec2, Vec3};
+use integrator::{radiance_frames, FramesScratch, RayCount, ShadowTest};
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::{Duration, Instant};
+
+/// Everything a render needs to know about the world.
+pub struct Scene {
+    /// The geometry: placed meshes in their BVHs.
+    pub accel: Accel,
+    /// Materials, indexed by [`Instance::material`].
+    pub materials: Vec<Material>,
+    /// The lights [`render`] renders with ([`render_frames`] takes each frame's lights from a
+    /// [`LightFrames`] instead).
+    pub lights: Vec<Light>,
+    /// The camera: pose, projection and image size.
+    pub camera: Camera,
+    /// Pixel reconstruction filter.
+    pub filter: Filter,
+}
+
+/// Sampling settings of one render.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderSettings {
+    /// Samples per pixel (1–1000000).
+    pub spp: u32,
+    /// Direct lighting only, or path tracing.
+    pub integrator: Integrator,
+    /// Random seed: the same seed gives the same image on any thread count.
+    pub seed: u64,
+}
+
+impl RenderSettings {
+    /// The EXR header attributes that say how an image of `scene` (its name and file) seen by
+    /// `camera` was made: scene, file, spp, seed, integrator and camera (the software attribute
+    /// carries xylem's version; [`image_io::stage_exr_layers`]). Camera axes as [`Camera`] has
+    /// them: right, up and view direction; lengths in mm.
+    pub fn exr_meta(
+        &self,
+        scene: &str,
+        file: &str,
+        camera: &Camera,
+    ) -> Vec<(&'static str, String)> {
+        let v = |v: glam::Vec3| format!("({}, {}, {})", v.x, v.y, v.z);
+        let f = &camera.frame;
+        let projection = match camera.projection {
+            camera::Projection::Perspective {
+                fov_y,
+                lens_radius,
+                focus_distance,
+            } => format!(
+                "perspective, fov_y {} deg, lens radius {lens_radius} mm, focus {focus_distance} mm",
+                fov_y.to_degrees()
+            ),
+            camera::Projection::Orthographic { width } => format!("orthographic, width {width} mm"),
+        };
+        vec![
+            ("scene", scene.to_string()),
+            ("scene_file", file.to_string()),
+            ("spp", self.spp.to_string()),
+            ("seed", self.seed.to_string()),
+            ("integrator", self.integrator.to_string()),
+            (
+                "camera",
+                format!(
+                    "eye {} right {} up {} view {}, {projection}, {}x{} px",
+                    v(camera.eye),
+                    v(f.s),
+                    v(f.t),
+                    v(f.n),
+                    camera.width,
+                    camera.height
+                ),
+            ),
+        ]
+    }
+}
+
+/// How to run a render (not part of the image: changing these never changes a pixel).
+///
+/// `RunOptions { threads: 2, ..Default::default() }` renders on two threads and reports no
+/// progress.
+#[derive(Clone, Copy, Debug)]
+pub struct RunOptions<'a> {
+    /// Worker threads; 0 = all cores.
+    pub threads: usize,
+    /// Told of every finished tile with the Mrays/s so far (the CLI draws a bar on stderr).
+    pub progress: &'a dyn Progress,
+}
+
+impl Default for RunOptions<'_> {
+    fn default() -> Self {
+        RunOptions {
+            threads: 0,
+            progress: &NoProgress,
+        }
+    }
+}
+
+/// A finished render with its statistics.
+#[derive(Clone, Debug)]
+pub struct RenderOutput {
+    /// The image with its AOV layers.
+    pub image: Image,
+    /// Wall time of the render.
+    pub elapsed: Duration,
+    /// Rays traced (camera, shadow and bounce rays).
+    pub rays: u64,
+}
+
+/// Why a render could not start.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// The rayon thread pool could not be built.
+    #[error("cannot start {threads} render threads: {message}")]
+    Threads {
+        /// The thread count asked for.
+        threads: usize,
+        /// rayon's message.
+        message: String,
+    },
+    /// The caller asked the run to stop ([`crate::progress::Progress::stop`]).
+    #[error("stopped before the render finished ({done} of {total} tiles)")]
+    Stopped {
+        /// Tiles finished.
+        done: u64,
+        /// Tiles in the render.
+        total: u64,
+    },
+    /// An image with no pixels.
+    #[error("image size {width}x{height} is empty")]
+    EmptyImage {
+        /// Image width in pixels.
+        width: u32,
+        /// Image height in pixels.
+        height: u32,
+    },
+}
+
+/// Side length of the square tiles handed to worker threads.
+pub const TILE: u32 = 16;
+
+/// Renders the scene with its own lights.
+///
+/// ```
+/// use std::path::Path;
+/// // A scene file (here a built-in one; `xylem::scene::load` reads any file), made small.
+/// let mut loaded = xylem::scene::load(Path::new("scenes/sweep_board.toml"))?;
+/// loaded.scene.camera = loaded.scene.camera.with_resolution(32, 24);
+/// loaded.settings.spp = 2;
+/// let out = xylem::render::render(&loaded.scene, &loaded.settings, &Default::default())?;
+/// assert_eq!(out.image.beauty.len(), 32 * 24);
+/// // Beauty with alpha, the AOV layers and the settings in the header:
+/// let dir = std::env::temp_dir().join(format!("xylem-doc-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// let meta = loaded.settings.exr_meta(&loaded.name, "scenes/sweep_board.toml", &loaded.scene.camera);
+/// xylem::render::image_io::write_image_exr(&dir.join("board.exr"), &out.image, &meta)?;
+/// # std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn render(
+    scene: &Scene,
+    settings: &RenderSettings,
+    run: &RunOptions,
+) -> Result<RenderOutput, RenderError> {
+    let mut frames = render_frames(scene, &LightFrames::fixed(&scene.lights), settings, run)?;
+    let frame = frames.frames.swap_remove(0);
+    Ok(RenderOutput {
+        image: Image {
+            width: frames.width,
+            height: frames.height,
+            beauty: frame.beauty,
+            std_error: frame.std_error,
+            aov: frames.aov,
+            nonfinite: frame.nonfinite,
+        },
+        elapsed: frames.elapsed,
+        rays: frames.rays,
+    })
+}
+
+/// One frame of a [`render_frames`] run: its radiance and per-pixel standard error (the AOVs,
+/// the same in every frame, are kept once in [`Frames`]).
+#[derive(Clone, Debug)]
+pub struct FrameImage {
+    /// Mean radiance per pixel (row-major, top row first).
+    pub beauty: Vec<Vec3>,
+    /// Standard error of each pixel's luminance.
+    pub std_error: Vec<f32>,
+    /// Samples that were not finite (counted, contributing zero).
+    pub nonfinite: u64,
+}
+
+/// The frames of a [`render_frames`] run with the first-hit AOVs they share.
+#[derive(Clone, Debug)]
+pub struct Frames {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// The first-hit AOVs, shared by every frame.
+    pub aov: Vec<Aov>,
+    /// One image per frame of the [`LightFrames`], in order.
+    pub frames: Vec<FrameImage>,
+    /// Wall time of the render.
+    pub elapsed: Duration,
+    /// Rays traced (camera, shadow and bounce rays).
+    pub rays: u64,
+}
+
+impl Frames {
+    /// Frame `k` as a renderer [`Image`] (for EXR output with the AOV layers).
+    pub fn image(&self, k: usize) -> Image {
+        let f = &self.frames[k];
+        Image {
+            width: self.width,
+            height: self.height,
+            beauty: f.beauty.clone(),
+            std_error: f.std_error.clone(),
+            aov: self.aov.clone(),
+            nonfinite: f.nonfinite,
+        }
+    }
+}
+
+/// Renders every frame of `lights` at once, tile by tile on a pool of `run.threads` threads.
+///
+/// Each pixel sample's light-independent part ([`primary_sample`]) and its path are computed
+/// once and lit for every frame straight away (pixel → sample → frame), so nothing but the
+/// tile's pixel sums is kept whatever the number of frames; each frame equals the render of
+/// that frame alone, bit for bit, on any thread count.
+pub fn render_frames(
+    scene: &Scene,
+    lights: &LightFrames,
+    settings: &RenderSettings,
+    run: &RunOptions,
+) -> Result<Frames, RenderError> {
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    if w == 0 || h == 0 {
+        return Err(RenderError::EmptyImage {
+            width: w,
+            height: h,
+        });
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(run.threads)
+        .build()
+        .map_err(|e| RenderError::Threads {
+            threads: run.threads,
+            message: e.to_string(),
+        })?;
+    let tiles: Vec<UVec2> = (0..h.div_ceil(TILE))
+        .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| UVec2::new(tx, ty) * TILE))
+        .collect();
+    let shadow = ShadowTest::culled(&scene.accel);
+    let n_tiles = tiles.len() as u64;
+    run.progress.start(n_tiles, &progress_unit(lights.len()));
+    let tiles_done = AtomicU64::new(0);
+    let total_rays = AtomicU64::new(0);
+    let start = Instant::now();
+    let stopped = std::sync::atomic::AtomicBool::new(false);
+    let results: Vec<Option<(UVec2, TileFrames)>> = pool.install(|| {
+        tiles
+            .par_iter()
+            .map(|&origin| {
+                if stopped.load(Ordering::Relaxed) || run.progress.stop() {
+                    stopped.store(true, Ordering::Relaxed);
+                    return None;
+                }
+                let tile = render_tile(scene, lights, &shadow, settings, origin);
+                let total = total_rays.fetch_add(tile.rays, Ordering::Relaxed) + tile.rays;
+                let secs = start.elapsed().as_secs_f64().max(1e-9);
+                let done = tiles_done.fetch_add(1, Ordering::Relaxed) + 1;
+                let rate = format!("{:.2} Mrays/s", total as f64 / secs / 1e6);
+                run.progress.update(done, n_tiles, &rate);
+                Some((origin, tile))
+            })
+            .collect()
+    });
+    run.progress.finish();
+    if stopped.into_inner() {
+        return Err(RenderError::Stopped {
+            done: tiles_done.into_inner(),
+            total: n_tiles,
+        });
+    }
+    let results = results.into_iter().flatten();
+    let n = (w * h) as usize;
+    let mut frames: Vec<FrameImage> = (0..lights.len())
+        .map(|_| FrameImage {
+            beauty: vec![Vec3::ZERO; n],
+            std_error: vec![0.0; n],
+            nonfinite: 0,
+        })
+        .collect();
+    let mut aov = vec![Aov::default(); n];
+    for (origin, tile) in results {
+        let tw = TILE.min(w - origin.x);
+        let place = |i: usize| {
+            let (x, y) = (origin.x + i as u32 % tw, origin.y + i as u32 / tw);
+            (y * w + x) as usize
+        };
+        for (i, a) in tile.aov.iter().enumerate() {
+            aov[place(i)] = *a;
+        }
+        for (f, img) in frames.iter_mut().zip(tile.frames) {
+            for i in 0..img.beauty.len() {
+                f.beauty[place(i)] = img.beauty[i];
+                f.std_error[place(i)] = img.std_error[i];
+            }
+            f.nonfinite += img.nonfinite;
+        }
+    }
+    Ok(Frames {
+        width: w,
+        height: h,
+        aov,
+        frames,
+        elapsed: start.elapsed(),
+        rays: total_rays.into_inner(),
+    })
+}
+
+/// What a render's progress counts: `tiles`, or `tiles × 48 frames` for a sweep.
+fn progress_unit(frames: usize) -> String {
+    if frames > 1 {
+        format!("tiles × {frames} frames")
+    } else {
+        "tiles".to_string()
+    }
+}
+
+/// One tile's frames (per frame the averaged pixels, an [`Image`] the size of the tile without
+/// AOVs), its AOVs once, and the rays traced.
+struct TileFrames {
+    aov: Vec<Aov>,
+    frames: Vec<Image>,
+    rays: u64,
+}
+
+/// One tile for every frame: each (pixel, frame) sums its samples in sample order; the AOVs,
+/// the same in every frame, are summed once.
+fn render_tile(
+    scene: &Scene,
+    lights: &LightFrames,
+    shadow: &ShadowTest,
+    settings: &RenderSettings,
+    origin: UVec2,
+) -> TileFrames {
+    #[cfg(target_arch = "x86_64")]
+    match Simd::best() {
+        // SAFETY: `Simd::best` detected the level's features on this CPU.
+        Simd::Avx512 => {
+            return unsafe { render_tile_avx512(scene, lights, shadow, settings, origin) }
+        }
+        Simd::Avx2 => return unsafe { render_tile_avx2(scene, lights, shadow, settings, origin) },
+        Simd::Sse2 | Simd::Scalar => {}
+    }
+    render_tile_in(scene, lights, shadow, settings, origin)
+}
+
+simd_level! { Avx512
+    unsafe fn render_tile_avx512(
+        scene: &Scene,
+        lights: &LightFrames,
+        shadow: &ShadowTest,
+        settings: &RenderSettings,
+        origin: UVec2,
+    ) -> TileFrames {
+        render_tile_in(scene, lights, shadow, settings, origin)
+    }
+}
+
+simd_level! { Avx2
+    unsafe fn render_tile_avx2(
+        scene: &Scene,
+        lights: &LightFrames,
+        shadow: &ShadowTest,
+        settings: &RenderSettings,
+        origin: UVec2,
+    ) -> TileFrames {
+        render_tile_in(scene, lights, shadow, settings, origin)
+    }
+}
+
+/// The body of [`render_tile`], compiled once per SIMD level (`simd_level!`): the per-frame
+/// loops it inlines (light samples, next-event terms, BSDF batches, sums) run in that level's
+/// lanes. The same IEEE operations at every level, so the same bits (crates/xylem-cli/tests/simd_levels.rs).
+#[inline(always)]
+fn render_tile_in(
+    scene: &Scene,
+    lights: &LightFrames,
+    shadow: &ShadowTest,
+    settings: &RenderSettings,
+    origin: UVec2,
+) -> TileFrames {
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let (tw, th) = (TILE.min(w - origin.x), TILE.min(h - origin.y));
+    let n = (tw * th) as usize;
+    let frames = lights.len();
+    let max_depth = settings.integrator.max_depth();
+    // Pixel-major (pixel i, frame k at i·frames + k): a pixel's samples update one contiguous
+    // run of sums instead of one cache line in each of `frames` arrays.
+    let mut sums = vec![RadianceSum::default(); n * frames];
+    let mut aov_sums = vec![PixelSum::default(); n];
+    let mut radiance = vec![Vec3::ZERO; frames];
+    let mut scratch = FramesScratch::default();
+    let mut rays = RayCount::default();
+    let fp_scale = integrator::footprint_scale(settings.spp);
+    for (i, pixel) in (origin.y..origin.y + th)
+        .flat_map(|y| (origin.x..origin.x + tw).map(move |x| UVec2::new(x, y)))
+        .enumerate()
+    {
+        for s in 0..settings.spp {
+            let ps = primary_sample(scene, pixel, s, settings.seed, fp_scale);
+            rays.0 += 1;
+            let mut rng = light_rng(scene, pixel, s, settings.seed);
+            radiance_frames(
+                scene,
+                lights,
+                shadow,
+                &ps,
+                &mut rng,
+                max_depth,
+                &mut scratch,
+                &mut radiance,
+                &mut rays,
+            );
+            for (sum, l) in sums[i * frames..(i + 1) * frames].iter_mut().zip(&radiance) {
+                sum.add(*l);
+            }
+            aov_sums[i].add(Vec3::ZERO, &ps.aov);
+        }
+    }
+    let aov = Image::from_sums(tw, th, &aov_sums).aov;
+    let frames = (0..frames)
+        .map(|k| Image::from_radiance(tw, th, sums.iter().skip(k).step_by(frames)))
+        .collect();
+    TileFrames {
+        aov,
+        frames,
+        rays: rays.0,
+    }
+}

@@ -1,0 +1,428 @@
+//! A whole `xylem sweep` job: set up the path from the scene, render the selected frames (cached
+//! or naive), write each frame's EXR, PNG and record, and assemble the sequence once every frame
+//! of the sweep is in the output folder.
+
+use super::batch::{batches, default_budget, frames_per_batch, BudgetError};
+use super::manifest::{Manifest, MANIFEST_FILE};
+use super::path::{parse_frames_range, PathError};
+use super::path::{SetupError, SweepPath};
+use super::sequence::{
+    assemble, clear_assembled, frame_stem, unmark_frame, write_record, AssembleOptions, Assembled,
+    FrameRecord, Region, SequenceError, SweepSettings,
+};
+use super::{render_naive, render_sweep};
+use crate::output::{remove_if_present, FolderLock, LockError, LockMode};
+use crate::picture::file::commit;
+use crate::picture::png::stage_png_linear;
+use crate::picture::ImageError;
+use crate::render::image_io::{
+    aov_layers, beauty_rgba, stage_exr_layers, write_exr_layers, ExrCompression, ExrLayer,
+};
+use crate::render::resources::{ResourceError, Resources};
+use crate::render::Frames;
+use crate::render::{RenderError, RunOptions};
+use crate::scene::LoadedScene;
+use rayon::prelude::*;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+/// Anything that stops a sweep job.
+#[derive(Debug, thiserror::Error)]
+pub enum SweepError {
+    /// The scene's `[sweep]` table does not describe a path.
+    #[error(transparent)]
+    Setup(#[from] SetupError),
+    /// A bad `--frames`, `--arc` or `--frames-range` value.
+    #[error(transparent)]
+    Path(#[from] PathError),
+    /// The renderer could not start.
+    #[error(transparent)]
+    Render(#[from] RenderError),
+    /// A frame record or an assembled output could not be written or read.
+    #[error(transparent)]
+    Sequence(#[from] SequenceError),
+    /// A frame's EXR or PNG could not be written.
+    #[error(transparent)]
+    Image(#[from] ImageError),
+    /// The output folder could not be created.
+    #[error("cannot create output folder {path}: {cause}")]
+    OutDir {
+        /// The folder.
+        path: String,
+        /// Why.
+        cause: std::io::Error,
+    },
+    /// Another job holds the output folder.
+    #[error(transparent)]
+    Lock(#[from] LockError),
+    /// The sweep would need more memory or disk than the machine has.
+    #[error(transparent)]
+    Resources(#[from] ResourceError),
+    /// `--memory` cannot hold one frame.
+    #[error(transparent)]
+    Budget(#[from] BudgetError),
+    /// A slice's sweep differs from the capture already in its folder.
+    #[error("{path} describes another sweep ({theirs}) than this slice ({ours}); render the slice with the same scene, --frames and --arc, or into another --out")]
+    OtherSweep {
+        /// The folder's manifest.
+        path: String,
+        /// What the folder's manifest describes.
+        theirs: String,
+        /// What this slice would write.
+        ours: String,
+    },
+}
+
+/// What to render and where.
+#[derive(Clone, Debug, Default)]
+pub struct SweepJob<'a> {
+    /// Frames along the arc (default: the scene's `[sweep] frames`).
+    pub frames: Option<usize>,
+    /// Arc ends in degrees (default: the scene's `[sweep] arc_deg`).
+    pub arc: Option<(f32, f32)>,
+    /// `--frames-range` text; `None` renders every frame.
+    pub range: Option<String>,
+    /// Output folder of the frames, records and assembled sequence.
+    pub out: PathBuf,
+    /// Render every frame from scratch instead of caching (for timing and checking the cache).
+    pub naive: bool,
+    /// Threads and progress reporting (never change a pixel).
+    pub run: RunOptions<'a>,
+    /// Compression of each frame's EXR (the shared AOV file is always ZIP).
+    pub exr: ExrCompression,
+    /// Skip the memory and disk estimate (`--ignore-limits`).
+    pub ignore_limits: bool,
+    /// Memory budget in bytes for the frames held at once (`--memory`; default
+    /// [`default_budget`]): frames are rendered and written in batches that fit it.
+    pub memory: Option<u64>,
+    /// What else decides the frames (scene file digest, quality preset), recorded with each frame
+    /// so that `--assemble` refuses slices that disagree.
+    pub provenance: String,
+}
+
+/// What a job did.
+#[derive(Debug)]
+pub struct JobReport {
+    /// The frames this job rendered (indices into the whole sweep).
+    pub rendered: Range<usize>,
+    /// Frames of the whole sweep.
+    pub total: usize,
+    /// Wall time of the rendering (without writing the files).
+    pub render_time: Duration,
+    /// Most frames rendered at once (the batch the memory budget allows).
+    pub batch: usize,
+    /// Batches rendered.
+    pub batches: usize,
+    /// Set when every frame was present and the sequence outputs were written.
+    pub assembled: Option<Assembled>,
+}
+
+/// The scene's named regions, for the CSV.
+pub fn scene_regions(loaded: &LoadedScene) -> Vec<Region> {
+    loaded
+        .sweep
+        .iter()
+        .flat_map(|t| &t.regions)
+        .map(|r| Region {
+            name: r.name.clone(),
+            x0: r.x0,
+            y0: r.y0,
+            x1: r.x1,
+            y1: r.y1,
+        })
+        .collect()
+}
+
+/// The file holding the first-hit AOV layers that every frame of a sweep shares. It is written
+/// by the job that renders frame 0 (the whole sweep, or the first slice of a farmed one), so no
+/// two slices ever write it.
+pub const AOV_FILE: &str = "aov.exr";
+
+/// Writes every frame of `render` into `dir`, frames in parallel. Each frame's old record goes
+/// first, then its EXR (radiance and standard error) and PNG are renamed into place and its new
+/// record is written last, so a record always describes the images beside it, even when the run
+/// is killed. The job that renders frame 0 also writes the AOVs every frame shares into
+/// [`AOV_FILE`] (the camera and geometry do not move). `render` holds frames `range` of the
+/// sweep `path`.
+///
+/// Each frame's EXR header carries one attribute, `sweep_frame` (one, because the exr crate
+/// writes several in hash-map order and frames must be byte-stable): the frame, the light's
+/// angle, azimuth, direction and position on the arc, then `header` (the render's spp, seed,
+/// integrator and camera, [`frame_header`]).
+#[allow(clippy::too_many_arguments)]
+pub fn write_frames(
+    dir: &Path,
+    render: &Frames,
+    path: &SweepPath,
+    range: Range<usize>,
+    total: usize,
+    exposure: f32,
+    regions: &[Region],
+    compression: ExrCompression,
+    settings: &SweepSettings,
+    header: &str,
+) -> Result<(), SweepError> {
+    let (w, h) = (render.width, render.height);
+    if range.start == 0 && !render.frames.is_empty() {
+        write_exr_layers(&dir.join(AOV_FILE), w, h, &aov_layers(&render.aov))?;
+    }
+    render
+        .frames
+        .par_iter()
+        .zip(range)
+        .try_for_each(|(f, index)| {
+            let light_deg = path.light_deg(index);
+            let stem = frame_stem(index);
+            let layers = [
+                beauty_rgba(&f.beauty, &render.aov),
+                ExrLayer {
+                    name: "std_error",
+                    channels: &["Y"],
+                    data: f.std_error.clone(),
+                },
+            ];
+            // One attribute: the exr crate writes its extra attributes in hash-map order, which
+            // differs run to run, and frames must be byte-stable (crates/xylem-cli/tests/robustness.rs).
+            let (to, at) = (
+                path.direction(index),
+                path.pivot + path.radius * path.direction(index),
+            );
+            let meta = [(
+                "sweep_frame",
+                format!(
+                    "frame {index} of {total}, light at {light_deg} deg, azimuth {} deg, \
+                     direction ({}, {}, {}), position ({}, {}, {}) mm; {header}",
+                    path.azimuth_deg(index),
+                    to.x,
+                    to.y,
+                    to.z,
+                    at.x,
+                    at.y,
+                    at.z
+                ),
+            )];
+            let exr = stage_exr_layers(
+                &dir.join(format!("{stem}.exr")),
+                w,
+                h,
+                &layers,
+                compression,
+                &meta,
+            )?;
+            let png =
+                stage_png_linear(&dir.join(format!("{stem}.png")), w, h, &f.beauty, exposure)?;
+            let mut rec = FrameRecord::measure(index, total, light_deg, (w, h), &f.beauty, regions);
+            rec.sweep = settings.clone();
+            unmark_frame(dir, index)?;
+            commit(exr)?;
+            commit(png)?;
+            write_record(dir, &rec)?;
+            Ok(())
+        })
+}
+
+/// What every frame of a sweep shares, for its EXR header: the moving light (its name and
+/// kind, the arc's pivot and radius), spp, seed, integrator and the camera (as
+/// [`RenderSettings::exr_meta`](crate::render::RenderSettings::exr_meta) words it).
+pub fn frame_header(loaded: &LoadedScene, path: &SweepPath, moving: usize) -> String {
+    let light = loaded
+        .light_names
+        .get(moving)
+        .cloned()
+        .flatten()
+        .unwrap_or_else(|| format!("lights[{moving}]"));
+    use crate::render::Light;
+    let kind = match loaded.scene.lights.get(moving) {
+        Some(Light::Point(_)) => "point",
+        Some(Light::Spot(_)) => "spot",
+        Some(Light::Distant(_)) => "distant",
+        Some(Light::Rect(_)) => "rect",
+        Some(Light::Sphere(_)) => "sphere",
+        Some(Light::Environment(_)) => "environment",
+        None => "?",
+    };
+    let p = path.pivot;
+    let meta = loaded
+        .settings
+        .exr_meta(&loaded.name, &loaded.name, &loaded.scene.camera);
+    let field = |k: &str| meta.iter().find(|m| m.0 == k).map_or("", |m| m.1.as_str());
+    format!(
+        "moving light {light} ({kind}) about pivot ({}, {}, {}) mm at radius {} mm; {} spp, seed {}, integrator {}; camera {}",
+        p.x,
+        p.y,
+        p.z,
+        path.radius,
+        field("spp"),
+        field("seed"),
+        field("integrator"),
+        field("camera")
+    )
+}
+
+/// Runs a sweep job on a loaded scene. A whole sweep holds its output folder alone, clears what
+/// an earlier sweep left there and assembles at the end; a slice (`range` set) shares the folder
+/// with the other slices, writes only its own frames and leaves assembling to `--assemble`.
+pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepError> {
+    let (path, moving) = SweepPath::from_scene(loaded, job.frames, job.arc)?;
+    let total = path.frames();
+    let range = match &job.range {
+        Some(text) => parse_frames_range(text, total)?,
+        None => 0..total,
+    };
+    let cam = &loaded.scene.camera;
+    let budget = job.memory.unwrap_or_else(default_budget);
+    let batch = frames_per_batch(cam.width, cam.height, job.run.threads, budget)?
+        .min(range.len())
+        .max(1);
+    let need = Resources::sweep(cam.width, cam.height, range.len(), batch, job.run.threads);
+    need.check(&job.out, job.ignore_limits)?;
+    std::fs::create_dir_all(&job.out).map_err(|cause| SweepError::OutDir {
+        path: job.out.display().to_string(),
+        cause,
+    })?;
+    let mode = if job.range.is_some() {
+        LockMode::Shared
+    } else {
+        LockMode::Exclusive
+    };
+    let _lock = FolderLock::try_new(&job.out, mode)?;
+    let manifest = Manifest::of_sweep(loaded, &path, moving);
+    if job.range.is_some() {
+        check_same_sweep(&job.out, &manifest)?;
+    }
+    // The old viewer, CSV and sheet describe frames about to change: they go before any frame.
+    clear_assembled(&job.out)?;
+    if job.range.is_none() {
+        clear_frames(&job.out)?;
+    }
+    let render = if job.naive {
+        render_naive
+    } else {
+        render_sweep
+    };
+    let settings = SweepSettings {
+        scene: loaded.name.clone(),
+        arc_deg: [path.arc.from_deg, path.arc.to_deg],
+        spp: loaded.settings.spp,
+        seed: loaded.settings.seed,
+        provenance: job.provenance.clone(),
+    };
+    let regions = scene_regions(loaded);
+    let header = frame_header(loaded, &path, moving);
+    let (mut render_time, mut n_batches) = (Duration::ZERO, 0);
+    // Each batch is written before the next is rendered, so only one batch is ever held.
+    for frames in batches(range.clone(), batch) {
+        let r = render(
+            &loaded.scene,
+            &loaded.settings,
+            &path,
+            moving,
+            frames.clone(),
+            &job.run,
+        )?;
+        render_time += r.elapsed;
+        n_batches += 1;
+        write_frames(
+            &job.out,
+            &r,
+            &path,
+            frames,
+            total,
+            loaded.exposure,
+            &regions,
+            job.exr,
+            &settings,
+            &header,
+        )?;
+        release_freed_memory();
+    }
+    // The capture manifest for `xylem fit` (the same text from every slice).
+    manifest
+        .write(&job.out)
+        .map_err(|cause| SweepError::OutDir {
+            path: job.out.join(MANIFEST_FILE).display().to_string(),
+            cause,
+        })?;
+    let assembled = if job.range.is_none() {
+        Some(assemble(&job.out, &AssembleOptions::default())?)
+    } else {
+        None
+    };
+    Ok(JobReport {
+        rendered: range,
+        total,
+        render_time,
+        batch,
+        batches: n_batches,
+        assembled,
+    })
+}
+
+/// Hands the pages a written batch freed back to the system. glibc keeps them in the arenas of
+/// the threads that freed them, and a long sweep's peak crept ≈ 20 % above a short one's
+/// (notes/cluster.md); trimming between batches keeps the peak that of one batch.
+fn release_freed_memory() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: malloc_trim only returns free memory to the system; it touches no live allocation.
+    unsafe {
+        libc::malloc_trim(0);
+    }
+}
+
+/// Refuses a slice whose manifest differs from the one already in `dir` (a capture of other
+/// settings, whose frames the slice would mix with its own); a folder without a manifest is
+/// fine. Every slice of one sweep writes the same manifest text.
+fn check_same_sweep(dir: &Path, ours: &Manifest) -> Result<(), SweepError> {
+    let file = dir.join(MANIFEST_FILE);
+    if std::fs::symlink_metadata(&file).is_err() {
+        return Ok(());
+    }
+    let text = super::manifest::read_text(&file)?;
+    let summary = |m: &Manifest| {
+        let camera = format!("{}x{}", m.camera.width, m.camera.height);
+        format!("{} frames, {camera} camera", m.frames.len())
+    };
+    let theirs = match serde_json::from_str::<Manifest>(&text) {
+        Ok(m) if m.text() == ours.text() => return Ok(()),
+        Ok(m) if summary(&m) == summary(ours) => {
+            format!("{}, other lights or camera pose", summary(&m))
+        }
+        Ok(m) => summary(&m),
+        Err(e) => format!("unreadable: {}", crate::jsonpath::describe(&text, &e)),
+    };
+    Err(SweepError::OtherSweep {
+        path: file.display().to_string(),
+        theirs,
+        ours: summary(ours),
+    })
+}
+
+/// Removes the frame files (`frame_NNNN.{json,png,exr}`) and the AOV file a previous sweep left
+/// in `dir`, so a new complete sweep never mixes with them. The records go first: a frame whose
+/// record is gone no longer looks complete.
+fn clear_frames(dir: &Path) -> Result<(), SweepError> {
+    let io = |cause| SweepError::OutDir {
+        path: dir.display().to_string(),
+        cause,
+    };
+    let mut stale = vec![dir.join(MANIFEST_FILE), dir.join(AOV_FILE)];
+    for entry in std::fs::read_dir(dir).map_err(io)? {
+        let p = entry.map_err(io)?.path();
+        let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        let is_frame = name
+            .strip_prefix("frame_")
+            .and_then(|r| r.split_once('.'))
+            .is_some_and(|(digits, ext)| {
+                digits.bytes().all(|b| b.is_ascii_digit()) && ["json", "png", "exr"].contains(&ext)
+            });
+        if is_frame {
+            stale.push(p);
+        }
+    }
+    stale.sort_by_key(|p| p.extension().is_none_or(|e| e != "json"));
+    for p in stale {
+        remove_if_present(&p).map_err(io)?;
+    }
+    Ok(())
+}
