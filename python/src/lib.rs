@@ -20,6 +20,7 @@ use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 use xylem::bsdf::{Bsdf, BsdfSample, WoodBsdfParams};
 use xylem::material::{Cutting, Material, MaterialHit, Placement, ShadingSwitches, WoodMaterial};
+use xylem::scene::Overrides;
 use xylem::wood::{Needs, WoodError, WoodTexel};
 
 /// Below this many items a call runs on the calling thread (rayon's start-up is not worth it).
@@ -1024,35 +1025,6 @@ fn load_dict(scene: &Bound<'_, PyDict>, name: &str, base: Option<PathBuf>) -> Py
     Ok(PyScene::new(loaded, "<dict>".into()))
 }
 
-/// `spp`, `res` = (width, height) and `seed` of `xylem render`, checked.
-struct Overrides {
-    spp: Option<u32>,
-    res: Option<(u32, u32)>,
-    seed: Option<u64>,
-}
-
-impl Overrides {
-    fn check(&self) -> PyResult<()> {
-        if let Some(spp) = self.spp {
-            if !(1..=1_000_000).contains(&spp) {
-                return Err(value_error(format!(
-                    "spp = {spp}: out of range (allowed 1 to 1000000 samples per pixel)"
-                )));
-            }
-        }
-        if let Some((w, h)) = self.res {
-            for (name, v) in [("width", w), ("height", h)] {
-                if !(1..=16384).contains(&v) {
-                    return Err(value_error(format!(
-                        "res {name} = {v}: must be a whole number in 1..=16384"
-                    )));
-                }
-            }
-        }
-        Ok(())
-    }
-}
-
 /// Runs `f` on the scene `scene` (a `Scene`, a dict or a file path) with the overrides
 /// applied; a `Scene`'s own settings are restored afterwards.
 fn with_scene<T>(
@@ -1061,18 +1033,11 @@ fn with_scene<T>(
     o: &Overrides,
     f: impl FnOnce(&xylem::scene::LoadedScene) -> PyResult<T>,
 ) -> PyResult<T> {
-    o.check()?;
+    o.check().map_err(value_error)?;
     let apply = |loaded: &mut xylem::scene::LoadedScene| -> PyResult<T> {
+        // Only spp, res and seed are offered, so settings and camera are all there is to restore.
         let (settings, camera) = (loaded.settings, loaded.scene.camera);
-        if let Some(spp) = o.spp {
-            loaded.settings.spp = spp;
-        }
-        if let Some(seed) = o.seed {
-            loaded.settings.seed = seed;
-        }
-        if let Some((w, h)) = o.res {
-            loaded.scene.camera = camera.with_resolution(w, h);
-        }
+        o.apply(loaded).map_err(value_error)?;
         let r = f(loaded);
         (loaded.settings, loaded.scene.camera) = (settings, camera);
         r
@@ -1163,13 +1128,17 @@ fn render<'py>(
     threads: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
     check_threads(threads)?;
-    let o = Overrides { spp, res, seed };
+    let o = Overrides {
+        spp,
+        res,
+        seed,
+        ..Default::default()
+    };
     let out = with_scene(py, scene, &o, |loaded| {
         interruptible(py, |stop| {
             let run = xylem::render::RunOptions {
                 threads,
                 progress: stop,
-                ..Default::default()
             };
             xylem::render::render(&loaded.scene, &loaded.settings, &run)
         })
@@ -1213,7 +1182,12 @@ fn sweep<'py>(
     threads: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
     check_threads(threads)?;
-    let o = Overrides { spp, res, seed };
+    let o = Overrides {
+        spp,
+        res,
+        seed,
+        ..Default::default()
+    };
     let (r, deg) = with_scene(py, scene, &o, |loaded| {
         let (path, moving) =
             xylem::sweep::SweepPath::from_scene(loaded, frames, arc).map_err(value_error)?;
@@ -1222,7 +1196,6 @@ fn sweep<'py>(
             let run = xylem::render::RunOptions {
                 threads,
                 progress: stop,
-                ..Default::default()
             };
             xylem::sweep::render_sweep(
                 &loaded.scene,

@@ -112,15 +112,15 @@ pub(crate) fn parse_threads(s: &str) -> Result<usize, String> {
     Ok(n)
 }
 
-/// The most samples per pixel `--spp` may ask for: the scene's `render.spp` range.
-pub(crate) const MAX_SPP: u32 = 1_000_000;
-
 /// `--spp`: 1 to [`MAX_SPP`] samples per pixel.
+///
+/// [`MAX_SPP`]: xylem::scene::MAX_SPP
 pub(crate) fn parse_spp(s: &str) -> Result<u32, String> {
     match s.trim().parse::<u32>() {
-        Ok(n) if (1..=MAX_SPP).contains(&n) => Ok(n),
+        Ok(n) if (1..=xylem::scene::MAX_SPP).contains(&n) => Ok(n),
         _ => Err(format!(
-            "`{s}` is out of range (allowed 1 to {MAX_SPP} samples per pixel)"
+            "`{s}` is out of range (allowed 1 to {} samples per pixel)",
+            xylem::scene::MAX_SPP
         )),
     }
 }
@@ -147,32 +147,6 @@ pub(crate) fn parse_on_off(s: &str) -> Result<bool, String> {
         "off" | "false" => Ok(false),
         _ => Err(format!("`{s}`: expected on or off")),
     }
-}
-
-/// The command line's settings over a loaded scene, applied in one order by every command that
-/// renders a scene (`render`, `sweep`): the `--quality` preset first (its spp and wood-model
-/// knobs, `validate::tradeoff::Quality::knobs`), then `--spp` and `--footprint-filter`, which
-/// override the preset and the scene file.
-pub(crate) fn apply_scene_overrides(
-    loaded: &mut xylem::scene::LoadedScene,
-    quality: Option<xylem::scene::quality::Quality>,
-    spp: Option<u32>,
-    footprint_filter: Option<bool>,
-) -> anyhow::Result<()> {
-    use anyhow::Context;
-    if let Some(q) = quality {
-        xylem::scene::quality::apply(loaded, &q.knobs())
-            .with_context(|| format!("applying --quality {q}"))?;
-    }
-    if let Some(spp) = spp {
-        loaded.settings.spp = spp;
-    }
-    if let Some(on) = footprint_filter {
-        for m in &mut loaded.scene.materials {
-            m.set_footprint_filter(on);
-        }
-    }
-    Ok(())
 }
 
 /// The largest `--exposure` magnitude in stops: ±30 stops scales by 2^±30 ≈ 10^±9, beyond

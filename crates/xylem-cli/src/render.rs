@@ -45,7 +45,7 @@ pub struct Args {
     json: Option<PathBuf>,
 }
 
-/// Parses `WxH` with both in 1..=16384.
+/// Parses `WxH` with both in 1..=[`MAX_RESOLUTION`](xylem::scene::MAX_RESOLUTION).
 pub(crate) fn parse_res(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
@@ -55,10 +55,11 @@ pub(crate) fn parse_res(s: &str) -> Result<(u32, u32), String> {
             .trim()
             .parse()
             .map_err(|_| format!("`{s}`: `{v}` is not a whole number"))?;
-        if (1..=16384).contains(&n) {
+        let max = xylem::scene::MAX_RESOLUTION;
+        if (1..=max).contains(&n) {
             Ok(n)
         } else {
-            Err(format!("`{s}`: {n} is out of range (allowed 1 to 16384)"))
+            Err(format!("`{s}`: {n} is out of range (allowed 1 to {max})"))
         }
     };
     Ok((p(w)?, p(h)?))
@@ -69,13 +70,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     for w in &loaded.warnings {
         eprintln!("warning: {w}");
     }
-    super::apply_scene_overrides(&mut loaded, args.quality, args.spp, args.footprint_filter)?;
-    if let Some(seed) = args.seed {
-        loaded.settings.seed = seed;
+    xylem::scene::Overrides {
+        quality: args.quality,
+        spp: args.spp,
+        res: args.res,
+        seed: args.seed,
+        footprint_filter: args.footprint_filter,
     }
-    if let Some((w, h)) = args.res {
-        loaded.scene.camera = loaded.scene.camera.with_resolution(w, h);
-    }
+    .apply(&mut loaded)?;
     let bar = super::progress::Bar::new(!args.quiet);
     let run = xylem::render::RunOptions {
         threads: args.threads,

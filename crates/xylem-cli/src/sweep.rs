@@ -84,10 +84,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     for w in &loaded.warnings {
         eprintln!("warning: {w}");
     }
-    super::apply_scene_overrides(&mut loaded, args.quality, args.spp, None)?;
-    if let Some((w, h)) = args.res {
-        loaded.scene.camera = loaded.scene.camera.with_resolution(w, h);
+    xylem::scene::Overrides {
+        quality: args.quality,
+        spp: args.spp,
+        res: args.res,
+        ..Default::default()
     }
+    .apply(&mut loaded)?;
     let arc = args
         .arc
         .as_deref()

@@ -211,12 +211,13 @@ fn read_glb(bytes: &[u8]) -> Result<GlbBoard, String> {
         let view = &root.buffer_views[img.buffer_view.ok_or("image without a view")?.value()];
         let off = view.byte_offset.map_or(0, |o| o.0 as usize);
         let png = &bin[off..off + view.byte_length.0 as usize];
-        let mut r = png::Decoder::new(png)
-            .read_info()
-            .map_err(|e| e.to_string())?;
-        let mut buf = vec![0; r.output_buffer_size()];
-        let info = r.next_frame(&mut buf).map_err(|e| e.to_string())?;
         let name = img.name.clone().unwrap_or_default();
+        let (info, buf) = xylem::picture::png::decode_png(
+            std::path::Path::new(&name),
+            png,
+            png::Transformations::IDENTITY,
+            0,
+        )?;
         images.push((name, info.width, info.height, buf));
     }
     let pos = root.meshes[0].primitives[0]
@@ -270,13 +271,7 @@ pub fn render_glb(bytes: &[u8], width: u32) -> Result<(u32, u32, Vec<Vec3>), Str
         let i = 3 * (y * tw + x);
         Vec3::new(img.3[i] as f32, img.3[i + 1] as f32, img.3[i + 2] as f32) / 255.0
     };
-    let srgb = |c: f32| {
-        if c <= 0.04045 {
-            c / 12.92
-        } else {
-            ((c + 0.055) / 1.055).powf(2.4)
-        }
-    };
+    let srgb = xylem::picture::srgb::srgb_to_linear;
     // glTF space (y up, metres): the face is y = top, x ∈ ±W/2 (u), z ∈ ±H/2 (v).
     let (w_m, top, h_m) = (board.size.x, board.size.y, board.size.z);
     let height = ((width as f32) * 0.6) as u32;

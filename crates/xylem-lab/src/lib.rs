@@ -16,7 +16,7 @@
 //!   coherence, dark streaks, rings, fibre-field correlation), measured against preset (issue 25);
 //! - [`report`]: validation/REPORT.md, one replaceable section per suite;
 //! - [`tradeoff`]: error and time of every quality knob (validation/TRADEOFF.md);
-//! - [`bench`]: the tracing benchmark against obvhs's own traversal and Embree 3.
+//! - [`mod@bench`]: the tracing benchmark against obvhs's own traversal and Embree 3.
 
 pub mod appearance;
 pub mod bench;

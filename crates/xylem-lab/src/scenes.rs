@@ -60,8 +60,8 @@ pub fn pixel_hits(scene: &Scene) -> Vec<PixelHit> {
                 .ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5), Vec2::splat(0.5));
             let hit = scene.accel.intersect(&ray, f32::INFINITY);
             let t_hit = hit.map_or(f32::INFINITY, |h| h.t);
-            if let Some((_, t, _, _)) = nearest_light(&scene.lights, &ray, t_hit) {
-                if t < t_hit {
+            if let Some((_, light)) = nearest_light(&scene.lights, &ray, t_hit) {
+                if light.distance < t_hit {
                     out.push(PixelHit::Light);
                     continue;
                 }
@@ -570,7 +570,7 @@ pub fn light_error(scene: &Scene, img: &Image, hits: &[PixelHit], expected: Vec3
             .accel
             .intersect(&ray, f32::INFINITY)
             .map_or(f32::INFINITY, |h| h.t);
-        nearest_light(&scene.lights, &ray, t_hit).is_some_and(|(_, t, _, _)| t < t_hit)
+        nearest_light(&scene.lights, &ray, t_hit).is_some_and(|(_, hit)| hit.distance < t_hit)
     };
     let (mut sum, mut n) = (glam::DVec3::ZERO, 0usize);
     for (i, h) in hits.iter().enumerate() {
@@ -1066,11 +1066,11 @@ mod tests {
     fn firefly_ratio_finds_the_one_bright_pixel() {
         // Grey 0.5 with one pixel at 10: its 3×3 median is 0.5, so the ratio is 20 (by hand).
         let img = image(9, 7, |x, y| if (x, y) == (4, 3) { 10.0 } else { 0.5 });
-        let (r, at) = firefly_ratio(&img, &vec![true; 63]);
+        let (r, at) = firefly_ratio(&img, &[true; 63]);
         assert!((r - 20.0).abs() < 1e-4, "{r}");
         assert_eq!(at, 3 * 9 + 4);
         // Nothing to judge is not clean.
-        assert!(firefly_ratio(&img, &vec![false; 63]).0.is_infinite());
+        assert!(firefly_ratio(&img, &[false; 63]).0.is_infinite());
     }
 
     #[test]
@@ -1084,7 +1084,7 @@ mod tests {
         assert!((c.weber - 0.2).abs() < 1e-6, "{c:?}");
         assert!(c.z > 1e6);
         // An empty set shows nothing.
-        assert_eq!(contrast(&img, &left, &vec![false; 100]).weber, 0.0);
+        assert_eq!(contrast(&img, &left, &[false; 100]).weber, 0.0);
     }
 
     /// An image whose albedo AOV equals its beauty and whose fibre runs along +x.
@@ -1180,8 +1180,8 @@ mod tests {
         // value and 12 of the other, so the residual is ±12(a − b)/25 and the local contrast
         // 12 (a − b) / 25 / ((a + b) / 2) = 0.192.
         let img = image(12, 12, |x, y| if (x + y) % 2 == 0 { 1.2 } else { 0.8 });
-        let f = figure_contrast(&img, &vec![true; 144]);
+        let f = figure_contrast(&img, &[true; 144]);
         assert!((f - 0.192).abs() < 1e-4, "{f}");
-        assert!(figure_contrast(&image(12, 12, |_, _| 0.7), &vec![true; 144]) < 1e-6);
+        assert!(figure_contrast(&image(12, 12, |_, _| 0.7), &[true; 144]) < 1e-6);
     }
 }

@@ -363,7 +363,7 @@ pub fn renderer_vs_bsdf(run: &RunOptions) -> Result<CheckOutcome, SweepCheckErro
         fiber_dir: inclined_fibre(Vec3::X, incl),
         ray_dir: Vec3::Z,
         ray_mask: 0.0,
-        highlight_width: (beta_deg as f32).to_radians(),
+        highlight_width: beta_deg.to_radians(),
         eta: ETA,
         roughness: 0.0,
     })

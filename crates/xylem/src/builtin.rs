@@ -91,7 +91,7 @@ fn entry(path: &Path) -> Option<(&'static str, &'static [u8])> {
         .copied()
 }
 
-/// The embedded contents for `path` (see [`entry`] for the names it answers to).
+/// The embedded contents for `path` (a repository-relative path, folded, or a built-in scene's bare name).
 pub fn lookup(path: &Path) -> Option<&'static [u8]> {
     entry(path).map(|(_, bytes)| bytes)
 }

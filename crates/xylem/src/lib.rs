@@ -1,4 +1,4 @@
-#![warn(missing_docs)]
+#![deny(missing_docs)]
 //! xylem: a wood-appearance simulator.
 //!
 //! The finished-wood fibre BSDF of Marschner et al. 2005, driven by the procedural

@@ -143,7 +143,7 @@ fn check_scene(loaded: &LoadedScene, integrator: Integrator, frames: std::ops::R
     let mut settings = loaded.settings;
     settings.integrator = integrator;
     let (path, moving) =
-        SweepPath::from_scene(&loaded, None, None).expect("the scene's [sweep] table");
+        SweepPath::from_scene(loaded, None, None).expect("the scene's [sweep] table");
     let run = RunOptions {
         threads: 1,
         ..Default::default()
@@ -312,7 +312,7 @@ fn batch_culled_shadow_segments_are_unoccluded() {
             let u = LightU::new(rng.next_vec2());
             samples.sample_sphere(sp.p, &centers, 5.0, glam::Vec3::ONE, &u);
             culled_test.culled_many(&sp, &samples, &mut seg, &mut culled);
-            for k in 0..samples.len() {
+            for (k, &is_culled) in culled.iter().enumerate().take(samples.len()) {
                 let Some(ls) = samples.get(k) else { continue };
                 let side = if sp.ng.dot(ls.wi) >= 0.0 { 1.0 } else { -1.0 };
                 let ray = Ray {
@@ -320,7 +320,7 @@ fn batch_culled_shadow_segments_are_unoccluded() {
                     d: ls.wi,
                 };
                 let t_max = ls.dist * (1.0 - 1e-4);
-                if culled[k] {
+                if is_culled {
                     assert!(bvh.unoccluded(&ray, t_max), "{ray:?} {t_max}");
                     n_culled += 1;
                 } else {

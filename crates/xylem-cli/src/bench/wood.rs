@@ -177,7 +177,8 @@ fn fixed_passes(args: &Args, points: &[Vec3], passes: usize) -> anyhow::Result<E
 /// Colour-only and full-model speed with each feature switched off in turn: the saving is that
 /// feature's cost.
 fn breakdown(params: &wood::WoodParams, points: &[Vec3]) -> anyhow::Result<()> {
-    let variants: [(&str, fn(&mut wood::WoodParams)); 8] = [
+    type SwitchOff = fn(&mut wood::WoodParams);
+    let variants: [(&str, SwitchOff); 8] = [
         ("no growth noise", |p| p.growth = None),
         ("no interlock", |p| p.interlock = None),
         ("no distortion", |p| p.distortion = Default::default()),

@@ -192,7 +192,7 @@ impl Bin<'_> {
         data: &[u8],
         target: Option<json::buffer::Target>,
     ) -> Index<json::buffer::View> {
-        while self.bytes.len() % 4 != 0 {
+        while !self.bytes.len().is_multiple_of(4) {
             self.bytes.push(0);
         }
         let offset = self.bytes.len();
@@ -426,7 +426,6 @@ pub fn glb_bytes(board: &BoardCut, maps: &BakedMaps, name: &str) -> Result<Vec<u
             )]
             .into_iter()
             .collect(),
-            ..Default::default()
         }),
         ..Default::default()
     };
@@ -450,7 +449,7 @@ pub fn glb_bytes(board: &BoardCut, maps: &BakedMaps, name: &str) -> Result<Vec<u
         bin.primitive(&sides, plain, false),
     ];
     let mut bytes = std::mem::take(&mut bin.bytes);
-    while bytes.len() % 4 != 0 {
+    while !bytes.len().is_multiple_of(4) {
         bytes.push(0);
     }
     let mesh = root.push(json::Mesh {
@@ -490,10 +489,10 @@ pub fn glb_bytes(board: &BoardCut, maps: &BakedMaps, name: &str) -> Result<Vec<u
 /// The GLB container (glTF 2.0 §4.4): header (magic `glTF`, version 2, total length), then the
 /// JSON chunk padded with spaces and the BIN chunk padded with zeros, each to 4 bytes.
 fn glb(mut json: Vec<u8>, mut bin: Vec<u8>) -> Vec<u8> {
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let total = 12 + 8 + json.len() + 8 + bin.len();

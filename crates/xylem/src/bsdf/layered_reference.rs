@@ -56,6 +56,17 @@ pub enum PathKind {
     MultiplePass,
 }
 
+/// How a traced path ended.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PathEnd {
+    /// It left upward in this direction with this weight, after this kind of path.
+    Exit(Vec3, f64, PathKind),
+    /// It was absorbed (by the substrate or the weight's roulette).
+    Absorbed,
+    /// It was cut at the event limit, neither counted nor lost (`ReferenceAlbedo::truncated`).
+    Truncated,
+}
+
 /// The estimate over one view: albedo per path kind and the reflected light binned by exit
 /// direction (`BINS_MU` bins in cos θi × 2 half-planes: the mirror side first).
 #[derive(Clone, Debug, Default)]
@@ -212,21 +223,22 @@ impl LayeredReference {
         None
     }
 
-    /// One path of light arriving from `wo` (z > 0): its exit direction, weight and kind, or
-    /// `None` if it was absorbed or cut.
-    pub fn trace(&self, wo: Vec3, rng: &mut Pcg32) -> Result<Option<(Vec3, f64, PathKind)>, ()> {
+    /// One path of light arriving from `wo` (z > 0): where it ended.
+    pub fn trace(&self, wo: Vec3, rng: &mut Pcg32) -> PathEnd {
         let mut d = -wo.as_dvec3();
         let (mut weight, mut hits) = (1.0f64, 0u32);
         let mut outside = true;
         for _ in 0..MAX_EVENTS {
-            let (out, up, _) = self.interface(d, outside, rng).ok_or(())?;
+            let Some((out, up, _)) = self.interface(d, outside, rng) else {
+                return PathEnd::Truncated;
+            };
             if up {
                 let kind = match hits {
                     0 => PathKind::Interface,
                     1 => PathKind::SinglePass,
                     _ => PathKind::MultiplePass,
                 };
-                return Ok(Some((out.as_vec3().normalize(), weight, kind)));
+                return PathEnd::Exit(out.as_vec3().normalize(), weight, kind);
             }
             // Down to the substrate: nothing in a clear finish changes a direction on the way.
             hits += 1;
@@ -239,24 +251,24 @@ impl LayeredReference {
                 }
                 Substrate::Fiber { axis, beta, k_f } => {
                     let Some(wi) = axis.sample(toward_light, u, beta, 0.0) else {
-                        return Ok(None);
+                        return PathEnd::Absorbed;
                     };
                     let pdf = axis.pdf(toward_light, wi, beta, 0.0);
                     let f = axis.eval(toward_light, wi, beta, FiberNormalization::EnergyBounded);
                     if !(pdf > 0.0) || wi.z <= 0.0 {
-                        return Ok(None);
+                        return PathEnd::Absorbed;
                     }
                     weight *= k_f * (f * wi.z / pdf) as f64;
                     wi
                 }
             };
             if weight <= 0.0 {
-                return Ok(None);
+                return PathEnd::Absorbed;
             }
             d = up_dir.as_dvec3();
             outside = false;
         }
-        Err(())
+        PathEnd::Truncated
     }
 
     /// Albedo for light from `wo` over `n` paths, per kind and binned by exit direction.
@@ -268,7 +280,7 @@ impl LayeredReference {
         let mut sq = 0.0;
         for _ in 0..n {
             match self.trace(wo, rng) {
-                Ok(Some((wi, w, kind))) => {
+                PathEnd::Exit(wi, w, kind) => {
                     match kind {
                         PathKind::Interface => r.interface += w,
                         PathKind::SinglePass => r.single_pass += w,
@@ -277,8 +289,8 @@ impl LayeredReference {
                     r.bins[direction_bin(wo, wi)] += w;
                     sq += w * w;
                 }
-                Ok(None) => {}
-                Err(()) => r.truncated += 1,
+                PathEnd::Absorbed => {}
+                PathEnd::Truncated => r.truncated += 1,
             }
         }
         let inv = 1.0 / n as f64;

@@ -190,7 +190,7 @@ impl Rejections {
             (self.too_bright, format!("pixel value over the light's irradiance exceeds {MAX_REFLECTANCE_FACTOR:.3e}, a million times a white diffuse surface: the frames do not match field `frames[].intensity`")),
             (self.glint, "every usable sample is the finish's mirror glint of the sphere light (field `frames[].radius`)".to_string()),
         ];
-        causes.sort_by(|a, b| b.0.cmp(&a.0));
+        causes.sort_by_key(|c| std::cmp::Reverse(c.0));
         let total = self.used
             + self.clipped
             + self.too_bright

@@ -28,12 +28,9 @@ pub enum ColorSpace {
 impl ColorSpace {
     /// The linear value of an 8-bit channel.
     pub fn decode(self, v: u8) -> f32 {
-        let x = v as f32 / 255.0;
         match self {
-            ColorSpace::Linear => x,
-            // IEC 61966-2-1 inverse transfer function.
-            ColorSpace::Srgb if x <= 0.040_45 => x / 12.92,
-            ColorSpace::Srgb => ((x + 0.055) / 1.055).powf(2.4),
+            ColorSpace::Linear => v as f32 / 255.0,
+            ColorSpace::Srgb => crate::picture::srgb::srgb8_to_linear(v),
         }
     }
 }

@@ -70,6 +70,9 @@ pub struct SurfaceAov {
 /// The BSDF at one hit, in its local shading frame. Small and `Copy`, so a light sweep can cache
 /// it per pixel sample.
 #[derive(Clone, Copy, Debug)]
+// The wood variant is most of the size, and most hits are wood: a box would add an indirection
+// and an allocation per shading point for the rare small variants' sake.
+#[allow(clippy::large_enum_variant)]
 pub enum SurfaceBsdf {
     /// Ideal diffuse reflection.
     Lambertian(Lambertian),

@@ -343,7 +343,7 @@ mod tests {
             .map(|i| {
                 let mut c = [0.0f32; 3];
                 for v in c.iter_mut() {
-                    *v = if r.next_u32() % 4 == 0 {
+                    *v = if r.next_u32().is_multiple_of(4) {
                         special[(r.next_u32() % special.len() as u32) as usize]
                     } else {
                         (r.next_f32() - 0.5) * 2000.0 * if i % 2 == 0 { 1.0 } else { 1e-3 }

@@ -8,7 +8,8 @@
 //! lights that do not move, the box the moving light stays in, and a sphere light's centres by
 //! component for sampling all frames in SIMD lanes.
 
-use super::integrator::{nearest_light, segment_misses_box, LightHit};
+use super::integrator::{nearest_light, segment_misses_box};
+use super::light::LightHit;
 use super::light::{sphere_line_misses, Light, SphereLight};
 use super::Ray;
 use glam::{Vec3, Vec3A};
@@ -135,7 +136,7 @@ impl LightFrames {
         &self,
         ray: &Ray,
         t_max: f32,
-        mut f: impl FnMut(usize, LightHit),
+        mut f: impl FnMut(usize, (usize, LightHit)),
     ) {
         let misses = self.moving.is_none()
             || self.swept.is_none_or(|(lo, hi)| {
@@ -162,9 +163,9 @@ impl LightFrames {
                     let c = Vec3::new(cx[start + j], cy[start + j], cz[start + j]);
                     miss[j] = sphere_line_misses(ray, c, s.radius);
                 }
-                for j in 0..n {
+                for (j, &missed) in miss.iter().enumerate().take(n) {
                     let k = start + j;
-                    let hit = if miss[j] {
+                    let hit = if missed {
                         fixed
                     } else {
                         nearest_light(&self.frames[k], ray, t_max)

@@ -370,7 +370,7 @@ fn open_exr(
 }
 
 /// Reads the RGB channels of the first layer of an EXR (alpha ignored): (width, height, pixels).
-/// The declared size is checked before decoding ([`open_exr`]).
+/// The declared size is checked before decoding.
 pub fn read_exr_rgb(path: &Path) -> Result<(usize, usize, Vec<Vec3>), ImageError> {
     use exr::prelude::*;
     let chunks = open_exr(path, std::mem::size_of::<Vec3>() as u64)?;

@@ -13,7 +13,7 @@
 use super::film::Aov;
 use super::frames::LightFrames;
 use super::geometry::{Accel, Hit, Ray};
-use super::light::{Light, LightSample, LightSamples, LightU};
+use super::light::{Light, LightHit, LightSample, LightSamples, LightU};
 use super::Scene;
 use crate::bsdf::{Bsdf, WoodAtWo};
 use crate::material::{MaterialHit, SurfaceBsdf};
@@ -228,18 +228,16 @@ pub fn light_rng(scene: &Scene, pixel: UVec2, sample: u32, seed: u64) -> Pcg32 {
     sample_rngs(seed, index, sample).1
 }
 
-/// A light met by a ray: (light index, distance, radiance, light pdf in solid angle).
-pub type LightHit = (usize, f32, Vec3, f32);
-
-/// The nearest light a ray meets before `t_max`.
-pub fn nearest_light(lights: &[Light], ray: &Ray, t_max: f32) -> Option<LightHit> {
-    let mut best: Option<LightHit> = None;
+/// The nearest light a ray meets before `t_max`: its index in `lights` and where it is met.
+pub fn nearest_light(lights: &[Light], ray: &Ray, t_max: f32) -> Option<(usize, LightHit)> {
+    let mut best: Option<(usize, LightHit)> = None;
     for (i, l) in lights.iter().enumerate() {
-        if let Some((t, le, pdf)) = l.hit(ray) {
-            let limit = best.map_or(t_max, |b| b.1);
+        if let Some(hit) = l.hit(ray) {
+            let t = hit.distance;
+            let limit = best.map_or(t_max, |b| b.1.distance);
             // Environment lights (t = ∞) count only when nothing else was hit.
             if t < limit || (t.is_infinite() && t_max.is_infinite() && best.is_none()) {
-                best = Some((i, t, le, pdf));
+                best = Some((i, hit));
             }
         }
     }
@@ -693,14 +691,14 @@ pub(crate) fn radiance_frames(
         // Emission along the current ray: a light in front of the surface, or the environment.
         let hit_surface = t_hit.is_finite();
         let alive = &mut scratch.alive;
-        lights.nearest_per_frame(&ray, t_hit, |k, (_, t, le, light_pdf)| {
-            if alive[k] && (t < t_hit || !hit_surface) {
+        lights.nearest_per_frame(&ray, t_hit, |k, (_, hit)| {
+            if alive[k] && (hit.distance < t_hit || !hit_surface) {
                 let w = if specular {
                     1.0
                 } else {
-                    power_heuristic(prev_pdf, light_pdf)
+                    power_heuristic(prev_pdf, hit.pdf)
                 };
-                out[k] += beta * le * w;
+                out[k] += beta * hit.radiance * w;
                 alive[k] = false;
             }
         });

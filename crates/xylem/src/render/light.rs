@@ -233,9 +233,9 @@ impl Light {
         }
     }
 
-    /// Where a ray first meets this light (distance and emitted radiance towards the ray origin),
-    /// and the solid-angle density `sample` would have chosen that direction with from `ray.o`.
-    pub fn hit(&self, ray: &Ray) -> Option<(f32, Vec3, f32)> {
+    /// Where a ray first meets this light, what it emits towards the ray's origin, and the
+    /// solid-angle density `sample` would have chosen that direction with from `ray.o`.
+    pub fn hit(&self, ray: &Ray) -> Option<LightHit> {
         match self {
             Light::Rect(RectLight {
                 corner,
@@ -268,7 +268,11 @@ impl Light {
                     return None;
                 }
                 let cos_l = -denom / area;
-                Some((t, *radiance, t * t / (cos_l * area)))
+                Some(LightHit {
+                    distance: t,
+                    radiance: *radiance,
+                    pdf: t * t / (cos_l * area),
+                })
             }
             Light::Sphere(SphereLight {
                 center,
@@ -281,19 +285,38 @@ impl Light {
                 if d2 <= r2 {
                     return None;
                 }
-                Some((t, *radiance, 1.0 / (2.0 * PI * one_minus_cos_cone(r2 / d2))))
+                Some(LightHit {
+                    distance: t,
+                    radiance: *radiance,
+                    pdf: 1.0 / (2.0 * PI * one_minus_cos_cone(r2 / d2)),
+                })
             }
             Light::Environment(env) => {
                 let pdf = match &env.map {
                     None => UNIFORM_SPHERE_PDF,
                     Some(map) => map.pdf(ray.d),
                 };
-                Some((f32::INFINITY, env.radiance(ray.d), pdf))
+                Some(LightHit {
+                    distance: f32::INFINITY,
+                    radiance: env.radiance(ray.d),
+                    pdf,
+                })
             }
             // Delta lights: no ray meets them.
             Light::Point(_) | Light::Spot(_) | Light::Distant(_) => None,
         }
     }
+}
+
+/// Where a ray meets a light ([`Light::hit`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightHit {
+    /// Distance along the ray (∞ for an environment light).
+    pub distance: f32,
+    /// Radiance the light emits towards the ray's origin.
+    pub radiance: Vec3,
+    /// Solid-angle density with which `Light::sample` from the ray's origin picks this direction.
+    pub pdf: f32,
 }
 
 /// A light sample's two uniform numbers with what [`Light::sample`] derives from them alone: the
@@ -785,7 +808,9 @@ mod tests {
         for l in &lights {
             for _ in 0..100 {
                 let s = l.sample(Vec3::ZERO, rng.next_vec2()).unwrap();
-                let (t, _, pdf) = l
+                let LightHit {
+                    distance: t, pdf, ..
+                } = l
                     .hit(&Ray {
                         o: Vec3::ZERO,
                         d: s.wi,

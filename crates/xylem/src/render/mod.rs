@@ -23,7 +23,8 @@ pub use integrator::{
     light_rng, primary_sample, sample_rngs, Integrator, PrimarySample, ShadingPoint,
 };
 pub use light::{
-    DistantLight, EnvMap, Environment, Light, PointLight, RectLight, SphereLight, SpotLight,
+    DistantLight, EnvMap, Environment, Light, LightHit, PointLight, RectLight, SphereLight,
+    SpotLight,
 };
 
 use crate::material::Material;

@@ -271,7 +271,7 @@ fn address_space_left() -> Option<u64> {
         .and_then(|s| s.lines().find_map(|l| l.strip_prefix("VmSize:")))
         .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
         .unwrap_or(0);
-    Some((lim.rlim_cur as u64).saturating_sub(vm_kib * 1024))
+    Some(lim.rlim_cur.saturating_sub(vm_kib * 1024))
 }
 
 #[cfg(not(unix))]

@@ -5,11 +5,13 @@
 
 pub mod format;
 pub mod mesh_io;
+pub mod overrides;
 pub mod quality;
 pub mod shapes;
 pub mod teapot;
 
 pub use format::{SceneFile, SweepBoard, SweepRegion, SweepTable, MAX_ARCS};
+pub use overrides::{OverrideError, Overrides, MAX_RESOLUTION, MAX_SPP};
 
 use crate::bsdf::{WoodBsdf, WoodBsdfParams};
 use crate::material::{
@@ -323,9 +325,10 @@ impl Builder<'_> {
 
     fn build(mut self, file: SceneFile, name: &str) -> Result<LoadedScene, SceneError> {
         let r = &file.render;
-        let width = self.range("render.width", r.width as f32, 1.0, 16384.0)? as u32;
-        let height = self.range("render.height", r.height as f32, 1.0, 16384.0)? as u32;
-        self.range("render.spp", r.spp as f32, 1.0, 1_000_000.0)?;
+        let width = self.range("render.width", r.width as f32, 1.0, MAX_RESOLUTION as f32)? as u32;
+        let height =
+            self.range("render.height", r.height as f32, 1.0, MAX_RESOLUTION as f32)? as u32;
+        self.range("render.spp", r.spp as f32, 1.0, MAX_SPP as f32)?;
         self.range("render.max_depth", r.max_depth as f32, 1.0, 1000.0)?;
         self.range("render.exposure", r.exposure, -30.0, 30.0)?;
         let integrator = match r.integrator {

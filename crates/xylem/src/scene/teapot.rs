@@ -23,8 +23,11 @@ const REVOLVED: [([[f32; 2]; 4], bool); 6] = [
     ([[0.0, 0.0], [1.425, 0.0], [1.5, 0.075], [1.5, 0.15]], true), // bottom
 ];
 
+/// Four Bézier control points (x, z).
+type Curve = [[f32; 2]; 4];
+
 /// Tubes: curve A, curve B (x, z) and the half-width of each row.
-const TUBES: [([[f32; 2]; 4], [[f32; 2]; 4], [f32; 4]); 4] = [
+const TUBES: [(Curve, Curve, [f32; 4]); 4] = [
     (
         [[-1.6, 2.025], [-2.3, 2.025], [-2.7, 2.025], [-2.7, 1.8]],
         [[-1.5, 2.25], [-2.5, 2.25], [-3.0, 2.25], [-3.0, 1.8]],

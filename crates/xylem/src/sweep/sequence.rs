@@ -288,7 +288,7 @@ pub struct AssembleOptions {
     pub animation_width: u32,
     /// Frames per second of the animated PNG and the viewer's playback.
     pub fps: u16,
-    /// Title of the viewer page; empty: "<scene> — light sweep" from the frames' records, so a
+    /// Title of the viewer page; empty: "`<scene>` — light sweep" from the frames' records, so a
     /// sweep assembled by `--assemble` gets the same page as one assembled by its own run.
     pub title: String,
 }

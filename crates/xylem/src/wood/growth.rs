@@ -195,7 +195,7 @@ impl SmoothRectangleWave {
 
     /// The box means of s, s² and s³ over [lo, hi] (as [`SmoothRectangleWave::box_mean`]; what a
     /// cubic of the ring value, such as ring-porous pore volume (1 − ρ s)³, averages to). The
-    /// plateaus give 0 and 1; a transition's ∫₀ˣ Pⁿ is the polynomial [`smootherstep_power_integral`].
+    /// plateaus give 0 and 1; a transition's ∫₀ˣ Pⁿ is the polynomial `smootherstep_power_integral`.
     pub fn box_moments(&self, lo: f32, hi: f32) -> Vec3 {
         let w = hi - lo;
         if !(w >= self.min_box()) {

@@ -66,7 +66,7 @@ const FLAT_SAWN_SHOWCASE: [&str; 7] = [
 ];
 
 /// The ring angle (degrees: 0 flat-sawn, 90 quartersawn) of the face on which preset `name`'s
-/// figure shows ([`FLAT_SAWN_SHOWCASE`]); with [`SHOWCASE_PITH_DISTANCE_MM`] it is the cut of
+/// figure shows (flat-sawn for the presets listed in `FLAT_SAWN_SHOWCASE`); with [`SHOWCASE_PITH_DISTANCE_MM`] it is the cut of
 /// every showcase board (`material::SawnCut`).
 pub fn showcase_ring_angle_deg(name: &str) -> f32 {
     if FLAT_SAWN_SHOWCASE.contains(&name) {

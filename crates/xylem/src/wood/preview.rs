@@ -25,8 +25,10 @@ mod tests {
 
     #[test]
     fn highlight_only_for_fibres_in_the_plane() {
-        let mut t = WoodTexel::default();
-        t.fiber_dir = Vec3::X;
+        let mut t = WoodTexel {
+            fiber_dir: Vec3::X,
+            ..Default::default()
+        };
         let lit = preview_color(&t, Vec3::Z, true);
         t.fiber_dir = Vec3::Z;
         let end = preview_color(&t, Vec3::Z, true);
