@@ -625,3 +625,49 @@ fn ring_widths_vary_year_to_year() {
         assert!(ruled < 0.2, "{name}: the ruled control varies by {ruled}");
     }
 }
+
+/// Fraction of radial steps of 0.1 mm, over the showcase board's depth (115–125 mm from the pith,
+/// every azimuth and 300 mm of height), where the distorted radius |f(p)|ₓᵧ falls as r rises: a
+/// fold of the growth layers, which a tree never lays down. On a face a fold shows as a bright
+/// rim round every quilt cell (the layers' slope flips along its line, like a caustic on water).
+fn fold_fraction(p: &WoodParams) -> f32 {
+    let v = WoodVolume::new(p.clone(), SEED).unwrap();
+    let mut rng = xylem::math::Pcg32::new(25, 3);
+    let (mut folds, mut steps) = (0usize, 0usize);
+    for _ in 0..400 {
+        let theta = std::f32::consts::TAU * rng.next_f32();
+        let z = 300.0 * rng.next_f32();
+        let (s, c) = theta.sin_cos();
+        let radius = |r: f32| {
+            let q = v.distortion(Vec3::new(r * c, r * s, z)).point;
+            q.x.hypot(q.y)
+        };
+        let mut prev = radius(115.0);
+        for i in 1..=100 {
+            let now = radius(115.0 + 0.1 * i as f32);
+            folds += usize::from(now <= prev);
+            steps += 1;
+            prev = now;
+        }
+    }
+    folds as f32 / steps as f32
+}
+
+#[test]
+fn quilt_growth_layers_never_fold() {
+    let new = current("quilted_maple");
+    // Control: the quilt's bulges as thin in r (8 mm) as their magnitude, as before this check.
+    let mut thin = new.clone();
+    thin.distortion.radial.as_mut().unwrap().size[0] = 8.0;
+    let (f_new, f_thin) = (fold_fraction(&new), fold_fraction(&thin));
+    println!(
+        "quilt folds: {:.3} % of radial steps; 8 mm bulges {:.3} %",
+        100.0 * f_new,
+        100.0 * f_thin
+    );
+    assert!(f_new == 0.0, "the quilt folds its growth layers at {f_new}");
+    assert!(
+        f_thin > 0.01,
+        "the thin-bulge control does not fold: {f_thin}"
+    );
+}
