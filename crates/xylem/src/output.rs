@@ -164,6 +164,16 @@ impl Staged {
         self.tmp.persist(&self.path).map_err(|e| e.error)?;
         Ok(())
     }
+
+    /// Renames the temporary file to the final name only where no file has that name yet
+    /// (atomically: of two runs committing at once exactly one succeeds); otherwise an
+    /// [`io::ErrorKind::AlreadyExists`] error, and the temporary is removed.
+    pub fn commit_new(self) -> io::Result<()> {
+        self.tmp
+            .persist_noclobber(&self.path)
+            .map_err(|e| e.error)?;
+        Ok(())
+    }
 }
 
 /// Writes `bytes` into a [`Staged`] file for `path`, to commit later.
