@@ -434,6 +434,15 @@ fn slices_racing_into_an_empty_folder_never_both_write() {
     assert_eq!(read_records(&out).unwrap().len(), 6);
     assert!(out.join("manifest.json").exists());
     assert_nothing_looks_complete_that_is_not(&out);
+    // A refused slice's folder is incomplete (its frames 3..6 missing): `fit` says so.
+    let (race0, maps) = (dir.path().join("race0"), dir.path().join("maps"));
+    let o = run(&[
+        "fit",
+        race0.to_str().unwrap(),
+        "--out",
+        maps.to_str().unwrap(),
+    ]);
+    assert_clean_error(&o, "an incomplete sweep");
 }
 
 #[test]

@@ -152,3 +152,43 @@ fn check_records(dir: &Path, ours: &Claim) -> Result<(), SweepError> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Eight slices of other settings claiming one empty folder at the same instant (a barrier):
+    /// exactly one succeeds, and the folder's claim is that one's.
+    #[test]
+    fn of_slices_racing_into_an_empty_folder_exactly_one_claims_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let claim = |spp: u32| Claim {
+            settings: SweepSettings {
+                spp,
+                ..SweepSettings::default()
+            },
+            frames: 4,
+            camera: "8x6".into(),
+            manifest_crc32: "00000000".into(),
+        };
+        let barrier = std::sync::Barrier::new(8);
+        let results: Vec<(u32, bool)> = std::thread::scope(|s| {
+            let runs: Vec<_> = (1..=8)
+                .map(|spp| {
+                    let (barrier, dir) = (&barrier, dir.path());
+                    s.spawn(move || {
+                        barrier.wait();
+                        (spp, claim_for_slice(dir, &claim(spp)).is_ok())
+                    })
+                })
+                .collect();
+            runs.into_iter().map(|r| r.join().unwrap()).collect()
+        });
+        let won: Vec<u32> = results.iter().filter(|r| r.1).map(|r| r.0).collect();
+        assert_eq!(won.len(), 1, "{results:?}");
+        let theirs = read(&dir.path().join(CLAIM_FILE)).unwrap().unwrap();
+        assert_eq!(theirs, claim(won[0]));
+        // A later slice of the winner's settings is welcome.
+        assert!(claim_for_slice(dir.path(), &claim(won[0])).is_ok());
+    }
+}
