@@ -9,6 +9,8 @@ mod bench;
 mod docs;
 mod fit;
 mod gallery;
+#[cfg(unix)]
+mod oom;
 mod preset;
 mod progress;
 mod render;
@@ -16,6 +18,11 @@ mod sweep;
 mod texture;
 mod tradeoff;
 mod validate;
+
+/// An allocation the system refuses is a clean error, not an abort (src/oom.rs).
+#[cfg(unix)]
+#[global_allocator]
+static ALLOCATOR: oom::CleanOom = oom::CleanOom;
 
 #[derive(Parser, Debug)]
 #[command(

@@ -406,3 +406,38 @@ fn texture_memory_is_checked_before_a_pixel_is_computed() {
     assert_refused(&o, &["1000 frames", "of memory"]);
     assert!(!dir.join("t.exr").exists() && !dir.join("a.png").exists());
 }
+
+/// Issue 26: an allocation the system refuses (here the BVH build of a 1 M-triangle sphere under
+/// a tight `ulimit -v`, its estimate skipped with `--ignore-limits` or passed) ends the run with
+/// a clean error naming the request and the limit, exit status 1 — never SIGABRT (before: the
+/// standard library's abort, "memory allocation of … bytes failed", as the 2 M-triangle grid of
+/// notes/limits.md did after its estimate had passed).
+#[test]
+fn a_refused_allocation_is_a_clean_error_not_an_abort() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let scene = scene_with("shape = \"sphere\"\nradius = 1.0\nsegments = 1024");
+    std::fs::write(dir.join("sphere.toml"), scene).unwrap();
+    for (cap_kib, ignore) in [(300_000, true), (450_000, true), (450_000, false)] {
+        let mut args = vec!["render", "sphere.toml", "--quiet", "--out", "o"];
+        if ignore {
+            args.push("--ignore-limits");
+        }
+        let o = Command::new("sh")
+            .arg("-c")
+            .arg(format!("ulimit -v {cap_kib}; exec \"$0\" \"$@\""))
+            .arg(env!("CARGO_BIN_EXE_xylem"))
+            .args(&args)
+            .current_dir(dir)
+            .env("RUST_BACKTRACE", "0")
+            .output()
+            .unwrap();
+        let needles: &[&str] = if ignore {
+            &["out of memory: the system refused", "MiB more", "ulimit -v"]
+        } else {
+            &["geometry (1046528 distinct triangles", "needs about"]
+        };
+        assert_refused(&o, needles);
+        assert!(!dir.join("o/sphere.exr").exists());
+    }
+}

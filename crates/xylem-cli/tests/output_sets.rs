@@ -180,3 +180,54 @@ fn sigint_and_sigterm_remove_the_runs_own_temporaries() {
     }
     assert!(hits > 0, "no signal arrived before the bake ended");
 }
+
+/// Issue 26: the temporaries of builds before host and pid were in the name
+/// (`.NAME.XXXXXX.tmp`, up to f97e541) are removed by the next run into the folder when no
+/// process has them open and nothing has written them for ten minutes. One a live process holds
+/// open, a fresh one (perhaps a run on another host sharing the folder) and other programs'
+/// stay. Before, they stayed forever.
+#[test]
+fn old_format_temporaries_of_dead_runs_are_removed_by_the_next_run() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("o");
+    std::fs::create_dir_all(&out).unwrap();
+    let hour_ago = std::time::SystemTime::now() - std::time::Duration::from_secs(3600);
+    let make = |name: &str, old: bool| {
+        let p = out.join(name);
+        std::fs::write(&p, vec![7u8; 4096]).unwrap();
+        if old {
+            let f = std::fs::File::options().write(true).open(&p).unwrap();
+            f.set_modified(hour_ago).unwrap();
+        }
+        name.to_string()
+    };
+    let dead = [
+        make(".walnut_diffuse.png.a1B2c3.tmp", true),
+        make(".bake.json.Zz9Yy8.tmp", true),
+        make(".board.exr.000000.tmp", true),
+    ];
+    let held = make(".walnut_normal.png.Qq1Ww2.tmp", true);
+    let mut holder = Command::new("sleep")
+        .arg("60")
+        .stdin(std::fs::File::open(out.join(&held)).unwrap())
+        .spawn()
+        .unwrap();
+    let kept = [
+        held,
+        make(".walnut_height.png.Ab3De4.tmp", false),
+        make(".cache.abcdef.tmp", true),
+        make(".walnut_diffuse.png.abcdefg.tmp", true),
+        make("walnut.png.a1B2c3.tmp", true),
+    ];
+    let ok = bake_at(64, 1, &out).status().unwrap().success();
+    let _ = holder.kill();
+    holder.wait().unwrap();
+    assert!(ok);
+    let (_, hidden) = listing(&out);
+    for name in &dead {
+        assert!(!hidden.contains(name), "{name} was left: {hidden:?}");
+    }
+    for name in &kept {
+        assert!(out.join(name).exists(), "{name} was removed");
+    }
+}

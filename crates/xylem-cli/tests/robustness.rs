@@ -243,7 +243,7 @@ fn assert_nothing_looks_complete_that_is_not(dir: &Path) {
             let text = std::fs::read_to_string(&p).unwrap();
             serde_json::from_str::<xylem::sweep::manifest::Manifest>(&text)
                 .unwrap_or_else(|e| panic!("{name}: {e}"));
-        } else if name.ends_with(".json") {
+        } else if name.starts_with("frame_") && name.ends_with(".json") {
             let rec: FrameRecord =
                 serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
             let exr = p.with_extension("exr");
@@ -262,6 +262,15 @@ fn assert_nothing_looks_complete_that_is_not(dir: &Path) {
                 .unwrap_or_else(|e| panic!("{name} is there but its PNG is not: {e}"));
             assert!(png.data == to_srgb8(&px, 0.0), "{name}: PNG and EXR differ");
         }
+    }
+    if dir.join("manifest.json").exists() {
+        // The capture `xylem fit` takes as complete: every frame there, all of one sweep.
+        let records = read_records(dir).unwrap_or_else(|e| {
+            panic!("a manifest beside frames of two runs or an incomplete sweep: {e}")
+        });
+        let text = std::fs::read_to_string(dir.join("manifest.json")).unwrap();
+        let m: xylem::sweep::manifest::Manifest = serde_json::from_str(&text).unwrap();
+        assert_eq!(m.frames.len(), records.len(), "manifest and records");
     }
     if dir.join(VIEWER).exists() {
         let records = read_records(dir).expect("a viewer beside an incomplete sweep");
@@ -317,6 +326,123 @@ fn sweeps_killed_at_random_points_leave_nothing_that_looks_complete() {
     assert!(args("9").status().unwrap().success());
     assert_eq!(read_records(&out).unwrap().len(), 9);
     assert_nothing_looks_complete_that_is_not(&out);
+}
+
+/// `xylem sweep SCENE --quiet --out OUT EXTRA…`, its errors kept.
+fn sweep_into(scene: &Path, out: &Path, extra: &[&str]) -> Command {
+    let mut c = xylem();
+    c.args(["sweep", scene.to_str().unwrap(), "--quiet", "--out"])
+        .arg(out)
+        .args(extra)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped());
+    c
+}
+
+/// Issue 26: reruns into a folder that holds a complete sweep, killed at points spread over
+/// their run — slices of other settings, slices of the same, whole sweeps of other settings —
+/// never leave a folder that looks complete (a manifest for `fit`, a viewer) with frames of two
+/// runs. Before, a slice of another spp kept the old manifest beside frames of both runs.
+#[test]
+fn reruns_killed_part_way_never_leave_a_capture_of_two_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = tiny_board(dir.path(), 40, 30, 9);
+    let out = dir.path().join("out");
+    let sweep = |extra: &[&str]| sweep_into(&scene, &out, extra);
+    let start = Instant::now();
+    assert!(sweep(&[]).status().unwrap().success());
+    let full = start.elapsed();
+    let other_slice = ["--spp", "2", "--frames-range", "0..5"];
+    let reruns: [&[&str]; 3] = [&other_slice, &["--frames-range", "0..5"], &["--spp", "2"]];
+    for (k, d) in delays(12, full.mul_f64(1.3), 0x2545_f491_4f6c_dd1d)
+        .into_iter()
+        .enumerate()
+    {
+        // Four of each, the whole sweeps last (they change the folder's settings).
+        let mut kid = sweep(reruns[k / 4]).spawn().unwrap();
+        std::thread::sleep(d);
+        let _ = kid.kill(); // SIGKILL
+        kid.wait().unwrap();
+        assert_nothing_looks_complete_that_is_not(&out);
+    }
+    assert!(sweep(&["--spp", "2"]).status().unwrap().success());
+    // The folder is a 2-spp sweep now: a 1-spp slice is refused before it writes a file.
+    let before = std::fs::read(out.join("frame_0000.exr")).unwrap();
+    let o = sweep(&["--frames-range", "0..5"]).output().unwrap();
+    assert_clean_error(&o, "sweep.json");
+    assert_clean_error(&o, "spp 2 there, 1 in this run");
+    assert_eq!(std::fs::read(out.join("frame_0000.exr")).unwrap(), before);
+    assert!(out.join("manifest.json").exists());
+    assert_nothing_looks_complete_that_is_not(&out);
+}
+
+/// Issue 26: two slices of other settings started at once into an empty folder — one claims it
+/// (`sweep.json`), the other refuses before writing a file, naming the setting (before, both
+/// rendered and the folder held frames of two sweeps); slices of the same settings share it.
+#[test]
+fn slices_racing_into_an_empty_folder_never_both_write() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = tiny_board(dir.path(), 40, 30, 6);
+    let race = |out: &Path, spp: [&str; 2]| -> Vec<Output> {
+        let kids: Vec<_> = [(spp[0], "0..3"), (spp[1], "3..6")]
+            .map(|(spp, range)| {
+                let extra = ["--spp", spp, "--frames-range", range];
+                sweep_into(&scene, out, &extra).spawn().unwrap()
+            })
+            .into_iter()
+            .collect();
+        kids.into_iter()
+            .map(|k| k.wait_with_output().unwrap())
+            .collect()
+    };
+    let spps = |out: &Path| -> std::collections::BTreeSet<u32> {
+        (std::fs::read_dir(out).unwrap())
+            .map(|e| e.unwrap().path())
+            .filter(|p| {
+                p.file_name()
+                    .unwrap()
+                    .to_string_lossy()
+                    .starts_with("frame_")
+            })
+            .filter(|p| p.extension().is_some_and(|e| e == "json"))
+            .map(|p| {
+                let text = std::fs::read_to_string(p).unwrap();
+                serde_json::from_str::<FrameRecord>(&text)
+                    .unwrap()
+                    .sweep
+                    .spp
+            })
+            .collect()
+    };
+    for round in 0..3 {
+        let out = dir.path().join(format!("race{round}"));
+        let outs = race(&out, ["1", "2"]);
+        let refused: Vec<&Output> = outs.iter().filter(|o| !o.status.success()).collect();
+        assert_eq!(refused.len(), 1, "round {round}: both slices ran");
+        assert_clean_error(refused[0], "sweep.json");
+        assert_clean_error(
+            refused[0],
+            "this folder holds a sweep of other settings (spp ",
+        );
+        assert_eq!(spps(&out).len(), 1, "round {round}: records of two sweeps");
+        assert_nothing_looks_complete_that_is_not(&out);
+    }
+    let out = dir.path().join("same");
+    for o in race(&out, ["1", "1"]) {
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    assert_eq!(read_records(&out).unwrap().len(), 6);
+    assert!(out.join("manifest.json").exists());
+    assert_nothing_looks_complete_that_is_not(&out);
+    // A refused slice's folder is incomplete (its frames 3..6 missing): `fit` says so.
+    let (race0, maps) = (dir.path().join("race0"), dir.path().join("maps"));
+    let o = run(&[
+        "fit",
+        race0.to_str().unwrap(),
+        "--out",
+        maps.to_str().unwrap(),
+    ]);
+    assert_clean_error(&o, "an incomplete sweep");
 }
 
 #[test]
@@ -376,9 +502,28 @@ fn assemble_refuses_slices_that_disagree_and_absurd_records() {
         assert!(!out.join(VIEWER).exists());
     };
     slice("0..2", &[]);
-    slice("2..4", &["--spp", "2"]);
+    // A slice of other settings is refused before it renders: the folder's claim (issue 26) ...
+    let o = run(&[
+        "sweep",
+        s,
+        "--quiet",
+        "--out",
+        o_,
+        "--frames-range",
+        "2..4",
+        "--spp",
+        "2",
+    ]);
+    assert_clean_error(&o, "spp 1 there, 2 in this run");
+    // ... and records of two settings (as a build without claims left them) are refused by
+    // `--assemble`.
+    slice("2..4", &[]);
+    let p = out.join("frame_0003.json");
+    let text = std::fs::read_to_string(&p).unwrap();
+    std::fs::write(&p, text.replace("\"spp\": 1", "\"spp\": 2")).unwrap();
     let o = run(&["sweep", "--assemble", o_]);
     assert_clean_error(&o, "spp = ");
+    std::fs::write(&p, &text).unwrap();
     // A slice of another arc is refused before it renders: the folder's manifest is of the
     // scene's arc (issue 26) ...
     let o = run(&[
@@ -393,13 +538,29 @@ fn assemble_refuses_slices_that_disagree_and_absurd_records() {
         "-30..30",
     ]);
     assert_clean_error(&o, "manifest.json");
-    // ... and where no manifest says so, `--assemble` refuses records of two arcs.
-    let manifest = out.join("manifest.json");
-    std::fs::remove_file(&manifest).unwrap();
-    slice("2..4", &["--arc", "-30..30"]);
+    // ... and where neither manifest nor claim says so, the records do; `--assemble` refuses
+    // records of two arcs.
+    std::fs::remove_file(out.join("manifest.json")).unwrap();
+    std::fs::remove_file(out.join("sweep.json")).unwrap();
+    let o = run(&[
+        "sweep",
+        s,
+        "--quiet",
+        "--out",
+        o_,
+        "--frames-range",
+        "2..4",
+        "--arc",
+        "-30..30",
+    ]);
+    assert_clean_error(
+        &o,
+        ".json: this folder holds a sweep of other settings (arc_deg",
+    );
+    std::fs::write(&p, text.replace("-60.0", "-30.0")).unwrap();
     let o = run(&["sweep", "--assemble", o_]);
     assert_clean_error(&o, "arc_deg");
-    std::fs::remove_file(&manifest).unwrap();
+    std::fs::write(&p, &text).unwrap();
     slice("2..4", &[]);
     let o = run(&["sweep", "--assemble", o_]);
     assert!(o.status.success(), "{}", stderr(&o));

@@ -87,6 +87,17 @@ fn unknown_preset_lists_the_valid_ones() {
     }
     let e = WoodParams::from_toml_file("/nonexistent/x.toml").unwrap_err();
     assert!(e.to_string().contains("/nonexistent/x.toml"));
+    // A device is refused at once, not read forever (issue 26; before, it read /dev/zero until
+    // memory ran out).
+    let e = WoodParams::from_toml_file("/dev/zero").unwrap_err();
+    let cause = std::error::Error::source(&e).map(|c| c.to_string());
+    assert!(
+        cause
+            .as_deref()
+            .unwrap_or("")
+            .contains("not a regular file"),
+        "{e}: {cause:?}"
+    );
 }
 
 #[test]

@@ -12,7 +12,9 @@
 //!
 //! Temporaries carry this host's name and the process id ([`Staged::new`]); the first file a
 //! process stages in a folder removes the temporaries there of dead processes of this host
-//! (runs killed before they could clean up), never those of live runs or other hosts.
+//! (runs killed before they could clean up), never those of live runs or other hosts, and the
+//! older builds' `.NAME.XXXXXX.tmp` that no process has open and nothing has written for ten
+//! minutes.
 
 use std::collections::BTreeSet;
 use std::fs::File;
@@ -164,6 +166,16 @@ impl Staged {
         self.tmp.persist(&self.path).map_err(|e| e.error)?;
         Ok(())
     }
+
+    /// Renames the temporary file to the final name only where no file has that name yet
+    /// (atomically: of two runs committing at once exactly one succeeds); otherwise an
+    /// [`io::ErrorKind::AlreadyExists`] error, and the temporary is removed.
+    pub fn commit_new(self) -> io::Result<()> {
+        self.tmp
+            .persist_noclobber(&self.path)
+            .map_err(|e| e.error)?;
+        Ok(())
+    }
 }
 
 /// Writes `bytes` into a [`Staged`] file for `path`, to commit later.
@@ -247,10 +259,14 @@ pub fn remove_stale_temporaries(dir: &Path) {
         return;
     };
     let me = host();
+    let mut old = Vec::new();
     for e in entries.flatten() {
         let name = e.file_name();
         let Some(name) = name.to_str() else { continue };
         let Some(tail) = name.rsplit_once(TMP_MARK).map(|(_, t)| t) else {
+            if is_old_temporary(name) {
+                old.push(e.path());
+            }
             continue;
         };
         // HOST-PID-RANDOM.tmp
@@ -263,6 +279,92 @@ pub fn remove_stale_temporaries(dir: &Path) {
             let _ = std::fs::remove_file(e.path());
         }
     }
+    remove_dead_old_temporaries(old);
+}
+
+/// Whether `name` is a temporary of a build before host and pid were in the name (up to
+/// f97e541): `.NAME.XXXXXX.tmp`, `XXXXXX` six letters or digits (the `tempfile` crate's), NAME
+/// an output of one of the kinds xylem writes.
+fn is_old_temporary(name: &str) -> bool {
+    let Some(inner) = name.strip_prefix('.').and_then(|n| n.strip_suffix(".tmp")) else {
+        return false;
+    };
+    let Some((output, random)) = inner.rsplit_once('.') else {
+        return false;
+    };
+    let kind = output.rsplit_once('.').map_or("", |(_, ext)| ext);
+    random.len() == 6
+        && random.bytes().all(|b| b.is_ascii_alphanumeric())
+        && OUTPUT_KINDS.contains(&kind)
+}
+
+/// The extensions of the files xylem writes (so no other program's `.x.abcdef.tmp` is taken
+/// for an old temporary).
+const OUTPUT_KINDS: [&str; 8] = ["exr", "png", "json", "csv", "html", "glb", "md", "txt"];
+
+/// How long an old-format temporary must have gone unwritten before it is taken for a dead
+/// run's: its name tells neither host nor process, and a run on another host sharing the folder
+/// (which no process table here shows) writes its temporary and renames it within moments.
+const OLD_TEMPORARY_AGE: std::time::Duration = std::time::Duration::from_secs(600);
+
+/// Removes the old-format temporaries `paths` that no process of this host has open (a live
+/// old run holds its temporary open until it renames it) and that have gone unwritten for
+/// [`OLD_TEMPORARY_AGE`]. Where the open files cannot be listed (no /proc) none is removed.
+fn remove_dead_old_temporaries(paths: Vec<PathBuf>) {
+    let stale: Vec<PathBuf> = paths
+        .into_iter()
+        .filter(|p| {
+            let age = std::fs::metadata(p)
+                .and_then(|m| m.modified())
+                .ok()
+                .and_then(|t| t.elapsed().ok());
+            age.is_some_and(|a| a >= OLD_TEMPORARY_AGE)
+        })
+        .collect();
+    if stale.is_empty() {
+        return;
+    }
+    let Some(open) = open_files() else { return };
+    for p in stale {
+        if std::fs::metadata(&p).is_ok_and(|m| !open.contains(&file_id(&m))) {
+            let _ = std::fs::remove_file(&p);
+        }
+    }
+}
+
+/// A file's identity (device and inode).
+#[cfg(unix)]
+fn file_id(m: &std::fs::Metadata) -> (u64, u64) {
+    use std::os::unix::fs::MetadataExt;
+    (m.dev(), m.ino())
+}
+
+#[cfg(not(unix))]
+fn file_id(_: &std::fs::Metadata) -> (u64, u64) {
+    (0, 0)
+}
+
+/// The files that processes of this host have open, as far as /proc shows them (every process
+/// of this user; others' where readable); None without /proc.
+#[cfg(target_os = "linux")]
+fn open_files() -> Option<BTreeSet<(u64, u64)>> {
+    let mut open = BTreeSet::new();
+    for proc in std::fs::read_dir("/proc").ok()?.flatten() {
+        let Ok(fds) = std::fs::read_dir(proc.path().join("fd")) else {
+            continue;
+        };
+        for fd in fds.flatten() {
+            if let Ok(m) = std::fs::metadata(fd.path()) {
+                open.insert(file_id(&m));
+            }
+        }
+    }
+    Some(open)
+}
+
+#[cfg(not(target_os = "linux"))]
+fn open_files() -> Option<BTreeSet<(u64, u64)>> {
+    None
 }
 
 /// A set file's record: the members with their sizes and CRC-32s, beside what the caller adds.

@@ -6,6 +6,7 @@
 use crate::math::Vec3;
 use crate::picture::srgb::srgb_to_linear;
 use crate::render::image_io::read_exr_rgb;
+use crate::sweep::claim::CLAIM_FILE;
 use crate::sweep::manifest::{Manifest, MANIFEST_FILE};
 use std::path::{Path, PathBuf};
 
@@ -259,7 +260,17 @@ impl Capture {
         let text =
             crate::sweep::manifest::read_text(&manifest_path).map_err(|e| CaptureError::Read {
                 path: path.clone(),
-                cause: e.reason(),
+                // A sweep folder without its manifest: killed, or slices still missing.
+                cause: if manifest_path.exists() || !dir.join(CLAIM_FILE).exists() {
+                    e.reason()
+                } else {
+                    format!(
+                        "{}: an incomplete sweep (its manifest is written once every frame is \
+                         there; `xylem sweep --assemble {}` names the missing frames)",
+                        e.reason(),
+                        dir.display()
+                    )
+                },
             })?;
         let m: Manifest = serde_json::from_str(&text).map_err(|e| CaptureError::Parse {
             path: path.clone(),

@@ -418,6 +418,9 @@ impl WideBvh {
             return bvh;
         }
         let plan = CollapsePlan::new(bvh2);
+        let (nodes, packets) = plan.sizes(bvh2);
+        bvh.nodes = with_huge_pages(nodes);
+        bvh.packets = with_huge_pages(packets);
         let mut prims = Vec::with_capacity(PACKET);
         if plan.leaf[0] {
             bvh.root = bvh.leaf(bvh2, 0, triangles, &mut prims);
@@ -450,8 +453,7 @@ impl WideBvh {
             }
         }
         bvh.stack_need = max_depth * (WIDTH - 1) + 1;
-        bvh.nodes = on_huge_pages(bvh.nodes);
-        bvh.packets = on_huge_pages(bvh.packets);
+        debug_assert_eq!((bvh.nodes.len(), bvh.packets.len()), (nodes, packets));
         bvh
     }
 
@@ -806,6 +808,31 @@ impl CollapsePlan {
     }
 
     /// The children of BVH2 node `n` made a wide node (2 to 8 BVH2 nodes).
+    /// The wide nodes and leaf packets the collapse makes (walked as [`WideBvh::from_bvh2`]
+    /// walks it), so that both are allocated once at their size: grown by doubling, up to half
+    /// of each was unused and the last doubling of the packets needed their size again, which
+    /// failed under a tight `ulimit -v` after the memory estimate had passed.
+    fn sizes(&self, bvh2: &Bvh2) -> (usize, usize) {
+        if self.leaf[0] {
+            return (0, 1);
+        }
+        let (mut nodes, mut packets) = (1, 0);
+        let (mut pending, mut kids) = (vec![0usize], Vec::with_capacity(WIDTH));
+        while let Some(n2) = pending.pop() {
+            kids.clear();
+            self.wide_children(bvh2, n2, &mut kids);
+            for &k in &kids {
+                if self.leaf[k] {
+                    packets += 1;
+                } else {
+                    nodes += 1;
+                    pending.push(k);
+                }
+            }
+        }
+        (nodes, packets)
+    }
+
     fn wide_children(&self, bvh2: &Bvh2, n: usize, out: &mut Vec<usize>) {
         let f = bvh2.nodes[n].first_index as usize;
         let (left, right) = self.wide[n];
@@ -831,19 +858,19 @@ fn avx2_available() -> bool {
     Simd::best() >= Simd::Avx2
 }
 
-/// Moves `v` into a fresh allocation that the kernel is asked to back with transparent huge
-/// pages (`madvise(MADV_HUGEPAGE)` before first touch): a traversal touches nodes all over a
-/// ~100 MB tree, and with 4 KiB pages nearly every node visit is also a TLB miss.
-fn on_huge_pages<T: Copy>(v: Vec<T>) -> Vec<T> {
+/// An empty vector with room for `len` items that the kernel is asked to back with transparent
+/// huge pages (`madvise(MADV_HUGEPAGE)` before first touch): a traversal touches nodes all over
+/// a ~100 MB tree, and with 4 KiB pages nearly every node visit is also a TLB miss.
+fn with_huge_pages<T: Copy>(len: usize) -> Vec<T> {
     const HUGE: usize = 2 << 20;
-    let bytes = std::mem::size_of_val(v.as_slice());
+    let bytes = len * std::mem::size_of::<T>();
+    let out: Vec<T> = Vec::with_capacity(len);
     if bytes < 4 * HUGE {
-        return v;
+        return out;
     }
-    let mut out: Vec<T> = Vec::with_capacity(v.len());
     #[cfg(target_os = "linux")]
     {
-        let start = out.as_mut_ptr() as usize;
+        let start = out.as_ptr() as usize;
         let aligned = start.next_multiple_of(HUGE);
         let end = (start + bytes) / HUGE * HUGE;
         if end > aligned {
@@ -858,7 +885,6 @@ fn on_huge_pages<T: Copy>(v: Vec<T>) -> Vec<T> {
             }
         }
     }
-    out.extend_from_slice(&v);
     out
 }
 

@@ -50,12 +50,10 @@ pub fn load_mesh(path: &Path) -> Result<TriMesh, MeshError> {
     }
     let mut input: Box<dyn BufRead> = match crate::builtin::stand_in(path) {
         Some((_, bytes)) => Box::new(bytes),
-        None => {
-            let file = open_regular(path, MAX_MESH_BYTES).map_err(|e| bad(path, e.reason()))?;
-            let bytes = file.metadata().map_or(0, |m| m.len());
-            check_parse_memory(path, bytes, ext.as_deref() == Some("obj"))?;
-            Box::new(BufReader::new(file.take(MAX_MESH_BYTES)))
-        }
+        None => Box::new(BufReader::new(open_mesh(
+            path,
+            ext.as_deref() == Some("obj"),
+        )?)),
     };
     let mesh = if ext.as_deref() == Some("obj") {
         parse_obj(&mut input, path)?
@@ -67,11 +65,17 @@ pub fn load_mesh(path: &Path) -> Result<TriMesh, MeshError> {
 }
 
 /// Peak memory of reading an OBJ, per byte of the file: tobj's positions, its per-corner index
-/// map (`single_index`) and our copy. Measured: a 70 MB grid of 1 M vertices and 2 M
-/// triangles peaked at 0.91 GB resident while parsing (13×), rounded up.
+/// map (`single_index`) and our copy. Measured (`mesh_parse_peak obj`, notes/limits.md): a
+/// 1026² grid (85 MB, 2.1 M triangles, every vector just past a doubling) raised the peak
+/// address space 7.3× its size (resident 4.3×); 16 leaves room for other layouts.
 pub const OBJ_PARSE_BYTES_PER_BYTE: u64 = 16;
-/// The same for a PLY: a binary vertex (12 bytes) becomes a 12-byte `Vec3`, a 13-byte face a
-/// 12-byte index triple, and ASCII is longer per value; with the vectors' doubling, 4×.
+/// The same for a PLY, whose parse holds only the mesh: a binary vertex of 12 (24 with normals)
+/// bytes becomes 12 (24), a 13-byte triangle 12 bytes of indices, a 17-byte quad 24. Measured
+/// (`mesh_parse_peak ply-*`, notes/limits.md) on the 1026² grid: peak address space 1.9× the
+/// file (binary triangles), 2.3× (binary quads), 1.1× (ASCII); resident 0.6–1.2×. 4 covers
+/// binary faces of up to six corners at the vectors' worst doubling; a PLY of larger
+/// polygons or byte-sized indices that needs more ends in the `xylem` binary's clean
+/// out-of-memory error.
 pub const PLY_PARSE_BYTES_PER_BYTE: u64 = 4;
 
 /// Refuses, before reading, a mesh file whose parse would need more memory than is available
@@ -137,9 +141,20 @@ fn check_finite(path: &Path, mesh: &TriMesh) -> Result<(), MeshError> {
     Ok(())
 }
 
-/// Reads an OBJ mesh.
+/// Opens a mesh file: a regular file of at most
+/// [`MAX_MESH_BYTES`](crate::render::resources::MAX_MESH_BYTES), read no further than that,
+/// whose parse fits the memory available ([`check_parse_memory`]).
+fn open_mesh(path: &Path, obj: bool) -> Result<std::io::Take<std::fs::File>, MeshError> {
+    use crate::render::resources::{open_regular, MAX_MESH_BYTES};
+    let file = open_regular(path, MAX_MESH_BYTES).map_err(|e| bad(path, e.reason()))?;
+    let bytes = file.metadata().map_or(0, |m| m.len());
+    check_parse_memory(path, bytes, obj)?;
+    Ok(file.take(MAX_MESH_BYTES))
+}
+
+/// Reads an OBJ mesh (a regular file within the mesh size limit, as [`load_mesh`] reads).
 pub fn load_obj(path: &Path) -> Result<TriMesh, MeshError> {
-    let file = std::fs::File::open(path).map_err(|e| bad(path, e.to_string()))?;
+    let file = open_mesh(path, true)?;
     parse_obj(&mut BufReader::new(file), path)
 }
 
@@ -292,9 +307,9 @@ impl<R: BufRead> Body<R> {
     }
 }
 
-/// Reads a PLY mesh.
+/// Reads a PLY mesh (checked as [`load_obj`]).
 pub fn load_ply(path: &Path) -> Result<TriMesh, MeshError> {
-    let file = std::fs::File::open(path).map_err(|e| bad(path, e.to_string()))?;
+    let file = open_mesh(path, false)?;
     parse_ply(BufReader::new(file)).map_err(|m| bad(path, m))
 }
 
@@ -424,6 +439,16 @@ fn parse_ply<R: BufRead>(mut r: R) -> Result<TriMesh, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn mesh_files_read_directly_are_bounded_like_scene_meshes() {
+        for e in [
+            load_obj(Path::new("/dev/zero")).unwrap_err(),
+            load_ply(Path::new("/dev/zero")).unwrap_err(),
+        ] {
+            assert!(e.to_string().contains("not a regular file"), "{e}");
+        }
+    }
 
     #[test]
     fn ascii_and_binary_ply_agree() {

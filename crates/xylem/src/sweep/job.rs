@@ -3,12 +3,13 @@
 //! of the sweep is in the output folder.
 
 use super::batch::{batches, default_budget, frames_per_batch, BudgetError};
+use super::claim::{claim_for_slice, replace_claim, Claim};
 use super::manifest::{Manifest, MANIFEST_FILE};
 use super::path::{parse_frames_range, PathError};
 use super::path::{SetupError, SweepPath};
 use super::sequence::{
-    assemble, clear_assembled, frame_stem, unmark_frame, write_record, AssembleOptions, Assembled,
-    FrameRecord, Region, SequenceError, SweepSettings,
+    assemble, clear_assembled, frame_stem, read_records, unmark_frame, write_record,
+    AssembleOptions, Assembled, FrameRecord, Region, SequenceError, SweepSettings,
 };
 use super::{render_naive, render_sweep};
 use crate::output::{remove_if_present, FolderLock, LockError, LockMode};
@@ -71,6 +72,14 @@ pub enum SweepError {
         theirs: String,
         /// What this slice would write.
         ours: String,
+    },
+    /// The folder holds (or is being filled with) a sweep of other settings.
+    #[error("{path}: this folder holds a sweep of other settings ({difference}); render every slice with the same scene and settings (--frames, --arc, --spp, --res, --quality), rerun the whole sweep, or choose another --out")]
+    Claimed {
+        /// The folder's claim (`sweep.json`) or the frame record that differs.
+        path: String,
+        /// How: the setting, the folder's value and this run's.
+        difference: String,
     },
 }
 
@@ -261,8 +270,11 @@ pub fn frame_header(loaded: &LoadedScene, path: &SweepPath, moving: usize) -> St
 }
 
 /// Runs a sweep job on a loaded scene. A whole sweep holds its output folder alone, clears what
-/// an earlier sweep left there and assembles at the end; a slice (`range` set) shares the folder
-/// with the other slices, writes only its own frames and leaves assembling to `--assemble`.
+/// an earlier sweep left there, claims the folder for its settings ([`super::claim`]) and
+/// assembles at the end; a slice (`range` set) shares the folder with the other slices of the
+/// folder's claim (refusing one of other settings before touching a file), writes only its own
+/// frames and leaves assembling to `--assemble`. Either removes the manifest before its first
+/// frame and writes it last, once every frame is there.
 pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepError> {
     let (path, moving) = SweepPath::from_scene(loaded, job.frames, job.arc)?;
     let total = path.frames();
@@ -288,25 +300,41 @@ pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepE
     };
     let _lock = FolderLock::try_new(&job.out, mode)?;
     let manifest = Manifest::of_sweep(loaded, &path, moving);
-    if job.range.is_some() {
-        check_same_sweep(&job.out, &manifest)?;
-    }
-    // The old viewer, CSV and sheet describe frames about to change: they go before any frame.
-    clear_assembled(&job.out)?;
-    if job.range.is_none() {
-        clear_frames(&job.out)?;
-    }
-    let render = if job.naive {
-        render_naive
-    } else {
-        render_sweep
-    };
     let settings = SweepSettings {
         scene: loaded.name.clone(),
         arc_deg: [path.arc.from_deg, path.arc.to_deg],
         spp: loaded.settings.spp,
         seed: loaded.settings.seed,
         provenance: job.provenance.clone(),
+    };
+    let claim = Claim {
+        settings: settings.clone(),
+        frames: total,
+        camera: format!("{}x{}", cam.width, cam.height),
+        manifest_crc32: format!("{:08x}", crc32fast::hash(manifest.text().as_bytes())),
+    };
+    if job.range.is_some() {
+        check_same_sweep(&job.out, &manifest)?;
+        claim_for_slice(&job.out, &claim)?;
+    }
+    // The manifest (what `xylem fit` takes as a complete capture) and the old viewer, CSV and
+    // sheet describe frames about to change: they go before any frame, and come back only
+    // once every frame is there.
+    clear_assembled(&job.out)?;
+    let manifest_path = job.out.join(MANIFEST_FILE);
+    let out_error = |path: &Path, cause| SweepError::OutDir {
+        path: path.display().to_string(),
+        cause,
+    };
+    remove_if_present(&manifest_path).map_err(|e| out_error(&manifest_path, e))?;
+    if job.range.is_none() {
+        clear_frames(&job.out)?;
+        replace_claim(&job.out, &claim)?;
+    }
+    let render = if job.naive {
+        render_naive
+    } else {
+        render_sweep
     };
     let regions = scene_regions(loaded);
     let header = frame_header(loaded, &path, moving);
@@ -337,13 +365,14 @@ pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepE
         )?;
         release_freed_memory();
     }
-    // The capture manifest for `xylem fit` (the same text from every slice).
-    manifest
-        .write(&job.out)
-        .map_err(|cause| SweepError::OutDir {
-            path: job.out.join(MANIFEST_FILE).display().to_string(),
-            cause,
-        })?;
+    // The capture manifest for `xylem fit` (the same text from every slice), written last and
+    // only once every frame of the sweep is in the folder: the slice that completes it writes
+    // it (each slice looks after writing its own records, so the last to look sees them all).
+    if job.range.is_none() || read_records(&job.out).is_ok() {
+        manifest
+            .write(&job.out)
+            .map_err(|e| out_error(&manifest_path, e))?;
+    }
     let assembled = if job.range.is_none() {
         Some(assemble(&job.out, &AssembleOptions::default())?)
     } else {

@@ -6,12 +6,14 @@
 //!   moving light goes in each frame ([`SweepPath`]);
 //! - [`batch`]: the batches of frames that fit `--memory`, rendered and written one by one;
 //! - [`job`]: a whole `xylem sweep` run (render, write, assemble);
+//! - [`claim`]: which sweep an output folder is for (`sweep.json`), so slices never mix;
 //! - [`openjd`]: the sweep as an Open Job Description job template (`--emit-openjd`);
 //! - [`manifest`]: the capture format (camera, board, lights per frame) a fit reads;
 //! - [`sequence`]: per-frame records and the assembly of a folder of frames into the contact
 //!   sheet, animated PNG, CSV and the HTML [`viewer`].
 
 pub mod batch;
+pub mod claim;
 pub mod job;
 pub mod manifest;
 pub mod openjd;

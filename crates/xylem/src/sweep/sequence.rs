@@ -145,6 +145,16 @@ pub struct SweepSettings {
 impl SweepSettings {
     /// The first setting in which `self` differs from `other`, as `name = mine (others: theirs)`.
     pub fn difference(&self, other: &SweepSettings) -> Option<String> {
+        self.first_difference(other)
+            .map(|(name, a, b)| format!("{name} = {a} (the others: {b})"))
+    }
+
+    /// The first setting in which `self` differs from `other`: its name, `self`'s value and
+    /// `other`'s.
+    pub fn first_difference(
+        &self,
+        other: &SweepSettings,
+    ) -> Option<(&'static str, String, String)> {
         let pairs = [
             ("scene", self.scene.clone(), other.scene.clone()),
             (
@@ -160,10 +170,7 @@ impl SweepSettings {
                 other.provenance.clone(),
             ),
         ];
-        pairs
-            .into_iter()
-            .find(|(_, a, b)| a != b)
-            .map(|(name, a, b)| format!("{name} = {a} (the others: {b})"))
+        pairs.into_iter().find(|(_, a, b)| a != b)
     }
 }
 

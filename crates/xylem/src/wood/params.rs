@@ -508,13 +508,16 @@ impl WoodParams {
         Ok(params)
     }
 
-    /// Read and validate a parameter file.
+    /// Read and validate a parameter file (a regular file of at most
+    /// [`MAX_SCENE_BYTES`](crate::render::resources::MAX_SCENE_BYTES), as scene files).
     pub fn from_toml_file(path: impl AsRef<Path>) -> Result<WoodParams, WoodError> {
+        use crate::render::resources::{read_text_bounded, MAX_SCENE_BYTES};
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| WoodError::Io {
-            file: path.to_path_buf(),
-            source,
-        })?;
+        let text =
+            read_text_bounded(path, MAX_SCENE_BYTES, "TOML text").map_err(|e| WoodError::Io {
+                file: path.to_path_buf(),
+                source: std::io::Error::other(e.reason()),
+            })?;
         Self::from_toml_str(&text, &path.display().to_string())
     }
 
