@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use xylem::render::image_io::ExrCompression;
 use xylem::scene::quality::Quality;
+use xylem::sweep::batch::PrimaryMode;
 use xylem::sweep::job::{run_job, SweepJob};
 use xylem::sweep::parse_arc;
 use xylem::sweep::sequence::{assemble, AssembleOptions};
@@ -46,7 +47,7 @@ pub struct Args {
     #[arg(long)]
     pub quiet: bool,
     /// Assemble contact sheet, animated PNG, CSV and viewer from the frames already in DIR.
-    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "frames", "arc", "frames_range", "spp", "res", "naive", "quality", "memory", "emit_openjd"])]
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["scene", "frames", "arc", "frames_range", "spp", "res", "naive", "quality", "memory", "primaries", "emit_openjd"])]
     pub assemble: Option<PathBuf>,
     /// Compression of each frame's EXR: `rle` is fast, `zip` gives files ≈ 20 % smaller for
     /// ≈ 50 ms more CPU per 512×384 frame (notes/sweep.md), `none` writes raw floats.
@@ -58,11 +59,17 @@ pub struct Args {
     /// Render even when the memory or disk estimate exceeds what the machine has.
     #[arg(long)]
     pub ignore_limits: bool,
-    /// Memory for the frames held at once, e.g. 512M or 4G (default: a quarter of the memory
-    /// available): frames are rendered and written in batches that fit it, so a long sweep
-    /// needs no more memory than a short one.
+    /// Memory for the frames held at once, e.g. 512M or 4G: frames are rendered and written in
+    /// batches that fit it, so a long sweep needs no more memory than a short one (default:
+    /// batches of 17 frames with the primary samples kept or 54 without, whichever takes less
+    /// memory, within a quarter of the memory available; notes/cluster.md).
     #[arg(long, value_name = "BYTES", value_parser = xylem::sweep::batch::parse_bytes)]
     pub memory: Option<u64>,
+    /// Whether a sweep in several batches keeps each pixel sample's light-independent part from
+    /// the first batch for the others (`keep`), computes it again per batch (`recompute`), or
+    /// does what fits the memory and models faster (`auto`). Never changes a pixel.
+    #[arg(long, default_value = "auto", value_parser = crate::named::<PrimaryMode>(&PrimaryMode::NAMES))]
+    pub primaries: PrimaryMode,
     /// Render nothing: write DIR/template.json, an Open Job Description job template of this
     /// sweep (render tasks over chunks of frames, then the assembly) for `openjd run` or a farm.
     #[arg(long, value_name = "DIR", conflicts_with_all = ["frames_range", "naive"])]
@@ -117,6 +124,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         exr: args.exr_compression,
         ignore_limits: args.ignore_limits,
         memory: args.memory,
+        primaries: args.primaries,
         provenance: format!(
             "scene crc32 {scene_crc:08x}, quality {}",
             args.quality.map_or("none".to_string(), |q| q.to_string())
@@ -139,7 +147,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let report = run_job(&loaded, &job).with_context(|| format!("sweep of {}", scene.display()))?;
     let n = report.rendered.len();
     println!(
-        "rendered frames {}..{} of {} in {:.2} s ({:.3} s per frame; {} batch{} of up to {}) into {}",
+        "rendered frames {}..{} of {} in {:.2} s ({:.3} s per frame; {} batch{} of up to {}{}) into {}",
         report.rendered.start,
         report.rendered.end,
         report.total,
@@ -148,6 +156,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         report.batches,
         if report.batches == 1 { "" } else { "es" },
         report.batch,
+        if report.kept_primaries {
+            ", primary samples kept"
+        } else {
+            ""
+        },
         job.out.display()
     );
     match report.assembled {

@@ -85,28 +85,46 @@ fn assert_same_files(a: &Path, b: &Path) {
 
 #[test]
 fn a_sweep_in_batches_writes_the_same_files_as_one_batch() {
+    use xylem::render::Primaries;
     let dir = tempfile::tempdir().unwrap();
     let scene = tiny_board(dir.path(), 24, 16);
     let s = scene.to_str().unwrap();
-    let one = ok(
-        xylem(dir.path(), &["sweep", s, "--frames", "10", "--out", "one"]),
-        "one batch",
-    );
-    assert!(one.contains("1 batch of up to 10"), "{one}");
-    // A budget of three frames (at the one thread asked for) cuts the sweep into 4 batches.
+    // The path tracer too (its later bounces follow a kept first bounce).
+    let text = std::fs::read_to_string(&scene).unwrap();
+    let path = dir.path().join("path.toml");
+    std::fs::write(&path, text.replace("\"direct\"", "\"path\"")).unwrap();
+    // A budget of three frames (at the one thread asked for) cuts the sweep into 10 batches;
+    // with the kept primary samples' memory on top, `keep` keeps them (`auto` would rather
+    // take the 17 frames that memory holds without them).
     let budget =
         Resources::sweep_fixed_bytes(24, 16, 1) + 3 * Resources::sweep_frame_bytes(24, 16, 1);
+    let kept = (budget + Primaries::bytes(24, 16, 1)).to_string();
     let budget = budget.to_string();
-    let args = ["--threads", "1", "--memory", &budget];
-    let many = ok(
-        xylem(
-            dir.path(),
-            &[&["sweep", s, "--frames", "10", "--out", "many"], &args[..]].concat(),
-        ),
-        "four batches",
-    );
-    assert!(many.contains("4 batches of up to 3"), "{many}");
-    assert_same_files(&dir.path().join("one"), &dir.path().join("many"));
+    for scene in [s, path.to_str().unwrap()] {
+        let sweep = |out: &str, more: &[&str]| {
+            let args = [
+                "sweep",
+                scene,
+                "--frames",
+                "30",
+                "--threads",
+                "1",
+                "--out",
+                out,
+            ];
+            ok(xylem(dir.path(), &[&args[..], more].concat()), out)
+        };
+        let one = sweep("one", &["--memory", "1G"]);
+        assert!(one.contains("1 batch of up to 30)"), "{one}");
+        for (memory, mode, says) in [
+            (&budget, "auto", "10 batches of up to 3)"),
+            (&kept, "keep", "10 batches of up to 3, primary samples kept"),
+        ] {
+            let many = sweep("many", &["--memory", memory, "--primaries", mode]);
+            assert!(many.contains(says), "{many}");
+            assert_same_files(&dir.path().join("one"), &dir.path().join("many"));
+        }
+    }
     // A budget below one frame is refused up front, naming the option and what one frame needs.
     let o = xylem(dir.path(), &["sweep", s, "--memory", "1K", "--out", "no"]);
     let e = String::from_utf8_lossy(&o.stderr);
@@ -126,14 +144,81 @@ fn a_sweep_in_batches_writes_the_same_files_as_one_batch() {
 
 #[test]
 fn the_memory_a_sweep_needs_does_not_grow_with_its_frames() {
+    use xylem::sweep::batch::{default_plan, PrimaryMode, SweepSize};
     // Batches of 48 frames: 48 frames and 100000 need the same memory (the disk still grows).
     let short = Resources::sweep(512, 384, 48, 48, 2);
     let long = Resources::sweep(512, 384, 100_000, 48, 2);
     assert_eq!(short.memory, long.memory);
     assert!(long.disk > 1000 * short.disk);
-    // The batch the default budget allows holds at least one frame of the largest image.
-    let per = xylem::sweep::batch::frames_per_batch(512, 384, 2, 1 << 30).unwrap();
-    assert!((100..2000).contains(&per), "{per} frames per GiB");
+    // The default plan: a 4800-frame sweep holds at most 1.2 times what a 48-frame one holds
+    // (the goal of issue 31), at 256² from 1 to 64 spp and at the board's own 512×384, 16 spp.
+    for (w, h, spp) in [(256, 256, 1), (256, 256, 8), (256, 256, 64), (512, 384, 16)] {
+        let memory = |frames| {
+            let size = SweepSize {
+                width: w,
+                height: h,
+                spp,
+                threads: 2,
+                frames,
+            };
+            let plan = default_plan(&size, PrimaryMode::Auto).unwrap();
+            plan.memory(&size) as f64
+        };
+        let (m48, m4800) = (memory(48), memory(4800));
+        assert!(
+            m4800 <= 1.2 * m48,
+            "{w}x{h} at {spp} spp: 4800 frames plan {m4800} bytes, 48 frames {m48}"
+        );
+    }
+}
+
+/// Runs `xylem ARGS` in `dir` with its output discarded and returns its peak resident memory
+/// in bytes (the child's `ru_maxrss`, from `wait4`).
+#[cfg(target_os = "linux")]
+fn peak_rss(dir: &Path, args: &[&str]) -> u64 {
+    #[allow(clippy::zombie_processes)] // reaped by the wait4 below, which also gives its rusage
+    let child = Command::new(env!("CARGO_BIN_EXE_xylem"))
+        .args(args)
+        .current_dir(dir)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let (mut status, mut usage) = (0, unsafe { std::mem::zeroed::<libc::rusage>() });
+    // SAFETY: waits for our own child; `status` and `usage` are writable.
+    let pid = unsafe { libc::wait4(child.id() as i32, &mut status, 0, &mut usage) };
+    assert!(pid > 0 && libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0);
+    usage.ru_maxrss as u64 * 1024
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn a_long_sweep_peaks_at_the_memory_of_a_short_one_by_default() {
+    // 64×64 at 1 spp: 480 frames held at once would add ≥ 60 MiB (128 KiB of radiance and
+    // error each) to the 48-frame sweep's peak; the default batches keep them level.
+    let dir = tempfile::tempdir().unwrap();
+    let scene = tiny_board(dir.path(), 64, 64);
+    let s = scene.to_str().unwrap();
+    let peak = |n: &str| {
+        let out = format!("out_{n}");
+        let args = [
+            "sweep",
+            s,
+            "--frames",
+            n,
+            "--out",
+            &out,
+            "--quiet",
+            "--threads",
+            "2",
+        ];
+        peak_rss(dir.path(), &args)
+    };
+    let (short, long) = (peak("48"), peak("480"));
+    assert!(
+        (long as f64) < 1.2 * short as f64,
+        "peak RSS {long} bytes for 480 frames, {short} for 48"
+    );
 }
 
 /// `sbatch`, or None (with the reason printed) where Slurm is not installed.

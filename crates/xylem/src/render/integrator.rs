@@ -632,6 +632,38 @@ pub fn light_terms(
     }
 }
 
+/// The light-independent rest of a path's first bounce: the state [`radiance_frames`] reaches
+/// after sampling the BSDF at the first vertex and tracing the ray it gives (throughput, MIS
+/// state, the ray, what it hit, and the lighting stream after the draws), `None` in a
+/// [`FirstBounce`] where the path ended there. Kept with the primary sample, it lets a later
+/// pass over other lights skip that sampling and tracing.
+#[derive(Clone, Debug)]
+pub(crate) struct Continuation {
+    beta: Vec3,
+    prev_pdf: f32,
+    specular: bool,
+    ray: Ray,
+    t_hit: f32,
+    hit: Option<Hit>,
+    rng: Pcg32,
+}
+
+/// One pixel sample kept for later passes: its primary sample and its first bounce's
+/// continuation ([`Continuation`]).
+#[derive(Clone, Debug)]
+pub(crate) struct KeptSample {
+    pub(crate) primary: PrimarySample,
+    pub(crate) next: Option<Continuation>,
+}
+
+/// What [`radiance_frames`] does at the first bounce: trace it, trace it and keep its
+/// continuation, or take a kept one.
+pub(crate) enum FirstBounce<'a> {
+    Trace,
+    Keep(&'a mut Option<Continuation>),
+    Reuse(&'a Option<Continuation>),
+}
+
 /// Scratch of [`radiance_frames`], reused from sample to sample.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct FramesScratch {
@@ -659,6 +691,11 @@ pub(crate) struct FramesScratch {
 /// are worked out: the fixed lights' terms once, the moving light's for all frames at once,
 /// frames in SIMD lanes ([`light_terms`]). Each frame sums its terms in the lights' order, so
 /// it equals the render of that frame alone bit for bit.
+///
+/// `first` keeps the first bounce's light-independent part or takes a kept one
+/// ([`FirstBounce`]): the same values either way, so the same bits. Keeping traces the bounce
+/// even where no frame needs it (every camera ray met a light, or nothing is hittable), since
+/// other frames may.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub(crate) fn radiance_frames(
@@ -671,6 +708,7 @@ pub(crate) fn radiance_frames(
     scratch: &mut FramesScratch,
     out: &mut [Vec3],
     rays: &mut RayCount,
+    mut first: FirstBounce,
 ) {
     let n = lights.len();
     out[..n].fill(Vec3::ZERO);
@@ -704,7 +742,8 @@ pub(crate) fn radiance_frames(
         });
         let vertex = if at_first { &ps.point } else { &bounce };
         let Some(sp) = vertex else { break };
-        if depth >= max_depth || !scratch.alive.contains(&true) {
+        let keeping = at_first && matches!(first, FirstBounce::Keep(_));
+        if depth >= max_depth || (!keeping && !scratch.alive.contains(&true)) {
             break;
         }
         if !sp.bsdf.is_delta() {
@@ -713,10 +752,25 @@ pub(crate) fn radiance_frames(
                 out[k] += beta * scratch.nee[k];
             }
         }
+        let last = depth + 1 >= max_depth;
+        if let (true, FirstBounce::Reuse(kept)) = (at_first, &first) {
+            // The continuation this sample's first bounce had when it was kept.
+            if last && !lights.hittable() {
+                break;
+            }
+            let Some(c) = kept else { break };
+            (beta, prev_pdf, specular, depth) = (c.beta, c.prev_pdf, c.specular, 1);
+            (ray, t_hit, *rng) = (c.ray, c.t_hit, c.rng.clone());
+            at_first = false;
+            bounce = match c.hit {
+                Some(h) if !last => Some(shading_point(scene, &ray, &h, None, 0.0)),
+                _ => None,
+            };
+            continue;
+        }
         let uc = rng.next_f32();
         let u = rng.next_vec2();
-        let last = depth + 1 >= max_depth;
-        if last && !lights.hittable() {
+        if last && !lights.hittable() && !keeping {
             // The continuation could only collect emission, and no ray meets a delta light.
             break;
         }
@@ -747,7 +801,23 @@ pub(crate) fn radiance_frames(
         };
         rays.0 += 1;
         at_first = false;
-        match scene.accel.intersect(&ray, f32::INFINITY) {
+        let hit = scene.accel.intersect(&ray, f32::INFINITY);
+        // Kept once, at the first bounce (then the path goes on as a traced one).
+        if let FirstBounce::Keep(kept) = std::mem::replace(&mut first, FirstBounce::Trace) {
+            *kept = Some(Continuation {
+                beta,
+                prev_pdf,
+                specular,
+                ray,
+                t_hit: hit.map_or(f32::INFINITY, |h| h.t),
+                hit,
+                rng: rng.clone(),
+            });
+            if last && !lights.hittable() {
+                break;
+            }
+        }
+        match hit {
             // The last vertex only needs its distance (emission in front of it), not shading.
             Some(h) if last => (t_hit, bounce) = (h.t, None),
             Some(h) => {

@@ -31,7 +31,7 @@ use crate::material::Material;
 use crate::progress::{NoProgress, Progress};
 use crate::simd::{simd_level, Simd};
 use glam::{UVec2, Vec3};
-use integrator::{radiance_frames, FramesScratch, RayCount, ShadowTest};
+use integrator::{radiance_frames, FirstBounce, FramesScratch, KeptSample, RayCount, ShadowTest};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
@@ -255,6 +255,29 @@ impl Frames {
     }
 }
 
+/// Every pixel sample's light-independent part of a render ([`primary_sample`] and the first
+/// bounce's sampled continuation), tile by tile, kept so that a later pass over other frames of the same scene and settings (a sweep's next
+/// batch) lights these samples again instead of tracing and shading them anew
+/// ([`render_frames_reusing`]). [`Primaries::bytes`] each; a sample is the same value whether
+/// computed or read here, so frames are the same bits either way.
+#[derive(Clone, Debug, Default)]
+pub struct Primaries {
+    /// Per tile (in [`render_frames`]'s order), its pixels' samples, pixel-major.
+    tiles: Vec<Vec<KeptSample>>,
+}
+
+impl Primaries {
+    /// Bytes the primary samples of a `width × height` render at `spp` take.
+    pub fn bytes(width: u32, height: u32, spp: u32) -> u64 {
+        width as u64 * height as u64 * spp as u64 * size_of::<KeptSample>() as u64
+    }
+
+    /// True until a pass has filled it.
+    pub fn is_empty(&self) -> bool {
+        self.tiles.is_empty()
+    }
+}
+
 /// Renders every frame of `lights` at once, tile by tile on a pool of `run.threads` threads.
 ///
 /// Each pixel sample's light-independent part ([`primary_sample`]) and its path are computed
@@ -266,6 +289,23 @@ pub fn render_frames(
     lights: &LightFrames,
     settings: &RenderSettings,
     run: &RunOptions,
+) -> Result<Frames, RenderError> {
+    render_frames_reusing(scene, lights, settings, run, None)
+}
+
+/// [`render_frames`], keeping or reusing the primary samples: with `Some` empty [`Primaries`]
+/// the pass computes them and keeps them there; with `Some` filled ones (from a pass over the
+/// same scene and settings) it reads them instead of computing them; the same frames, bit for
+/// bit, in every case.
+///
+/// # Panics
+/// If filled `primaries` do not have this render's tiles and samples.
+pub fn render_frames_reusing(
+    scene: &Scene,
+    lights: &LightFrames,
+    settings: &RenderSettings,
+    run: &RunOptions,
+    primaries: Option<&mut Primaries>,
 ) -> Result<Frames, RenderError> {
     let (w, h) = (scene.camera.width, scene.camera.height);
     if w == 0 || h == 0 {
@@ -284,6 +324,11 @@ pub fn render_frames(
     let tiles: Vec<UVec2> = (0..h.div_ceil(TILE))
         .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| UVec2::new(tx, ty) * TILE))
         .collect();
+    let keep = primaries.as_ref().is_some_and(|p| p.is_empty());
+    let reuse = primaries.as_deref().filter(|p| !p.is_empty());
+    if let Some(p) = reuse {
+        assert_eq!(p.tiles.len(), tiles.len(), "primaries of another render");
+    }
     let shadow = ShadowTest::culled(&scene.accel);
     let n_tiles = tiles.len() as u64;
     run.progress.start(n_tiles, &progress_unit(lights.len()));
@@ -294,12 +339,18 @@ pub fn render_frames(
     let results: Vec<Option<(UVec2, TileFrames)>> = pool.install(|| {
         tiles
             .par_iter()
-            .map(|&origin| {
+            .enumerate()
+            .map(|(t, &origin)| {
                 if stopped.load(Ordering::Relaxed) || run.progress.stop() {
                     stopped.store(true, Ordering::Relaxed);
                     return None;
                 }
-                let tile = render_tile(scene, lights, &shadow, settings, origin);
+                let primary = match reuse {
+                    Some(p) => Primary::Reuse(&p.tiles[t]),
+                    None if keep => Primary::Keep,
+                    None => Primary::Compute,
+                };
+                let tile = render_tile(scene, lights, &shadow, settings, origin, primary);
                 let total = total_rays.fetch_add(tile.rays, Ordering::Relaxed) + tile.rays;
                 let secs = start.elapsed().as_secs_f64().max(1e-9);
                 let done = tiles_done.fetch_add(1, Ordering::Relaxed) + 1;
@@ -316,7 +367,15 @@ pub fn render_frames(
             total: n_tiles,
         });
     }
-    let results = results.into_iter().flatten();
+    let mut results: Vec<(UVec2, TileFrames)> = results.into_iter().flatten().collect();
+    if keep {
+        if let Some(p) = primaries {
+            p.tiles = results
+                .iter_mut()
+                .map(|(_, t)| std::mem::take(&mut t.kept))
+                .collect();
+        }
+    }
     let n = (w * h) as usize;
     let mut frames: Vec<FrameImage> = (0..lights.len())
         .map(|_| FrameImage {
@@ -363,11 +422,21 @@ fn progress_unit(frames: usize) -> String {
 }
 
 /// One tile's frames (per frame the averaged pixels, an [`Image`] the size of the tile without
-/// AOVs), its AOVs once, and the rays traced.
+/// AOVs), its AOVs once, the rays traced and, when asked to keep them, its primary samples.
 struct TileFrames {
     aov: Vec<Aov>,
     frames: Vec<Image>,
     rays: u64,
+    kept: Vec<KeptSample>,
+}
+
+/// Where a tile's primary samples come from: computed, computed and kept, or read from an
+/// earlier pass (the tile's samples, pixel-major).
+#[derive(Clone, Copy)]
+enum Primary<'a> {
+    Compute,
+    Keep,
+    Reuse(&'a [KeptSample]),
 }
 
 /// One tile for every frame: each (pixel, frame) sums its samples in sample order; the AOVs,
@@ -378,17 +447,20 @@ fn render_tile(
     shadow: &ShadowTest,
     settings: &RenderSettings,
     origin: UVec2,
+    primary: Primary,
 ) -> TileFrames {
     #[cfg(target_arch = "x86_64")]
     match Simd::best() {
         // SAFETY: `Simd::best` detected the level's features on this CPU.
         Simd::Avx512 => {
-            return unsafe { render_tile_avx512(scene, lights, shadow, settings, origin) }
+            return unsafe { render_tile_avx512(scene, lights, shadow, settings, origin, primary) }
         }
-        Simd::Avx2 => return unsafe { render_tile_avx2(scene, lights, shadow, settings, origin) },
+        Simd::Avx2 => {
+            return unsafe { render_tile_avx2(scene, lights, shadow, settings, origin, primary) }
+        }
         Simd::Sse2 | Simd::Scalar => {}
     }
-    render_tile_in(scene, lights, shadow, settings, origin)
+    render_tile_in(scene, lights, shadow, settings, origin, primary)
 }
 
 simd_level! { Avx512
@@ -398,8 +470,9 @@ simd_level! { Avx512
         shadow: &ShadowTest,
         settings: &RenderSettings,
         origin: UVec2,
+        primary: Primary,
     ) -> TileFrames {
-        render_tile_in(scene, lights, shadow, settings, origin)
+        render_tile_in(scene, lights, shadow, settings, origin, primary)
     }
 }
 
@@ -410,8 +483,9 @@ simd_level! { Avx2
         shadow: &ShadowTest,
         settings: &RenderSettings,
         origin: UVec2,
+        primary: Primary,
     ) -> TileFrames {
-        render_tile_in(scene, lights, shadow, settings, origin)
+        render_tile_in(scene, lights, shadow, settings, origin, primary)
     }
 }
 
@@ -425,6 +499,7 @@ fn render_tile_in(
     shadow: &ShadowTest,
     settings: &RenderSettings,
     origin: UVec2,
+    primary: Primary,
 ) -> TileFrames {
     let (w, h) = (scene.camera.width, scene.camera.height);
     let (tw, th) = (TILE.min(w - origin.x), TILE.min(h - origin.y));
@@ -439,25 +514,53 @@ fn render_tile_in(
     let mut scratch = FramesScratch::default();
     let mut rays = RayCount::default();
     let fp_scale = integrator::footprint_scale(settings.spp);
+    let spp = settings.spp as usize;
+    let mut kept = Vec::new();
+    if let Primary::Keep = primary {
+        kept.reserve_exact(n * spp);
+    }
+    if let Primary::Reuse(p) = primary {
+        assert_eq!(p.len(), n * spp, "primaries of another render");
+    }
     for (i, pixel) in (origin.y..origin.y + th)
         .flat_map(|y| (origin.x..origin.x + tw).map(move |x| UVec2::new(x, y)))
         .enumerate()
     {
         for s in 0..settings.spp {
-            let ps = primary_sample(scene, pixel, s, settings.seed, fp_scale);
-            rays.0 += 1;
+            let computed;
+            let (ps, reused) = match primary {
+                Primary::Reuse(p) => {
+                    let k = &p[i * spp + s as usize];
+                    (&k.primary, Some(&k.next))
+                }
+                Primary::Compute | Primary::Keep => {
+                    rays.0 += 1;
+                    computed = primary_sample(scene, pixel, s, settings.seed, fp_scale);
+                    (&computed, None)
+                }
+            };
+            let mut next = None;
+            let first = match (primary, reused) {
+                (_, Some(next)) => FirstBounce::Reuse(next),
+                (Primary::Keep, _) => FirstBounce::Keep(&mut next),
+                _ => FirstBounce::Trace,
+            };
             let mut rng = light_rng(scene, pixel, s, settings.seed);
             radiance_frames(
                 scene,
                 lights,
                 shadow,
-                &ps,
+                ps,
                 &mut rng,
                 max_depth,
                 &mut scratch,
                 &mut radiance,
                 &mut rays,
+                first,
             );
+            if let Primary::Keep = primary {
+                kept.push(KeptSample { primary: *ps, next });
+            }
             for (sum, l) in sums[i * frames..(i + 1) * frames].iter_mut().zip(&radiance) {
                 sum.add(*l);
             }
@@ -472,5 +575,6 @@ fn render_tile_in(
         aov,
         frames,
         rays: rays.0,
+        kept,
     }
 }

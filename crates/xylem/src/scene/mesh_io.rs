@@ -38,7 +38,6 @@ fn bad(path: &Path, message: impl Into<String>) -> MeshError {
 /// refused), or the embedded copy of a built-in scene's mesh where the disk has none
 /// (`crate::builtin`).
 pub fn load_mesh(path: &Path) -> Result<TriMesh, MeshError> {
-    use crate::render::resources::{open_regular, MAX_MESH_BYTES};
     let ext = path
         .extension()
         .and_then(|e| e.to_str())

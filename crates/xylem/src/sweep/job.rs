@@ -2,16 +2,16 @@
 //! or naive), write each frame's EXR, PNG and record, and assemble the sequence once every frame
 //! of the sweep is in the output folder.
 
-use super::batch::{batches, default_budget, frames_per_batch, BudgetError};
+use super::batch::{batches, default_plan, plan, BudgetError, PrimaryMode, SweepSize};
 use super::claim::{claim_for_slice, replace_claim, Claim};
 use super::manifest::{Manifest, MANIFEST_FILE};
 use super::path::{parse_frames_range, PathError};
 use super::path::{SetupError, SweepPath};
+use super::render_naive;
 use super::sequence::{
     assemble, clear_assembled, frame_stem, read_records, unmark_frame, write_record,
     AssembleOptions, Assembled, FrameRecord, Region, SequenceError, SweepSettings,
 };
-use super::{render_naive, render_sweep};
 use crate::output::{remove_if_present, FolderLock, LockError, LockMode};
 use crate::picture::file::commit;
 use crate::picture::png::stage_png_linear;
@@ -20,7 +20,7 @@ use crate::render::image_io::{
     aov_layers, beauty_rgba, stage_exr_layers, write_exr_layers, ExrCompression, ExrLayer,
 };
 use crate::render::resources::{ResourceError, Resources};
-use crate::render::Frames;
+use crate::render::{render_frames_reusing, Frames, Primaries};
 use crate::render::{RenderError, RunOptions};
 use crate::scene::LoadedScene;
 use rayon::prelude::*;
@@ -103,8 +103,10 @@ pub struct SweepJob<'a> {
     /// Skip the memory and disk estimate (`--ignore-limits`).
     pub ignore_limits: bool,
     /// Memory budget in bytes for the frames held at once (`--memory`; default
-    /// [`default_budget`]): frames are rendered and written in batches that fit it.
+    /// [`default_plan`]): frames are rendered and written in batches that fit it.
     pub memory: Option<u64>,
+    /// Whether the primary samples are kept across batches (`--primaries`).
+    pub primaries: PrimaryMode,
     /// What else decides the frames (scene file digest, quality preset), recorded with each frame
     /// so that `--assemble` refuses slices that disagree.
     pub provenance: String,
@@ -123,6 +125,8 @@ pub struct JobReport {
     pub batch: usize,
     /// Batches rendered.
     pub batches: usize,
+    /// Whether the primary samples were kept from the first batch for the others.
+    pub kept_primaries: bool,
     /// Set when every frame was present and the sequence outputs were written.
     pub assembled: Option<Assembled>,
 }
@@ -283,11 +287,21 @@ pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepE
         None => 0..total,
     };
     let cam = &loaded.scene.camera;
-    let budget = job.memory.unwrap_or_else(default_budget);
-    let batch = frames_per_batch(cam.width, cam.height, job.run.threads, budget)?
-        .min(range.len())
-        .max(1);
-    let need = Resources::sweep(cam.width, cam.height, range.len(), batch, job.run.threads);
+    let size = SweepSize {
+        width: cam.width,
+        height: cam.height,
+        spp: loaded.settings.spp,
+        threads: job.run.threads,
+        frames: range.len(),
+    };
+    let mut plan = match job.memory {
+        Some(budget) => plan(&size, budget, job.primaries)?,
+        None => default_plan(&size, job.primaries)?,
+    };
+    plan.keep &= !job.naive;
+    let batch = plan.batch.max(1);
+    let mut need = Resources::sweep(size.width, size.height, size.frames, batch, size.threads);
+    need.memory = plan.memory(&size);
     need.check(&job.out, job.ignore_limits)?;
     std::fs::create_dir_all(&job.out).map_err(|cause| SweepError::OutDir {
         path: job.out.display().to_string(),
@@ -331,24 +345,20 @@ pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepE
         clear_frames(&job.out)?;
         replace_claim(&job.out, &claim)?;
     }
-    let render = if job.naive {
-        render_naive
-    } else {
-        render_sweep
-    };
     let regions = scene_regions(loaded);
     let header = frame_header(loaded, &path, moving);
     let (mut render_time, mut n_batches) = (Duration::ZERO, 0);
+    let mut primaries = Primaries::default();
     // Each batch is written before the next is rendered, so only one batch is ever held.
     for frames in batches(range.clone(), batch) {
-        let r = render(
-            &loaded.scene,
-            &loaded.settings,
-            &path,
-            moving,
-            frames.clone(),
-            &job.run,
-        )?;
+        let (scene, look, run) = (&loaded.scene, &loaded.settings, &job.run);
+        let r = if job.naive {
+            render_naive(scene, look, &path, moving, frames.clone(), run)?
+        } else {
+            let lights = path.light_frames(&scene.lights, moving, frames.clone());
+            let kept = plan.keep.then_some(&mut primaries);
+            render_frames_reusing(scene, &lights, look, run, kept)?
+        };
         render_time += r.elapsed;
         n_batches += 1;
         write_frames(
@@ -384,6 +394,7 @@ pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepE
         render_time,
         batch,
         batches: n_batches,
+        kept_primaries: plan.keep,
         assembled,
     })
 }
