@@ -16,9 +16,6 @@ const GOLDEN_ANGLE: f32 = 2.399_963;
 /// How much further the branch collar (`KnotParams::swell`) reaches along the trunk than across.
 const SWELL_ELONGATION: f32 = 2.0;
 
-/// Width of the bark rim around a dead knot, mm.
-const BARK_RIM: f32 = 0.4;
-
 /// Knot layout and time fields, precomputed from [`KnotParams`].
 #[derive(Clone, Debug)]
 pub struct Knots {
@@ -38,6 +35,8 @@ pub struct Knots {
     /// Largest lowering of the trunk time round a knot (years; 0: none) and its fade width (mm).
     swell: f32,
     inv_swell_width: f32,
+    /// Bark rim round a dead knot, mm.
+    bark_width: f32,
     seed: u64,
 }
 
@@ -77,6 +76,7 @@ impl Knots {
             darkening: p.darkening,
             swell: p.swell,
             inv_swell_width: 1.0 / p.swell_width,
+            bark_width: p.bark_width,
             seed,
         }
     }
@@ -194,7 +194,7 @@ impl Knots {
                 let radius = death / self.inv_branch_ring;
                 if t_branch < t_trunk && t_branch <= death {
                     knot(t_branch, 1.0, 0.0, radius)
-                } else if t_trunk > death && rho < radius + BARK_RIM {
+                } else if t_trunk > death && rho < radius + self.bark_width {
                     knot(t_trunk, 0.0, 1.0, radius)
                 } else {
                     knot(t_trunk, 0.0, 0.0, radius.min(radius_live))
@@ -267,6 +267,7 @@ mod tests {
             darkening: 0.5,
             swell: 0.0,
             swell_width: 20.0,
+            bark_width: 0.4,
         }
     }
 
@@ -330,6 +331,31 @@ mod tests {
     }
 
     #[test]
+    fn bark_rim_is_as_wide_as_asked() {
+        let w = 4.0;
+        let rim_at = |bark_width: f32, d: f32| {
+            let knots = Knots::new(
+                &KnotParams {
+                    bark_width,
+                    ..params(Some(10.0))
+                },
+                w,
+                1,
+            );
+            let (o, a, _) = knots.branch(0, 0.0);
+            let side = a.cross(Vec3::Z).normalize();
+            let radius = at(&knots, o + a * 150.0, w).unwrap().radius;
+            at(&knots, o + a * 150.0 + side * (radius + d), w)
+                .unwrap()
+                .bark
+        };
+        // 1 mm outside the knot: bark under a 1.5 mm rim, trunk wood under the 0.4 mm default.
+        assert_eq!(rim_at(1.5, 1.0), 1.0);
+        assert_eq!(rim_at(0.4, 1.0), 0.0);
+        assert_eq!(rim_at(1.5, 1.6), 0.0);
+    }
+
+    #[test]
     fn deflected_fibre_is_tangent_on_the_boundary() {
         let (w, death) = (4.0, 10.0);
         let knots = Knots::new(&params(Some(death)), w, 1);
@@ -340,12 +366,17 @@ mod tests {
         let s = 150.0;
         let radius = at(&knots, o + a * s, w).unwrap().radius;
         for e in [side, -side, up] {
-            let k = at(&knots, o + a * s + e * (radius + BARK_RIM + 1e-3), w).unwrap();
+            let k = at(
+                &knots,
+                o + a * s + e * (radius + knots.bark_width + 1e-3),
+                w,
+            )
+            .unwrap();
             assert_eq!((k.inside, k.bark), (0.0, 0.0));
             // A trunk fibre with a component across the knot is turned along its boundary: no
             // component along the offset e (potential flow is tangent on the cylinder).
             let u = knots.deflect_fiber(Vec3::new(0.0, 0.6, 0.8).normalize(), &k);
-            let tangent_ratio = (radius / (radius + BARK_RIM)).powi(2);
+            let tangent_ratio = (radius / (radius + knots.bark_width)).powi(2);
             assert!(
                 u.dot(e).abs() < 0.02 + (1.0 - tangent_ratio),
                 "{e}: u·e = {}",

@@ -390,6 +390,10 @@ pub struct KnotParams {
     /// Distance from the knot's surface over which the swell fades, mm.
     #[serde(default = "swell_width", skip_serializing_if = "is_swell_width")]
     pub swell_width: f32,
+    /// Thickness of the bark rim round a dead knot, mm: the branch's bark, which the trunk grew
+    /// over when the branch died (an encased knot's dark ring).
+    #[serde(default = "bark_width", skip_serializing_if = "is_bark_width")]
+    pub bark_width: f32,
 }
 
 fn is_zero(v: &f32) -> bool {
@@ -400,6 +404,12 @@ fn swell_width() -> f32 {
 }
 fn is_swell_width(v: &f32) -> bool {
     *v == 20.0
+}
+fn bark_width() -> f32 {
+    0.4
+}
+fn is_bark_width(v: &f32) -> bool {
+    *v == 0.4
 }
 
 fn one() -> f32 {
@@ -639,6 +649,7 @@ impl WoodParams {
             c.range("knots.darkening", k.darkening, 0.0, 10.0)?;
             c.range("knots.swell", k.swell, 0.0, 50.0)?;
             c.range("knots.swell_width", k.swell_width, 0.5, 500.0)?;
+            c.range("knots.bark_width", k.bark_width, 0.0, 20.0)?;
         }
         if let Some(e) = &self.eyes {
             c.range("eyes.density", e.density, 0.0, 10.0)?;
