@@ -14,11 +14,13 @@ fn maps_of_an_incomplete_or_mixed_fit_are_refused() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
     small_capture(dir);
-    for (out, texels) in [("f", "8"), ("g", "6")] {
-        let o = xylem(
-            &["fit", "cap", "--out", out, "--quiet", "--texels", texels],
-            dir,
-        );
+    // Another fit of the same size (a map of another size is refused before its record is
+    // read, as the wrong size): from a capture of 4 frames an arc.
+    let sweep = ["sweep", "fit_maple_sweep", "--frames", "4", "--spp", "1"];
+    let o = xylem(&[&sweep[..], &["--quiet", "--out", "cap4"]].concat(), dir);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for (cap, out) in [("cap", "f"), ("cap4", "g")] {
+        let o = xylem(&["fit", cap, "--out", out, "--quiet", "--texels", "8"], dir);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     }
     let repo = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."));

@@ -146,12 +146,16 @@ fn fit_refuses_hostile_frames_and_manifests_at_once() {
     std::fs::write(cap.join("hostile.png"), png_declaring(65535, 65535, 8, 2)).unwrap();
     set_first_frame(&cap, "hostile.png");
     assert_refused(&xylem(&fit, tmp.path()), &["hostile.png", "65535x65535"]);
-    // One within the pixel limit but beyond the memory left under the 4 GiB cap: 16384² of
-    // 16-bit RGBA (8 bytes) decoded, and 12 bytes of linear RGB each.
+    // One within the pixel limit (16384² of 16-bit RGBA: 5 GiB to decode) is refused on its
+    // header too, not being the camera's size (before: decoded, then compared; with the size
+    // left unchecked, "needs about 5.0 GiB of memory" under the 4 GiB cap).
     std::fs::write(cap.join("big.png"), png_declaring(16384, 16384, 16, 6)).unwrap();
     set_first_frame(&cap, "big.png");
     let o = xylem(&fit, tmp.path());
-    assert_refused(&o, &["big.png", "16384x16384", "of memory"]);
+    assert_refused(
+        &o,
+        &["big.png", "declares 16384x16384", "camera is 512x512"],
+    );
     // A FIFO as a frame.
     mkfifo(&cap.join("fifo.exr"));
     set_first_frame(&cap, "fifo.exr");
@@ -167,17 +171,148 @@ fn fit_refuses_hostile_frames_and_manifests_at_once() {
     assert!(!tmp.path().join("fitted").exists());
 }
 
+/// Runs the binary in `dir` (no cap) and returns (exit code, stderr, peak resident set in MiB),
+/// the peak from `wait4`'s resource usage of that one child (which `wait4` reaps: hence the
+/// lint's allowance).
+#[allow(clippy::zombie_processes)]
+fn xylem_peak(args: &[&str], dir: &Path) -> (Option<i32>, String, u64) {
+    use std::io::Read;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_xylem"))
+        .args(args)
+        .current_dir(dir)
+        .env("RUST_BACKTRACE", "0")
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut err = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    let mut status = 0;
+    // SAFETY: `rusage` is plain integers, for which all zeros is a value.
+    let mut usage = unsafe { std::mem::zeroed::<libc::rusage>() };
+    // SAFETY: waits for the child this test started (not reaped by `Child`, which is dropped
+    // unwaited), with a writable status and rusage.
+    let pid = unsafe { libc::wait4(child.id() as i32, &mut status, 0, &mut usage) };
+    assert_eq!(pid, child.id() as i32);
+    let code = libc::WIFEXITED(status).then(|| libc::WEXITSTATUS(status));
+    (code, err, usage.ru_maxrss as u64 / 1024)
+}
+
+/// [`xylem_peak`] refused with exit status 1, naming every needle, at a peak resident set
+/// under 200 MiB (nothing the size of the declared image was allocated).
+fn refused_lean(args: &[&str], dir: &Path, needles: &[&str]) {
+    let (code, e, peak_mib) = xylem_peak(args, dir);
+    assert_eq!(code, Some(1), "{e}");
+    for n in needles {
+        assert!(e.contains(n), "the error does not name `{n}`: {e}");
+    }
+    assert!(peak_mib < 200, "{args:?}: peak RSS {peak_mib} MiB: {e}");
+}
+
+/// A quick render of `scene` into `o`.
+fn render_args(scene: &str) -> [&str; 9] {
+    [
+        "render", scene, "--res", "4x4", "--spp", "1", "--quiet", "--out", "o",
+    ]
+}
+
+/// The maple board's scene with its `map` (e.g. `fiber_axis`) replaced by the file `to` and its
+/// other maps named by absolute paths into the repository.
+fn board(map: &str, to: &str) -> String {
+    let repo = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."));
+    let text = std::fs::read_to_string(repo.join("scenes/measured_maple_sweep.toml")).unwrap();
+    let text = text.replace(&format!("../data/marschner2005/maple/{map}.png"), to);
+    text.replace("../data/", &format!("{}/data/", repo.display()))
+}
+
+/// Issue 26, item 2: a small file declaring a large image of the wrong size is refused on its
+/// header, before the decoder allocates its pixels — a fit's frame must be the manifest's camera
+/// size, a measured map the diffuse map's — and a measured board's first map answers for the
+/// memory of the whole board (48 bytes a texel), not of its own decoding (6). Before: a 200 KB
+/// 8192² PNG as a fit frame was decoded (peak RSS 998 MB, 1.3 s) and only then found the wrong
+/// size; as a fibre-axis map, 405 MB.
+#[test]
+fn images_of_the_wrong_size_are_refused_on_their_header() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let cap = capture(dir);
+    // A real, valid 8192² PNG of 200 KB (a flat grey compresses 1000:1).
+    let side = 8192;
+    let band_rows = 256;
+    xylem::picture::png::write_png_bands(
+        &cap.join("wide.png"),
+        (side, side),
+        (side / band_rows) as usize,
+        |_| {
+            Ok(xylem::picture::contact::Rgb8 {
+                width: side,
+                height: band_rows,
+                data: vec![64; (side * band_rows * 3) as usize],
+            })
+        },
+    )
+    .unwrap();
+    assert!(std::fs::metadata(cap.join("wide.png")).unwrap().len() < 1 << 20);
+    set_first_frame(&cap, "wide.png");
+    let fit = ["fit", "cap", "--out", "fitted", "--quiet", "--texels", "8"];
+    refused_lean(
+        &fit,
+        dir,
+        &[
+            "wide.png",
+            "frames[0].image",
+            "declares 8192x8192",
+            "camera is 512x512",
+        ],
+    );
+    // An EXR frame of the wrong size (433 bytes declaring 4096²), refused on its header too.
+    std::fs::write(cap.join("other.exr"), exr_declaring(4096)).unwrap();
+    set_first_frame(&cap, "other.exr");
+    let o = xylem(&fit, dir);
+    assert_refused(
+        &o,
+        &["other.exr", "declares 4096x4096", "camera is 512x512"],
+    );
+
+    // Measured maps: the fibre axis 8192² beside a 256² diffuse map.
+    std::fs::write(dir.join("axis.toml"), board("fiber_axis", "cap/wide.png")).unwrap();
+    let needles = [
+        "fiber_axis map",
+        "wide.png is 8192x8192",
+        "the diffuse map is",
+    ];
+    refused_lean(&render_args("axis.toml"), dir, &needles);
+    // A diffuse map of 16384x8192 texels: 0.8 GB to decode alone, but the board needs about
+    // 6 GiB, beyond the 4 GiB cap: refused before reading (before: decoded, then out of memory).
+    std::fs::write(
+        dir.join("wide_diffuse.png"),
+        png_declaring(16384, 8192, 8, 2),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("diffuse.toml"),
+        board("diffuse", "wide_diffuse.png"),
+    )
+    .unwrap();
+    let o = xylem(&render_args("diffuse.toml"), dir);
+    assert_refused(
+        &o,
+        &["diffuse map", "wide_diffuse.png", "16384x8192", "of memory"],
+    );
+}
+
 #[test]
 fn scenes_refuse_fifos_as_scene_mesh_and_map() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
     let repo = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."));
-    let render = |scene: &str| {
-        let args = [
-            "render", scene, "--res", "4x4", "--spp", "1", "--quiet", "--out", "o",
-        ];
-        xylem(&args, dir)
-    };
+    let render = |scene: &str| xylem(&render_args(scene), dir);
     mkfifo(&dir.join("fifo.toml"));
     assert_refused(&render("fifo.toml"), &["fifo.toml", "a FIFO"]);
     std::os::unix::fs::symlink("/dev/zero", dir.join("zero.toml")).unwrap();
@@ -201,11 +336,6 @@ fn scenes_refuse_fifos_as_scene_mesh_and_map() {
     std::fs::write(dir.join("mesh.toml"), text).unwrap();
     assert_refused(&render("mesh.toml"), &["fifo.obj", "a FIFO"]);
     // The measured board's scene, its maps named by absolute paths but for `map`.
-    let board = |map: &str, to: &str| {
-        let text = std::fs::read_to_string(repo.join("scenes/measured_maple_sweep.toml")).unwrap();
-        let text = text.replace(&format!("../data/marschner2005/maple/{map}.png"), to);
-        text.replace("../data/", &format!("{}/data/", repo.display()))
-    };
     let text = board("fiber_axis", "fifo.png");
     std::fs::write(dir.join("map.toml"), text).unwrap();
     assert_refused(&render("map.toml"), &["fifo.png", "fiber_axis", "a FIFO"]);

@@ -1,7 +1,8 @@
 //! Multi-file outputs are committed as a set (issue 26): `bake` killed at points spread over its
 //! run never leaves files of two runs side by side, its record `bake.json` (written last)
-//! verifies whenever present, the next run removes the temporaries of killed runs, and SIGINT
-//! or SIGTERM remove the run's own.
+//! verifies whenever present, the next run removes the temporaries of killed runs, SIGINT or
+//! SIGTERM remove the run's own, and a `bake` or `fit` whose writes fail part-way (a full disk)
+//! leaves the previous set whole.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -229,5 +230,87 @@ fn old_format_temporaries_of_dead_runs_are_removed_by_the_next_run() {
     }
     for name in &kept {
         assert!(out.join(name).exists(), "{name} was removed");
+    }
+}
+
+/// `cmd` (a `bake` or `fit` into `out`) run under a file-size limit of `kib` KiB (`ulimit -f`,
+/// with SIGXFSZ ignored so that a write past it fails with EFBIG, as on a full disk).
+fn capped(cmd: &Command, kib: u64) -> std::process::Output {
+    Command::new("bash")
+        .arg("-c")
+        .arg(format!("trap '' XFSZ; ulimit -f {kib}; exec \"$0\" \"$@\""))
+        .arg(cmd.get_program())
+        .args(cmd.get_args())
+        .current_dir(cmd.get_current_dir().unwrap_or(Path::new(".")))
+        .env("RUST_BACKTRACE", "0")
+        .output()
+        .unwrap()
+}
+
+/// Issue 26, item 4: a write that fails part-way (a full disk; here a file-size limit, so that
+/// the members up to some size are staged and the next fails) leaves the previous complete set
+/// as it was — every file, the record verifying — and no temporary, for `bake` and `fit`, the
+/// failure placed at each member in turn. Before: `bake` on a full disk left 5 maps of the
+/// failed run under their final names beside the old ones.
+#[test]
+fn a_write_failing_part_way_leaves_the_previous_set_whole() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    #[path = "common/capture.rs"]
+    mod common_capture;
+    common_capture::small_capture(dir);
+    let fit = |texels: &str| {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_xylem"));
+        c.args(["fit", "cap", "--out", "f", "--quiet", "--texels", texels])
+            .current_dir(dir);
+        c
+    };
+    let cases = [
+        (
+            bake(1, &dir.join("b")),
+            bake(2, &dir.join("b")),
+            "bake.json",
+        ),
+        (fit("64"), fit("48"), "fit.json"),
+    ];
+    for (first, second, record) in cases {
+        let out = dir.join(if record == "fit.json" { "f" } else { "b" });
+        assert!(capped(&first, 1 << 30).status.success());
+        let (mut before, _) = listing(&out);
+        let mut sizes: Vec<u64> = before.values().map(|b| b.len() as u64).collect();
+        sizes.sort_unstable();
+        sizes.dedup();
+        let mut failed = 0;
+        for size in sizes.iter().filter(|&&s| s >= 2048) {
+            // Just under this member's size: it and every larger one cannot be written.
+            let o = capped(&second, (size - 1) / 1024);
+            let e = String::from_utf8_lossy(&o.stderr);
+            assert!(!e.contains("panicked"), "{e}");
+            if o.status.success() {
+                // The second run's files happen to fit: a whole set; the first one back.
+                verify_set(&out, record).unwrap();
+                assert!(capped(&first, 1 << 30).status.success());
+                before = listing(&out).0;
+                continue;
+            }
+            failed += 1;
+            assert_eq!(o.status.code(), Some(1), "{e}");
+            assert!(e.contains("File too large"), "{e}");
+            let (files, hidden) = listing(&out);
+            assert!(
+                files == before,
+                "{record}, limit {size} B: the set changed: {e}"
+            );
+            assert!(hidden.is_empty(), "{record}: temporaries left: {hidden:?}");
+            verify_set(&out, record).unwrap();
+        }
+        eprintln!(
+            "{record}: {failed} of {} limits failed the run",
+            sizes.len()
+        );
+        assert!(
+            failed >= 3,
+            "{record}: only {failed} limits made the run fail"
+        );
     }
 }

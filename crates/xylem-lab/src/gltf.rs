@@ -217,6 +217,7 @@ fn read_glb(bytes: &[u8]) -> Result<GlbBoard, String> {
             png,
             png::Transformations::IDENTITY,
             0,
+            &xylem::render::resources::any_size,
         )?;
         images.push((name, info.width, info.height, buf));
     }

@@ -5,7 +5,7 @@
 
 use crate::math::Vec3;
 use crate::picture::srgb::srgb_to_linear;
-use crate::render::image_io::read_exr_rgb;
+use crate::render::image_io::read_exr_rgb_checked;
 use crate::sweep::claim::CLAIM_FILE;
 use crate::sweep::manifest::{Manifest, MANIFEST_FILE};
 use std::path::{Path, PathBuf};
@@ -602,20 +602,29 @@ impl Capture {
             .and_then(|e| e.to_str())
             .unwrap_or("")
             .to_ascii_lowercase();
+        // Checked on the header, before a pixel is decoded: a small file declaring a large
+        // image must not cost its decoded size first.
+        let camera = (self.camera.width, self.camera.height);
+        let size_ok = |w: u32, h: u32| -> Result<(), String> {
+            match (w, h) == camera {
+                true => Ok(()),
+                false => Err(format!(
+                    "declares {w}x{h} pixels, the manifest's camera is {}x{} (allowed: every frame the camera's size)",
+                    camera.0, camera.1
+                )),
+            }
+        };
         let (w, h, mut px) = match ext.as_str() {
             "exr" => {
-                let (w, h, px) = read_exr_rgb(path).map_err(|e| fail(e.to_string()))?;
+                let (w, h, px) =
+                    read_exr_rgb_checked(path, &size_ok).map_err(|e| fail(e.to_string()))?;
                 (w as u32, h as u32, px)
             }
-            "png" => read_png(path, self.srgb).map_err(fail)?,
+            "png" => read_png(path, self.srgb, &size_ok).map_err(fail)?,
             other => return Err(fail(format!("extension `{other}` (allowed .exr, .png)"))),
         };
-        if (w, h) != (self.camera.width, self.camera.height) {
-            return Err(fail(format!(
-                "is {w}x{h}, the manifest's camera is {}x{} (allowed: every frame the camera's size)",
-                self.camera.width, self.camera.height
-            )));
-        }
+        // The decoder read the size it checked; a file replaced in between is caught here.
+        size_ok(w, h).map_err(fail)?;
         if let Some(clip) = self.clip {
             for p in &mut px {
                 if p.max_element() >= clip {
@@ -634,7 +643,11 @@ impl Capture {
 
 /// An 8- or 16-bit PNG as linear RGB (sRGB decoded when `srgb`, IEC 61966-2-1), each channel
 /// v / (2^bits − 1) first.
-fn read_png(path: &Path, srgb: bool) -> Result<(u32, u32, Vec<Vec3>), String> {
+fn read_png(
+    path: &Path,
+    srgb: bool,
+    size_ok: crate::render::resources::SizeCheck,
+) -> Result<(u32, u32, Vec<Vec3>), String> {
     use crate::picture::png::{decode_png, open_png};
     let px_bytes = std::mem::size_of::<Vec3>() as u64;
     let (info, buf) = decode_png(
@@ -642,6 +655,7 @@ fn read_png(path: &Path, srgb: bool) -> Result<(u32, u32, Vec<Vec3>), String> {
         open_png(path)?,
         png::Transformations::EXPAND,
         px_bytes,
+        size_ok,
     )?;
     let channels = info.color_type.samples();
     let sixteen = info.bit_depth == png::BitDepth::Sixteen;

@@ -6,6 +6,7 @@ use super::contact::Rgb8;
 use super::file::{commit, stage, ImageError};
 use super::srgb::to_srgb8;
 use crate::output::Staged;
+use crate::render::resources::{any_size, SizeCheck};
 use glam::Vec3;
 use std::path::Path;
 
@@ -311,17 +312,20 @@ pub fn write_png_bands(
 /// ICC profiles): the png crate's default of 64 MiB, stated here so that it stays bounded.
 const PNG_DECODER_BYTES: usize = 64 << 20;
 
-/// A PNG decoded into one buffer after its header's size was checked: the decoded buffer plus
-/// `extra_bytes_per_pixel` (what the caller builds from it) must pass
-/// [`check_image`](crate::render::resources::check_image) before anything is allocated.
+/// A PNG decoded into one buffer after its header's size was checked: the declared size must
+/// pass `size_ok` (the size the caller expects, e.g. the camera's for a fit's frame), and the
+/// decoded buffer plus `extra_bytes_per_pixel` (what the caller builds from it) must pass
+/// [`check_image`](crate::render::resources::check_image), before anything is allocated.
 /// Errors name no file: callers do.
 pub fn decode_png(
     path: &Path,
     input: impl std::io::Read,
     transformations: png::Transformations,
     extra_bytes_per_pixel: u64,
+    size_ok: SizeCheck,
 ) -> Result<(png::OutputInfo, Vec<u8>), String> {
-    decode_png_text(path, input, transformations, extra_bytes_per_pixel).map(|(i, b, _)| (i, b))
+    decode_png_text(path, input, transformations, extra_bytes_per_pixel, size_ok)
+        .map(|(i, b, _)| (i, b))
 }
 
 /// A PNG's `tEXt` chunks: (keyword, text).
@@ -333,6 +337,7 @@ pub fn decode_png_text(
     input: impl std::io::Read,
     transformations: png::Transformations,
     extra_bytes_per_pixel: u64,
+    size_ok: SizeCheck,
 ) -> Result<(png::OutputInfo, Vec<u8>, PngText), String> {
     let limits = png::Limits {
         bytes: PNG_DECODER_BYTES,
@@ -351,6 +356,7 @@ pub fn decode_png_text(
         1
     };
     let decoded = color.samples() as u64 * sample_bytes;
+    size_ok(w, h)?;
     crate::render::resources::check_image(
         path,
         w as u64,
@@ -376,6 +382,11 @@ pub fn open_png(path: &Path) -> Result<std::io::Take<std::fs::File>, String> {
 /// Reads an 8-bit PNG as RGB: RGBA loses its alpha, grey is repeated in R, G and B, palettes
 /// are expanded and 16-bit samples keep their high byte.
 pub fn read_png_rgb8(path: &Path) -> Result<Rgb8, ImageError> {
+    read_png_rgb8_checked(path, &any_size)
+}
+
+/// [`read_png_rgb8`] refusing, before decoding, a declared size that fails `size_ok`.
+pub fn read_png_rgb8_checked(path: &Path, size_ok: SizeCheck) -> Result<Rgb8, ImageError> {
     let name = path.display().to_string();
     let invalid = |what: String| ImageError::Invalid {
         path: name.clone(),
@@ -386,6 +397,7 @@ pub fn read_png_rgb8(path: &Path) -> Result<Rgb8, ImageError> {
         open_png(path).map_err(invalid)?,
         png::Transformations::EXPAND | png::Transformations::STRIP_16,
         3,
+        size_ok,
     )
     .map_err(invalid)?;
     let data = match info.color_type {

@@ -2,6 +2,7 @@
 //! not at all ([`crate::picture::file::stage`]) and byte-identical for equal input; PNG files are
 //! [`crate::picture::png`]'s.
 
+use super::resources::{any_size, SizeCheck};
 use crate::output::Staged;
 use crate::picture::file::{commit, stage, ImageError};
 use glam::Vec3;
@@ -350,9 +351,11 @@ fn exr_read_failed(path: &Path, message: impl ToString) -> ImageError {
 /// [`MAX_IMAGE_BYTES`](super::resources::MAX_IMAGE_BYTES) or a layer whose declared size fails
 /// [`check_image`](super::resources::check_image) with 8 bytes per channel (the decoded
 /// samples and a float copy of them) plus `extra_bytes_per_pixel` (what the caller builds).
+/// Every layer's declared size must also pass `size_ok` (the size the caller expects).
 fn open_exr(
     path: &Path,
     extra_bytes_per_pixel: u64,
+    size_ok: SizeCheck,
 ) -> Result<exr::block::reader::Reader<std::io::BufReader<std::fs::File>>, ImageError> {
     use super::resources::{check_image, open_regular, MAX_IMAGE_BYTES};
     use std::io::{BufReader, Seek};
@@ -362,8 +365,10 @@ fn open_exr(
         .map_err(|e| fail(e.to_string()))?;
     for h in &meta.headers {
         let bytes = 8 * h.channels.list.len() as u64 + extra_bytes_per_pixel;
-        let (w, ht) = (h.layer_size.width() as u64, h.layer_size.height() as u64);
-        check_image(path, w, ht, bytes).map_err(|e| fail(e.reason()))?;
+        let (w, ht) = (h.layer_size.width(), h.layer_size.height());
+        let side = |v: usize| u32::try_from(v).unwrap_or(u32::MAX);
+        size_ok(side(w), side(ht)).map_err(fail)?;
+        check_image(path, w as u64, ht as u64, bytes).map_err(|e| fail(e.reason()))?;
     }
     file.rewind().map_err(|e| fail(e.to_string()))?;
     exr::block::read(BufReader::new(file), false).map_err(|e| fail(e.to_string()))
@@ -372,8 +377,16 @@ fn open_exr(
 /// Reads the RGB channels of the first layer of an EXR (alpha ignored): (width, height, pixels).
 /// The declared size is checked before decoding.
 pub fn read_exr_rgb(path: &Path) -> Result<(usize, usize, Vec<Vec3>), ImageError> {
+    read_exr_rgb_checked(path, &any_size)
+}
+
+/// [`read_exr_rgb`] refusing, before decoding, a layer whose declared size fails `size_ok`.
+pub fn read_exr_rgb_checked(
+    path: &Path,
+    size_ok: SizeCheck,
+) -> Result<(usize, usize, Vec<Vec3>), ImageError> {
     use exr::prelude::*;
-    let chunks = open_exr(path, std::mem::size_of::<Vec3>() as u64)?;
+    let chunks = open_exr(path, std::mem::size_of::<Vec3>() as u64, size_ok)?;
     let img = read()
         .no_deep_data()
         .largest_resolution_level()
@@ -402,7 +415,7 @@ fn read_exr_layer(
     path: &Path,
 ) -> Result<exr::prelude::Layer<exr::prelude::AnyChannels<exr::prelude::FlatSamples>>, ImageError> {
     use exr::prelude::*;
-    let chunks = open_exr(path, 0)?;
+    let chunks = open_exr(path, 0, &any_size)?;
     let img = read()
         .no_deep_data()
         .largest_resolution_level()

@@ -404,6 +404,17 @@ pub const MAX_IMAGE_PIXELS: u64 = 1 << 28;
 /// EXR is 17 GiB.
 pub const MAX_IMAGE_BYTES: u64 = 20 << 30;
 
+/// A check of an image's declared size (width, height) made on its header alone, before a pixel
+/// is decoded or its buffer allocated: a fit's frame must be the manifest's camera size, a
+/// measured map the diffuse map's, a sweep frame its record's. `Err` says why, naming the
+/// declared size; the caller names the file.
+pub type SizeCheck<'a> = &'a dyn Fn(u32, u32) -> Result<(), String>;
+
+/// A [`SizeCheck`] that takes any size ([`check_image`] still bounds it).
+pub fn any_size(_: u32, _: u32) -> Result<(), String> {
+    Ok(())
+}
+
 /// Checks an image's declared size before it is decoded: each side 1 to [`MAX_IMAGE_SIDE`],
 /// at most [`MAX_IMAGE_PIXELS`] pixels, and `bytes_per_pixel` × pixels (what the decoder and
 /// the caller allocate for it) within the available memory.

@@ -8,7 +8,9 @@ use super::viewer::viewer_html;
 use crate::math::{luminance, Vec3};
 use crate::output::{remove_if_present, write_atomic};
 use crate::picture::contact::{sheet_band, sheet_columns, shrunk_size, Rgb8};
-use crate::picture::png::{read_png_rgb8, write_apng_streamed, write_png_bands, write_png_linear};
+use crate::picture::png::{
+    read_png_rgb8_checked, write_apng_streamed, write_png_bands, write_png_linear,
+};
 use crate::picture::ImageError;
 use crate::render::resources::read_text_bounded;
 use serde::{Deserialize, Serialize};
@@ -513,16 +515,21 @@ pub fn assemble(dir: &Path, opts: &AssembleOptions) -> Result<Assembled, Sequenc
     let anim = shrunk_size(w, h, opts.animation_width);
     let read = |r: &FrameRecord| -> Result<Rgb8, ImageError> {
         let path = dir.join(format!("{}.png", frame_stem(r.index)));
-        let img = read_png_rgb8(&path)?;
-        if (img.width, img.height) != (r.width, r.height) {
-            return Err(ImageError::Invalid {
-                path: path.display().to_string(),
-                what: format!(
-                    "is {}x{} but its record says {}x{}",
-                    img.width, img.height, r.width, r.height
-                ),
-            });
-        }
+        // The record's size is checked on the header, before the frame is decoded.
+        let size_ok = |w: u32, h: u32| -> Result<(), String> {
+            match (w, h) == (r.width, r.height) {
+                true => Ok(()),
+                false => Err(format!(
+                    "is {w}x{h} but its record says {}x{}",
+                    r.width, r.height
+                )),
+            }
+        };
+        let img = read_png_rgb8_checked(&path, &size_ok)?;
+        size_ok(img.width, img.height).map_err(|what| ImageError::Invalid {
+            path: path.display().to_string(),
+            what,
+        })?;
         Ok(img)
     };
     let labels: Vec<String> = records
