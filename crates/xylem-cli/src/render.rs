@@ -33,6 +33,11 @@ pub struct Args {
     /// Random seed (overrides render.seed).
     #[arg(long)]
     seed: Option<u64>,
+    /// Before rendering, print which wood features the scene skips and why: per wood material,
+    /// the smallest pixel footprint its objects get from the camera and each fine feature (pores,
+    /// rays, cell texture) kept, fading or skipped (faded to its mean in every pixel).
+    #[arg(long)]
+    explain: bool,
     /// Do not show the progress bar.
     #[arg(long)]
     quiet: bool,
@@ -43,6 +48,47 @@ pub struct Args {
     /// text lines): scene, settings, camera, time, rays, outputs, image statistics.
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
+}
+
+/// The `--explain` text: what [`xylem::render::lod::plan`] finds for every wood material.
+pub(crate) fn explain(scene: &xylem::render::Scene, spp: u32) -> String {
+    use xylem::render::lod::{plan, Detail};
+    let plans = plan(scene, spp);
+    if plans.is_empty() {
+        return "explain: no procedural wood in view, nothing to skip\n".into();
+    }
+    let mut s = String::new();
+    for p in plans {
+        let fp = if p.footprint.is_infinite() {
+            "no object in view".to_string()
+        } else if p.footprint == 0.0 {
+            "footprint filter off or an object at the eye: every feature kept".to_string()
+        } else {
+            format!("smallest pixel footprint {:.3} mm of wood", p.footprint)
+        };
+        s += &format!(
+            "explain: material #{} ({} object{}): {fp}\n",
+            p.material,
+            p.objects,
+            if p.objects == 1 { "" } else { "s" }
+        );
+        for f in &p.features {
+            let why = match f.detail {
+                Detail::Skipped => format!(
+                    "skipped: {:.3} mm, under half of every footprint (faded to its mean, not \
+                     evaluated)",
+                    f.size
+                ),
+                Detail::Fading => format!(
+                    "fading: {:.3} mm, under every footprint, over half of the smallest (part faded)",
+                    f.size
+                ),
+                Detail::Kept => format!("kept: {:.3} mm, shown where the footprint is smaller", f.size),
+            };
+            s += &format!("explain:   {:<16}{why}\n", f.name);
+        }
+    }
+    s
 }
 
 /// Parses `WxH` with both in 1..=[`MAX_RESOLUTION`](xylem::scene::MAX_RESOLUTION).
@@ -94,6 +140,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         loaded.scene.accel.triangle_count(),
         loaded.scene.accel.build_time.as_secs_f64() * 1e3
     );
+    if args.explain {
+        eprint!("{}", explain(&loaded.scene, loaded.settings.spp));
+    }
     xylem::render::resources::Resources::render(cam.width, cam.height)
         .check(&args.out, args.ignore_limits)?;
     // The output folder is made (and so checked) before the render, not after it.

@@ -445,6 +445,12 @@ impl CellTexture {
         CellTexture { scales }
     }
 
+    /// The across-grain correlation length (mm) of each scale: [`CellTexture::path`] fades a
+    /// scale out at twice it and drops it at four times it.
+    pub fn widths(&self) -> impl Iterator<Item = f32> + '_ {
+        self.scales.iter().map(|&(_, across)| across)
+    }
+
     /// The extra absorption path at the distorted point `q` (zero mean) for a pixel footprint
     /// `footprint` mm wide: each scale fades out as the footprint grows from twice its
     /// across-grain correlation length to four times it (and is not evaluated beyond), as pores do.

@@ -589,6 +589,28 @@ impl WoodVolume {
         texel
     }
 
+    /// The sizes (tree mm) of the features [`WoodVolume::eval_footprint`] fades to their means:
+    /// each is evaluated in full under a footprint of its size, fades linearly to its mean as the
+    /// footprint grows to twice it, and is not evaluated at all beyond ([`footprint_weight`]).
+    /// Pores by their diameter, rays by the widest trace a face can cut through their sheet (the
+    /// quartersawn fleck, `trace_limit`: the conservative size when the face is not known), each
+    /// scale of the cell texture by twice its across-grain correlation length.
+    pub fn fading_features(&self) -> Vec<(&'static str, f32)> {
+        let mut v = Vec::new();
+        if let Some(p) = &self.pores {
+            v.push(("pores", p.diameter));
+        }
+        if let Some(r) = &self.rays {
+            v.push(("rays", r.trace_limit.max(r.width)));
+        }
+        if let Some(t) = &self.texture {
+            for (i, across) in t.widths().enumerate() {
+                v.push((["cell texture", "texture streaks"][i.min(1)], 2.0 * across));
+            }
+        }
+        v
+    }
+
     /// The growth times t(r + Δ (i/N − ½)), i = 0…N (N = [`RING_PIECES`]), across the radial
     /// extent Δ = width · |Jᵀ r̂ − ((Jᵀ r̂)·n) n| of the footprint (Jᵀ r̂ the gradient of the
     /// distorted radius, eq. 18, projected into the surface where its normal n is known), or
