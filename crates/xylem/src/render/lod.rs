@@ -1,6 +1,6 @@
 //! Level of detail from the scene (issue 28, "model only what a scene requires"): before a
 //! render, the smallest pixel footprint the camera leaves on each wood material, and which of
-//! its fine features ([`WoodVolume::fading_features`]) that footprint already fades to their
+//! its fine features ([`WoodVolume::fading_features`](crate::wood::WoodVolume::fading_features)) that footprint already fades to their
 //! means in every pixel, so that no camera hit evaluates them (`xylem render --explain`).
 //!
 //! The footprint of a camera hit at depth z along the view axis is at least

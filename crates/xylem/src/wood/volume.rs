@@ -591,7 +591,7 @@ impl WoodVolume {
 
     /// The sizes (tree mm) of the features [`WoodVolume::eval_footprint`] fades to their means:
     /// each is evaluated in full under a footprint of its size, fades linearly to its mean as the
-    /// footprint grows to twice it, and is not evaluated at all beyond ([`footprint_weight`]).
+    /// footprint grows to twice it, and is not evaluated at all beyond (`footprint_weight`).
     /// Pores by their diameter, rays by the widest trace a face can cut through their sheet (the
     /// quartersawn fleck, `trace_limit`: the conservative size when the face is not known), each
     /// scale of the cell texture by twice its across-grain correlation length.
