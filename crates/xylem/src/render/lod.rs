@@ -1,7 +1,7 @@
 //! Level of detail from the scene (issue 28, "model only what a scene requires"): before a
 //! render, the smallest pixel footprint the camera leaves on each wood material, and which of
-//! its fine features ([`WoodVolume::fading_features`](crate::wood::WoodVolume::fading_features)) that footprint already fades to their
-//! means in every pixel, so that no camera hit evaluates them (`xylem render --explain`).
+//! its fine features ([`fading_features`](crate::wood::WoodVolume::fading_features)) that
+//! footprint already fades to their means in every pixel, so that no camera hit evaluates them (`xylem render --explain`).
 //!
 //! The footprint of a camera hit at depth z along the view axis is at least
 //! `footprint_scale(spp) · 2 tan(fov/2) / height · z` ([`Camera::pixel_footprint`]; the
@@ -36,7 +36,7 @@ pub enum Detail {
 pub struct FeaturePlan {
     /// The feature (`pores`, `rays`, `cell texture`, `texture streaks`).
     pub name: &'static str,
-    /// Its size, tree mm ([`WoodVolume::fading_features`](crate::wood::WoodVolume::fading_features)).
+    /// Its size, tree mm ([`fading_features`](crate::wood::WoodVolume::fading_features)).
     pub size: f32,
     /// Kept, fading or skipped at the smallest footprint.
     pub detail: Detail,
