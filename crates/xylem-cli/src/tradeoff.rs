@@ -378,7 +378,7 @@ fn markdown(
         }
     }
     s += "\n`--quality draft|default|final` (on `xylem render` and `xylem sweep`) applies the \
-          presets of `Quality::knobs` in `crates/xylem-lab/src/tradeoff.rs`, fixed from this table (rows \
+          presets of `Quality::knobs` in `crates/xylem/src/scene/quality.rs`, fixed from this table (rows \
           `--quality` above); rerunning on another scene or machine may recommend others.\n";
     s
 }
