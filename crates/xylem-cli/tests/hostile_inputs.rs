@@ -504,7 +504,13 @@ fn meshes_and_shapes_are_checked_before_they_are_built() {
     std::fs::write(dir.join("lathe.toml"), text).unwrap();
     assert_refused(
         &render("lathe.toml"),
-        &["objects[0].profile", "1638391808 triangles", "of memory"],
+        // The remedy names the knob that lowers it, not the image's resolution.
+        &[
+            "objects[0].profile",
+            "1638391808 triangles",
+            "of memory",
+            "fewer triangles (a shape's `segments`",
+        ],
     );
 }
 

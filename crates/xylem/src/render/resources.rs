@@ -19,10 +19,12 @@ pub const MAX_MESH_BYTES: u64 = 4 << 30;
 #[derive(Debug, thiserror::Error)]
 pub enum ResourceError {
     /// An estimate above what the machine has.
-    #[error("{what} needs about {need} of {kind} but {have} is available; lower the resolution or the frame count, or pass --ignore-limits to try anyway")]
+    #[error("{what} needs about {need} of {kind} but {have} is available; {remedy}, or pass --ignore-limits to try anyway")]
     TooLarge {
         /// What needs it (a render, a sweep, a scene).
         what: String,
+        /// What to lower to need less (the knob of the thing that needs it).
+        remedy: &'static str,
         /// `"memory"` or `"disk space"`.
         kind: &'static str,
         /// The estimate.
@@ -81,7 +83,15 @@ pub struct Resources {
     pub memory: u64,
     /// Disk estimate of the files written (bytes).
     pub disk: u64,
+    /// What to lower to need less, for the message ("lower the resolution or the frame count").
+    pub remedy: &'static str,
 }
+
+/// The remedy of an image's estimate: its size and, for a sweep, its length.
+const LOWER_RESOLUTION: &str = "lower the resolution or the frame count";
+/// The remedy of a geometry estimate: the triangles it builds.
+pub const LOWER_TRIANGLES: &str =
+    "use fewer triangles (a shape's `segments`, a lighter or decimated mesh)";
 
 /// Peak bytes per stored triangle while its BVH is built: the triangle copies, obvhs's BVH2 and
 /// PLOC buffers, the reinsertion pass and the wide BVH (444–459 B measured with VmHWM on 1 M and
@@ -104,6 +114,7 @@ impl Resources {
             what: format!("a {width}x{height} render"),
             memory: px * (size_of::<PixelSum>() as u64 + image + 2 * 4 * RENDER_EXR_CHANNELS),
             disk: px * (4 * RENDER_EXR_CHANNELS + 3),
+            remedy: LOWER_RESOLUTION,
         }
     }
 
@@ -118,6 +129,7 @@ impl Resources {
             memory: batch * Self::sweep_frame_bytes(width, height, threads)
                 + Self::sweep_fixed_bytes(width, height, threads),
             disk: frames as u64 * px * (4 * FRAME_EXR_CHANNELS + 3) + px * 4 * 14,
+            remedy: LOWER_RESOLUTION,
         }
     }
 
@@ -157,6 +169,7 @@ impl Resources {
             memory: triangles * BUILD_BYTES_PER_TRIANGLE
                 + (instances.len() * 2 * size_of::<Instance>()) as u64,
             disk: 0,
+            remedy: LOWER_TRIANGLES,
         }
     }
 
@@ -173,6 +186,7 @@ impl Resources {
         }
         let too_large = |kind, need, have| ResourceError::TooLarge {
             what: self.what.clone(),
+            remedy: self.remedy,
             kind,
             need: Bytes(need),
             have: Bytes(have),

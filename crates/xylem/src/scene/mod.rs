@@ -1040,6 +1040,7 @@ impl Builder<'_> {
                     ),
                     memory: triangles * bytes,
                     disk: 0,
+                    remedy: crate::render::resources::LOWER_TRIANGLES,
                 }
                 .check(self.base, self.ignore_limits)
                 .map_err(|source| SceneError::Resources {
