@@ -483,16 +483,37 @@ impl WoodBsdf {
             return 0.0;
         }
         let eta = self.params.eta;
-        let mut pdf = probs.diffuse * wi.z * INV_PI;
-        if probs.fiber > 0.0 || probs.ray > 0.0 {
-            let (wo_in, wi_in) = (refract_in(wo, eta), refract_in(wi, eta));
-            // dω_int/dω_ext = cos θi / (η² cos θi') (notes/bsdf.md §1.1).
-            let jac = wi.z * self.inv_eta2 / wi_in.z.max(1e-7);
+        let wi_in = refract_in(wi, eta);
+        let (p_fib, p_ray) = if probs.fiber > 0.0 || probs.ray > 0.0 {
             let about = match view {
                 Some(v) => About::Rough(v),
-                None => About::Refracted(wo_in),
+                None => About::Refracted(refract_in(wo, eta)),
             };
-            let (p_fib, p_ray) = self.lobe_densities(probs, about, wi_in);
+            self.lobe_densities(probs, about, wi_in)
+        } else {
+            (0.0, 0.0)
+        };
+        self.density(probs, wo, wi, wi_in, p_fib, p_ray)
+    }
+
+    /// The density of [`Bsdf::sample`] from the lobe probabilities and the fibre and ray lobes'
+    /// interior densities `p_fib`, `p_ray` at `wi_in` (ωi refracted into the finish): the
+    /// diffuse's cos θi/π, the lobes' densities mapped to exterior solid angle, the rough
+    /// finish's visible-normal density; 0 where not finite.
+    #[inline(always)]
+    fn density(
+        &self,
+        probs: &LobeProbs,
+        wo: Vec3,
+        wi: Vec3,
+        wi_in: Vec3,
+        p_fib: f32,
+        p_ray: f32,
+    ) -> f32 {
+        let mut pdf = probs.diffuse * wi.z * INV_PI;
+        if probs.fiber > 0.0 || probs.ray > 0.0 {
+            // dω_int/dω_ext = cos θi / (η² cos θi') (notes/bsdf.md §1.1).
+            let jac = wi.z * self.inv_eta2 / wi_in.z.max(1e-7);
             let mut p_int = 0.0;
             if probs.fiber > 0.0 {
                 p_int += probs.fiber * p_fib;
@@ -512,6 +533,22 @@ impl WoodBsdf {
             pdf
         } else {
             0.0
+        }
+    }
+
+    /// f from the substrate's value (no cosine, interior directions) and the finish's
+    /// transmission `t` = T(θo) T(θi) / η²: their product plus the rough finish's reflection,
+    /// clamped to ≥ 0, 0 where not finite (notes/bsdf.md eq. 1.4).
+    #[inline(always)]
+    fn value(&self, wo: Vec3, wi: Vec3, substrate: Vec3, t: f32) -> Vec3 {
+        let mut f = substrate * t;
+        if let Some(r) = &self.rough {
+            f += Vec3::splat(r.reflection(wo, wi));
+        }
+        if f.is_finite() {
+            f.max(Vec3::ZERO)
+        } else {
+            Vec3::ZERO
         }
     }
 }
@@ -676,48 +713,18 @@ impl WoodAtWo<'_> {
     }
 
     /// f from the finish's [`WoodAtWo::transmission`] `t` and the fibre and ray lobes' values at
-    /// ωi: the steps of `Bsdf::eval` and `substrate`, in their order (notes/bsdf.md eq. 1.4).
+    /// ωi ([`WoodBsdf::value`] of their blend).
     #[inline(always)]
     fn value(&self, wi: Vec3, t: f32, f_fib: f32, f_ray: f32) -> Vec3 {
         let b = self.bsdf;
-        let mut f = b.blend(f_fib, f_ray) * t;
-        if let Some(r) = &b.rough {
-            f += Vec3::splat(r.reflection(self.wo, wi));
-        }
-        if f.is_finite() {
-            f.max(Vec3::ZERO)
-        } else {
-            Vec3::ZERO
-        }
+        b.value(self.wo, wi, b.blend(f_fib, f_ray), t)
     }
 
-    /// The density from the lobes' interior densities: the steps of `pdf_with`.
+    /// The density from the lobes' interior densities ([`WoodBsdf::density`] at this ωo).
     #[inline(always)]
     fn density(&self, wi: Vec3, wi_in: Vec3, p_fib: f32, p_ray: f32) -> f32 {
-        let (b, probs) = (self.bsdf, &self.probs);
-        let mut pdf = probs.diffuse * wi.z * INV_PI;
-        if probs.fiber > 0.0 || probs.ray > 0.0 {
-            let jac = wi.z * b.inv_eta2 / wi_in.z.max(1e-7);
-            let mut p_int = 0.0;
-            if probs.fiber > 0.0 {
-                p_int += probs.fiber * p_fib;
-            }
-            if probs.ray > 0.0 {
-                p_int += probs.ray * p_ray;
-            }
-            pdf += p_int * jac;
-        }
-        if let Some(r) = &b.rough {
-            if probs.specular > 0.0 {
-                let h = (self.wo + wi).normalize_or_zero();
-                pdf += probs.specular * r.ggx.reflection_pdf(self.wo, h);
-            }
-        }
-        if pdf.is_finite() {
-            pdf
-        } else {
-            0.0
-        }
+        let b = self.bsdf;
+        b.density(&self.probs, self.wo, wi, wi_in, p_fib, p_ray)
     }
 }
 
@@ -738,15 +745,7 @@ impl Bsdf for WoodBsdf {
             }
             None => self.substrate(wo_in, wi_in),
         };
-        let mut f = substrate * t;
-        if let Some(r) = &self.rough {
-            f += Vec3::splat(r.reflection(wo, wi));
-        }
-        if f.is_finite() {
-            f.max(Vec3::ZERO)
-        } else {
-            Vec3::ZERO
-        }
+        self.value(wo, wi, substrate, t)
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
