@@ -137,7 +137,7 @@ pub struct BoardPlane {
 
 impl BoardPlane {
     /// The world point at the centre of texel (col, row) of a `w` × `h` map (row 0 at the top).
-    pub fn texel_point(&self, col: usize, row: usize, w: usize, h: usize) -> Vec3 {
+    pub(crate) fn texel_point(&self, col: usize, row: usize, w: usize, h: usize) -> Vec3 {
         let u = ((col as f32 + 0.5) / w as f32 - 0.5) * self.size[0];
         let v = (0.5 - (row as f32 + 0.5) / h as f32) * self.size[1];
         self.origin + u * self.x + v * self.y
@@ -194,7 +194,7 @@ pub struct CaptureFrame {
 impl CaptureFrame {
     /// The light's direction from `p` (unit) and the irradiance factor: I/d² for a point light,
     /// E for a distant one (the radiance of a pixel is f · cos θi times it per channel).
-    pub fn light_at(&self, p: Vec3) -> (Vec3, Vec3) {
+    pub(crate) fn light_at(&self, p: Vec3) -> (Vec3, Vec3) {
         match self.light {
             FrameLight::Point { position, .. } => {
                 let d = position - p;
@@ -282,7 +282,7 @@ impl Capture {
     }
 
     /// Checks a parsed manifest; `dir` is the folder its image paths are relative to.
-    pub fn from_manifest(dir: &Path, m: &Manifest) -> Result<Capture, CaptureError> {
+    pub(crate) fn from_manifest(dir: &Path, m: &Manifest) -> Result<Capture, CaptureError> {
         let manifest_path = dir.join(MANIFEST_FILE);
         let check = ManifestChecker {
             path: manifest_path.display().to_string(),
@@ -358,7 +358,7 @@ impl Capture {
     }
 
     /// The azimuths (degrees, one per distinct arc) of the frames.
-    pub fn arc_azimuths(&self) -> Vec<f32> {
+    pub(crate) fn arc_azimuths(&self) -> Vec<f32> {
         let mut arcs: Vec<(usize, f32)> = Vec::new();
         for f in &self.frames {
             if !arcs.iter().any(|a| a.0 == f.arc) {
