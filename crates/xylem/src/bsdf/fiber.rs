@@ -222,7 +222,7 @@ impl FiberAxis {
     /// convolution of g(β, ψi + ψr) is g(√(β² + var ψr + var ψi), ψ̄i + ψ̄r); summed over the
     /// single- and multiple-scattering parts of both ends with their shares. The normalisation
     /// is taken at the mean angles.
-    pub fn eval_spread(
+    pub(crate) fn eval_spread(
         o: &[PsiSpread; 2],
         i: &[PsiSpread; 2],
         beta: f32,
@@ -390,7 +390,7 @@ impl FiberAxis {
     }
 
     /// [`FiberAxis::sample`] for a view given by its longitudinal angle ψr alone.
-    pub fn sample_about(&self, psi_r: f32, u: Vec2, beta: f32, z_min: f32) -> Option<Vec3> {
+    pub(crate) fn sample_about(&self, psi_r: f32, u: Vec2, beta: f32, z_min: f32) -> Option<Vec3> {
         let x = (2.0 * u.x - 1.0).clamp(-0.999_999_9, 0.999_999_9);
         let psi_i = -psi_r + beta * std::f32::consts::SQRT_2 * erf_inv(x);
         if !(psi_i.abs() < 0.5 * PI) {
@@ -425,7 +425,7 @@ impl FiberAxis {
     }
 
     /// [`FiberAxis::pdf`] for a view given by its longitudinal angle ψr alone.
-    pub fn pdf_about(&self, psi_r: f32, wi: Vec3, beta: f32, z_min: f32) -> f32 {
+    pub(crate) fn pdf_about(&self, psi_r: f32, wi: Vec3, beta: f32, z_min: f32) -> f32 {
         let sin_psi = wi.dot(self.frame.n).clamp(-1.0, 1.0);
         let (cos_psi, t) = self.arc_argument(sin_psi, z_min);
         if !arc_needed(wi.z, z_min, cos_psi) {
