@@ -834,33 +834,92 @@ fn summarise(
     rough: Option<RoughSettings>,
 ) -> BsdfValidation {
     let mut checks = Vec::new();
-    let mut worst =
-        |check: &str, criterion: String, items: Vec<(f64, String, bool)>, larger_is_worse: bool| {
-            let passed = items.iter().all(|x| x.2);
-            let pick = items.iter().max_by(|a, b| {
-                let o = a.0.total_cmp(&b.0);
-                if larger_is_worse {
-                    o
-                } else {
-                    o.reverse()
-                }
-            });
-            let (w, case) = pick
-                .map(|x| (x.0, x.1.clone()))
-                .unwrap_or((0.0, "-".into()));
-            checks.push(CheckSummary {
-                check: check.into(),
-                passed,
-                reported: criterion.starts_with("reported"),
-                worst: w,
-                case,
-                criterion,
-            });
-        };
-    let label = |c: &CaseResult, extra: String| format!("{} {}", c.spec.name, extra);
+    furnace_checks(&mut checks, &cases, &s);
+    sampling_checks(&mut checks, &cases, &s);
+    push_worst(
+        &mut checks,
+        "extremes: NaN / Inf / negative values",
+        "0".into(),
+        extreme_violations
+            .iter()
+            .map(|(n, v)| (*v as f64, n.clone(), *v == 0))
+            .collect(),
+        true,
+    );
+    if let Some(r) = &rough {
+        rough_checks(&mut checks, &rough_rows, r);
+    }
+    let published_max_albedo = published_max_albedo(&cases);
+    BsdfValidation {
+        checks,
+        cases,
+        extreme_violations,
+        settings: s,
+        published_max_albedo,
+        rough_rows,
+        rough_settings: rough,
+    }
+}
 
+/// The largest quadrature albedo of the cases with the published (unbounded) normalisation,
+/// and where it occurs.
+fn published_max_albedo(cases: &[CaseResult]) -> Option<(f64, String)> {
+    cases
+        .iter()
+        .filter(|c| !c.spec.bounded)
+        .flat_map(|c| {
+            c.furnace.iter().map(move |f| {
+                (
+                    f.quadrature,
+                    format!("{} θo {}°", c.spec.name, f.theta_o_deg),
+                )
+            })
+        })
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+}
+
+/// Adds to `checks` the check `check` over `items` (figure, case, pass): passed when every item
+/// passes, its worst figure the largest (`larger_is_worse`) or the smallest, with its case.
+fn push_worst(
+    checks: &mut Vec<CheckSummary>,
+    check: &str,
+    criterion: String,
+    items: Vec<(f64, String, bool)>,
+    larger_is_worse: bool,
+) {
+    let passed = items.iter().all(|x| x.2);
+    let pick = items.iter().max_by(|a, b| {
+        let o = a.0.total_cmp(&b.0);
+        if larger_is_worse {
+            o
+        } else {
+            o.reverse()
+        }
+    });
+    let (w, case) = pick
+        .map(|x| (x.0, x.1.clone()))
+        .unwrap_or((0.0, "-".into()));
+    checks.push(CheckSummary {
+        check: check.into(),
+        passed,
+        reported: criterion.starts_with("reported"),
+        worst: w,
+        case,
+        criterion,
+    });
+}
+
+/// `"{case} {extra}"`, the case column of a per-case row.
+fn label(c: &CaseResult, extra: String) -> String {
+    format!("{} {}", c.spec.name, extra)
+}
+
+/// The white-furnace checks: bounded albedo, the smallest albedo, Monte Carlo against
+/// quadrature, and the white substrate under a smooth finish.
+fn furnace_checks(checks: &mut Vec<CheckSummary>, cases: &[CaseResult], s: &Settings) {
     let bounded: Vec<&CaseResult> = cases.iter().filter(|c| c.spec.bounded).collect();
-    worst(
+    push_worst(
+        checks,
         "furnace: albedo ≤ 1 + 3σ (max channel)",
         "MC ≤ 1 + 3σ and quadrature ≤ 1.001".into(),
         bounded
@@ -877,7 +936,8 @@ fn summarise(
             .collect(),
         true,
     );
-    worst(
+    push_worst(
+        checks,
         "furnace: min albedo (max channel)",
         "reported".into(),
         cases
@@ -894,7 +954,8 @@ fn summarise(
             .collect(),
         false,
     );
-    worst(
+    push_worst(
+        checks,
         "furnace: MC agrees with quadrature (max abs Δ)",
         format!(
             "abs Δ ≤ {}σ + {} per channel",
@@ -914,7 +975,8 @@ fn summarise(
             .collect(),
         true,
     );
-    worst(
+    push_worst(
+        checks,
         "white substrate under smooth finish: min albedo",
         format!(
             "≥ {} for θo ≤ {}°",
@@ -943,7 +1005,13 @@ fn summarise(
             .collect(),
         false,
     );
-    worst(
+}
+
+/// Reciprocity, and the sampling checks over the χ² runs: p-values (Šidák-corrected), pdf
+/// normalisation, sample weights.
+fn sampling_checks(checks: &mut Vec<CheckSummary>, cases: &[CaseResult], s: &Settings) {
+    push_worst(
+        checks,
         "reciprocity: max relative error",
         format!("≤ {}", s.reciprocity_tolerance),
         cases
@@ -961,7 +1029,8 @@ fn summarise(
     let tests = cases.iter().map(|c| c.chi2.len()).sum::<usize>().max(1);
     // Šidák correction: per-test level 1 − (1 − α)^(1/m) keeps the family-wise level at α.
     let alpha = 1.0 - (1.0 - s.significance).powf(1.0 / tests as f64);
-    worst(
+    push_worst(
+        checks,
         "chi-square: min p-value",
         format!(
             "p ≥ {alpha:.3e} (α = {} Šidák-corrected over {tests} tests)",
@@ -981,7 +1050,8 @@ fn summarise(
             .collect(),
         false,
     );
-    worst(
+    push_worst(
+        checks,
         "pdf normalisation: max abs(∫pdf − accepted fraction)",
         format!(
             "≤ {} × accepted fraction, or ≤ 5σ (binomial)",
@@ -1007,7 +1077,8 @@ fn summarise(
             .collect(),
         true,
     );
-    worst(
+    push_worst(
+        checks,
         "sample weights: max relative error of f and pdf",
         format!("≤ {}", s.weight_tolerance),
         cases
@@ -1024,106 +1095,82 @@ fn summarise(
             .collect(),
         true,
     );
-    worst(
-        "extremes: NaN / Inf / negative values",
-        "0".into(),
-        extreme_violations
+}
+
+/// The rough finish against the layered random walk: white substrate, albedo (Lambertian and
+/// fibre substrates), interface reflection, BSDF shape, the analytic albedo's bound.
+fn rough_checks(checks: &mut Vec<CheckSummary>, rough_rows: &[RoughRow], r: &RoughSettings) {
+    push_worst(
+        checks,
+        "white substrate under rough finish: min albedo",
+        format!(
+            "≥ {} for θo ≤ {}°, α ≤ {} (≥ {} where the reference is)",
+            r.white_min_albedo, r.white_max_theta_deg, r.white_max_roughness, r.white_strict_albedo
+        ),
+        rough_rows
             .iter()
-            .map(|(n, v)| (*v as f64, n.clone(), *v == 0))
+            .filter(|x| white_row_checked(x, r))
+            .map(|x| (x.model, x.label(), white_row_ok(x, r)))
+            .collect(),
+        false,
+    );
+    push_worst(
+        checks,
+        "rough finish, Lambertian: albedo against the layered reference (max rel Δ)",
+        format!("|Δ| ≤ {} · reference + 3σ", r.tolerance),
+        rough_rows
+            .iter()
+            .filter(|x| !x.is_fiber())
+            .map(|x| (x.rel_diff(), x.label(), x.agrees(r)))
             .collect(),
         true,
     );
-    if let Some(r) = &rough {
-        worst(
-            "white substrate under rough finish: min albedo",
-            format!(
-                "≥ {} for θo ≤ {}°, α ≤ {} (≥ {} where the reference is)",
-                r.white_min_albedo,
-                r.white_max_theta_deg,
-                r.white_max_roughness,
-                r.white_strict_albedo
-            ),
-            rough_rows
-                .iter()
-                .filter(|x| white_row_checked(x, r))
-                .map(|x| (x.model, x.label(), white_row_ok(x, r)))
-                .collect(),
-            false,
-        );
-        worst(
-            "rough finish, Lambertian: albedo against the layered reference (max rel Δ)",
-            format!("|Δ| ≤ {} · reference + 3σ", r.tolerance),
-            rough_rows
-                .iter()
-                .filter(|x| !x.is_fiber())
-                .map(|x| (x.rel_diff(), x.label(), x.agrees(r)))
-                .collect(),
-            true,
-        );
-        // Interface plus the single pass (the model drops fibre light the finish reflects back
-        // down, notes/bsdf.md §4.6).
-        worst(
-            "rough finish, fibre: albedo against the layered reference (max rel Δ)",
-            format!("|Δ| ≤ {} · reference + 3σ (single pass)", r.tolerance),
-            rough_rows
-                .iter()
-                .filter(|x| x.is_fiber())
-                .map(|x| (x.rel_diff(), x.label(), x.agrees(r)))
-                .collect(),
-            true,
-        );
-        worst(
-            "rough finish: interface reflection against the reference (max abs Δ)",
-            "reported".into(),
-            rough_rows
-                .iter()
-                .map(|x| {
-                    let d = (x.model_interface - x.reference_interface).abs();
-                    (d, x.label(), true)
-                })
-                .collect(),
-            true,
-        );
-        worst(
-            "rough finish: BSDF shape, max |Δ| over direction bins",
-            "reported (fraction of incident light, 16 bins)".into(),
-            rough_rows
-                .iter()
-                .map(|x| (x.max_bin_diff, x.label(), true))
-                .collect(),
-            true,
-        );
-        worst(
-            "rough finish: analytic albedo ≤ 1",
-            "quadrature ≤ 1.001, reference paths cut = 0".into(),
-            rough_rows
-                .iter()
-                .map(|x| (x.model, x.label(), x.model <= 1.001 && x.truncated == 0))
-                .collect(),
-            true,
-        );
-    }
-    let published_max_albedo = cases
-        .iter()
-        .filter(|c| !c.spec.bounded)
-        .flat_map(|c| {
-            c.furnace.iter().map(move |f| {
-                (
-                    f.quadrature,
-                    format!("{} θo {}°", c.spec.name, f.theta_o_deg),
-                )
-            })
-        })
-        .max_by(|a, b| a.0.total_cmp(&b.0));
-    BsdfValidation {
+    // Interface plus the single pass (the model drops fibre light the finish reflects back
+    // down, notes/bsdf.md §4.6).
+    push_worst(
         checks,
-        cases,
-        extreme_violations,
-        settings: s,
-        published_max_albedo,
-        rough_rows,
-        rough_settings: rough,
-    }
+        "rough finish, fibre: albedo against the layered reference (max rel Δ)",
+        format!("|Δ| ≤ {} · reference + 3σ (single pass)", r.tolerance),
+        rough_rows
+            .iter()
+            .filter(|x| x.is_fiber())
+            .map(|x| (x.rel_diff(), x.label(), x.agrees(r)))
+            .collect(),
+        true,
+    );
+    push_worst(
+        checks,
+        "rough finish: interface reflection against the reference (max abs Δ)",
+        "reported".into(),
+        rough_rows
+            .iter()
+            .map(|x| {
+                let d = (x.model_interface - x.reference_interface).abs();
+                (d, x.label(), true)
+            })
+            .collect(),
+        true,
+    );
+    push_worst(
+        checks,
+        "rough finish: BSDF shape, max |Δ| over direction bins",
+        "reported (fraction of incident light, 16 bins)".into(),
+        rough_rows
+            .iter()
+            .map(|x| (x.max_bin_diff, x.label(), true))
+            .collect(),
+        true,
+    );
+    push_worst(
+        checks,
+        "rough finish: analytic albedo ≤ 1",
+        "quadrature ≤ 1.001, reference paths cut = 0".into(),
+        rough_rows
+            .iter()
+            .map(|x| (x.model, x.label(), x.model <= 1.001 && x.truncated == 0))
+            .collect(),
+        true,
+    );
 }
 
 /// The rough-finish table of the report: model against reference per row.

@@ -22,7 +22,7 @@ use std::path::Path;
 
 /// The finish's refractive index the exported material assumes: glTF's default dielectric
 /// (ior 1.5, F0 = 0.04; glTF 2.0 Appendix B.3.4).
-pub const FINISH_IOR: f32 = 1.5;
+pub(crate) const FINISH_IOR: f32 = 1.5;
 
 /// GGX slope width α per unit of Gaussian slope deviation σ, matched at half maximum through the
 /// peak: GGX's slope density along one axis through its peak, (1 + x²/α²)⁻², halves at
@@ -33,7 +33,7 @@ const GGX_PER_SIGMA: f32 = 1.829_47;
 /// deviation of ψi + ψr in Marschner et al. 2005 eq. 3): the exterior half-vector's slope along
 /// the fibre is η (sin ψi + sin ψr)/2 near the normal (the finish scales tangential components by
 /// η, Snell), deviation σ = η β / 2; α = 1.8295 σ (`GGX_PER_SIGMA`). Derivation: notes/gltf.md.
-pub fn ggx_alpha_along_fiber(beta: f32) -> f32 {
+pub(crate) fn ggx_alpha_along_fiber(beta: f32) -> f32 {
     GGX_PER_SIGMA * FINISH_IOR * beta / 2.0
 }
 

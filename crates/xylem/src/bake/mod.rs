@@ -123,7 +123,7 @@ pub fn anisotropy_texel(f: Vec3, right: Vec3, up: Vec3) -> Vec3 {
 
 /// The tangent-space normal of a height field h with tree-space gradient `g` seen on a face with
 /// axes `right`, `up`: n ∝ (−∂h/∂x, −∂h/∂y, 1) (the surface z = h(x, y)).
-pub fn bump_normal(g: Vec3, right: Vec3, up: Vec3) -> Vec3 {
+pub(crate) fn bump_normal(g: Vec3, right: Vec3, up: Vec3) -> Vec3 {
     let n = Vec3::new(-g.dot(right), -g.dot(up), 1.0);
     let n = n.normalize_or_zero();
     if n == Vec3::ZERO {

@@ -195,18 +195,9 @@ impl FiberAxis {
 
     /// The lobe without its colour k_f, for interior directions `wo`, `wi`.
     pub fn eval(&self, wo: Vec3, wi: Vec3, beta: f32, norm: FiberNormalization) -> f32 {
-        let (psi_r, psi_i) = (self.psi(wo), self.psi(wi));
-        let g = gaussian(beta, psi_i + psi_r);
-        match norm {
-            FiberNormalization::EnergyBounded => {
-                let c = cos(psi_i).max(cos(psi_r)).max(MIN_COS_PSI);
-                g / (2.0 * PI * c)
-            }
-            FiberNormalization::Published => {
-                let c = cos(0.5 * (psi_r - psi_i));
-                g / (c * c).max(MIN_COS_PSI * MIN_COS_PSI)
-            }
-        }
+        let (at, psi_i) = (self.at_wo(wo), self.psi(wi));
+        let g = gaussian(beta, psi_i + at.psi_r);
+        lobe_value(norm, g, lobe_cos(norm, psi_i, &at), &at)
     }
 
     /// How this fibre sees the light a rough finish transmits from the exterior direction `w`
@@ -231,7 +222,7 @@ impl FiberAxis {
     /// convolution of g(β, ψi + ψr) is g(√(β² + var ψr + var ψi), ψ̄i + ψ̄r); summed over the
     /// single- and multiple-scattering parts of both ends with their shares. The normalisation
     /// is taken at the mean angles.
-    pub fn eval_spread(
+    pub(crate) fn eval_spread(
         o: &[PsiSpread; 2],
         i: &[PsiSpread; 2],
         beta: f32,
@@ -399,7 +390,7 @@ impl FiberAxis {
     }
 
     /// [`FiberAxis::sample`] for a view given by its longitudinal angle ψr alone.
-    pub fn sample_about(&self, psi_r: f32, u: Vec2, beta: f32, z_min: f32) -> Option<Vec3> {
+    pub(crate) fn sample_about(&self, psi_r: f32, u: Vec2, beta: f32, z_min: f32) -> Option<Vec3> {
         let x = (2.0 * u.x - 1.0).clamp(-0.999_999_9, 0.999_999_9);
         let psi_i = -psi_r + beta * std::f32::consts::SQRT_2 * erf_inv(x);
         if !(psi_i.abs() < 0.5 * PI) {
@@ -434,20 +425,14 @@ impl FiberAxis {
     }
 
     /// [`FiberAxis::pdf`] for a view given by its longitudinal angle ψr alone.
-    pub fn pdf_about(&self, psi_r: f32, wi: Vec3, beta: f32, z_min: f32) -> f32 {
-        if !(wi.z > z_min) {
-            return 0.0;
-        }
+    pub(crate) fn pdf_about(&self, psi_r: f32, wi: Vec3, beta: f32, z_min: f32) -> f32 {
         let sin_psi = wi.dot(self.frame.n).clamp(-1.0, 1.0);
-        let cos_psi = safe_sqrt(1.0 - sin_psi * sin_psi);
-        if cos_psi < MIN_COS_PSI {
+        let (cos_psi, t) = self.arc_argument(sin_psi, z_min);
+        if !arc_needed(wi.z, z_min, cos_psi) {
             return 0.0;
         }
-        let delta = self.half_width(sin_psi, cos_psi, z_min);
-        if delta <= 0.0 {
-            return 0.0;
-        }
-        gaussian(beta, asin(sin_psi) + psi_r) / (2.0 * delta.max(MIN_ARC) * cos_psi)
+        let g = gaussian(beta, asin(sin_psi) + psi_r);
+        pdf_value(g, wi.z, z_min, cos_psi, arc_from_argument(t))
     }
 }
 

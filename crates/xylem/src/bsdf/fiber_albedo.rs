@@ -123,7 +123,7 @@ pub fn max_lobe_albedo(beta: f32, dip: f32) -> f32 {
 
 /// The dip δ = asin|u_z| of a unit axis in the shading frame (z the normal).
 #[inline]
-pub fn dip_of(axis_z: f32) -> f32 {
+pub(crate) fn dip_of(axis_z: f32) -> f32 {
     axis_z.abs().min(1.0).asin()
 }
 

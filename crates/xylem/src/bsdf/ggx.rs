@@ -45,13 +45,13 @@ impl Ggx {
     /// Height-correlated masking-shadowing G2 = 1 / (1 + Λ(ωo) + Λ(ωi)) (Heitz 2014, eq. 99);
     /// symmetric in its arguments, so the reflection lobe stays reciprocal.
     #[inline]
-    pub fn g2(&self, wo: Vec3, wi: Vec3) -> f32 {
+    pub(crate) fn g2(&self, wo: Vec3, wi: Vec3) -> f32 {
         1.0 / (1.0 + self.lambda(wo) + self.lambda(wi))
     }
 
     /// Samples a visible microfacet normal for `wo` (z > 0) (Heitz 2018, Listing 1): stretch,
     /// sample the projected hemisphere, unstretch. Density `g1(wo) max(0, wo·h) d(h) / wo.z`.
-    pub fn sample_visible_normal(&self, wo: Vec3, u: Vec2) -> Vec3 {
+    pub(crate) fn sample_visible_normal(&self, wo: Vec3, u: Vec2) -> Vec3 {
         let vh = Vec3::new(self.alpha * wo.x, self.alpha * wo.y, wo.z).normalize();
         let len2 = vh.x * vh.x + vh.y * vh.y;
         let t1 = if len2 > 0.0 {
@@ -72,7 +72,7 @@ impl Ggx {
     /// Density per solid angle of the reflected direction `wi = reflect(wo, h)` when h is drawn by
     /// [`Ggx::sample_visible_normal`]: D_vis(h) / (4 wo·h) = G1(wo) D(h) / (4 wo.z).
     #[inline]
-    pub fn reflection_pdf(&self, wo: Vec3, h: Vec3) -> f32 {
+    pub(crate) fn reflection_pdf(&self, wo: Vec3, h: Vec3) -> f32 {
         if wo.z <= 0.0 || wo.dot(h) <= 0.0 {
             return 0.0;
         }

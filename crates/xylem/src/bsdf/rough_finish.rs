@@ -35,7 +35,7 @@ pub fn eta_node(k: usize) -> f32 {
 
 /// R_ss is raised by 1 % where it sets what enters the finish, so that the table's
 /// interpolation error (≤ 2.5·10⁻³, tested) cannot push the white furnace above 1.
-pub const SS_MARGIN: f32 = 0.01;
+pub(crate) const SS_MARGIN: f32 = 0.01;
 
 /// Smallest μ the quadrature is run at (μ = 0 itself is a horizontal view).
 pub(crate) const MU_FLOOR: f32 = 1e-4;
@@ -81,7 +81,7 @@ pub(crate) fn locate(t: f32, n: usize) -> (usize, f32) {
 /// reflectance R(μ) = R_ss(μ) + R_ms(μ) and the multiple-scattering part R_ms(μ) for this (α, η),
 /// interpolated from the table once at construction.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RoughFinish {
+pub(crate) struct RoughFinish {
     /// The finish's microfacet distribution (α = the finish roughness).
     pub ggx: Ggx,
     eta: f32,
@@ -144,13 +144,13 @@ impl RoughFinish {
     }
 
     /// R̄ = 2∫R(μ)μ dμ, the finish's hemispherical reflectance from outside.
-    pub fn avg_reflectance(&self) -> f32 {
+    pub(crate) fn avg_reflectance(&self) -> f32 {
         self.avg_reflectance
     }
 
     /// The directional albedo of the multiple-scattering lobe, R_ms(μ).
     #[inline]
-    pub fn ms_albedo(&self, mu: f32) -> f32 {
+    pub(crate) fn ms_albedo(&self, mu: f32) -> f32 {
         Self::lookup(&self.multiple, mu)
     }
 
@@ -327,7 +327,7 @@ mod tests {
         );
         s += &format!(
             "pub const MU_NODES: usize = {MU_NODES};\npub const ALPHA_NODES: usize = {ALPHA_NODES};\n\
-             pub const ETA_NODES: usize = {ETA_NODES};\n\n"
+             pub(crate) const ETA_NODES: usize = {ETA_NODES};\n\n"
         );
         s += "/// Weights of 2∫f(μ)μ dμ for f linear in √μ between the nodes.\n#[rustfmt::skip]\n";
         s += &format!(

@@ -80,7 +80,7 @@ impl TransmittedPart {
 
 /// The tabulated spreads of one finish (α, η): where the table's nodes around them lie.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RoughTransmission {
+pub(crate) struct RoughTransmission {
     eta: f32,
     j: usize,
     fa: f32,

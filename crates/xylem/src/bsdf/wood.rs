@@ -4,7 +4,7 @@
 //! reciprocity, the closed-form internal reflections of the diffuse part and the sampling
 //! densities are derived in notes/bsdf.md.
 
-use super::fiber::{FiberAtWo, FiberAxis, FiberNormalization, PsiSpread, BATCH};
+use super::fiber::{FiberAxis, FiberNormalization, PsiSpread};
 use super::fiber_albedo::{dip_of, max_lobe_albedo};
 use super::fresnel::{fresnel_dielectric, fresnel_diffuse_reflectance, refract_in, refract_out};
 use super::rough_finish::RoughFinish;
@@ -12,6 +12,9 @@ use super::rough_transmission::RoughTransmission;
 use super::{Bsdf, BsdfError, BsdfSample, WoodBsdfParams};
 use crate::math::{cosine_hemisphere, luminance, safe_sqrt, INV_PI, PI};
 use glam::{Vec2, Vec3};
+
+mod at_wo;
+pub use at_wo::WoodAtWo;
 
 /// Below this roughness the finish is treated as smooth (a delta reflection): a GGX lobe of
 /// α < 1e-3 is narrower than f32 directions resolve reliably.
@@ -483,16 +486,37 @@ impl WoodBsdf {
             return 0.0;
         }
         let eta = self.params.eta;
-        let mut pdf = probs.diffuse * wi.z * INV_PI;
-        if probs.fiber > 0.0 || probs.ray > 0.0 {
-            let (wo_in, wi_in) = (refract_in(wo, eta), refract_in(wi, eta));
-            // dω_int/dω_ext = cos θi / (η² cos θi') (notes/bsdf.md §1.1).
-            let jac = wi.z * self.inv_eta2 / wi_in.z.max(1e-7);
+        let wi_in = refract_in(wi, eta);
+        let (p_fib, p_ray) = if probs.fiber > 0.0 || probs.ray > 0.0 {
             let about = match view {
                 Some(v) => About::Rough(v),
-                None => About::Refracted(wo_in),
+                None => About::Refracted(refract_in(wo, eta)),
             };
-            let (p_fib, p_ray) = self.lobe_densities(probs, about, wi_in);
+            self.lobe_densities(probs, about, wi_in)
+        } else {
+            (0.0, 0.0)
+        };
+        self.density(probs, wo, wi, wi_in, p_fib, p_ray)
+    }
+
+    /// The density of [`Bsdf::sample`] from the lobe probabilities and the fibre and ray lobes'
+    /// interior densities `p_fib`, `p_ray` at `wi_in` (ωi refracted into the finish): the
+    /// diffuse's cos θi/π, the lobes' densities mapped to exterior solid angle, the rough
+    /// finish's visible-normal density; 0 where not finite.
+    #[inline(always)]
+    fn density(
+        &self,
+        probs: &LobeProbs,
+        wo: Vec3,
+        wi: Vec3,
+        wi_in: Vec3,
+        p_fib: f32,
+        p_ray: f32,
+    ) -> f32 {
+        let mut pdf = probs.diffuse * wi.z * INV_PI;
+        if probs.fiber > 0.0 || probs.ray > 0.0 {
+            // dω_int/dω_ext = cos θi / (η² cos θi') (notes/bsdf.md §1.1).
+            let jac = wi.z * self.inv_eta2 / wi_in.z.max(1e-7);
             let mut p_int = 0.0;
             if probs.fiber > 0.0 {
                 p_int += probs.fiber * p_fib;
@@ -514,209 +538,20 @@ impl WoodBsdf {
             0.0
         }
     }
-}
 
-/// [`WoodBsdf`]'s `eval` and `pdf` for one fixed `wo`, with what depends on `wo` alone — its
-/// refraction into the finish, the transmittance T(θo), the lobe probabilities and the fibre
-/// angles ψr — worked out once, and ψi and the Gaussian shared between `eval` and `pdf`. A
-/// renderer lighting one shading point by many light samples (next-event estimation, a light
-/// sweep) uses it; the values are those of `eval` and `pdf` exactly (tested).
-#[derive(Clone, Copy, Debug)]
-pub struct WoodAtWo<'a> {
-    bsdf: &'a WoodBsdf,
-    wo: Vec3,
-    t_o: f32,
-    probs: LobeProbs,
-    fiber: FiberAtWo,
-    ray: FiberAtWo,
-    rough: Option<RoughView>,
-}
-
-impl WoodBsdf {
-    /// This BSDF with `wo` fixed.
-    pub fn at_wo(&self, wo: Vec3) -> WoodAtWo<'_> {
-        let wo_in = refract_in(wo, self.params.eta);
-        WoodAtWo {
-            bsdf: self,
-            wo,
-            t_o: self.transmittance(wo.z),
-            probs: self.lobe_probs(wo),
-            fiber: self.fiber.at_wo(wo_in),
-            ray: self.ray.at_wo(wo_in),
-            rough: self.rough_view(wo),
-        }
-    }
-}
-
-impl WoodAtWo<'_> {
-    /// `(eval(wo, wi), pdf(wo, wi))`; the density only when `with_pdf` (else 0).
-    pub fn eval_pdf(&self, wi: Vec3, with_pdf: bool) -> (Vec3, f32) {
-        let (b, probs) = (self.bsdf, &self.probs);
-        if !(self.wo.z > 0.0 && wi.z > 0.0) {
-            return (Vec3::ZERO, 0.0);
-        }
-        let p = &b.params;
-        let wi_in = refract_in(wi, p.eta);
-        if let Some(view) = &self.rough {
-            let (f_fib, f_ray) = b.rough_lobes(view, wi);
-            let f = self.value(wi, self.transmission(wi.z), f_fib, f_ray);
-            if !with_pdf {
-                return (f, 0.0);
-            }
-            let (p_fib, p_ray) = b.lobe_densities(probs, About::Rough(view), wi_in);
-            return (f, self.density(wi, wi_in, p_fib, p_ray));
-        }
-        let lobe = |axis: &FiberAxis, at: &FiberAtWo, in_f: bool, in_pdf: bool| {
-            if in_f || (with_pdf && in_pdf) {
-                axis.eval_pdf_at(at, wi_in, p.highlight_width, b.norm, b.z_crit)
-            } else {
-                (0.0, 0.0)
-            }
-        };
-        let (f_fib, p_fib) = lobe(&b.fiber, &self.fiber, p.ray_mask < 1.0, probs.fiber > 0.0);
-        let (f_ray, p_ray) = lobe(&b.ray, &self.ray, p.ray_mask > 0.0, probs.ray > 0.0);
-        let f = self.value(wi, self.transmission(wi.z), f_fib, f_ray);
-        if !with_pdf {
-            return (f, 0.0);
-        }
-        (f, self.density(wi, wi_in, p_fib, p_ray))
-    }
-
-    /// [`WoodAtWo::eval_pdf`] of every `wi[k]` into `f[k]`, `pdf[k]` (`f`, `pdf` as long as
-    /// `wi`): the same stages, each run over `BATCH` directions at a time ([`FiberAxis::
-    /// eval_pdf_many_at`] for the fibre lobes), so that the same values come out (tested) with
-    /// the arithmetic in SIMD lanes.
+    /// f from the substrate's value (no cosine, interior directions) and the finish's
+    /// transmission `t` = T(θo) T(θi) / η²: their product plus the rough finish's reflection,
+    /// clamped to ≥ 0, 0 where not finite (notes/bsdf.md eq. 1.4).
     #[inline(always)]
-    pub fn eval_pdf_many(&self, wi: &[Vec3], with_pdf: bool, f: &mut [Vec3], pdf: &mut [f32]) {
-        assert!(f.len() == wi.len() && pdf.len() == wi.len());
-        if self.rough.is_some() {
-            // Under a rough finish every direction has its own spreads: one at a time.
-            for k in 0..wi.len() {
-                (f[k], pdf[k]) = self.eval_pdf(wi[k], with_pdf);
-            }
-            return;
-        }
-        let (b, probs) = (self.bsdf, &self.probs);
-        let p = &b.params;
-        for ((wi, f), pdf) in wi
-            .chunks(BATCH)
-            .zip(f.chunks_mut(BATCH))
-            .zip(pdf.chunks_mut(BATCH))
-        {
-            let n = wi.len();
-            let mut wi_in = [Vec3::ZERO; BATCH];
-            for k in 0..n {
-                wi_in[k] = refract_in(wi[k], p.eta);
-            }
-            let wi_in = &wi_in[..n];
-            let (f_fib, p_fib) = self.lobe_many(
-                &b.fiber,
-                &self.fiber,
-                wi_in,
-                with_pdf,
-                p.ray_mask < 1.0,
-                probs.fiber > 0.0,
-            );
-            let (f_ray, p_ray) = self.lobe_many(
-                &b.ray,
-                &self.ray,
-                wi_in,
-                with_pdf,
-                p.ray_mask > 0.0,
-                probs.ray > 0.0,
-            );
-            let mut t = [0.0; BATCH];
-            for k in 0..n {
-                t[k] = self.transmission(wi[k].z);
-            }
-            for k in 0..n {
-                let above = self.wo.z > 0.0 && wi[k].z > 0.0;
-                f[k] = self.value(wi[k], t[k], f_fib[k], f_ray[k]);
-                pdf[k] = if with_pdf {
-                    self.density(wi[k], wi_in[k], p_fib[k], p_ray[k])
-                } else {
-                    0.0
-                };
-                if !above {
-                    (f[k], pdf[k]) = (Vec3::ZERO, 0.0);
-                }
-            }
-        }
-    }
-
-    /// One fibre lobe (`axis`, seen from `at`) at up to [`BATCH`] interior directions, its
-    /// values and densities, or zeros where neither is needed (`in_f`: the lobe is in f;
-    /// `in_pdf`: it is sampled). A method rather than a closure so that it inlines into the
-    /// caller's SIMD level.
-    #[allow(clippy::too_many_arguments)]
-    #[inline(always)]
-    fn lobe_many(
-        &self,
-        axis: &FiberAxis,
-        at: &FiberAtWo,
-        wi_in: &[Vec3],
-        with_pdf: bool,
-        in_f: bool,
-        in_pdf: bool,
-    ) -> ([f32; BATCH], [f32; BATCH]) {
-        let b = self.bsdf;
-        let (mut f, mut pdf) = ([0.0; BATCH], [0.0; BATCH]);
-        if in_f || (with_pdf && in_pdf) {
-            let (beta, norm) = (b.params.highlight_width, b.norm);
-            axis.eval_pdf_many_at(at, wi_in, beta, norm, b.z_crit, with_pdf, &mut f, &mut pdf);
-        }
-        (f, pdf)
-    }
-
-    /// T(θo) T(θi) / η², the finish's share of f (notes/bsdf.md eq. 1.4) for cos θi = `wi_z`.
-    #[inline(always)]
-    fn transmission(&self, wi_z: f32) -> f32 {
-        let b = self.bsdf;
-        self.t_o * b.transmittance(wi_z) * b.inv_eta2
-    }
-
-    /// f from the finish's [`WoodAtWo::transmission`] `t` and the fibre and ray lobes' values at
-    /// ωi: the steps of `Bsdf::eval` and `substrate`, in their order (notes/bsdf.md eq. 1.4).
-    #[inline(always)]
-    fn value(&self, wi: Vec3, t: f32, f_fib: f32, f_ray: f32) -> Vec3 {
-        let b = self.bsdf;
-        let mut f = b.blend(f_fib, f_ray) * t;
-        if let Some(r) = &b.rough {
-            f += Vec3::splat(r.reflection(self.wo, wi));
+    fn value(&self, wo: Vec3, wi: Vec3, substrate: Vec3, t: f32) -> Vec3 {
+        let mut f = substrate * t;
+        if let Some(r) = &self.rough {
+            f += Vec3::splat(r.reflection(wo, wi));
         }
         if f.is_finite() {
             f.max(Vec3::ZERO)
         } else {
             Vec3::ZERO
-        }
-    }
-
-    /// The density from the lobes' interior densities: the steps of `pdf_with`.
-    #[inline(always)]
-    fn density(&self, wi: Vec3, wi_in: Vec3, p_fib: f32, p_ray: f32) -> f32 {
-        let (b, probs) = (self.bsdf, &self.probs);
-        let mut pdf = probs.diffuse * wi.z * INV_PI;
-        if probs.fiber > 0.0 || probs.ray > 0.0 {
-            let jac = wi.z * b.inv_eta2 / wi_in.z.max(1e-7);
-            let mut p_int = 0.0;
-            if probs.fiber > 0.0 {
-                p_int += probs.fiber * p_fib;
-            }
-            if probs.ray > 0.0 {
-                p_int += probs.ray * p_ray;
-            }
-            pdf += p_int * jac;
-        }
-        if let Some(r) = &b.rough {
-            if probs.specular > 0.0 {
-                let h = (self.wo + wi).normalize_or_zero();
-                pdf += probs.specular * r.ggx.reflection_pdf(self.wo, h);
-            }
-        }
-        if pdf.is_finite() {
-            pdf
-        } else {
-            0.0
         }
     }
 }
@@ -738,15 +573,7 @@ impl Bsdf for WoodBsdf {
             }
             None => self.substrate(wo_in, wi_in),
         };
-        let mut f = substrate * t;
-        if let Some(r) = &self.rough {
-            f += Vec3::splat(r.reflection(wo, wi));
-        }
-        if f.is_finite() {
-            f.max(Vec3::ZERO)
-        } else {
-            Vec3::ZERO
-        }
+        self.value(wo, wi, substrate, t)
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
@@ -820,361 +647,6 @@ impl Bsdf for WoodBsdf {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::math::{Pcg32, PI};
-
-    fn dir(theta_deg: f32, phi_deg: f32) -> Vec3 {
-        let (t, p) = (theta_deg.to_radians(), phi_deg.to_radians());
-        Vec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
-    }
-
-    fn configs() -> Vec<WoodBsdfParams> {
-        let base = WoodBsdfParams::default();
-        vec![
-            base,
-            WoodBsdfParams { eta: 1.0, ..base },
-            WoodBsdfParams {
-                fiber_dir: Vec3::new(1.0, 0.0, -0.5).normalize(),
-                ray_dir: Vec3::new(0.0, 0.6, 0.8),
-                ray_mask: 0.5,
-                highlight_width: 0.3,
-                eta: 1.8,
-                ..base
-            },
-            WoodBsdfParams {
-                roughness: 0.3,
-                ..base
-            },
-        ]
-    }
-
-    /// Every configuration with ray masks 0, 0.4 and 1, in both normalisations.
-    fn variants() -> Vec<WoodBsdf> {
-        let norms = [
-            FiberNormalization::EnergyBounded,
-            FiberNormalization::Published,
-        ];
-        configs()
-            .into_iter()
-            .flat_map(|base| [0.0, 0.4, 1.0].map(|ray_mask| WoodBsdfParams { ray_mask, ..base }))
-            .flat_map(|p| norms.map(|n| WoodBsdf::new(p).unwrap().with_normalization(n)))
-            .collect()
-    }
-
-    /// ∫ f cos dω over the upper hemisphere by the midpoint rule in (cos θ, φ).
-    fn quadrature_albedo(b: &WoodBsdf, wo: Vec3, n: usize) -> Vec3 {
-        let mut s = Vec3::ZERO;
-        for i in 0..n {
-            let mu = (i as f32 + 0.5) / n as f32;
-            let st = (1.0 - mu * mu).sqrt();
-            for j in 0..2 * n {
-                let phi = (j as f32 + 0.5) / (2 * n) as f32 * 2.0 * PI;
-                let wi = Vec3::new(st * phi.cos(), st * phi.sin(), mu);
-                s += b.eval(wo, wi) * mu;
-            }
-        }
-        s * (2.0 * PI / (2 * n * n) as f32)
-    }
-
-    #[test]
-    fn prepared_wo_gives_exactly_eval_and_pdf() {
-        // `at_wo(wo).eval_pdf(wi)` must be bit-identical to `eval` and `pdf` (a light sweep's
-        // frames are compared with naive renders that use the same routine; this pins it to
-        // the plain BSDF): every configuration, both normalisations, ray masks 0, 0.4 and 1,
-        // directions over the whole sphere (below-horizon ones must give 0 too).
-        let mut rng = Pcg32::new(29, 3);
-        let mut nonzero = 0;
-        for b in variants() {
-            for _ in 0..40 {
-                let wo = crate::math::uniform_sphere(rng.next_vec2());
-                let at = b.at_wo(wo);
-                for _ in 0..40 {
-                    let wi = crate::math::uniform_sphere(rng.next_vec2());
-                    let (f, pdf) = at.eval_pdf(wi, true);
-                    assert_eq!(f, b.eval(wo, wi), "{wo} {wi}");
-                    assert_eq!(pdf.to_bits(), b.pdf(wo, wi).to_bits(), "{wo} {wi}");
-                    assert_eq!(at.eval_pdf(wi, false), (f, 0.0));
-                    nonzero += (pdf > 0.0) as u32;
-                }
-            }
-        }
-        // About a quarter of the 38 400 pairs lie above the horizon on both sides: the test saw
-        // real values, not only the zeros below it.
-        assert!(nonzero > 7_000, "{nonzero}");
-    }
-
-    #[test]
-    fn batch_eval_pdf_equals_one_at_a_time() {
-        // `eval_pdf_many` (a light sweep's frames in SIMD lanes) must give `eval_pdf`'s bits for
-        // every direction: all configurations, both normalisations, ray masks 0, 0.4, 1, with and
-        // without the density, batches of 1..=40 directions (partial and several chunks),
-        // directions over the whole sphere, within 0.1° of the horizon and exactly ±z; a grazing wo.
-        let mut rng = Pcg32::new(53, 9);
-        let (mut nonzero, mut below) = (0, 0);
-        for b in variants() {
-            for n in [1, 7, 16, 17, 40] {
-                let wo = match n % 3 {
-                    0 => dir(89.95, 360.0 * rng.next_f32()),
-                    _ => crate::math::uniform_sphere(rng.next_vec2()),
-                };
-                let at = b.at_wo(wo);
-                let wi: Vec<Vec3> = (0..n)
-                    .map(|k| match k % 4 {
-                        0 => dir(90.0 - 0.1 * rng.next_f32(), 360.0 * rng.next_f32()),
-                        1 if k % 8 == 1 => Vec3::Z,
-                        1 => -Vec3::Z,
-                        _ => crate::math::uniform_sphere(rng.next_vec2()),
-                    })
-                    .collect();
-                for with_pdf in [true, false] {
-                    let (mut f, mut pdf) = (vec![Vec3::NAN; n], vec![f32::NAN; n]);
-                    at.eval_pdf_many(&wi, with_pdf, &mut f, &mut pdf);
-                    for k in 0..n {
-                        let (f1, p1) = at.eval_pdf(wi[k], with_pdf);
-                        let bits = |v: Vec3| v.to_array().map(f32::to_bits);
-                        assert_eq!(bits(f[k]), bits(f1), "{wo} {}", wi[k]);
-                        assert_eq!(pdf[k].to_bits(), p1.to_bits(), "{wo} {}", wi[k]);
-                        assert!(f[k].is_finite() && pdf[k].is_finite());
-                        nonzero += (pdf[k] > 0.0) as u32;
-                        below += (wi[k].z <= 0.0) as u32;
-                    }
-                }
-            }
-        }
-        assert!(nonzero > 300 && below > 300, "{nonzero} {below}");
-    }
-
-    #[test]
-    fn rejects_bad_parameters_naming_the_field() {
-        let base = WoodBsdfParams::default();
-        let cases: [(WoodBsdfParams, &str); 6] = [
-            (WoodBsdfParams { eta: 0.5, ..base }, "eta"),
-            (
-                WoodBsdfParams {
-                    roughness: f32::NAN,
-                    ..base
-                },
-                "roughness",
-            ),
-            (
-                WoodBsdfParams {
-                    highlight_width: 0.0,
-                    ..base
-                },
-                "highlight_width",
-            ),
-            (
-                WoodBsdfParams {
-                    fiber_dir: Vec3::ZERO,
-                    ..base
-                },
-                "fiber_dir",
-            ),
-            (
-                WoodBsdfParams {
-                    diffuse: Vec3::splat(1.5),
-                    ..base
-                },
-                "diffuse",
-            ),
-            (
-                WoodBsdfParams {
-                    ray_mask: -0.1,
-                    ..base
-                },
-                "ray_mask",
-            ),
-        ];
-        for (p, field) in cases {
-            let e = WoodBsdf::new(p).unwrap_err().to_string();
-            assert!(e.contains(field), "{e}");
-        }
-        assert!(WoodBsdf::new(base).is_ok());
-    }
-
-    #[test]
-    fn eval_is_reciprocal() {
-        let mut r = Pcg32::new(5, 0);
-        for p in configs() {
-            for norm in [
-                FiberNormalization::EnergyBounded,
-                FiberNormalization::Published,
-            ] {
-                let b = WoodBsdf::new(p).unwrap().with_normalization(norm);
-                for _ in 0..2000 {
-                    let a = cosine_hemisphere(r.next_vec2());
-                    let c = cosine_hemisphere(r.next_vec2());
-                    let (f1, f2) = (b.eval(a, c), b.eval(c, a));
-                    let d = (f1 - f2).abs().max_element();
-                    assert!(
-                        d <= 1e-4 * f1.max(f2).max_element().max(1e-6),
-                        "{p:?} {f1} {f2}"
-                    );
-                }
-            }
-        }
-    }
-
-    #[test]
-    fn white_substrate_under_smooth_finish_reflects_everything() {
-        // Independent check: delta reflection F(θo) plus a quadrature of eval·cos.
-        for eta in [1.0f32, 1.33, 1.5, 2.0, 2.5] {
-            let b = WoodBsdf::new(WoodBsdfParams {
-                diffuse: Vec3::ONE,
-                fiber_color: Vec3::ZERO,
-                eta,
-                ..WoodBsdfParams::default()
-            })
-            .unwrap();
-            for theta in [0.0f32, 30.0, 60.0, 80.0, 85.0] {
-                let wo = dir(theta, 20.0);
-                let a = quadrature_albedo(&b, wo, 200).x + fresnel_dielectric(wo.z, eta);
-                assert!((0.99..=1.001).contains(&a), "eta {eta} θ {theta}: {a}");
-            }
-        }
-    }
-
-    #[test]
-    fn samples_match_eval_and_pdf_and_weights_stay_bounded() {
-        let mut r = Pcg32::new(8, 3);
-        for p in configs() {
-            let b = WoodBsdf::new(p).unwrap();
-            for theta in [5.0f32, 45.0, 80.0] {
-                let wo = dir(theta, 60.0);
-                for _ in 0..3000 {
-                    let Some(s) = b.sample(wo, r.next_f32(), r.next_vec2()) else {
-                        continue;
-                    };
-                    assert!(s.f.is_finite() && s.pdf.is_finite() && s.pdf > 0.0);
-                    if s.is_delta {
-                        let w = s.f * s.wi.z / s.pdf;
-                        assert!(w.max_element() <= 1.0 + 1e-4, "{w}");
-                        continue;
-                    }
-                    let (f, pdf) = (b.eval(wo, s.wi), b.pdf(wo, s.wi));
-                    assert!((f - s.f).abs().max_element() <= 1e-5 * f.max_element().max(1e-6));
-                    assert!((pdf - s.pdf).abs() <= 1e-5 * pdf);
-                }
-            }
-        }
-    }
-
-    #[test]
-    fn sampled_fraction_equals_integral_of_pdf() {
-        // P(sample returns a non-delta direction) = ∫ pdf dω: pdf is the density of `sample`.
-        for p in configs() {
-            let b = WoodBsdf::new(p).unwrap();
-            let wo = dir(40.0, 10.0);
-            let n_q = 400;
-            let mut integral = 0.0f64;
-            for i in 0..n_q {
-                let mu = (i as f32 + 0.5) / n_q as f32;
-                let st = (1.0 - mu * mu).sqrt();
-                for j in 0..2 * n_q {
-                    let phi = (j as f32 + 0.5) / (2 * n_q) as f32 * 2.0 * PI;
-                    let wi = Vec3::new(st * phi.cos(), st * phi.sin(), mu);
-                    integral += b.pdf(wo, wi) as f64;
-                }
-            }
-            integral *= 2.0 * PI as f64 / (2 * n_q * n_q) as f64;
-            let mut r = Pcg32::new(21, 0);
-            let n = 200_000;
-            let hits = (0..n)
-                .filter(
-                    |_| matches!(b.sample(wo, r.next_f32(), r.next_vec2()), Some(s) if !s.is_delta),
-                )
-                .count() as f64
-                / n as f64;
-            // Binomial standard error ≤ 0.5/√n ≈ 1.1e-3; allow 5σ plus 0.5 % quadrature error.
-            assert!(
-                (hits - integral).abs() < 5.5e-3 + 0.005 * integral,
-                "{p:?}: {hits} vs {integral}"
-            );
-        }
-    }
-
-    #[test]
-    fn energy_bounded_lobe_never_exceeds_one() {
-        // Worst case for the bound: white diffuse, k_f = 1, grazing and along-fibre views.
-        let mut r = Pcg32::new(77, 0);
-        for fiber_dir in [Vec3::X, Vec3::new(1.0, 0.0, -1.0).normalize(), Vec3::Z] {
-            let b = WoodBsdf::new(WoodBsdfParams {
-                diffuse: Vec3::ONE,
-                fiber_color: Vec3::ONE,
-                fiber_dir,
-                highlight_width: 0.5,
-                eta: 1.0,
-                ..WoodBsdfParams::default()
-            })
-            .unwrap();
-            for wo in [
-                dir(0.0, 0.0),
-                dir(60.0, 0.0),
-                dir(88.0, 0.0),
-                dir(88.0, 180.0),
-            ] {
-                let n = 100_000;
-                let mut s = 0.0f64;
-                for _ in 0..n {
-                    if let Some(x) = b.sample(wo, r.next_f32(), r.next_vec2()) {
-                        s += (x.f.x * x.wi.z / x.pdf) as f64;
-                    }
-                }
-                let a = s / n as f64;
-                assert!(a <= 1.0 + 0.01, "{fiber_dir} {wo}: {a}");
-            }
-        }
-    }
-}
-
+mod bounded_diffuse_tests;
 #[cfg(test)]
-mod bounded_diffuse_tests {
-    use super::bounded_diffuse;
-    use crate::bsdf::fiber_albedo::TABLE_MARGIN;
-    use crate::bsdf::WoodBsdfParams;
-    use glam::Vec3;
-    use std::f32::consts::FRAC_1_PI;
-
-    fn params(diffuse: Vec3, fiber_color: Vec3) -> WoodBsdfParams {
-        WoodBsdfParams {
-            diffuse,
-            fiber_color,
-            fiber_dir: Vec3::X,
-            ray_dir: Vec3::Z,
-            ray_mask: 0.0,
-            highlight_width: 1e-3,
-            eta: 1.5,
-            roughness: 0.0,
-        }
-    }
-
-    /// In-plane fibres with a sharp highlight reflect at most 1/π (notes/bsdf.md §2.1, C = 2 cos ψ),
-    /// so a pale maple keeps (1 − k_f/π)/ρ of its colour, not (1 − k_f)/ρ, in the same hue.
-    #[test]
-    fn leaves_room_for_what_the_lobe_reflects() {
-        let (rho, kf) = (Vec3::new(0.9, 0.8, 0.6), Vec3::new(0.9, 0.85, 0.75));
-        let b = bounded_diffuse(&params(rho, kf));
-        let lobe = FRAC_1_PI * (1.0 + TABLE_MARGIN);
-        let s = (1.0 - kf.x * lobe) / rho.x;
-        assert!((b / rho - Vec3::splat(s)).abs().max_element() < 1e-4, "{b}");
-        assert!((b + kf * lobe).max_element() <= 1.0 + 1e-4);
-        // Colours that already fit are unchanged.
-        let dark = Vec3::new(0.3, 0.2, 0.1);
-        assert_eq!(bounded_diffuse(&params(dark, kf)), dark);
-    }
-
-    /// Ray fibres along the normal reflect every sharp highlight into the surface (the cone about
-    /// ψi = −ψr lies below it), so a full ray mask leaves the diffuse as it is.
-    #[test]
-    fn blends_the_ray_lobe_by_the_mask() {
-        let (rho, kf) = (Vec3::splat(0.95), Vec3::ONE);
-        let mut p = params(rho, kf);
-        p.ray_mask = 1.0;
-        assert!((bounded_diffuse(&p) - rho).abs().max_element() < 2e-3);
-        p.ray_mask = 0.5;
-        let half = bounded_diffuse(&p).x;
-        let want = (1.0 - 0.5 * FRAC_1_PI * (1.0 + TABLE_MARGIN)) / 0.95;
-        assert!((half / 0.95 - want.min(1.0)).abs() < 2e-3, "{half}");
-    }
-}
+mod tests;

@@ -30,9 +30,9 @@ pub fn cases() -> [(&'static str, WoodBsdfParams); 3] {
 }
 
 /// Direction pairs (wo, wi) at which a BSDF is evaluated.
-pub type DirectionPairs = Vec<(Vec3, Vec3)>;
+pub(crate) type DirectionPairs = Vec<(Vec3, Vec3)>;
 /// Sample inputs (uc, u) of `Bsdf::sample`.
-pub type SampleInputs = Vec<(f32, Vec2)>;
+pub(crate) type SampleInputs = Vec<(f32, Vec2)>;
 
 /// 1024 (wo, wi) pairs and 1024 (uc, u) sample inputs from a fixed seed.
 pub fn inputs() -> (DirectionPairs, SampleInputs) {

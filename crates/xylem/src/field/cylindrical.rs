@@ -21,7 +21,7 @@ pub struct Cylindrical {
 impl Cylindrical {
     /// Coordinates of `p`; at the pith θ = 0.
     #[inline]
-    pub fn from_point(p: Vec3) -> Self {
+    pub(crate) fn from_point(p: Vec3) -> Self {
         let r = (p.x * p.x + p.y * p.y).sqrt();
         let theta = if r > PITH_EPSILON {
             p.y.atan2(p.x)

@@ -77,7 +77,7 @@ impl Distortion {
     /// J⁻¹ (for transporting several vectors); identity when J is singular (only possible when
     /// several terms combine badly), so results stay finite.
     #[inline]
-    pub fn inverse_jacobian(&self) -> Mat3 {
+    pub(crate) fn inverse_jacobian(&self) -> Mat3 {
         let det = self.jacobian.determinant();
         if det.abs() > 1e-6 && det.is_finite() {
             self.jacobian.inverse()

@@ -7,7 +7,9 @@ use crate::math::Vec3;
 use crate::picture::srgb::srgb_to_linear;
 use crate::render::image_io::read_exr_rgb_checked;
 use crate::sweep::claim::CLAIM_FILE;
-use crate::sweep::manifest::{Manifest, MANIFEST_FILE};
+use crate::sweep::manifest::{
+    BoardManifest, CameraManifest, FrameManifest, Manifest, MANIFEST_FILE,
+};
 use std::path::{Path, PathBuf};
 
 /// Why a capture cannot be fitted; every message names the file and the field.
@@ -135,7 +137,7 @@ pub struct BoardPlane {
 
 impl BoardPlane {
     /// The world point at the centre of texel (col, row) of a `w` × `h` map (row 0 at the top).
-    pub fn texel_point(&self, col: usize, row: usize, w: usize, h: usize) -> Vec3 {
+    pub(crate) fn texel_point(&self, col: usize, row: usize, w: usize, h: usize) -> Vec3 {
         let u = ((col as f32 + 0.5) / w as f32 - 0.5) * self.size[0];
         let v = (0.5 - (row as f32 + 0.5) / h as f32) * self.size[1];
         self.origin + u * self.x + v * self.y
@@ -192,7 +194,7 @@ pub struct CaptureFrame {
 impl CaptureFrame {
     /// The light's direction from `p` (unit) and the irradiance factor: I/d² for a point light,
     /// E for a distant one (the radiance of a pixel is f · cos θi times it per channel).
-    pub fn light_at(&self, p: Vec3) -> (Vec3, Vec3) {
+    pub(crate) fn light_at(&self, p: Vec3) -> (Vec3, Vec3) {
         match self.light {
             FrameLight::Point { position, .. } => {
                 let d = position - p;
@@ -280,14 +282,12 @@ impl Capture {
     }
 
     /// Checks a parsed manifest; `dir` is the folder its image paths are relative to.
-    pub fn from_manifest(dir: &Path, m: &Manifest) -> Result<Capture, CaptureError> {
+    pub(crate) fn from_manifest(dir: &Path, m: &Manifest) -> Result<Capture, CaptureError> {
         let manifest_path = dir.join(MANIFEST_FILE);
-        let path = manifest_path.display().to_string();
-        let bad = |field: &str, message: String| CaptureError::Field {
-            path: path.clone(),
-            field: field.to_string(),
-            message,
+        let check = ManifestChecker {
+            path: manifest_path.display().to_string(),
         };
+        let bad = |field: &str, message: String| check.bad(field, message);
         if m.format != crate::sweep::manifest::FORMAT {
             return Err(bad(
                 "format",
@@ -298,117 +298,8 @@ impl Capture {
                 ),
             ));
         }
-        let c = &m.camera;
-        if c.width == 0 || c.height == 0 || c.width > 16384 || c.height > 16384 {
-            return Err(bad(
-                "camera.width",
-                format!("{}x{} (allowed 1 to 16384 each)", c.width, c.height),
-            ));
-        }
-        let unit = |field: &str, a: [f32; 3]| -> Result<Vec3, CaptureError> {
-            let v = vec3(a);
-            if v.is_finite() && (v.length() - 1.0).abs() < 1e-3 {
-                Ok(v.normalize())
-            } else {
-                Err(bad(field, format!("{v} (allowed a unit vector)")))
-            }
-        };
-        let (right, up, forward) = (
-            unit("camera.right", c.right)?,
-            unit("camera.up", c.up)?,
-            unit("camera.forward", c.forward)?,
-        );
-        // A camera whose axes are not orthogonal projects the board onto a line (a 1×23 map).
-        for (field, a, b, an) in [
-            ("camera.up", up, right, "camera.right"),
-            ("camera.forward", forward, right, "camera.right"),
-            ("camera.forward", forward, up, "camera.up"),
-        ] {
-            if a.dot(b).abs() > 1e-3 {
-                return Err(bad(
-                    field,
-                    format!(
-                        "{a} is {:.2}° from {an} {b} (allowed: perpendicular, within 0.06°)",
-                        a.dot(b).clamp(-1.0, 1.0).acos().to_degrees()
-                    ),
-                ));
-            }
-        }
-        if !vec3(c.eye).is_finite() {
-            return Err(bad("camera.eye", "must be finite".into()));
-        }
-        let (scale, orthographic) = match c.projection.as_str() {
-            "perspective" => {
-                let fov = c
-                    .fov_y_deg
-                    .ok_or_else(|| bad("camera.fov_y_deg", "missing (perspective)".into()))?;
-                if !(fov > 0.01 && fov < 179.0) {
-                    return Err(bad(
-                        "camera.fov_y_deg",
-                        format!("{fov} (allowed 0.01 to 179)"),
-                    ));
-                }
-                ((0.5 * fov.to_radians()).tan(), false)
-            }
-            "orthographic" => {
-                let w = c
-                    .film_width_mm
-                    .ok_or_else(|| bad("camera.film_width_mm", "missing (orthographic)".into()))?;
-                if !(w > 0.0 && w.is_finite()) {
-                    return Err(bad("camera.film_width_mm", format!("{w} (allowed > 0)")));
-                }
-                (0.5 * w * c.height as f32 / c.width as f32, true)
-            }
-            other => {
-                return Err(bad(
-                    "camera.projection",
-                    format!("`{other}` (allowed `perspective`, `orthographic`)"),
-                ))
-            }
-        };
-        let camera = FilmCamera {
-            width: c.width,
-            height: c.height,
-            eye: vec3(c.eye),
-            right,
-            up,
-            forward,
-            scale,
-            orthographic,
-        };
-        let b = m.board.as_ref().ok_or_else(|| {
-            bad(
-                "board",
-                "missing (a scene's [sweep.board] table writes it; notes/fit.md)".into(),
-            )
-        })?;
-        let (x, y) = (
-            unit("board.x_axis", b.x_axis)?,
-            unit("board.y_axis", b.y_axis)?,
-        );
-        if x.dot(y).abs() > 1e-3 {
-            return Err(bad("board.y_axis", "not perpendicular to x_axis".into()));
-        }
-        if !vec3(b.origin).is_finite() {
-            return Err(bad("board.origin", "must be finite".into()));
-        }
-        if !b.size_mm.iter().all(|s| s.is_finite() && *s > 0.0) {
-            return Err(bad(
-                "board.size_mm",
-                format!("{:?} (allowed positive mm)", b.size_mm),
-            ));
-        }
-        if !(1.0..=4.0).contains(&b.eta) {
-            return Err(bad("board.eta", format!("{} (allowed 1 to 4)", b.eta)));
-        }
-        let board = BoardPlane {
-            origin: vec3(b.origin),
-            x,
-            y,
-            z: x.cross(y),
-            size: b.size_mm,
-            eta: b.eta,
-        };
+        let camera = check.camera(&m.camera)?;
+        let board = check.board(m.board.as_ref())?;
         let srgb = match m.color_space.as_str() {
             "linear" => false,
             "srgb" => true,
@@ -443,58 +334,7 @@ impl Capture {
                     format!("{intensity} (allowed finite, ≥ 0, not all 0)"),
                 ));
             }
-            let light = match f.light.as_str() {
-                "point" => {
-                    let p =
-                        vec3(f.position.ok_or_else(|| {
-                            bad(&field("position"), "missing (point light)".into())
-                        })?);
-                    if !p.is_finite() {
-                        return Err(bad(&field("position"), "must be finite".into()));
-                    }
-                    // The light must be above the board's plane (outside the board).
-                    let h = (p - board.origin).dot(board.z);
-                    if h <= 1e-3 * board.size[0].max(board.size[1]) {
-                        return Err(bad(
-                            &field("position"),
-                            format!(
-                                "{p} lies {h} mm from the board plane, inside or below the board (allowed: above the face)"
-                            ),
-                        ));
-                    }
-                    if !(f.radius.is_finite() && f.radius >= 0.0 && f.radius < h) {
-                        return Err(bad(
-                            &field("radius"),
-                            format!("{} (allowed 0 to the light's height {h} mm)", f.radius),
-                        ));
-                    }
-                    FrameLight::Point {
-                        position: p,
-                        radius: f.radius,
-                    }
-                }
-                "distant" => {
-                    let d = unit(
-                        &field("direction"),
-                        f.direction.ok_or_else(|| {
-                            bad(&field("direction"), "missing (distant light)".into())
-                        })?,
-                    )?;
-                    if d.dot(board.z) <= 0.0 {
-                        return Err(bad(
-                            &field("direction"),
-                            "below the board's horizon (allowed: towards the face)".into(),
-                        ));
-                    }
-                    FrameLight::Distant { direction: d }
-                }
-                other => {
-                    return Err(bad(
-                        &field("light"),
-                        format!("`{other}` (allowed `point`, `distant`)"),
-                    ))
-                }
-            };
+            let light = check.frame_light(k, f, &board)?;
             frames.push(CaptureFrame {
                 image: dir.join(&f.image),
                 light,
@@ -518,7 +358,7 @@ impl Capture {
     }
 
     /// The azimuths (degrees, one per distinct arc) of the frames.
-    pub fn arc_azimuths(&self) -> Vec<f32> {
+    pub(crate) fn arc_azimuths(&self) -> Vec<f32> {
         let mut arcs: Vec<(usize, f32)> = Vec::new();
         for f in &self.frames {
             if !arcs.iter().any(|a| a.0 == f.arc) {
@@ -691,4 +531,216 @@ fn read_png(
         })
         .collect();
     Ok((info.width, info.height, px))
+}
+/// Where a manifest's errors point: its file, and the field named by each check.
+struct ManifestChecker {
+    path: String,
+}
+
+impl ManifestChecker {
+    /// The error for `field` of the manifest, with `message`.
+    fn bad(&self, field: &str, message: String) -> CaptureError {
+        CaptureError::Field {
+            path: self.path.clone(),
+            field: field.to_string(),
+            message,
+        }
+    }
+
+    /// `a` as a unit vector (normalised), or the error for `field`: finite, length 1 ± 1e-3.
+    fn unit(&self, field: &str, a: [f32; 3]) -> Result<Vec3, CaptureError> {
+        let v = vec3(a);
+        if v.is_finite() && (v.length() - 1.0).abs() < 1e-3 {
+            Ok(v.normalize())
+        } else {
+            Err(self.bad(field, format!("{v} (allowed a unit vector)")))
+        }
+    }
+
+    /// The manifest's camera checked: size, orthonormal axes, a finite eye, the projection and
+    /// its field of view or film width.
+    fn camera(&self, c: &CameraManifest) -> Result<FilmCamera, CaptureError> {
+        let (bad, unit) = (
+            |at: &str, m: String| self.bad(at, m),
+            |at: &str, a| self.unit(at, a),
+        );
+        if c.width == 0 || c.height == 0 || c.width > 16384 || c.height > 16384 {
+            return Err(bad(
+                "camera.width",
+                format!("{}x{} (allowed 1 to 16384 each)", c.width, c.height),
+            ));
+        }
+        let (right, up, forward) = (
+            unit("camera.right", c.right)?,
+            unit("camera.up", c.up)?,
+            unit("camera.forward", c.forward)?,
+        );
+        // A camera whose axes are not orthogonal projects the board onto a line (a 1×23 map).
+        for (field, a, b, an) in [
+            ("camera.up", up, right, "camera.right"),
+            ("camera.forward", forward, right, "camera.right"),
+            ("camera.forward", forward, up, "camera.up"),
+        ] {
+            if a.dot(b).abs() > 1e-3 {
+                return Err(bad(
+                    field,
+                    format!(
+                        "{a} is {:.2}° from {an} {b} (allowed: perpendicular, within 0.06°)",
+                        a.dot(b).clamp(-1.0, 1.0).acos().to_degrees()
+                    ),
+                ));
+            }
+        }
+        if !vec3(c.eye).is_finite() {
+            return Err(bad("camera.eye", "must be finite".into()));
+        }
+        let (scale, orthographic) = match c.projection.as_str() {
+            "perspective" => {
+                let fov = c
+                    .fov_y_deg
+                    .ok_or_else(|| bad("camera.fov_y_deg", "missing (perspective)".into()))?;
+                if !(fov > 0.01 && fov < 179.0) {
+                    return Err(bad(
+                        "camera.fov_y_deg",
+                        format!("{fov} (allowed 0.01 to 179)"),
+                    ));
+                }
+                ((0.5 * fov.to_radians()).tan(), false)
+            }
+            "orthographic" => {
+                let w = c
+                    .film_width_mm
+                    .ok_or_else(|| bad("camera.film_width_mm", "missing (orthographic)".into()))?;
+                if !(w > 0.0 && w.is_finite()) {
+                    return Err(bad("camera.film_width_mm", format!("{w} (allowed > 0)")));
+                }
+                (0.5 * w * c.height as f32 / c.width as f32, true)
+            }
+            other => {
+                return Err(bad(
+                    "camera.projection",
+                    format!("`{other}` (allowed `perspective`, `orthographic`)"),
+                ))
+            }
+        };
+        Ok(FilmCamera {
+            width: c.width,
+            height: c.height,
+            eye: vec3(c.eye),
+            right,
+            up,
+            forward,
+            scale,
+            orthographic,
+        })
+    }
+
+    /// The manifest's board checked: present, orthonormal axes, a finite origin, a positive
+    /// size and the finish's η in [1, 4].
+    fn board(&self, b: Option<&BoardManifest>) -> Result<BoardPlane, CaptureError> {
+        let (bad, unit) = (
+            |at: &str, m: String| self.bad(at, m),
+            |at: &str, a| self.unit(at, a),
+        );
+        let b = b.ok_or_else(|| {
+            bad(
+                "board",
+                "missing (a scene's [sweep.board] table writes it; notes/fit.md)".into(),
+            )
+        })?;
+        let (x, y) = (
+            unit("board.x_axis", b.x_axis)?,
+            unit("board.y_axis", b.y_axis)?,
+        );
+        if x.dot(y).abs() > 1e-3 {
+            return Err(bad("board.y_axis", "not perpendicular to x_axis".into()));
+        }
+        if !vec3(b.origin).is_finite() {
+            return Err(bad("board.origin", "must be finite".into()));
+        }
+        if !b.size_mm.iter().all(|s| s.is_finite() && *s > 0.0) {
+            return Err(bad(
+                "board.size_mm",
+                format!("{:?} (allowed positive mm)", b.size_mm),
+            ));
+        }
+        if !(1.0..=4.0).contains(&b.eta) {
+            return Err(bad("board.eta", format!("{} (allowed 1 to 4)", b.eta)));
+        }
+        Ok(BoardPlane {
+            origin: vec3(b.origin),
+            x,
+            y,
+            z: x.cross(y),
+            size: b.size_mm,
+            eta: b.eta,
+        })
+    }
+
+    /// The light of frame `k` checked against the board: a point light above the face (its
+    /// radius below its height), or a distant light towards the face.
+    fn frame_light(
+        &self,
+        k: usize,
+        f: &FrameManifest,
+        board: &BoardPlane,
+    ) -> Result<FrameLight, CaptureError> {
+        let (bad, unit) = (
+            |at: &str, m: String| self.bad(at, m),
+            |at: &str, a| self.unit(at, a),
+        );
+        let field = |name: &str| format!("frames[{k}].{name}");
+        Ok(match f.light.as_str() {
+            "point" => {
+                let p = vec3(
+                    f.position
+                        .ok_or_else(|| bad(&field("position"), "missing (point light)".into()))?,
+                );
+                if !p.is_finite() {
+                    return Err(bad(&field("position"), "must be finite".into()));
+                }
+                // The light must be above the board's plane (outside the board).
+                let h = (p - board.origin).dot(board.z);
+                if h <= 1e-3 * board.size[0].max(board.size[1]) {
+                    return Err(bad(
+                        &field("position"),
+                        format!(
+                            "{p} lies {h} mm from the board plane, inside or below the board (allowed: above the face)"
+                        ),
+                    ));
+                }
+                if !(f.radius.is_finite() && f.radius >= 0.0 && f.radius < h) {
+                    return Err(bad(
+                        &field("radius"),
+                        format!("{} (allowed 0 to the light's height {h} mm)", f.radius),
+                    ));
+                }
+                FrameLight::Point {
+                    position: p,
+                    radius: f.radius,
+                }
+            }
+            "distant" => {
+                let d = unit(
+                    &field("direction"),
+                    f.direction.ok_or_else(|| {
+                        bad(&field("direction"), "missing (distant light)".into())
+                    })?,
+                )?;
+                if d.dot(board.z) <= 0.0 {
+                    return Err(bad(
+                        &field("direction"),
+                        "below the board's horizon (allowed: towards the face)".into(),
+                    ));
+                }
+                FrameLight::Distant { direction: d }
+            }
+            other => {
+                return Err(bad(
+                    &field("light"),
+                    format!("`{other}` (allowed `point`, `distant`)"),
+                ))
+            }
+        })
+    }
 }

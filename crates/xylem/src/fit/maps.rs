@@ -72,7 +72,7 @@ pub struct FittedMaps {
 impl FittedMaps {
     /// Maps from per-texel fits; a texel that could not be fitted (too few usable frames) gets
     /// black colours, the x axis, β = 10° and residual 1, so no map holds a NaN.
-    pub fn from_fits(width: usize, height: usize, fits: &[Option<TexelFit>]) -> FittedMaps {
+    pub(crate) fn from_fits(width: usize, height: usize, fits: &[Option<TexelFit>]) -> FittedMaps {
         let blank = TexelFit {
             diffuse: Vec3::ZERO,
             fiber_color: Vec3::ZERO,
@@ -95,7 +95,7 @@ impl FittedMaps {
     }
 
     /// Refuses maps holding a NaN or an infinity (the error names the map and texel).
-    pub fn check_finite(&self, dir: &Path) -> Result<(), MapsError> {
+    pub(crate) fn check_finite(&self, dir: &Path) -> Result<(), MapsError> {
         let vectors = [
             ("diffuse", &self.diffuse),
             ("fiber_color", &self.fiber_color),
@@ -147,7 +147,7 @@ fn rgb8(v: &[Vec3], f: impl Fn(Vec3) -> Vec3) -> Vec<u8> {
 /// The `tEXt` chunk (`Software`) that marks a PNG map written by `xylem fit`: a reader of such
 /// a map requires the fit's record `fit.json` beside it (`material::measured`), so the maps of
 /// a fit killed while committing are never read as a complete set.
-pub const FIT_PNG_MARK: (&str, &str) = ("Software", "xylem fit");
+pub(crate) const FIT_PNG_MARK: (&str, &str) = ("Software", "xylem fit");
 
 /// Stages the PNG maps of `board` in the `measured` encoding into `dir` (β map if it has one).
 pub fn stage_board_pngs(dir: &Path, board: &MeasuredBoard) -> Result<Vec<Staged>, MapsError> {
@@ -182,7 +182,7 @@ fn stage_board_pngs_text(
 }
 
 /// The record of a fit's outputs: the report, with the maps' sizes and CRC-32s, written last.
-pub const FIT_RECORD: &str = "fit.json";
+pub(crate) const FIT_RECORD: &str = "fit.json";
 
 /// Writes the maps, the residual map, `maps.exr` and `report` (as `fit.json`) into `dir`,
 /// holding the folder's lock; every file is staged first, and all are committed as one set

@@ -236,7 +236,7 @@ impl Default for FitOptions<'_> {
 }
 
 /// Texels the board covers in the frames: its edges' lengths in pixels, rounded.
-pub fn default_texels(c: &Capture) -> (usize, usize) {
+pub(crate) fn default_texels(c: &Capture) -> (usize, usize) {
     let b = &c.board;
     let px = |d: Vec3| -> f32 {
         match (

@@ -51,7 +51,7 @@ const BETA_MAX: f32 = 45.0 * std::f32::consts::PI / 180.0;
 const DIP_MAX: f32 = 80.0 * std::f32::consts::PI / 180.0;
 
 /// u(φ, δ) = (cos δ cos φ, cos δ sin φ, sin δ).
-pub fn axis_of(phi: f32, dip: f32) -> Vec3 {
+pub(crate) fn axis_of(phi: f32, dip: f32) -> Vec3 {
     let (sd, cd) = dip.sin_cos();
     let (sp, cp) = phi.sin_cos();
     Vec3::new(cd * cp, cd * sp, sd)

@@ -52,7 +52,7 @@ impl FaceRect {
     }
 
     /// The object-space direction of tangent-space `t` (x right, y up = −down, z the normal).
-    pub fn tangent_to_object(&self, t: Vec3) -> Vec3 {
+    pub(crate) fn tangent_to_object(&self, t: Vec3) -> Vec3 {
         self.right * t.x - self.down * t.y + self.normal() * t.z
     }
 }
@@ -90,7 +90,7 @@ pub struct FaceTexel {
 /// fibre goes tangent → object → world by the instance's linear map (directions are
 /// contravariant, Liu et al. 2016 §6.2); the ray axis lies in the face across the fibre, as on a
 /// quartersawn face.
-pub fn face_shading(
+pub(crate) fn face_shading(
     hit: &MaterialHit,
     face: &FaceRect,
     n: Vec3,

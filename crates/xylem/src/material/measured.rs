@@ -144,7 +144,7 @@ type Rgb8 = (u32, u32, Vec<[u8; 3]>);
 /// samples and 8-bit copies of each map, then three maps of linear `Vec3`s, and β): measured
 /// 45 bytes (three 4096² maps: peak RSS 798 MB, 46 MB of it the process before reading).
 /// The diffuse map, read first, is checked against this for the whole board.
-pub const BOARD_BYTES_PER_TEXEL: u64 = 48;
+pub(crate) const BOARD_BYTES_PER_TEXEL: u64 = 48;
 
 /// Reads one map; `want` is the diffuse map's size (None when reading the diffuse map itself),
 /// checked on the header before a texel is decoded.
@@ -356,7 +356,7 @@ pub enum BoardFace {
 
 impl BoardFace {
     /// The face named "+z", "-z", "+x", "-x", "+y" or "-y".
-    pub fn from_name(name: &str) -> Option<BoardFace> {
+    pub(crate) fn from_name(name: &str) -> Option<BoardFace> {
         Some(match name {
             "+z" => BoardFace::PosZ,
             "-z" => BoardFace::NegZ,

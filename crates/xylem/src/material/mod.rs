@@ -94,7 +94,7 @@ impl SurfaceBsdf {
     }
 
     /// True when the BSDF transmits (the renderer must not flip the normal towards the viewer).
-    pub fn is_transmissive(&self) -> bool {
+    pub(crate) fn is_transmissive(&self) -> bool {
         match self {
             SurfaceBsdf::Glass(_) => true,
             SurfaceBsdf::Lambertian(_) | SurfaceBsdf::Wood(_) | SurfaceBsdf::Mirror(_) => false,

@@ -83,7 +83,7 @@ impl Fractal {
 
     /// Σ of the amplitudes, Σ gainⁱ: a bound for |fBm| / max|basis| and the scale textures use
     /// to normalise.
-    pub fn amplitude_sum(&self) -> f32 {
+    pub(crate) fn amplitude_sum(&self) -> f32 {
         (0..self.octaves).map(|i| self.gain.powi(i as i32)).sum()
     }
 

@@ -49,7 +49,7 @@ pub fn cell3(ix: i32, iy: i32, iz: i32, seed: u32) -> [u32; 3] {
 
 /// [`cell3`] with the seed's [`seed_offsets`] computed once by the caller (hot loops).
 #[inline(always)]
-pub fn cell3_offset(ix: i32, iy: i32, iz: i32, s: &[u32; 3]) -> [u32; 3] {
+pub(crate) fn cell3_offset(ix: i32, iy: i32, iz: i32, s: &[u32; 3]) -> [u32; 3] {
     pcg3d([
         (ix as u32).wrapping_add(s[0]),
         (iy as u32).wrapping_add(s[1]),
@@ -71,13 +71,13 @@ pub fn seed_offsets(seed: u32) -> [u32; 3] {
 }
 
 /// Teschner et al. 2003 constants (large primes) for the per-axis multiply of [`lattice`].
-pub const PRIME_X: u32 = 73_856_093;
+pub(crate) const PRIME_X: u32 = 73_856_093;
 /// Teschner et al. 2003's prime for y.
-pub const PRIME_Y: u32 = 19_349_663;
+pub(crate) const PRIME_Y: u32 = 19_349_663;
 /// Teschner et al. 2003's prime for z.
-pub const PRIME_Z: u32 = 83_492_791;
+pub(crate) const PRIME_Z: u32 = 83_492_791;
 /// Knuth's multiplicative-hash constant ⌊2^32/φ⌋ (odd).
-pub const KNUTH: u32 = 0x9e37_79b1;
+pub(crate) const KNUTH: u32 = 0x9e37_79b1;
 
 /// The cheap lattice hash: `((x·P1) ^ (y·P2) ^ (z·P3) ^ s) · K`, returning all 32 bits; callers use
 /// the high bits. Callers pass the per-axis products (`x·P1` ...), so neighbouring corners cost one
@@ -90,13 +90,13 @@ pub fn lattice(xp: u32, yp: u32, zp: u32, s: u32) -> u32 {
 
 /// Uniform in [0, 1) from the top 24 bits of a hash.
 #[inline(always)]
-pub fn unit_f32(h: u32) -> f32 {
+pub(crate) fn unit_f32(h: u32) -> f32 {
     (h >> 8) as f32 * (1.0 / 16_777_216.0)
 }
 
 /// Uniform in [-1, 1) from the top 24 bits of a hash.
 #[inline(always)]
-pub fn signed_f32(h: u32) -> f32 {
+pub(crate) fn signed_f32(h: u32) -> f32 {
     (h >> 8) as f32 * (2.0 / 16_777_216.0) - 1.0
 }
 
@@ -122,7 +122,7 @@ pub fn saturating_i32(x: f32) -> i32 {
 /// `⌊x⌋` as an integer without a libm call (`f32::floor` is not an instruction on baseline
 /// x86-64). Exact for |x| < 2^31; vectorises (through [`saturating_i32`]).
 #[inline(always)]
-pub fn floor_i32(x: f32) -> i32 {
+pub(crate) fn floor_i32(x: f32) -> i32 {
     let i = saturating_i32(x);
     i - ((x < i as f32) as i32)
 }

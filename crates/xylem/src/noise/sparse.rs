@@ -33,7 +33,7 @@ pub enum Kernel {
 impl Kernel {
     /// `(K, dK/dq)` at `q = r²`; `(0, 0)` for `q ≥ 1`.
     #[inline(always)]
-    pub fn eval_q(self, q: f32) -> (f32, f32) {
+    pub(crate) fn eval_q(self, q: f32) -> (f32, f32) {
         if q >= 1.0 {
             return (0.0, 0.0);
         }

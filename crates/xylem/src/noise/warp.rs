@@ -64,7 +64,7 @@ impl Warp {
     /// [`Warp::sample`] with the warp fields q and r looked up at `drift` from where they would
     /// be (the final lookup stays at p + s r): animating `drift` over time makes the pattern flow
     /// and re-form instead of sliding ("Procedural Textures: wood, marble and beyond").
-    pub fn sample_drifting(&self, p: Vec3, drift: Vec3, seed: u32) -> WarpSample {
+    pub(crate) fn sample_drifting(&self, p: Vec3, drift: Vec3, seed: u32) -> WarpSample {
         let s = self.strength;
         let q = self.field(p + drift, 0, seed);
         let r = if self.levels >= 2 {

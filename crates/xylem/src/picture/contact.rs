@@ -85,7 +85,7 @@ fn shrink_factor(width: u32, max_width: u32) -> u32 {
 }
 
 /// The size [`Rgb8::shrink_to_width`] gives a `width × height` image.
-pub fn shrunk_size(width: u32, height: u32, max_width: u32) -> (u32, u32) {
+pub(crate) fn shrunk_size(width: u32, height: u32, max_width: u32) -> (u32, u32) {
     match shrink_factor(width, max_width) {
         1 => (width, height),
         f => ((width / f).max(1), (height / f).max(1)),
@@ -126,7 +126,13 @@ pub fn contact_sheet_rows(thumbs: &[Rgb8], labels: &[String], cols: usize, gap: 
 /// all one size) with `labels[i]` in each lower-left corner, and, for the `last` row, the gap
 /// below. A sheet is its bands one below the other, so a long sweep's sheet can be written band
 /// by band. A label of a thumbnail under 9 px tall reaches into the gap above it, never further.
-pub fn sheet_band(thumbs: &[Rgb8], labels: &[String], cols: usize, gap: u32, last: bool) -> Rgb8 {
+pub fn sheet_band(
+    thumbs: &[Rgb8],
+    labels: &[String],
+    cols: usize,
+    gap: u32,
+    last: bool,
+) -> Rgb8 {
     let Some(first) = thumbs.first() else {
         return Rgb8::filled(1, 1, [24, 24, 24]);
     };

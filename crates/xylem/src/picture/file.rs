@@ -77,7 +77,7 @@ pub enum ImageError {
 }
 
 /// The buffered writer an encoder writes a staged file through.
-pub type StagedWriter<'a> = BufWriter<&'a mut File>;
+pub(crate) type StagedWriter<'a> = BufWriter<&'a mut File>;
 
 /// Encodes an image into a uniquely named temporary file beside `path` with `encode`, and
 /// flushes it, to [`commit`] later (dropping the result deletes the temporary).

@@ -39,7 +39,7 @@ fn encoder<W: std::io::Write>(
 }
 
 /// Encodes 8-bit RGB bytes (row-major, top row first) as a PNG into `out`.
-pub fn encode_png_rgb8(
+pub(crate) fn encode_png_rgb8(
     out: impl std::io::Write,
     width: u32,
     height: u32,
@@ -50,7 +50,7 @@ pub fn encode_png_rgb8(
 }
 
 /// [`encode_png_rgb8`] with `tEXt` chunks (keyword, Latin-1 text), e.g. who wrote the file.
-pub fn encode_png_rgb8_text(
+pub(crate) fn encode_png_rgb8_text(
     out: impl std::io::Write,
     width: u32,
     height: u32,
@@ -68,7 +68,7 @@ pub fn encode_png_rgb8_text(
 }
 
 /// An sRGB-tagged PNG with `tEXt` chunks, staged beside `path` to [`commit`] later.
-pub fn stage_png_rgb8_text(
+pub(crate) fn stage_png_rgb8_text(
     path: &Path,
     width: u32,
     height: u32,
@@ -105,7 +105,7 @@ fn png_error(path: &Path) -> impl Fn(png::EncodingError) -> ImageError + '_ {
 
 /// Encodes 8-bit RGB with the colour-space chunk of `tag` into a uniquely named temporary file
 /// beside `path`, to [`commit`] later.
-pub fn stage_png_tagged(
+pub(crate) fn stage_png_tagged(
     path: &Path,
     width: u32,
     height: u32,
@@ -329,10 +329,10 @@ pub fn decode_png(
 }
 
 /// A PNG's `tEXt` chunks: (keyword, text).
-pub type PngText = Vec<(String, String)>;
+pub(crate) type PngText = Vec<(String, String)>;
 
 /// [`decode_png`] with the `tEXt` chunks read before the image data.
-pub fn decode_png_text(
+pub(crate) fn decode_png_text(
     path: &Path,
     input: impl std::io::Read,
     transformations: png::Transformations,
@@ -372,7 +372,7 @@ pub fn decode_png_text(
 
 /// Opens `path` for [`decode_png`] (a regular file of at most
 /// [`MAX_IMAGE_BYTES`](crate::render::resources::MAX_IMAGE_BYTES)).
-pub fn open_png(path: &Path) -> Result<std::io::Take<std::fs::File>, String> {
+pub(crate) fn open_png(path: &Path) -> Result<std::io::Take<std::fs::File>, String> {
     use crate::render::resources::{open_regular, MAX_IMAGE_BYTES};
     use std::io::Read;
     let file = open_regular(path, MAX_IMAGE_BYTES).map_err(|e| e.reason())?;
@@ -386,7 +386,7 @@ pub fn read_png_rgb8(path: &Path) -> Result<Rgb8, ImageError> {
 }
 
 /// [`read_png_rgb8`] refusing, before decoding, a declared size that fails `size_ok`.
-pub fn read_png_rgb8_checked(path: &Path, size_ok: SizeCheck) -> Result<Rgb8, ImageError> {
+pub(crate) fn read_png_rgb8_checked(path: &Path, size_ok: SizeCheck) -> Result<Rgb8, ImageError> {
     let name = path.display().to_string();
     let invalid = |what: String| ImageError::Invalid {
         path: name.clone(),

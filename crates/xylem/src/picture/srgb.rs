@@ -28,7 +28,7 @@ pub fn srgb_to_linear(x: f32) -> f32 {
 }
 
 /// The linear value of an 8-bit sRGB code ([`srgb_to_linear`] of `v / 255`).
-pub fn srgb8_to_linear(v: u8) -> f32 {
+pub(crate) fn srgb8_to_linear(v: u8) -> f32 {
     srgb_to_linear(v as f32 / 255.0)
 }
 

@@ -126,7 +126,7 @@ impl Aov {
 /// One pixel's accumulated radiance samples in one frame (a light sweep keeps one per frame;
 /// the AOVs, the same in every frame, are summed once in a [`PixelSum`]).
 #[derive(Clone, Copy, Debug, Default)]
-pub struct RadianceSum {
+pub(crate) struct RadianceSum {
     sum: Vec3,
     /// Samples taken (finite or not).
     count: u32,
@@ -195,7 +195,7 @@ pub struct Image {
 
 impl Image {
     /// Averages pixel sums into an image.
-    pub fn from_sums(width: u32, height: u32, sums: &[PixelSum]) -> Self {
+    pub(crate) fn from_sums(width: u32, height: u32, sums: &[PixelSum]) -> Self {
         let mut img = Self::from_radiance(width, height, sums.iter().map(|s| &s.radiance));
         img.aov = (sums.iter())
             .map(|s| {
@@ -208,7 +208,7 @@ impl Image {
     }
 
     /// Averages radiance sums into an image without AOVs (`aov` empty).
-    pub fn from_radiance<'a>(
+    pub(crate) fn from_radiance<'a>(
         width: u32,
         height: u32,
         sums: impl ExactSizeIterator<Item = &'a RadianceSum>,

@@ -109,7 +109,7 @@ impl LightFrames {
     }
 
     /// The index of the light that moves from frame to frame, if any.
-    pub fn moving_index(&self) -> Option<usize> {
+    pub(crate) fn moving_index(&self) -> Option<usize> {
         self.moving
     }
 

@@ -109,7 +109,7 @@ impl Transform {
     }
 
     /// True when the map is invertible and finite.
-    pub fn is_valid(&self) -> bool {
+    pub(crate) fn is_valid(&self) -> bool {
         let d = self.to_world.matrix3.determinant();
         d.is_finite() && d.abs() > 1e-12 && self.to_object.is_finite()
     }
@@ -122,13 +122,13 @@ impl Transform {
 
     /// A point (world space) in object space.
     #[inline]
-    pub fn point_to_object(&self, p: Vec3) -> Vec3 {
+    pub(crate) fn point_to_object(&self, p: Vec3) -> Vec3 {
         self.to_object.transform_point3(p)
     }
 
     /// A direction (object space) in world space, not renormalised.
     #[inline]
-    pub fn vector_to_world(&self, v: Vec3) -> Vec3 {
+    pub(crate) fn vector_to_world(&self, v: Vec3) -> Vec3 {
         self.to_world.transform_vector3(v)
     }
 
@@ -384,7 +384,7 @@ impl Accel {
     }
 
     /// True when instance `i`'s mesh is shared, so that it is traced in object space.
-    pub fn is_instanced(&self, i: usize) -> bool {
+    pub(crate) fn is_instanced(&self, i: usize) -> bool {
         self.instanced[i]
     }
 
@@ -581,7 +581,7 @@ impl Accel {
 
 /// obvhs's BVH2 over `world`, built as its `build_cwbvh_from_tris` helper does up to the BVH2:
 /// optional spatial pre-splits, PLOC (one primitive per leaf), reinsertion.
-pub fn build_bvh2(world: &[Triangle], params: &BvhBuildParams) -> Bvh2 {
+pub(crate) fn build_bvh2(world: &[Triangle], params: &BvhBuildParams) -> Bvh2 {
     let mut indices: Vec<u32> = (0..world.len() as u32).collect();
     let mut bvh2 = if params.pre_split {
         let mut aabbs: Vec<_> = world.iter().map(|t| t.aabb()).collect();

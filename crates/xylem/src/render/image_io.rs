@@ -285,7 +285,7 @@ pub fn stage_image_exr(
 }
 
 /// The beauty layer `R G B A` of radiance and the AOVs' coverage (alpha).
-pub fn beauty_rgba(beauty: &[Vec3], aov: &[super::Aov]) -> ExrLayer<'static> {
+pub(crate) fn beauty_rgba(beauty: &[Vec3], aov: &[super::Aov]) -> ExrLayer<'static> {
     ExrLayer {
         name: "",
         channels: &["R", "G", "B", "A"],
@@ -299,7 +299,7 @@ pub fn beauty_rgba(beauty: &[Vec3], aov: &[super::Aov]) -> ExrLayer<'static> {
 
 /// The AOV layers of [`write_image_exr`] (`albedo` … `growth_time`), e.g. for a file of AOVs that
 /// several images share.
-pub fn aov_layers(aov: &[super::Aov]) -> Vec<ExrLayer<'static>> {
+pub(crate) fn aov_layers(aov: &[super::Aov]) -> Vec<ExrLayer<'static>> {
     let v3 = |f: &dyn Fn(&super::Aov) -> Vec3| -> Vec<f32> {
         aov.iter().flat_map(|a| f(a).to_array()).collect()
     };
@@ -381,7 +381,7 @@ pub fn read_exr_rgb(path: &Path) -> Result<(usize, usize, Vec<Vec3>), ImageError
 }
 
 /// [`read_exr_rgb`] refusing, before decoding, a layer whose declared size fails `size_ok`.
-pub fn read_exr_rgb_checked(
+pub(crate) fn read_exr_rgb_checked(
     path: &Path,
     size_ok: SizeCheck,
 ) -> Result<(usize, usize, Vec<Vec3>), ImageError> {

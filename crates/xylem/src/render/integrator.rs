@@ -86,7 +86,7 @@ pub struct PrimarySample {
 
 /// Counts of rays traced, for the rays/s report.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct RayCount(pub u64);
+pub(crate) struct RayCount(pub u64);
 
 /// The two independent random streams of sample `sample` of pixel `pixel_index`: the first for
 /// the camera (filter and lens), the second for lighting. PCG32 streams keyed by a SplitMix64
@@ -109,7 +109,7 @@ fn splitmix64(x: u64) -> u64 {
 
 /// Builds the shading point of a hit seen along `ray`. `aov` is given at the camera's first hit,
 /// whose pixel footprint (times `footprint_scale`, [`footprint_scale`]) band-limits the textures.
-pub fn shading_point(
+pub(crate) fn shading_point(
     scene: &Scene,
     ray: &Ray,
     hit: &Hit,
@@ -223,7 +223,7 @@ pub fn primary_sample(
 }
 
 /// The lighting random stream of a sample (the second of [`sample_rngs`]).
-pub fn light_rng(scene: &Scene, pixel: UVec2, sample: u32, seed: u64) -> Pcg32 {
+pub(crate) fn light_rng(scene: &Scene, pixel: UVec2, sample: u32, seed: u64) -> Pcg32 {
     let index = pixel.y as u64 * scene.camera.width as u64 + pixel.x as u64;
     sample_rngs(seed, index, sample).1
 }
@@ -255,7 +255,7 @@ pub(crate) fn offset_origin(sp: &ShadingPoint, dir: Vec3) -> Vec3 {
 /// with its `wo`-only terms worked out once (`WoodBsdf::at_wo`), any other BSDF as it is.
 /// Values identical to `eval` and `pdf`.
 #[derive(Clone, Copy, Debug)]
-pub enum BsdfAtWo<'a> {
+pub(crate) enum BsdfAtWo<'a> {
     /// The wood BSDF with its `wo`-only terms worked out.
     Wood(WoodAtWo<'a>),
     /// Any other BSDF, with `wo` (local frame).
@@ -393,7 +393,7 @@ impl<'a> ShadowTest<'a> {
         self.accel.unoccluded(ray, t_max)
     }
 
-    /// For the shadow segment from `sp` towards each sample of `ls` (as [`light_term`] builds
+    /// For the shadow segment from `sp` towards each sample of `ls` (as `light_term` builds
     /// it), whether the boxes alone show it unoccluded (`culled[k]`; all false without boxes).
     /// The segments are set up in one loop and tested in one loop per box, so the slab tests
     /// run in SIMD lanes.
@@ -454,7 +454,7 @@ pub struct Segments {
 /// `inv` = 1/d per axis (±∞ for d = 0): true only when the segment surely misses. A NaN (an
 /// origin exactly on a slab plane of an axis the ray runs parallel to) answers "may hit".
 #[inline]
-pub fn segment_misses_box(o: Vec3A, inv: Vec3A, t_max: f32, lo: Vec3A, hi: Vec3A) -> bool {
+pub(crate) fn segment_misses_box(o: Vec3A, inv: Vec3A, t_max: f32, lo: Vec3A, hi: Vec3A) -> bool {
     slab_misses(
         o.to_array(),
         inv.to_array(),
@@ -483,7 +483,7 @@ fn slab_misses(o: [f32; 3], inv: [f32; 3], t_max: f32, lo: [f32; 3], hi: [f32; 3
 /// the light is unoccluded, w the power heuristic against BSDF sampling (1 for delta lights);
 /// zero when the sample failed, the BSDF vanishes or the light is occluded.
 #[inline]
-pub fn light_term(
+pub(crate) fn light_term(
     shadow: &ShadowTest,
     sp: &ShadingPoint,
     bsdf: &BsdfAtWo,
@@ -543,7 +543,7 @@ fn mis_scale(wi_z: f32, pdf: f32, bsdf_pdf: f32, is_delta: bool) -> f32 {
 
 /// Scratch columns of [`light_terms`], reused from call to call.
 #[derive(Clone, Debug, Default)]
-pub struct TermScratch {
+pub(crate) struct TermScratch {
     /// The samples' directions in the local shading frame.
     wi: Vec<Vec3>,
     f: Vec<Vec3>,
@@ -562,7 +562,7 @@ pub struct TermScratch {
 /// [`light_term`] on the same values, so the same bits (tested by the sweep's equality test).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-pub fn light_terms(
+pub(crate) fn light_terms(
     shadow: &ShadowTest,
     sp: &ShadingPoint,
     bsdf: &BsdfAtWo,

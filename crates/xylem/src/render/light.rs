@@ -386,7 +386,7 @@ struct ConeSample {
 /// 1 − √(1 − s) is 0 for s < 6e-8, a sphere light of radius ≤ 0.01 mm at 50 mm went black, and
 /// 11 % off at 0.1 mm); the same identity behind pbrt-v4's small-angle branch (§6.2.4).
 #[inline(always)]
-pub fn one_minus_cos_cone(sin2_max: f32) -> f32 {
+pub(crate) fn one_minus_cos_cone(sin2_max: f32) -> f32 {
     let s = sin2_max.clamp(0.0, 1.0);
     s / (1.0 + (1.0 - s).sqrt())
 }
@@ -419,7 +419,7 @@ impl ConeSample {
 
 /// Samples of one light from one point at many places of the light (the frames of a light
 /// sweep) with the same numbers, as columns (structure of arrays), for the batch next-event
-/// terms of [`crate::render::integrator::light_terms`]. A sphere light is sampled by one loop over
+/// terms of `render::integrator::light_terms`. A sphere light is sampled by one loop over
 /// the frames' centres ([`LightSamples::sample_sphere`]): no frame depends on another, so the
 /// loop runs in SIMD lanes instead of one latency-bound chain of square roots and divisions per
 /// frame. Values bit-identical to [`Light::sample_at`] (tested).
@@ -487,7 +487,7 @@ impl LightSamples {
 
     /// Samples from `p` of `lights` — one light's place in each frame, any kind of light — one
     /// at a time ([`Light::sample_at`]); a failed sample is stored with density 0.
-    pub fn sample_each<'a>(
+    pub(crate) fn sample_each<'a>(
         &mut self,
         p: Vec3,
         lights: impl ExactSizeIterator<Item = &'a Light>,
@@ -563,7 +563,7 @@ fn sphere_discriminant(oc: Vec3, b: f32, d: Vec3, radius: f32) -> f32 {
 /// True when the line of `ray` surely misses the sphere (negative discriminant): the first test
 /// of [`intersect_sphere`], branch-free so that a loop of it over many spheres vectorises.
 #[inline(always)]
-pub fn sphere_line_misses(ray: &Ray, center: Vec3, radius: f32) -> bool {
+pub(crate) fn sphere_line_misses(ray: &Ray, center: Vec3, radius: f32) -> bool {
     let oc = ray.o - center;
     sphere_discriminant(oc, oc.dot(ray.d), ray.d, radius) < 0.0
 }

@@ -17,15 +17,14 @@ pub mod resources;
 pub mod wide_bvh;
 
 pub use camera::{Camera, Projection};
-pub use film::{Aov, Filter, Image, PixelSum, RadianceSum};
+pub(crate) use film::RadianceSum;
+pub use film::{Aov, Filter, Image, PixelSum};
 pub use frames::LightFrames;
 pub use geometry::{Accel, Instance, Ray, Transform, TriMesh};
-pub use integrator::{
-    light_rng, primary_sample, sample_rngs, Integrator, PrimarySample, ShadingPoint,
-};
+pub(crate) use integrator::light_rng;
+pub use integrator::{primary_sample, sample_rngs, Integrator, ShadingPoint};
 pub use light::{
-    DistantLight, EnvMap, Environment, Light, LightHit, PointLight, RectLight, SphereLight,
-    SpotLight,
+    DistantLight, EnvMap, Environment, Light, PointLight, RectLight, SphereLight, SpotLight,
 };
 
 use crate::material::Material;
@@ -171,7 +170,7 @@ pub enum RenderError {
 }
 
 /// Side length of the square tiles handed to worker threads.
-pub const TILE: u32 = 16;
+pub(crate) const TILE: u32 = 16;
 
 /// Renders the scene with its own lights.
 ///

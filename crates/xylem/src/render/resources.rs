@@ -96,7 +96,7 @@ pub const LOWER_TRIANGLES: &str =
 /// Peak bytes per stored triangle while its BVH is built: the triangle copies, obvhs's BVH2 and
 /// PLOC buffers, the reinsertion pass and the wide BVH (444–459 B measured with VmHWM on 1 M and
 /// 4 M triangles, notes/render.md), rounded up.
-pub const BUILD_BYTES_PER_TRIANGLE: u64 = 480;
+pub(crate) const BUILD_BYTES_PER_TRIANGLE: u64 = 480;
 
 /// Channels of a render's EXR: beauty RGB, albedo RGB, normal XYZ, depth, fibre XYZ, ray mask,
 /// growth time, standard error.
@@ -318,7 +318,7 @@ fn available_system_memory() -> Option<u64> {
 /// Free space (for unprivileged users) on the file system that holds `dir` or, when it does not
 /// exist yet, its nearest existing ancestor (the `fs4` crate: statvfs on Unix,
 /// GetDiskFreeSpaceExW on Windows). None where unknown.
-pub fn available_disk(dir: &Path) -> Option<u64> {
+pub(crate) fn available_disk(dir: &Path) -> Option<u64> {
     let abs = std::path::absolute(dir).ok()?;
     let existing = abs.ancestors().find(|p| p.exists())?;
     fs4::available_space(existing).ok()
@@ -403,11 +403,6 @@ pub fn read_text_bounded(path: &Path, max: u64, what: &str) -> Result<String, Re
         path: path.display().to_string(),
         message: format!("not UTF-8 text (allowed: {what})"),
     })
-}
-
-/// [`open_regular`]'s checks alone, for files another library opens itself.
-pub fn check_regular(path: &Path, max: u64) -> Result<(), ResourceError> {
-    open_regular(path, max).map(drop)
 }
 
 /// The largest side of an image read (pixels): twice `--res`'s 16384.

@@ -67,7 +67,7 @@ pub fn load_mesh(path: &Path) -> Result<TriMesh, MeshError> {
 /// map (`single_index`) and our copy. Measured (`mesh_parse_peak obj`, notes/limits.md): a
 /// 1026² grid (85 MB, 2.1 M triangles, every vector just past a doubling) raised the peak
 /// address space 7.3× its size (resident 4.3×); 16 leaves room for other layouts.
-pub const OBJ_PARSE_BYTES_PER_BYTE: u64 = 16;
+pub(crate) const OBJ_PARSE_BYTES_PER_BYTE: u64 = 16;
 /// The same for a PLY, whose parse holds only the mesh: a binary vertex of 12 (24 with normals)
 /// bytes becomes 12 (24), a 13-byte triangle 12 bytes of indices, a 17-byte quad 24. Measured
 /// (`mesh_parse_peak ply-*`, notes/limits.md) on the 1026² grid: peak address space 1.9× the
@@ -75,7 +75,7 @@ pub const OBJ_PARSE_BYTES_PER_BYTE: u64 = 16;
 /// binary faces of up to six corners at the vectors' worst doubling; a PLY of larger
 /// polygons or byte-sized indices that needs more ends in the `xylem` binary's clean
 /// out-of-memory error.
-pub const PLY_PARSE_BYTES_PER_BYTE: u64 = 4;
+pub(crate) const PLY_PARSE_BYTES_PER_BYTE: u64 = 4;
 
 /// Refuses, before reading, a mesh file whose parse would need more memory than is available
 /// (a 4 GiB OBJ needs about 64 GiB); the BVH's own estimate comes after

@@ -85,7 +85,7 @@ pub enum SceneError {
 
 /// How far from the origin (mm) any object may reach: 1 km, so that f32 coordinates keep a
 /// resolution of 0.06 mm or better (2⁻²⁴ relative) where a scene has geometry.
-pub const MAX_EXTENT_MM: f32 = 1e6;
+pub(crate) const MAX_EXTENT_MM: f32 = 1e6;
 
 /// A loaded scene: what to render and how.
 pub struct LoadedScene {

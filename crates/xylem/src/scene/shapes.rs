@@ -6,7 +6,7 @@ use crate::render::TriMesh;
 use glam::{Vec2, Vec3};
 
 /// An axis-aligned box of edge lengths `size`, centred at the origin, flat-shaded, normals out.
-pub fn make_box(size: Vec3) -> TriMesh {
+pub(crate) fn make_box(size: Vec3) -> TriMesh {
     let h = size * 0.5;
     let mut m = TriMesh::default();
     // Each face: outward normal n and two in-plane axes (a, b) with a × b = n.
@@ -65,7 +65,7 @@ pub fn make_sphere(radius: f32, segments: u32) -> TriMesh {
 }
 
 /// A cylinder of `radius` along z from 0 to `height`, smooth side and flat caps.
-pub fn make_cylinder(radius: f32, height: f32, segments: u32) -> TriMesh {
+pub(crate) fn make_cylinder(radius: f32, height: f32, segments: u32) -> TriMesh {
     let side = revolve(
         &[Vec2::new(radius, 0.0), Vec2::new(radius, height)],
         Some(&[Vec2::X, Vec2::X]),
@@ -90,7 +90,7 @@ pub fn make_cylinder(radius: f32, height: f32, segments: u32) -> TriMesh {
 /// A solid of revolution: the (radius, z) `profile` turned about z. Normals are the profile's
 /// normals, averaged at interior profile points (so a sharp rim should repeat its point).
 /// The outside is on the right of the profile when walking along it (bottom to top = outward).
-pub fn make_lathe(profile: &[Vec2], segments: u32) -> TriMesh {
+pub(crate) fn make_lathe(profile: &[Vec2], segments: u32) -> TriMesh {
     let n = profile.len();
     let seg_normal = |i: usize| {
         let d = profile[i + 1] - profile[i];

@@ -120,7 +120,7 @@ fn eval(p: &Patch, u: f32, v: f32) -> (Vec3, Vec3, Vec3) {
 
 /// The teapot tessellated `resolution` × `resolution` quads per patch, scaled by `size`
 /// (z up, resting on z = 0), with normals from the patch derivatives.
-pub fn make_teapot(size: f32, resolution: u32) -> TriMesh {
+pub(crate) fn make_teapot(size: f32, resolution: u32) -> TriMesh {
     let n = resolution.max(1);
     let mut m = TriMesh {
         normals: Some(Vec::new()),

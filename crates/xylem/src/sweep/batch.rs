@@ -191,7 +191,7 @@ pub fn default_plan(size: &SweepSize, mode: PrimaryMode) -> Result<Plan, BudgetE
 }
 
 /// The most frames of a `width × height` sweep one batch may hold within `budget` bytes.
-pub fn frames_per_batch(
+pub(crate) fn frames_per_batch(
     width: u32,
     height: u32,
     threads: usize,

@@ -18,11 +18,11 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 /// The claim's file name in a sweep folder.
-pub const CLAIM_FILE: &str = "sweep.json";
+pub(crate) const CLAIM_FILE: &str = "sweep.json";
 
 /// What decides a sweep's frames; two runs with equal claims render equal frames.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Claim {
+pub(crate) struct Claim {
     /// Scene, arc, spp, seed, scene digest and quality.
     pub settings: SweepSettings,
     /// Frames of the whole sweep.
@@ -95,7 +95,7 @@ fn agree(path: &Path, ours: &Claim, theirs: &Claim) -> Result<(), SweepError> {
 /// every frame record already in the folder (left by a build without claims) must match, and
 /// the claim is created — atomically, so that of two slices racing into an empty folder one
 /// creates it and the other compares with it. Called before the slice touches a file.
-pub fn claim_for_slice(dir: &Path, ours: &Claim) -> Result<(), SweepError> {
+pub(crate) fn claim_for_slice(dir: &Path, ours: &Claim) -> Result<(), SweepError> {
     let path = dir.join(CLAIM_FILE);
     if let Some(theirs) = read(&path)? {
         return agree(&path, ours, &theirs);
@@ -115,7 +115,7 @@ pub fn claim_for_slice(dir: &Path, ours: &Claim) -> Result<(), SweepError> {
 
 /// Replaces the claim of `dir` (a whole sweep, which holds the folder alone and has cleared its
 /// frames first).
-pub fn replace_claim(dir: &Path, ours: &Claim) -> Result<(), SweepError> {
+pub(crate) fn replace_claim(dir: &Path, ours: &Claim) -> Result<(), SweepError> {
     let path = dir.join(CLAIM_FILE);
     let text = serde_json::to_string_pretty(ours).expect("a claim serializes");
     write_atomic(&path, text.as_bytes()).map_err(|e| io_error(&path, e))

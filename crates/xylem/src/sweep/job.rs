@@ -132,7 +132,7 @@ pub struct JobReport {
 }
 
 /// The scene's named regions, for the CSV.
-pub fn scene_regions(loaded: &LoadedScene) -> Vec<Region> {
+pub(crate) fn scene_regions(loaded: &LoadedScene) -> Vec<Region> {
     loaded
         .sweep
         .iter()
@@ -150,7 +150,7 @@ pub fn scene_regions(loaded: &LoadedScene) -> Vec<Region> {
 /// The file holding the first-hit AOV layers that every frame of a sweep shares. It is written
 /// by the job that renders frame 0 (the whole sweep, or the first slice of a farmed one), so no
 /// two slices ever write it.
-pub const AOV_FILE: &str = "aov.exr";
+pub(crate) const AOV_FILE: &str = "aov.exr";
 
 /// Writes every frame of `render` into `dir`, frames in parallel. Each frame's old record goes
 /// first, then its EXR (radiance and standard error) and PNG are renamed into place and its new
@@ -164,7 +164,7 @@ pub const AOV_FILE: &str = "aov.exr";
 /// angle, azimuth, direction and position on the arc, then `header` (the render's spp, seed,
 /// integrator and camera, [`frame_header`]).
 #[allow(clippy::too_many_arguments)]
-pub fn write_frames(
+pub(crate) fn write_frames(
     dir: &Path,
     render: &Frames,
     path: &SweepPath,

@@ -124,7 +124,7 @@ pub struct Manifest {
 impl Manifest {
     /// The manifest of a sweep of `loaded` along `path` (light `moving`), frames as
     /// `frame_NNNN.exr`.
-    pub fn of_sweep(loaded: &LoadedScene, path: &SweepPath, moving: usize) -> Manifest {
+    pub(crate) fn of_sweep(loaded: &LoadedScene, path: &SweepPath, moving: usize) -> Manifest {
         let cam = &loaded.scene.camera;
         let (fov_y_deg, film_width_mm, projection) = match cam.projection {
             Projection::Perspective { fov_y, .. } => {

@@ -53,7 +53,7 @@ pub fn render_sweep(
 
 /// The same frames rendered naively, one whole render per frame (nothing shared between
 /// frames): the reference the one-pass sweep is tested and timed against.
-pub fn render_naive(
+pub(crate) fn render_naive(
     scene: &Scene,
     settings: &RenderSettings,
     path: &SweepPath,

@@ -49,7 +49,7 @@ pub fn default_chunk(frames: usize) -> usize {
 }
 
 /// The job template (JSON) of `sweep`.
-pub fn job_template(sweep: &OpenJdSweep) -> Value {
+pub(crate) fn job_template(sweep: &OpenJdSweep) -> Value {
     let path = |p: &Path| p.display().to_string();
     let mut render_args: Vec<Value> = [
         "-c",

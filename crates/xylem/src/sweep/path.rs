@@ -120,7 +120,7 @@ pub struct ArcPlane {
 impl ArcPlane {
     /// The plane through `zenith` perpendicular to the rotation `axis`; `None` when the two are
     /// parallel (or either is zero), so no plane is defined.
-    pub fn from_axis(zenith: Vec3, axis: Vec3) -> Option<Self> {
+    pub(crate) fn from_axis(zenith: Vec3, axis: Vec3) -> Option<Self> {
         let z = zenith.try_normalize()?;
         let toward = axis.cross(z).try_normalize()?;
         Some(ArcPlane { zenith: z, toward })
@@ -434,7 +434,7 @@ impl SweepPath {
 
     /// A path of one arc per entry of `azimuths_deg` (at most [`MAX_ARCS`]; extra ones are
     /// dropped).
-    pub fn with_arcs(
+    pub(crate) fn with_arcs(
         arc: LightArc,
         plane: ArcPlane,
         pivot: Vec3,
@@ -472,7 +472,7 @@ impl SweepPath {
 
     /// The plane of the arc frame `frame` lies on: `plane` turned about its zenith by the arc's
     /// azimuth (Rodrigues' rotation of `toward`, which is perpendicular to the zenith).
-    pub fn frame_plane(&self, frame: usize) -> ArcPlane {
+    pub(crate) fn frame_plane(&self, frame: usize) -> ArcPlane {
         let (s, c) = self.azimuth_deg(frame).to_radians().sin_cos();
         let (z, a) = (self.plane.zenith, self.plane.toward);
         ArcPlane {

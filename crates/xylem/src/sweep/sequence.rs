@@ -108,7 +108,7 @@ impl Region {
     }
 
     /// Mean luminance of the region in a linear RGB image.
-    pub fn mean_luminance(&self, width: u32, height: u32, pixels: &[Vec3]) -> f32 {
+    pub(crate) fn mean_luminance(&self, width: u32, height: u32, pixels: &[Vec3]) -> f32 {
         let (xs, ys) = self.pixels(width, height);
         let n = xs.len() * ys.len();
         let sum: f64 = ys
@@ -153,7 +153,7 @@ impl SweepSettings {
 
     /// The first setting in which `self` differs from `other`: its name, `self`'s value and
     /// `other`'s.
-    pub fn first_difference(
+    pub(crate) fn first_difference(
         &self,
         other: &SweepSettings,
     ) -> Option<(&'static str, String, String)> {
@@ -236,7 +236,7 @@ impl FrameRecord {
 }
 
 /// The file stem of frame `index`: `frame_0007`.
-pub fn frame_stem(index: usize) -> String {
+pub(crate) fn frame_stem(index: usize) -> String {
     format!("frame_{index:04}")
 }
 
@@ -254,13 +254,13 @@ fn io_error(path: &Path, cause: std::io::Error) -> SequenceError {
 }
 
 /// The record of frame `index` in `dir`.
-pub fn record_path(dir: &Path, index: usize) -> PathBuf {
+pub(crate) fn record_path(dir: &Path, index: usize) -> PathBuf {
     dir.join(format!("{}.json", frame_stem(index)))
 }
 
 /// Removes frame `index`'s record, so that while its images are being replaced it does not look
 /// complete (a record marks a frame complete).
-pub fn unmark_frame(dir: &Path, index: usize) -> Result<(), SequenceError> {
+pub(crate) fn unmark_frame(dir: &Path, index: usize) -> Result<(), SequenceError> {
     let path = record_path(dir, index);
     remove_if_present(&path).map_err(|cause| io_error(&path, cause))
 }
@@ -279,7 +279,7 @@ pub fn write_frame(
 }
 
 /// Writes a frame's record, which marks the frame complete: call it after its images.
-pub fn write_record(dir: &Path, record: &FrameRecord) -> Result<(), SequenceError> {
+pub(crate) fn write_record(dir: &Path, record: &FrameRecord) -> Result<(), SequenceError> {
     let json = record_path(dir, record.index);
     let text = serde_json::to_string_pretty(record).map_err(|cause| SequenceError::Json {
         path: json.display().to_string(),
@@ -314,7 +314,7 @@ impl Default for AssembleOptions {
 }
 
 /// The largest frame record read (a record is under 1 KiB; this bounds `/dev/zero`).
-pub const MAX_RECORD_BYTES: u64 = 1 << 20;
+pub(crate) const MAX_RECORD_BYTES: u64 = 1 << 20;
 
 /// Reads every `frame_NNNN.json` in `dir`, sorted by frame index, and checks that they describe
 /// one complete sweep (same frame count and size, every frame present exactly once).
@@ -440,7 +440,7 @@ fn runs(sorted: &[usize]) -> Vec<Range<usize>> {
 }
 
 /// The CSV of light angle and mean radiance per frame, one column per named region.
-pub fn csv_table(records: &[FrameRecord]) -> String {
+pub(crate) fn csv_table(records: &[FrameRecord]) -> String {
     let mut s = String::from("frame,light_deg,mean_luminance,mean_r,mean_g,mean_b");
     if let Some(r) = records.first() {
         for reg in &r.regions {
@@ -485,11 +485,11 @@ pub struct Assembled {
 }
 
 /// The files [`assemble`] writes, the viewer (written last, so it marks the sweep complete) first.
-pub const ASSEMBLED: [&str; 4] = [VIEWER, CSV, CONTACT_SHEET, ANIMATION];
+pub(crate) const ASSEMBLED: [&str; 4] = [VIEWER, CSV, CONTACT_SHEET, ANIMATION];
 
 /// Removes the outputs of an earlier assembly (the viewer first), so that a sweep being
 /// re-rendered never looks complete with the old viewer, CSV and sheet beside new frames.
-pub fn clear_assembled(dir: &Path) -> Result<(), SequenceError> {
+pub(crate) fn clear_assembled(dir: &Path) -> Result<(), SequenceError> {
     for name in ASSEMBLED {
         let path = dir.join(name);
         remove_if_present(&path).map_err(|cause| io_error(&path, cause))?;
@@ -498,7 +498,7 @@ pub fn clear_assembled(dir: &Path) -> Result<(), SequenceError> {
 }
 
 /// The widest contact sheet [`assemble`] writes: a long sweep's thumbnails shrink to fit it.
-pub const MAX_SHEET_WIDTH: u32 = 4096;
+pub(crate) const MAX_SHEET_WIDTH: u32 = 4096;
 
 /// Builds the contact sheet, the animated PNG, the CSV and the viewer from the frames in `dir`.
 /// The stale outputs of an earlier assembly go first and the viewer is written last. The sheet

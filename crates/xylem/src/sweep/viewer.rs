@@ -5,7 +5,7 @@
 use super::sequence::{frame_stem, FrameRecord, ANIMATION, CONTACT_SHEET, CSV};
 
 /// Escapes text for HTML element content and attribute values.
-pub fn html_escape(s: &str) -> String {
+pub(crate) fn html_escape(s: &str) -> String {
     s.chars()
         .map(|c| match c {
             '&' => "&amp;".to_string(),
@@ -38,7 +38,7 @@ fn frames_json(records: &[FrameRecord]) -> String {
 }
 
 /// The viewer page for a complete, index-sorted list of frame records.
-pub fn viewer_html(records: &[FrameRecord], title: &str, fps: u16) -> String {
+pub(crate) fn viewer_html(records: &[FrameRecord], title: &str, fps: u16) -> String {
     let title = html_escape(title);
     let data = frames_json(records);
     let (w, h) = records

@@ -137,7 +137,7 @@ pub(crate) const SLAB_PARAMS: &[ParamSpec] = &[
 ];
 
 /// The classic three-stripe slab marble.
-pub struct SlabMarble {
+pub(crate) struct SlabMarble {
     stripe: f32,
     scale: f32,
     turbulence: f32,

@@ -59,7 +59,7 @@ pub(crate) const RING_PARAMS: &[ParamSpec] = &[
 ];
 
 /// Concentric-cylinder ring wood.
-pub struct RingWood {
+pub(crate) struct RingWood {
     spacing: f32,
     latewood: f32,
     wobble: f32,
@@ -165,7 +165,7 @@ pub(crate) const LOG_PARAMS: &[ParamSpec] = &[
 ];
 
 /// Log-coordinate wood.
-pub struct LogWood {
+pub(crate) struct LogWood {
     freq: f32,
     taper: f32,
     warp: f32,

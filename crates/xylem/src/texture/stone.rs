@@ -31,7 +31,7 @@ pub(crate) const STONE_PARAMS: &[ParamSpec] = &[
     p("seed", 1.0, 0.0, 1e9, "noise seed"),
 ];
 
-pub struct Stone {
+pub(crate) struct Stone {
     cell: f32,
     jitter: f32,
     crack: f32,

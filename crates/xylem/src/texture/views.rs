@@ -20,7 +20,7 @@ pub(crate) const LATTICE_PARAMS: &[ParamSpec] = &[
 ];
 
 /// Gradient or value noise, mapped from [−1, 1] to grey.
-pub struct LatticeView {
+pub(crate) struct LatticeView {
     basis: Basis,
     scale: f32,
     seed: u32,
@@ -85,7 +85,7 @@ pub(crate) const FBM_PARAMS: &[ParamSpec] = &[
 ];
 
 /// A fractal sum, normalised by its amplitude sum.
-pub struct FbmView {
+pub(crate) struct FbmView {
     fractal: Fractal,
     /// sqrt(Σ gain²ⁱ): the standard deviation of the sum in units of one octave's.
     rms_amplitude: f32,
@@ -164,7 +164,7 @@ pub(crate) const WORLEY_PARAMS: &[ParamSpec] = &[
     SEED,
 ];
 
-pub struct WorleyView {
+pub(crate) struct WorleyView {
     scale: f32,
     jitter: f32,
     feature: u32,
@@ -206,7 +206,7 @@ pub(crate) const WARP_PARAMS: &[ParamSpec] = &[
     SEED,
 ];
 
-pub struct WarpView {
+pub(crate) struct WarpView {
     warp: Warp,
     scale: f32,
     seed: u32,
@@ -301,7 +301,7 @@ pub(crate) const SPARSE_PARAMS: &[ParamSpec] = &[
     SEED,
 ];
 
-pub struct SparseView {
+pub(crate) struct SparseView {
     noise: SparseConvolution,
     seed: u32,
     /// Display mapping: value ↦ offset + gain · value.

@@ -70,7 +70,7 @@ impl Default for TreeRegion {
 /// A board of a layout: its index (hashed into the tree) and the point's coordinates in the board:
 /// `along` the grain and `across` it, mm from the board's corner.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct BoardPoint {
+pub(crate) struct BoardPoint {
     /// Which board (hashed into the tree by [`board_to_tree`]).
     pub index: [i32; 3],
     /// Distance along the grain from the board's corner (mm).
@@ -80,7 +80,7 @@ pub struct BoardPoint {
 }
 
 /// The board under surface point `uv` (mm).
-pub fn board_at(layout: &BoardLayout, uv: Vec2) -> BoardPoint {
+pub(crate) fn board_at(layout: &BoardLayout, uv: Vec2) -> BoardPoint {
     match *layout {
         BoardLayout::Planks {
             width,
@@ -164,7 +164,7 @@ pub fn solid_to_tree(p: Vec3, origin: Vec3, grain: Vec3) -> Vec3 {
 /// `p` is the object-space point and `normal` its face normal; the face is identified by the
 /// dominant axis of the normal and its sign, hashed into `region` as a flat-sawn board whose grain
 /// runs along the face's first in-plane axis.
-pub fn veneer_to_tree(p: Vec3, normal: Vec3, region: &TreeRegion, seed: u64) -> Vec3 {
+pub(crate) fn veneer_to_tree(p: Vec3, normal: Vec3, region: &TreeRegion, seed: u64) -> Vec3 {
     let a = normal.abs();
     let (axis, u, v) = if a.x >= a.y && a.x >= a.z {
         (0, p.y, p.z)

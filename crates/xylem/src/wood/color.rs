@@ -62,7 +62,7 @@ impl BeerColor {
     /// law averages to exp(−a₀) · E[exp(−k g)], which `mean_exp(i)` gives for `ring_scales()[i]`.
     /// `None` where the clamp at zero absorbance would act (a negative path: the caller falls
     /// back to the colour of the mean ring value).
-    pub fn ring_filtered_colors(
+    pub(crate) fn ring_filtered_colors(
         &self,
         pore: f32,
         ray: f32,
@@ -81,7 +81,14 @@ impl BeerColor {
     /// Channel `ch` (0 red, 1 green, 2 blue) of [`BeerColor::absorbance`]: one scalar expression,
     /// so a loop over many texels runs it in SIMD lanes.
     #[inline(always)]
-    pub fn channel_absorbance(&self, ch: usize, g: f32, pore: f32, ray: f32, extra: f32) -> f32 {
+    pub(crate) fn channel_absorbance(
+        &self,
+        ch: usize,
+        g: f32,
+        pore: f32,
+        ray: f32,
+        extra: f32,
+    ) -> f32 {
         self.base[ch]
             + self.ring[ch] * g
             + self.late[ch] * (self.pore_path * pore + self.ray_path * ray + extra)
@@ -90,7 +97,7 @@ impl BeerColor {
     /// Channel `ch` of [`BeerColor::colors`]: (diffuse, fibre), by the branch-free `exp` that
     /// vectorises.
     #[inline(always)]
-    pub fn channel_colors(&self, ch: usize, absorbance: f32) -> (f32, f32) {
+    pub(crate) fn channel_colors(&self, ch: usize, absorbance: f32) -> (f32, f32) {
         use crate::math::elementary::exp;
         let a = absorbance.max(0.0);
         (exp(-a), exp(-a * self.fiber_saturation[ch]))

@@ -16,7 +16,7 @@ const CELL_SCALE: f32 = 1.0;
 const RAY_ARC_CELLS: f32 = 2.0;
 
 /// A sub-seed for one noise field from the volume seed and a salt.
-pub fn sub_seed(seed: u64, salt: u32) -> u32 {
+pub(crate) fn sub_seed(seed: u64, salt: u32) -> u32 {
     use crate::noise::hash::mix32;
     mix32(mix32(seed as u32 ^ salt) ^ mix32((seed >> 32) as u32).wrapping_add(salt))
 }
@@ -26,7 +26,7 @@ pub fn sub_seed(seed: u64, salt: u32) -> u32 {
 /// Cartesian cells as wide as the larger of the r and θ semi-axes fit the kernel at any rotation
 /// about ẑ, so the eq. 11 shrink never applies.
 #[derive(Clone, Debug)]
-pub struct DistortionNoise {
+pub(crate) struct DistortionNoise {
     noise: SeededSparse,
 }
 
@@ -75,7 +75,7 @@ impl DistortionNoise {
     /// How many bands (from the largest) have kernels at least `footprint` mm across: band i has
     /// semi-axes βⁱ Sₑ (Liu 2016 eq. 8), so its narrowest diameter is 2 βⁱ min(Sₑ).
     #[inline]
-    pub fn bands_above(&self, footprint: f32) -> u32 {
+    pub(crate) fn bands_above(&self, footprint: f32) -> u32 {
         let noise = self.noise.noise();
         let mut d = 2.0 * noise.envelope.min_element();
         let mut n = 0;
@@ -89,7 +89,12 @@ impl DistortionNoise {
     /// [`DistortionNoise::eval`] with only the first `bands` bands (the finer ones dropped: their
     /// mean is zero, signed weights); all bands give exactly `eval`.
     #[inline]
-    pub fn eval_bands<const GRAD: bool>(&self, p: Vec3, cyl: &Frame, bands: u32) -> (f32, Vec3) {
+    pub(crate) fn eval_bands<const GRAD: bool>(
+        &self,
+        p: Vec3,
+        cyl: &Frame,
+        bands: u32,
+    ) -> (f32, Vec3) {
         if bands == 0 {
             return (0.0, Vec3::ZERO);
         }
@@ -117,7 +122,7 @@ pub fn bump_kernel_mean(sharpness: f32) -> f32 {
 /// 1 (kept) up to footprint = size, 0 (replaced by its mean) from footprint = 2 size, linear in
 /// between so the change is not a visible seam (notes/sweep.md "Footprint").
 #[inline]
-pub fn footprint_weight(size: f32, footprint: f32) -> f32 {
+pub(crate) fn footprint_weight(size: f32, footprint: f32) -> f32 {
     (2.0 - footprint / size).clamp(0.0, 1.0)
 }
 
@@ -189,7 +194,7 @@ impl Pores {
     /// E[size³] = 1 − 3ρE[g] + 3ρ²E[g²] − ρ³E[g³] (the mean of a ring-porous wood's pores over
     /// rings it cannot resolve; the mean size's cube would drop most of the earlywood vessels).
     #[inline]
-    pub fn mean_mask_over(&self, moments: Vec3) -> f32 {
+    pub(crate) fn mean_mask_over(&self, moments: Vec3) -> f32 {
         let r = self.ring_porosity;
         let cube = 1.0 - 3.0 * r * moments.x + 3.0 * r * r * moments.y - r * r * r * moments.z;
         self.mean_full * cube.clamp(0.0, 1.0)
@@ -221,7 +226,7 @@ impl Pores {
     /// [`Pores::mask`]'s value at `N` points with their fibre frames and ring values (the query
     /// set-up in lanes, [`SeededSparse::eval_oriented_many`]); the same values.
     #[inline(always)]
-    pub fn mask_many<const N: usize>(
+    pub(crate) fn mask_many<const N: usize>(
         &self,
         q: &[Vec3; N],
         fiber: &[Frame; N],
@@ -382,7 +387,7 @@ impl FibreWander {
     /// dδ/dn = pore_deflection · radius · ∂m/∂n (streamlines around an obstacle; Hoadley,
     /// "Understanding Wood" ch. 2).
     #[inline]
-    pub fn around_pore(&self, fiber: Vec3, along: Vec3, grad: Vec3, radius: f32) -> Vec3 {
+    pub(crate) fn around_pore(&self, fiber: Vec3, along: Vec3, grad: Vec3, radius: f32) -> Vec3 {
         let dn = grad.dot(along);
         let across = grad - dn * along;
         let len = across.length();
@@ -425,7 +430,7 @@ fn grain_noise(std: f32, (along, across): (f32, f32), density: f32, seed: u32) -
 /// density and extractive content of neighbouring fibres, vessels and parenchyma strands do (the
 /// "texture" of the wood trade: Hoadley, "Understanding Wood", ch. 5).
 #[derive(Clone, Debug)]
-pub struct CellTexture {
+pub(crate) struct CellTexture {
     /// Per scale (cells, then streaks), the noise and its across-grain correlation length (mm):
     /// the feature size the footprint filter fades it at.
     scales: Vec<(SeededSparse, f32)>,
@@ -471,7 +476,7 @@ impl CellTexture {
 /// 1D sparse convolution noise ([`SparseConvolution1`]) scaled to its largest value `amp`:
 /// |value| ≤ amp, |derivative| ≤ amp · MAX_SLOPE / width (notes/wood.md §2, §4).
 #[derive(Clone, Copy, Debug)]
-pub struct Noise1 {
+pub(crate) struct Noise1 {
     pub amp: f32,
     noise: SparseConvolution1,
 }

@@ -172,7 +172,7 @@ impl SmoothRectangleWave {
     /// the box mean and the point value differ by w² s″/24 + O(w⁴), and |s″| ≤ 5.78/L² on a
     /// transition of length L, so by at most 0.01 · 5.78 / 24 = 0.0024 (under half an 8-bit
     /// level) where they switch.
-    pub const MIN_BOX_FRACTION: f32 = 0.1;
+    pub(crate) const MIN_BOX_FRACTION: f32 = 0.1;
 
     /// The filter width (periods) below which the box filters return the point value.
     #[inline]
@@ -196,7 +196,7 @@ impl SmoothRectangleWave {
     /// The box means of s, s² and s³ over [lo, hi] (as [`SmoothRectangleWave::box_mean`]; what a
     /// cubic of the ring value, such as ring-porous pore volume (1 − ρ s)³, averages to). The
     /// plateaus give 0 and 1; a transition's ∫₀ˣ Pⁿ is the polynomial `smootherstep_power_integral`.
-    pub fn box_moments(&self, lo: f32, hi: f32) -> Vec3 {
+    pub(crate) fn box_moments(&self, lo: f32, hi: f32) -> Vec3 {
         let w = hi - lo;
         if !(w >= self.min_box()) {
             let s = self.normalized(0.5 * (lo + hi));
@@ -242,7 +242,7 @@ impl SmoothRectangleWave {
     }
 
     /// The table [`SmoothRectangleWave::box_exp_mean`] reads for absorbance scale `k`.
-    pub fn exp_table(&self, k: Vec3) -> RingExpTable {
+    pub(crate) fn exp_table(&self, k: Vec3) -> RingExpTable {
         RingExpTable::new(self, k)
     }
 }

@@ -116,17 +116,17 @@ const BATCH: usize = 16;
 
 /// Salts of the independent noise fields, so each feature has its own seed.
 mod salt {
-    pub const GROWTH: u32 = 1;
-    pub const INTERLOCK: u32 = 2;
-    pub const DISTORT: [u32; 3] = [3, 4, 5];
-    pub const PORES: u32 = 6;
-    pub const RAYS: u32 = 7;
-    pub const PHASE: u32 = 8;
-    pub const WANDER: [u32; 4] = [9, 10, 11, 12];
-    pub const TEXTURE: [u32; 2] = [13, 14];
-    pub const KNOTS: u64 = 0x6b6e_6f74;
-    pub const EYES: u64 = 0x6579_6573;
-    pub const RAY_WANDER: u32 = 15;
+    pub(crate) const GROWTH: u32 = 1;
+    pub(crate) const INTERLOCK: u32 = 2;
+    pub(crate) const DISTORT: [u32; 3] = [3, 4, 5];
+    pub(crate) const PORES: u32 = 6;
+    pub(crate) const RAYS: u32 = 7;
+    pub(crate) const PHASE: u32 = 8;
+    pub(crate) const WANDER: [u32; 4] = [9, 10, 11, 12];
+    pub(crate) const TEXTURE: [u32; 2] = [13, 14];
+    pub(crate) const KNOTS: u64 = 0x6b6e_6f74;
+    pub(crate) const EYES: u64 = 0x6579_6573;
+    pub(crate) const RAY_WANDER: u32 = 15;
 }
 
 /// What `eval` computes at the distorted point before deciding what else it needs.
