@@ -126,13 +126,7 @@ pub fn contact_sheet_rows(thumbs: &[Rgb8], labels: &[String], cols: usize, gap: 
 /// all one size) with `labels[i]` in each lower-left corner, and, for the `last` row, the gap
 /// below. A sheet is its bands one below the other, so a long sweep's sheet can be written band
 /// by band. A label of a thumbnail under 9 px tall reaches into the gap above it, never further.
-pub fn sheet_band(
-    thumbs: &[Rgb8],
-    labels: &[String],
-    cols: usize,
-    gap: u32,
-    last: bool,
-) -> Rgb8 {
+pub fn sheet_band(thumbs: &[Rgb8], labels: &[String], cols: usize, gap: u32, last: bool) -> Rgb8 {
     let Some(first) = thumbs.first() else {
         return Rgb8::filled(1, 1, [24, 24, 24]);
     };

@@ -113,7 +113,7 @@ impl Camera {
     /// film, 2 tan(fov/2)/height per unit distance for a pinhole (× cos of the angle off the view
     /// axis, the film's foreshortening seen along the ray), film width / pixels for orthographic.
     /// The lens blur of a thin lens is not included. Used to band-limit textures.
-    pub(crate) fn pixel_footprint(&self, ray: &Ray, t: f32) -> f32 {
+    pub fn pixel_footprint(&self, ray: &Ray, t: f32) -> f32 {
         match self.projection {
             Projection::Perspective { fov_y, .. } => {
                 2.0 * (0.5 * fov_y).tan() / self.height as f32 * t * ray.d.dot(self.frame.n).abs()
