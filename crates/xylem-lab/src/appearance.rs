@@ -837,6 +837,14 @@ impl PairReport {
     pub fn passes(&self) -> bool {
         self.rows.iter().all(Comparison::passes)
     }
+
+    /// Every compared row, board and pattern, and how many of them pass only by the 25 % leg
+    /// (outside the band): the share [`MAX_LEG_SHARE`] bounds (issue 25).
+    pub fn rows_by_leg(&self) -> (usize, usize) {
+        let all = || self.rows.iter().chain(&self.pattern_rows);
+        let by_leg = all().filter(|c| c.passes() && !c.in_band()).count();
+        (all().count(), by_leg)
+    }
 }
 
 /// Compares `pair.preset` (seed 7, cut as the measured board) with its measured board: maps and a
@@ -1361,10 +1369,8 @@ pub fn run_report(
         progress(&pair.preset);
         let r = compare_pair(pair, base, preset_dir, sweep)?;
         ok &= r.passes() && r.pattern_rows.iter().all(Comparison::passes);
-        // Every compared row, board and pattern alike, counts towards the share (issue 25).
-        let all = || r.rows.iter().chain(&r.pattern_rows);
-        rows += all().count();
-        by_leg += all().filter(|c| c.passes() && !c.in_band()).count();
+        let (n, leg) = r.rows_by_leg();
+        (rows, by_leg) = (rows + n, by_leg + leg);
         md += &pair_section(&r, dir, sweep)?;
     }
     if !pairs.is_empty() {
