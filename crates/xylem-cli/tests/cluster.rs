@@ -195,9 +195,11 @@ fn peak_rss(dir: &Path, args: &[&str]) -> u64 {
 #[test]
 fn a_long_sweep_peaks_at_the_memory_of_a_short_one_by_default() {
     // 128×128 at 1 spp: 480 frames held at once would add ≥ 240 MiB (512 KiB of radiance and
-    // error each) to the 48-frame sweep's peak; the default batches keep them level, and the
-    // held malloc thresholds (sweep::job) keep the heap from creeping batch by batch (+9 %
-    // without them, +1.5 % with them: notes/cluster.md).
+    // error each) to the 48-frame sweep's ~33 MiB peak; the default batches keep them level
+    // within issue 31's goal of 1.2×. Peak RSS varies run to run (+1.5 % to +5.8 % measured
+    // for 480 frames, the latter on CI), so each length takes the least of three runs; the
+    // heap creep the held malloc thresholds prevent (+9 % without them) is measured in
+    // notes/cluster.md, not here.
     let dir = tempfile::tempdir().unwrap();
     let scene = tiny_board(dir.path(), 128, 128);
     let s = scene.to_str().unwrap();
@@ -214,11 +216,11 @@ fn a_long_sweep_peaks_at_the_memory_of_a_short_one_by_default() {
             "--threads",
             "2",
         ];
-        peak_rss(dir.path(), &args)
+        (0..3).map(|_| peak_rss(dir.path(), &args)).min().unwrap()
     };
     let (short, long) = (peak("48"), peak("480"));
     assert!(
-        (long as f64) < 1.05 * short as f64,
+        (long as f64) < 1.2 * short as f64,
         "peak RSS {long} bytes for 480 frames, {short} for 48"
     );
 }
