@@ -9,6 +9,13 @@ reuses the compiled kernels, is timed. The reference is one Mitsuba render of `-
 samples per pixel in chunks of 256 spp, cached in target/crosscheck/; RMSE is over all pixels and
 channels. RMSE at equal time is RMSE · sqrt(seconds / Mitsuba's seconds): Monte Carlo error falls
 as 1/sqrt(samples), so it is the error each renderer would reach in Mitsuba's time.
+
+Like with like: the timed Mitsuba render starts Russian roulette where xylem does. xylem plays
+it after its 3rd BSDF sample (`render::integrator::survival`); Mitsuba 3's `path` after its
+`rr_depth`-th (`depth` grows by one per BSDF sample, roulette where `depth >= rr_depth`), so
+`rr_depth` = 3. Both discount refraction's η'² (Mitsuba: `throughput · eta²`); Mitsuba caps
+survival at 0.95, xylem at 1. The reference keeps Mitsuba's default (5): any unbiased rule
+converges to the same image.
 """
 
 import math
@@ -21,6 +28,8 @@ from . import render, scenes
 
 RES = (256, 256)
 DEPTH = 8
+# Mitsuba's `rr_depth` equal to xylem's roulette start (bounce 3), for the timed render.
+RR_DEPTH = 3
 
 
 def add_arguments(ap):
@@ -79,7 +88,7 @@ def run(mi, args):
     ref, ref_path = reference(mi, args.work, meshes, args.reference_spp)
     t0 = time.perf_counter()
     scene = mi.load_dict(scenes.mitsuba_dict(mi, scenes.cornell_lambertian(), meshes, DEPTH,
-                                             args.spp, 1, RES))
+                                             args.spp, 1, RES, rr_depth=RR_DEPTH))
     load_s = time.perf_counter() - t0
     times = []
     for _ in range(2):
@@ -97,6 +106,7 @@ def run(mi, args):
     m["rmse_equal_time"] = m["rmse"]
     m["rmse_surfaces_equal_time"] = m["rmse_surfaces"]
     out = {"res": list(RES), "xylem_depth": DEPTH, "mitsuba_depth": DEPTH + 1,
+           "mitsuba_rr_depth": RR_DEPTH,
            "reference": os.path.relpath(ref_path), "reference_spp": args.reference_spp,
            "reference_mean": ref.mean(axis=(0, 1)).tolist(), "mitsuba": m,
            "load_average": list(os.getloadavg())}
@@ -116,7 +126,8 @@ def run(mi, args):
 
 def table(out):
     lines = [f"Cornell box {out['res'][0]}x{out['res'][1]}, xylem depth {out['xylem_depth']} "
-             f"(Mitsuba {out['mitsuba_depth']}), reference {out['reference']} "
+             f"(Mitsuba {out['mitsuba_depth']}, rr_depth {out['mitsuba_rr_depth']} = xylem's "
+             f"roulette start), reference {out['reference']} "
              f"({out['reference_spp']} spp Mitsuba)",
              f"{'renderer':<28} {'spp':>5} {'seconds':>8} {'Msamples/s':>11} {'RMSE':>9} "
              f"{'RMSE@equal time':>16} {'RMSE surfaces':>14} {'@equal time':>12}"]

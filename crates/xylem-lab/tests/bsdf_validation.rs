@@ -103,6 +103,7 @@ fn chi_square_detects_a_wrong_pdf() {
                 f: self.eval(wo, wi),
                 pdf: self.pdf(wo, wi),
                 is_delta: false,
+                eta: 1.0,
             })
         }
     }

@@ -42,6 +42,7 @@ impl Bsdf for Lambertian {
             f: self.albedo * INV_PI,
             pdf,
             is_delta: false,
+            eta: 1.0,
         })
     }
 }

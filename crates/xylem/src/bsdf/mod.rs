@@ -38,6 +38,10 @@ pub struct BsdfSample {
     pub pdf: f32,
     /// True when `wi` came from a delta lobe (`eval` and `pdf` do not see it).
     pub is_delta: bool,
+    /// Relative index of refraction η' crossed by `wi`: η_inside/η_outside entering, its
+    /// inverse leaving, 1 for reflection. `f` carries refraction's radiance scaling 1/η'²,
+    /// which Russian roulette undoes (Veach 1997 §5.2; pbrt-v4 §13.4 `etaScale`).
+    pub eta: f32,
 }
 
 /// A BSDF: `eval` is f(wo, wi) without the cosine and without delta lobes; `pdf` is the density

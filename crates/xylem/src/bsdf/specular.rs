@@ -31,6 +31,7 @@ impl Bsdf for Mirror {
             f: self.reflectance / wo.z.abs(),
             pdf: 1.0,
             is_delta: true,
+            eta: 1.0,
         })
     }
 }
@@ -84,6 +85,7 @@ impl Bsdf for Glass {
                 f: Vec3::splat(f / cos_o),
                 pdf: f,
                 is_delta: true,
+                eta: 1.0,
             });
         }
         let wi = refract(wo, n, eta)?;
@@ -97,6 +99,7 @@ impl Bsdf for Glass {
             f: self.tint * (t / (cos_i * eta * eta)),
             pdf: t,
             is_delta: true,
+            eta,
         })
     }
 }

@@ -605,6 +605,7 @@ impl Bsdf for WoodBsdf {
                         f: Vec3::splat(f / wo.z),
                         pdf: probs.specular,
                         is_delta: true,
+                        eta: 1.0,
                     });
                 }
                 Some(r) => {
@@ -642,6 +643,7 @@ impl Bsdf for WoodBsdf {
             f: self.eval(wo, wi),
             pdf,
             is_delta: false,
+            eta: 1.0,
         })
     }
 }

@@ -632,6 +632,15 @@ pub(crate) fn light_terms(
     }
 }
 
+/// Russian roulette's survival probability for a path of throughput `beta` that has crossed
+/// refractive boundaries whose η'² multiply to `eta_scale`: min(1, max(β) · η'²). Refraction
+/// scales radiance by 1/η'² (Veach 1997 §5.2), a factor a path inside glass undoes when it
+/// leaves, so counting it would kill paths whose weight comes back; pbrt-v4 §13.4 (`etaScale`)
+/// and Mitsuba 3's path integrator take it out the same way (notes/render.md).
+pub(crate) fn survival(beta: Vec3, eta_scale: f32) -> f32 {
+    (beta.max_element() * eta_scale).min(1.0)
+}
+
 /// The light-independent rest of a path's first bounce: the state [`radiance_frames`] reaches
 /// after sampling the BSDF at the first vertex and tracing the ray it gives (throughput, MIS
 /// state, the ray, what it hit, and the lighting stream after the draws), `None` in a
@@ -640,6 +649,7 @@ pub(crate) fn light_terms(
 #[derive(Clone, Debug)]
 pub(crate) struct Continuation {
     beta: Vec3,
+    eta_scale: f32,
     prev_pdf: f32,
     specular: bool,
     ray: Ray,
@@ -682,8 +692,8 @@ pub(crate) struct FramesScratch {
 /// The radiance of one primary sample in every frame of `lights`, into `out` (one per frame):
 /// unidirectional path tracing (pbrt-v4 §13.4 structure) with next-event estimation at every
 /// non-delta vertex, the BSDF-sampled continuation MIS-weighted (power heuristic, Veach 1997
-/// eq. 9.13) where it meets a light, and Russian roulette with survival min(1, max throughput)
-/// from bounce 3 (pbrt-v4 §13.4). Direct lighting is the path of one bounce.
+/// eq. 9.13) where it meets a light, and Russian roulette from bounce 3 ([`survival`]). Direct
+/// lighting is the path of one bounce.
 ///
 /// The frames share everything but the lights, so the path — its rays, hits, BSDF samples and
 /// roulette, all drawn from `rng` the same way whatever the lights — is traced once; per frame
@@ -715,6 +725,8 @@ pub(crate) fn radiance_frames(
     scratch.alive.clear();
     scratch.alive.resize(n, true);
     let mut beta = Vec3::ONE;
+    // The product of η'² over the refractions so far (`survival`).
+    let mut eta_scale = 1.0f32;
     let mut ray = ps.ray;
     let mut t_hit = ps.t_hit;
     // The first vertex is read where it lies (`ps.point`), the later ones from `bounce`: a
@@ -759,7 +771,8 @@ pub(crate) fn radiance_frames(
                 break;
             }
             let Some(c) = kept else { break };
-            (beta, prev_pdf, specular, depth) = (c.beta, c.prev_pdf, c.specular, 1);
+            (beta, eta_scale, prev_pdf, specular, depth) =
+                (c.beta, c.eta_scale, c.prev_pdf, c.specular, 1);
             (ray, t_hit, *rng) = (c.ray, c.t_hit, c.rng.clone());
             at_first = false;
             bounce = match c.hit {
@@ -781,11 +794,12 @@ pub(crate) fn radiance_frames(
             break;
         }
         beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
+        eta_scale *= bs.eta * bs.eta;
         specular = bs.is_delta;
         prev_pdf = bs.pdf;
         depth += 1;
         if depth >= 3 {
-            let q = beta.max_element().min(1.0);
+            let q = survival(beta, eta_scale);
             if rng.next_f32() >= q {
                 break;
             }
@@ -806,6 +820,7 @@ pub(crate) fn radiance_frames(
         if let FirstBounce::Keep(kept) = std::mem::replace(&mut first, FirstBounce::Trace) {
             *kept = Some(Continuation {
                 beta,
+                eta_scale,
                 prev_pdf,
                 specular,
                 ray,
