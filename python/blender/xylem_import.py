@@ -3,7 +3,8 @@
 Blender's glTF importer reads `KHR_materials_anisotropy` from Blender 4.0 on; older importers
 (Debian's Blender 3.4, for one) load the .glb without it and the highlight loses its grain.
 This add-on builds the material from the folder's maps instead, in any Blender whose
-Principled BSDF has the Anisotropic and Tangent inputs (2.8 on; the coat needs 4.0):
+Principled BSDF has the Anisotropic and Tangent inputs and Separate Color (3.3 on; the coat
+needs 4.0 and is left out before):
 
 - Base Color: base_color.png (sRGB);
 - Normal: normal.png (tangent space, non-colour);
@@ -32,7 +33,7 @@ bl_info = {
     "name": "xylem bake folder",
     "author": "xylem",
     "version": (0, 1, 0),
-    "blender": (4, 0, 0),
+    "blender": (3, 3, 0),
     "location": "File > Import > xylem bake folder (bake.json)",
     "description": "A board with a Principled BSDF built from xylem's baked maps "
     "(base colour, roughness, anisotropy and tangent from the fibre map, coat)",
