@@ -134,7 +134,10 @@ fn blender_imports_the_anisotropy_and_renders_it_across_the_fibre() {
         .arg(&script)
         .args(["--bake", bake.to_str().unwrap()])
         .args(["--scene", scene.to_str().unwrap()])
-        .args(["--xylem-png", out.join("grazing_board.png").to_str().unwrap()])
+        .args([
+            "--xylem-png",
+            out.join("grazing_board.png").to_str().unwrap(),
+        ])
         .args(["--out", out.to_str().unwrap()])
         .output()
         .unwrap();
@@ -174,11 +177,21 @@ fn blender_imports_the_anisotropy_and_renders_it_across_the_fibre() {
     let across = |(angle, elong): (f64, f64)| axis_gap(angle, 90.0) <= 15.0 && elong >= 2.0;
     assert!(across(check("gltf")), "glTF import: {}", cases["gltf"]);
     // Negative controls: the anisotropy stripped (a round GGX lobe) and the board turned 90°.
-    assert!(!across(check("stripped")), "stripped: {}", cases["stripped"]);
+    assert!(
+        !across(check("stripped")),
+        "stripped: {}",
+        cases["stripped"]
+    );
     assert!(!across(check("turned")), "turned: {}", cases["turned"]);
     // The add-on: its node tree and its render (the coat's mirror spot shortens the region).
     let addon = &cases["addon"];
-    for input in ["Base Color", "Roughness", "Anisotropic", "Tangent", "Normal"] {
+    for input in [
+        "Base Color",
+        "Roughness",
+        "Anisotropic",
+        "Tangent",
+        "Normal",
+    ] {
         assert!(
             linked(addon, input),
             "add-on left {input} unlinked: {addon}"
