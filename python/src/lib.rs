@@ -840,6 +840,13 @@ impl PyWoodSurface {
     }
 }
 /// `threads`: 0 (all cores) up to 16 per core, as `--threads`.
+/// A `quality=` keyword (`draft`, `default` or `final`, as `--quality`).
+fn parse_quality(quality: Option<&str>) -> PyResult<Option<xylem::scene::quality::Quality>> {
+    quality
+        .map(|q| q.parse().map_err(|e| value_error(format!("quality: {e}"))))
+        .transpose()
+}
+
 fn check_threads(threads: usize) -> PyResult<()> {
     use xylem::render::resources::{check_threads, ResourceError};
     check_threads(threads).map_err(|e| match e {
@@ -1035,11 +1042,19 @@ fn with_scene<T>(
 ) -> PyResult<T> {
     o.check().map_err(value_error)?;
     let apply = |loaded: &mut xylem::scene::LoadedScene| -> PyResult<T> {
-        // Only spp, res and seed are offered, so settings and camera are all there is to restore.
+        // Overrides change the settings and camera, and a quality preset or footprint switch
+        // the materials (wood volumes rebuilt with the knobs): all three are restored after.
         let (settings, camera) = (loaded.settings, loaded.scene.camera);
-        o.apply(loaded).map_err(value_error)?;
-        let r = f(loaded);
+        let materials = (o.quality.is_some() || o.footprint_filter.is_some())
+            .then(|| loaded.scene.materials.clone());
+        let r = o
+            .apply(loaded)
+            .map_err(value_error)
+            .and_then(|()| f(loaded));
         (loaded.settings, loaded.scene.camera) = (settings, camera);
+        if let Some(m) = materials {
+            loaded.scene.materials = m;
+        }
         r
     };
     if let Ok(s) = scene.downcast::<PyScene>() {
@@ -1111,14 +1126,18 @@ fn interruptible<T: Send>(py: Python<'_>, f: impl FnOnce(&StopFlag) -> T + Send)
     })
 }
 
-/// `render(scene, spp=None, res=None, seed=None, threads=0)`: renders a scene (a file path, a
-/// built-in scene name, a dict as `load_dict` takes, or a `Scene`) as `xylem render` does and returns a dict of (H, W[, 3]) float32 arrays, top row first: `beauty`
+/// `render(scene, spp=None, res=None, seed=None, threads=0, quality=None, footprint_filter=None)`:
+/// renders a scene (a file path, a built-in scene name, a dict as `load_dict` takes, or a
+/// `Scene`) as `xylem render` does — `quality` is `--quality` (`draft`, `default`, `final`: spp
+/// and wood-model knobs, validation/TRADEOFF.md), `spp` and `footprint_filter` override it —
+/// and returns a dict of (H, W[, 3]) float32 arrays, top row first: `beauty`
 /// (linear RGB), `std_error` (of each pixel's luminance), and the first-hit AOVs `albedo`,
 /// `normal`, `depth`, `fiber`, `ray_mask`, `growth_time`; plus `nonfinite` (samples dropped) and
 /// `seconds`. The GIL is released while rendering; Ctrl-C stops it within a tile and raises
 /// KeyboardInterrupt.
 #[pyfunction]
-#[pyo3(signature = (scene, spp=None, res=None, seed=None, threads=0))]
+#[pyo3(signature = (scene, spp=None, res=None, seed=None, threads=0, quality=None, footprint_filter=None))]
+#[allow(clippy::too_many_arguments)]
 fn render<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
@@ -1126,13 +1145,16 @@ fn render<'py>(
     res: Option<(u32, u32)>,
     seed: Option<u64>,
     threads: usize,
+    quality: Option<&str>,
+    footprint_filter: Option<bool>,
 ) -> PyResult<Bound<'py, PyDict>> {
     check_threads(threads)?;
     let o = Overrides {
+        quality: parse_quality(quality)?,
         spp,
         res,
         seed,
-        ..Default::default()
+        footprint_filter,
     };
     let out = with_scene(py, scene, &o, |loaded| {
         interruptible(py, |stop| {
@@ -1163,13 +1185,14 @@ fn render<'py>(
     Ok(d)
 }
 
-/// `sweep(scene, frames=None, arc=None, spp=None, res=None, seed=None, threads=0)`: renders the
+/// `sweep(scene, frames=None, arc=None, spp=None, res=None, seed=None, threads=0, quality=None,
+/// footprint_filter=None)`: renders the
 /// light sweep of a scene's (a path, a name, a dict or a `Scene`, as `render` takes) `[sweep]` table (with the per-sweep cache, as `xylem sweep` does)
 /// without writing files; `arc` = (from_deg, to_deg). Returns a dict: `frames` (F, H, W, 3),
 /// `std_error` (F, H, W), `light_deg` (F,), `seconds`. The GIL is released while rendering;
 /// Ctrl-C stops it within a tile and raises KeyboardInterrupt.
 #[pyfunction]
-#[pyo3(signature = (scene, frames=None, arc=None, spp=None, res=None, seed=None, threads=0))]
+#[pyo3(signature = (scene, frames=None, arc=None, spp=None, res=None, seed=None, threads=0, quality=None, footprint_filter=None))]
 #[allow(clippy::too_many_arguments)]
 fn sweep<'py>(
     py: Python<'py>,
@@ -1180,13 +1203,16 @@ fn sweep<'py>(
     res: Option<(u32, u32)>,
     seed: Option<u64>,
     threads: usize,
+    quality: Option<&str>,
+    footprint_filter: Option<bool>,
 ) -> PyResult<Bound<'py, PyDict>> {
     check_threads(threads)?;
     let o = Overrides {
+        quality: parse_quality(quality)?,
         spp,
         res,
         seed,
-        ..Default::default()
+        footprint_filter,
     };
     let (r, deg) = with_scene(py, scene, &o, |loaded| {
         let (path, moving) =

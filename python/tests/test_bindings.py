@@ -171,3 +171,20 @@ def test_builtin_scenes_render_by_bare_name_from_an_empty_folder(tmp_path, monke
         assert img["beauty"].shape == (6, 8, 3), name
     sw = xylem.sweep("sweep_board", frames=2, spp=1, res=(8, 6))
     assert sw["frames"].shape == (2, 6, 8, 3)
+
+
+def test_render_takes_a_quality_preset_and_restores_a_scene(root):
+    """`quality=` is `--quality`: the draft preset changes the wood model (the exact distortion
+    Jacobian) and spp, `spp=` overrides its spp, and a loaded `Scene` renders as before
+    afterwards (the preset's rebuilt materials are restored, like its settings)."""
+    scene = xylem.load_file(str(root / "scenes" / "sweep_board.toml"))
+    small = dict(spp=1, res=(24, 18), threads=1)
+    before = xylem.render(scene, **small)["beauty"]
+    draft = xylem.render(scene, quality="draft", **small)["beauty"]
+    assert not np.array_equal(before, draft), "the preset's knobs must change the image"
+    after = xylem.render(scene, **small)["beauty"]
+    assert np.array_equal(before, after), "the Scene must come back as it was"
+    with pytest.raises(ValueError, match=r"quality: `best` is not a quality \(allowed: draft"):
+        xylem.render(scene, quality="best")
+    out = xylem.sweep(scene, frames=2, quality="final", **small)
+    assert out["frames"].shape == (2, 18, 24, 3)

@@ -93,6 +93,8 @@ def render(
     res: tuple[int, int] | None = None,
     seed: int | None = None,
     threads: int = 0,
+    quality: str | None = None,
+    footprint_filter: bool | None = None,
 ) -> dict[str, Any]: ...
 def sweep(
     scene: _SceneLike,
@@ -102,6 +104,8 @@ def sweep(
     res: tuple[int, int] | None = None,
     seed: int | None = None,
     threads: int = 0,
+    quality: str | None = None,
+    footprint_filter: bool | None = None,
 ) -> dict[str, Any]: ...
 def fit(
     capture: _PathLike, out: _PathLike, texels: tuple[int, int] | None = None, threads: int = 0

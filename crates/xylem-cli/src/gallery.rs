@@ -11,6 +11,8 @@ use xylem::picture::contact::Rgb8;
 use xylem::picture::png::{write_apng, write_png_rgb8};
 use xylem::picture::srgb::to_srgb8;
 use xylem::render::{render, RunOptions};
+use xylem::scene::quality::Quality;
+use xylem::scene::Overrides;
 use xylem::sweep::{render_sweep, SweepPath};
 
 #[derive(clap::Args, Debug)]
@@ -28,6 +30,11 @@ pub struct Args {
     /// Frames of each sweep close-up, 1 to 1000.
     #[arg(long, default_value_t = FRAMES, value_parser = parse_frames)]
     frames: usize,
+    /// Speed/accuracy preset for every render (draft, default, final: spp and wood-model knobs,
+    /// validation/TRADEOFF.md) [default: each scene's own settings]; with it the images are
+    /// not the README's, so `--out` must be named.
+    #[arg(long)]
+    quality: Option<Quality>,
 }
 
 /// Frames of each sweep close-up in the README's gallery.
@@ -68,28 +75,35 @@ const CLOSE_FOV_DEG: f64 = 18.0;
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let part = |p: &str| args.only.is_empty() || args.only.iter().any(|o| o == p);
-    let reduced =
-        (args.frames != FRAMES && part("sweeps")).then(|| format!("--frames {}", args.frames));
+    let reduced = match (args.frames != FRAMES && part("sweeps"), args.quality) {
+        (true, _) => Some(format!("--frames {}", args.frames)),
+        (false, Some(q)) => Some(format!("--quality {q}")),
+        _ => None,
+    };
+    let o = Overrides {
+        quality: args.quality,
+        ..Default::default()
+    };
     let out = crate::output_path(args.out.clone(), "notes/gallery", "--out", reduced)?;
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
     let _lock = xylem::output::FolderLock::try_new(&out, xylem::output::LockMode::Exclusive)?;
     let start = Instant::now();
     let mut ok = true;
     if part("scenes") {
-        ok &= scenes(&out.join("scenes"), &args.scene)?;
+        ok &= scenes(&out.join("scenes"), &args.scene, &o)?;
     }
     if part("presets") {
         super::preset::gallery(
             &out.join("presets"),
             (480, 240),
-            16,
+            &o,
             &[-40.0, 0.0, 40.0],
             &[],
             None,
         )?;
     }
     if part("sweeps") {
-        sweeps(&out.join("sweeps"), args.frames)?;
+        sweeps(&out.join("sweeps"), args.frames, &o)?;
     }
     println!("gallery done in {:.0} s", start.elapsed().as_secs_f64());
     Ok(if ok {
@@ -101,7 +115,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 
 /// Renders each scene at its defaults to `out/NAME.png`, measures its subject, and writes
 /// `out/checks.md` (time and numbers per scene). False when a check fails.
-fn scenes(out: &Path, only: &[String]) -> anyhow::Result<bool> {
+fn scenes(out: &Path, only: &[String], o: &Overrides) -> anyhow::Result<bool> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let names: Vec<&str> = if only.is_empty() {
         SCENES.to_vec()
@@ -120,7 +134,8 @@ fn scenes(out: &Path, only: &[String]) -> anyhow::Result<bool> {
             .into_iter()
             .map(|o| o.name)
             .collect();
-        let s = xylem::scene::load(&path)?;
+        let mut s = xylem::scene::load(&path)?;
+        o.apply(&mut s)?;
         let (w, h) = (s.scene.camera.width, s.scene.camera.height);
         eprintln!("{name}: {w}x{h}, {} spp", s.settings.spp);
         let r = render(
@@ -216,13 +231,14 @@ fn merge_check_rows(old: &str, rows: &[(String, String)]) -> String {
 
 /// A light sweep over a close-up of each figured preset on the README board, as a looping APNG
 /// (`out/NAME.png`, 12 frames/s), the light moving along the board's own arc (−60° to 60°).
-fn sweeps(out: &Path, frames: usize) -> anyhow::Result<()> {
+fn sweeps(out: &Path, frames: usize, o: &Overrides) -> anyhow::Result<()> {
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let board = super::preset::board_table()?;
     let bar = super::progress::Bar::new(true);
     for name in FIGURED {
-        let loaded =
+        let mut loaded =
             super::preset::preset_board(&board, name, (160, 120), 16, CLOSE_EYE, CLOSE_FOV_DEG)?;
+        o.apply(&mut loaded)?;
         let (path, moving) = SweepPath::from_scene(&loaded, Some(frames), None)?;
         eprintln!("{name}: {frames} frames");
         let r = render_sweep(

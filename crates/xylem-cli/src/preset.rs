@@ -4,6 +4,7 @@ use anyhow::Context;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use xylem::picture::png::write_png_linear;
+use xylem::scene::Overrides;
 use xylem::texture::{Plane, Slice};
 use xylem::wood;
 use xylem::wood::{preview_color, Needs};
@@ -90,7 +91,13 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             angles,
             only,
             presets,
-        } => gallery(&out, res, spp, &angles, &only, presets.as_deref())?,
+        } => {
+            let o = Overrides {
+                spp: Some(spp),
+                ..Default::default()
+            };
+            gallery(&out, res, &o, &angles, &only, presets.as_deref())?
+        }
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -201,7 +208,7 @@ const GALLERY_FOV_DEG: f64 = 24.0;
 pub(super) fn gallery(
     out: &Path,
     (width, height): (u32, u32),
-    spp: u32,
+    o: &Overrides,
     angles: &[f32],
     only: &[String],
     presets: Option<&Path>,
@@ -232,15 +239,16 @@ pub(super) fn gallery(
     let board = board_table()?;
     let (mut thumbs, mut labels) = (Vec::new(), Vec::new());
     for name in &names {
-        let loaded = preset_board_with(
+        let mut loaded = preset_board_with(
             &board,
             name,
             presets,
             (width, height),
-            spp,
+            xylem::scene::DEFAULT_SPP,
             GALLERY_EYE,
             GALLERY_FOV_DEG,
         )?;
+        o.apply(&mut loaded)?;
         let mut row = Vec::new();
         for &angle in angles {
             let (path, moving) = SweepPath::from_scene(&loaded, Some(1), Some((angle, angle)))?;

@@ -84,6 +84,10 @@ fn reduced_runs_never_overwrite_the_full_results() {
         &["gallery", "--frames", "4"],
         &[&full[..], &["--frames 4", "notes/gallery", "--out"]].concat(),
     );
+    refused(
+        &["gallery", "--quality", "draft"],
+        &[&full[..], &["--quality draft", "notes/gallery", "--out"]].concat(),
+    );
     // Beyond 10 samples per chi-square cell on average the check itself is not valid.
     refused(
         &["validate", "bsdf", "--reduce", "50", "--no-report"],
@@ -91,4 +95,32 @@ fn reduced_runs_never_overwrite_the_full_results() {
     );
     refused(&["validate", "bsdf", "--reduce", "0"], &["allowed 1 to 24"]);
     assert!(files(dir).is_empty(), "{:?}", files(dir));
+}
+
+/// `gallery --quality` renders every scene at the preset's settings (the draft's 4 spp where
+/// the scene asks for 16), and says so in its checks table.
+#[test]
+fn gallery_takes_a_quality_preset() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = xylem(
+        &[
+            "gallery",
+            "--only",
+            "scenes",
+            "--scene",
+            "sweep_board",
+            "--quality",
+            "draft",
+            "--out",
+            "g",
+        ],
+        tmp.path(),
+    );
+    // Exit 1 would only say a subject check missed its bound at 4 spp; the row is what counts.
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{err}");
+    assert!(err.contains("sweep_board: 512x384, 4 spp"), "{err}");
+    let checks = std::fs::read_to_string(tmp.path().join("g/scenes/checks.md")).unwrap();
+    let row = checks.lines().find(|l| l.contains("sweep_board")).unwrap();
+    assert!(row.contains("512×384, 4 |"), "{row}");
 }

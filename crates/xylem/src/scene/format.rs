@@ -48,6 +48,35 @@ pub struct SceneFile {
     pub objects: Vec<ObjectTable>,
     /// Light-sweep setup (used by `xylem sweep`).
     pub sweep: Option<SweepTable>,
+    /// `[quality]`: the speed/accuracy preset and wood-model knobs (none: the full model).
+    pub quality: Option<QualityTable>,
+}
+
+/// `[quality]`: what the scene trades for speed, as `--quality` does on the command line
+/// (validation/TRADEOFF.md). The preset comes first, then the knobs named here, then
+/// `[render] spp` and `[render] footprint_filter` where they are given.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct QualityTable {
+    /// `draft`, `default` or `final`: 4, 16 or 64 spp, the exact distortion Jacobian and the
+    /// footprint filter.
+    pub preset: Option<crate::scene::quality::Quality>,
+    /// Distortion Jacobian: `simplified` (Liu et al. 2016 eq. 22) or `exact`.
+    pub jacobian: Option<JacobianName>,
+    /// Keep the wood's pores and rays (false drops them: "model only what the scene needs").
+    pub pores_and_rays: Option<bool>,
+    /// Keep at most this many bands of every multiband distortion noise, 1 to 16.
+    pub max_noise_bands: Option<u32>,
+}
+
+/// `[quality] jacobian`.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum JacobianName {
+    /// Liu et al. 2016 eq. 22 (the full model's default).
+    Simplified,
+    /// The exact derivative (the quality presets').
+    Exact,
 }
 
 /// `[render]`: image size and sampling.
@@ -58,8 +87,8 @@ pub struct RenderTable {
     pub width: u32,
     /// Image height in pixels, 1–16384 (default 512; `--res` overrides).
     pub height: u32,
-    /// Samples per pixel, 1–1000000 (default 16; `--spp` overrides).
-    pub spp: u32,
+    /// Samples per pixel, 1–1000000 (default: `[quality] preset`'s, else 16; `--spp` overrides).
+    pub spp: Option<u32>,
     /// Direct lighting only (default) or path tracing.
     pub integrator: IntegratorName,
     /// Path tracing: most bounces, 1–1000 (default 8).
@@ -82,7 +111,7 @@ impl Default for RenderTable {
         RenderTable {
             width: 512,
             height: 512,
-            spp: 16,
+            spp: None,
             integrator: IntegratorName::Direct,
             max_depth: 8,
             seed: 0,

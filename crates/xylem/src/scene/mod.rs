@@ -13,7 +13,11 @@ pub mod teapot;
 pub use format::{SceneFile, SweepBoard, SweepRegion, SweepTable, MAX_ARCS};
 pub use overrides::{OverrideError, Overrides, MAX_RESOLUTION, MAX_SPP};
 
+/// Samples per pixel of a scene whose file gives neither `[render] spp` nor a quality preset.
+pub const DEFAULT_SPP: u32 = 16;
+
 use crate::bsdf::{WoodBsdf, WoodBsdfParams};
+use crate::field::JacobianModel;
 use crate::material::{
     BoardFace, ColorSpace, Cutting, Material, MeasuredBoard, MeasuredFiles, MeasuredMaterial,
     Placement, TextureMaterial, WoodMaterial,
@@ -25,6 +29,7 @@ use crate::render::{
 use crate::wood::BoardLayout;
 use format::*;
 use glam::{Affine3A, EulerRot, Quat, Vec2, Vec3};
+use quality::Knobs;
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -328,7 +333,13 @@ impl Builder<'_> {
         let width = self.range("render.width", r.width as f32, 1.0, MAX_RESOLUTION as f32)? as u32;
         let height =
             self.range("render.height", r.height as f32, 1.0, MAX_RESOLUTION as f32)? as u32;
-        self.range("render.spp", r.spp as f32, 1.0, MAX_SPP as f32)?;
+        if let Some(spp) = r.spp {
+            self.range("render.spp", spp as f32, 1.0, MAX_SPP as f32)?;
+        }
+        let knobs = match &file.quality {
+            Some(q) => Some(self.quality_knobs(q, r)?),
+            None => None,
+        };
         self.range("render.max_depth", r.max_depth as f32, 1.0, 1000.0)?;
         self.range("render.exposure", r.exposure, -30.0, 30.0)?;
         let integrator = match r.integrator {
@@ -391,11 +402,11 @@ impl Builder<'_> {
             camera,
             filter,
         };
-        Ok(LoadedScene {
+        let mut loaded = LoadedScene {
             name: name.to_string(),
             scene,
             settings: RenderSettings {
-                spp: r.spp,
+                spp: r.spp.unwrap_or(DEFAULT_SPP),
                 integrator,
                 seed: r.seed,
             },
@@ -403,7 +414,41 @@ impl Builder<'_> {
             light_names,
             sweep: file.sweep,
             warnings: self.warnings,
-        })
+        };
+        if let Some(k) = knobs {
+            quality::apply(&mut loaded, &k).map_err(|e| SceneError::Invalid {
+                path: self.path.to_string(),
+                field: "quality".into(),
+                message: e.to_string(),
+            })?;
+        }
+        Ok(loaded)
+    }
+
+    /// The knobs of a `[quality]` table: its preset's (or the full model's), its own knobs
+    /// over them, then `[render] spp` and `footprint_filter`.
+    fn quality_knobs(&self, q: &QualityTable, r: &RenderTable) -> Result<Knobs, SceneError> {
+        let mut k = q
+            .preset
+            .map_or(Knobs::full(DEFAULT_SPP), |preset| preset.knobs());
+        if let Some(j) = q.jacobian {
+            k.jacobian = match j {
+                JacobianName::Simplified => JacobianModel::Simplified,
+                JacobianName::Exact => JacobianModel::Exact,
+            };
+        }
+        if let Some(keep) = q.pores_and_rays {
+            k.pores_and_rays = keep;
+        }
+        if let Some(bands) = q.max_noise_bands {
+            self.range("quality.max_noise_bands", bands as f32, 1.0, 16.0)?;
+            k.max_bands = Some(bands);
+        }
+        if let Some(spp) = r.spp {
+            k.spp = spp;
+        }
+        k.footprint_filter = r.footprint_filter;
+        Ok(k)
     }
 
     fn camera(&self, c: &CameraTable, width: u32, height: u32) -> Result<Camera, SceneError> {

@@ -8,7 +8,7 @@ use crate::field::JacobianModel;
 use crate::material::{BakedFibers, BakedWoodMaterial, FaceRect, Material};
 use crate::scene::LoadedScene;
 use crate::wood::{NoiseParams, WoodParams, WoodVolume};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
 /// One setting of the model knobs.
@@ -78,7 +78,8 @@ impl Knobs {
 /// ≤ 16 spp), and 4 / 16 / 64 spp for SSIM ≥ 0.9 / 0.97 / 0.99 on the mahogany board. Noise bands
 /// and impulse density are not reduced: they change the figure itself (≤ 1 band drops curly
 /// maple to SSIM 0.86).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Quality {
     /// 4 spp: SSIM ≥ 0.9 on the mahogany board.
     Draft,
