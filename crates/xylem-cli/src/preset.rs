@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use xylem::picture::png::write_png_linear;
 use xylem::scene::Overrides;
-use xylem::texture::{Plane, Slice};
+use xylem::texture::{Plane, Slice, DEFAULT_SLICE_SAMPLES};
 use xylem::wood;
 use xylem::wood::{preview_color, Needs};
 
@@ -164,6 +164,7 @@ fn cuts(
                 offset,
                 size,
                 res,
+                samples: DEFAULT_SLICE_SAMPLES,
             };
             let needs = if shade {
                 Needs::COLOR_FIBERS

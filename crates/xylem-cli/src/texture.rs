@@ -10,7 +10,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use xylem::picture::png::write_png_linear;
 use xylem::render::image_io::{write_exr_layers_with, ExrCompression, ExrLayer};
-use xylem::texture::{self, first_non_finite, Plane, Slice, SolidTexture};
+use xylem::texture::{
+    self, first_non_finite, Plane, Slice, SolidTexture, DEFAULT_SLICE_SAMPLES, MAX_SLICE_SAMPLES,
+};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -32,6 +34,11 @@ pub struct Args {
     /// Image side in pixels, 1 to 16384.
     #[arg(long, default_value_t = 256)]
     pub res: u32,
+    /// Samples along each side of a pixel, 1 to 16: each pixel is the mean over a regular grid
+    /// of SAMPLES² points (a box filter); 1 point-samples the pixel centre, which aliases where
+    /// the texture has detail finer than a pixel (notes/picture.md).
+    #[arg(long, default_value_t = DEFAULT_SLICE_SAMPLES)]
+    pub samples: u32,
     /// Exposure of the PNG in stops, -30 to 30 (an EXR keeps the linear values).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = super::parse_exposure)]
     pub exposure: f32,
@@ -264,11 +271,18 @@ fn slice(args: &Args) -> anyhow::Result<Slice> {
     if !(1..=16384).contains(&args.res) {
         bail!("--res {} must be in 1..=16384", args.res);
     }
+    if !(1..=MAX_SLICE_SAMPLES).contains(&args.samples) {
+        bail!(
+            "--samples {} must be in 1..={MAX_SLICE_SAMPLES} (per side of a pixel)",
+            args.samples
+        );
+    }
     Ok(Slice {
         plane: args.plane,
         offset: args.offset,
         size: args.size,
         res: args.res,
+        samples: args.samples,
     })
 }
 

@@ -29,7 +29,7 @@ mod views;
 
 pub use params::{ParamSpec, TextureError, Values};
 pub use ramp::{smoothstep, Ramp};
-pub use slice::{first_non_finite, Plane, Slice};
+pub use slice::{first_non_finite, Plane, Slice, DEFAULT_SLICE_SAMPLES, MAX_SLICE_SAMPLES};
 
 use crate::noise::Basis;
 use glam::Vec3;
