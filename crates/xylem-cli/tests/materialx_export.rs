@@ -137,7 +137,7 @@ fn baked_materialx_and_usd_pass_the_materialx_and_usd_checks() {
                     r#"name="coat_ior" type="float" value="1.3""#,
                 )
             }),
-            "coat_ior 1.3",
+            "coat_ior 1.29",
         ),
         (
             "stage_elsewhere",
