@@ -5,6 +5,8 @@
 //! generation, and the stage's binding to the document. Negative controls: a document with a
 //! wrong input type, a missing texture, a wrong coat IOR and a stage pointing elsewhere fail.
 
+// `common::python::libllvm` serves the Mitsuba tests only.
+#[allow(dead_code)]
 mod common;
 
 use common::python::venv;
@@ -36,6 +38,9 @@ fn bake(preset: &str, out: &Path) {
         String::from_utf8_lossy(&st.stderr)
     );
 }
+
+/// A change to a file's text (a negative control).
+type Edit = Box<dyn Fn(&str) -> String>;
 
 /// The checker's report and whether it passed.
 fn check(dir: &Path, preset: &str, coat_ior: f32) -> (bool, Value) {
@@ -104,7 +109,7 @@ fn baked_materialx_and_usd_pass_the_materialx_and_usd_checks() {
     assert_eq!(r["images"].as_object().unwrap().len(), 5, "{r}");
 
     // Negative controls: each must fail, for its own reason.
-    let controls: [(&str, &str, Box<dyn Fn(&str) -> String>, &str); 5] = [
+    let controls: [(&str, &str, Edit, &str); 5] = [
         (
             "wrong_type",
             "curly_maple.mtlx",
