@@ -4,6 +4,8 @@
 use anyhow::Context;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use xylem::bake::materialx::stage_materialx;
+use xylem::bake::usd::stage_usda;
 use xylem::bake::{bake, gltf::stage_glb, stage_maps, BakeCut, BoardCut};
 use xylem::output::{commit_set, FolderLock, LockMode};
 
@@ -29,6 +31,11 @@ pub struct Args {
     /// Output folder.
     #[arg(long)]
     pub out: PathBuf,
+    /// Also write the material as an OpenPBR MaterialX document (`PRESET.mtlx`, with its
+    /// specular roughness and anisotropy maps) and the board as a USD stage (`PRESET.usda`)
+    /// that binds it (notes/gltf.md, "MaterialX / OpenPBR").
+    #[arg(long)]
+    pub materialx: bool,
 }
 
 /// Parses `W×H×T` (or `WxHxT`), each a positive finite length in mm up to 10 m.
@@ -85,6 +92,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let mut staged = stage_maps(&args.out, &maps)?;
     let glb = args.out.join(format!("{}.glb", args.preset));
     staged.push(stage_glb(&glb, &board, &maps, &args.preset)?);
+    if args.materialx {
+        staged.extend(stage_materialx(&args.out, &maps, &args.preset)?);
+        let usda = args.out.join(format!("{}.usda", args.preset));
+        let mtlx = format!("{}.mtlx", args.preset);
+        staged.push(
+            stage_usda(&usda, &board, &maps, &args.preset, &mtlx)
+                .with_context(|| format!("writing {}", usda.display()))?,
+        );
+    }
     let mut files: Vec<_> = staged.iter().map(|s| s.path().to_path_buf()).collect();
     let record = serde_json::json!({
         "preset": args.preset,
@@ -93,6 +109,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         "res": args.res,
         "radius_mm": args.radius,
         "seed": args.seed,
+        "materialx": args.materialx,
     });
     let record = record.as_object().cloned().unwrap_or_default();
     files.push(

@@ -18,6 +18,8 @@ use crate::picture::ImageError;
 use crate::render::image_io::{stage_exr_layers, ExrCompression, ExrLayer};
 
 pub mod gltf;
+pub mod materialx;
+pub mod usd;
 use crate::wood::{Needs, WoodVolume};
 use glam::{Affine3A, Vec2, Vec3};
 use rayon::prelude::*;
