@@ -780,10 +780,8 @@ impl PyWoodSurface {
                 (s.bsdf, to_xylem)
             })
         });
-        let (bsdfs, to_xylem) = hits.into_iter().unzip();
         Ok(PyWoodHits {
-            bsdfs,
-            to_xylem,
+            hits,
             shape: b.shape,
         })
     }
@@ -911,9 +909,9 @@ fn orthonormal(m: &[Vec3; 3]) -> bool {
 /// `WoodSurface.shade_count` does not move). `eval` is f without the cosine.
 #[pyclass(module = "xylem", name = "WoodHits", frozen)]
 struct PyWoodHits {
-    bsdfs: Vec<xylem::material::SurfaceBsdf>,
-    /// Caller-local -> xylem-local rotation per point (its transpose is the inverse).
-    to_xylem: Vec<Mat3>,
+    /// The BSDF at each point and the caller-local -> xylem-local rotation there (its
+    /// transpose is the inverse); one vector, as `prepare` collects them.
+    hits: Vec<(xylem::material::SurfaceBsdf, Mat3)>,
     shape: Vec<usize>,
 }
 
@@ -931,13 +929,8 @@ impl PyWoodHits {
         let m = &b.maps;
         let v = py.allow_threads(|| {
             map_indices(b.len, |i| {
-                let k = m[0].get(i);
-                let r = self.to_xylem[k];
-                f(
-                    &self.bsdfs[k],
-                    r * wo.data[m[1].get(i)],
-                    r * wi.data[m[2].get(i)],
-                )
+                let (bsdf, r) = &self.hits[m[0].get(i)];
+                f(bsdf, *r * wo.data[m[1].get(i)], *r * wi.data[m[2].get(i)])
             })
         });
         Ok((v, b.shape))
@@ -948,7 +941,7 @@ impl PyWoodHits {
 impl PyWoodHits {
     /// Number of hit points (the product of `shape`).
     fn __len__(&self) -> usize {
-        self.bsdfs.len()
+        self.hits.len()
     }
 
     /// The hit points' shape (the broadcast of `prepare`'s `p` and `frame`).
@@ -961,7 +954,7 @@ impl PyWoodHits {
         format!(
             "<WoodHits of shape {}: {} hit points>",
             batch::shape_str(&self.shape),
-            self.bsdfs.len()
+            self.hits.len()
         )
     }
 
@@ -1018,18 +1011,16 @@ impl PyWoodHits {
         let m = &b.maps;
         let s = py.allow_threads(|| {
             map_indices(b.len, |i| {
-                let k = m[0].get(i);
-                let r = self.to_xylem[k];
-                self.bsdfs[k]
-                    .sample(
-                        r * wo.data[m[1].get(i)],
-                        uc.data[m[2].get(i)],
-                        u.data[m[3].get(i)],
-                    )
-                    .map(|x| BsdfSample {
-                        wi: r.transpose() * x.wi,
-                        ..x
-                    })
+                let (bsdf, r) = &self.hits[m[0].get(i)];
+                bsdf.sample(
+                    *r * wo.data[m[1].get(i)],
+                    uc.data[m[2].get(i)],
+                    u.data[m[3].get(i)],
+                )
+                .map(|x| BsdfSample {
+                    wi: r.transpose() * x.wi,
+                    ..x
+                })
             })
         });
         sample_dict(py, &s, &b.shape)
