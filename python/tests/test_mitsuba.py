@@ -354,12 +354,21 @@ def test_shared_wood_gives_the_separate_calls_values():
     count = lambda b: b.surface.shade_count
     assert count(shared) == n, "the shared plugin evaluated the wood more than once"
     assert count(fresh) == 4 * n, "the control plugin should evaluate it in each of 4 calls"
-    # The same interaction again costs nothing; a moved point is shaded anew (no stale wood).
-    calls(shared, si, wo, u1, u2)
-    assert count(shared) == n
+    # The same interaction again costs nothing until sample releases the entry; a moved point
+    # is shaded anew (no stale wood).
+    ctx = mi.BSDFContext()
+    shared.eval_pdf(ctx, si, wo)
+    assert count(shared) == 2 * n, "sample releases the entry"
+    shared.eval(ctx, si, wo)
+    shared.pdf(ctx, si, wo)
+    assert count(shared) == 2 * n
+    shared.sample(ctx, si, u1, u2)
+    assert shared._cache is None
+    shared.eval(ctx, si, wo)      # an entry for these points, which must not answer for new ones
+    assert count(shared) == 3 * n
     si.p = si.p + mi.Vector3f(3.0, 1.0, 0.0)
     moved, control = calls(shared, si, wo, u1, u2), calls(fresh, si, wo, u1, u2)
-    assert count(shared) == 2 * n
+    assert count(shared) == 4 * n
     for k in moved:
         np.testing.assert_array_equal(moved[k], control[k], err_msg=k)
     assert not np.array_equal(moved["f"], got["f"]), "the moved points' wood differs"

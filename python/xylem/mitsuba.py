@@ -26,7 +26,8 @@ Cost: the wood (tree point, texel, BSDF parameters) is evaluated once per surfac
 and shared by ``eval_pdf``, ``eval``, ``pdf`` and ``sample`` at that interaction (Mitsuba's
 path integrator calls ``eval_pdf`` for emitter sampling and ``sample`` at every bounce's ``si``):
 the plugin keeps the last interaction's prepared wood (``WoodSurface.prepare``), keyed by the
-Dr.Jit variables of ``si.p`` and ``si.sh_frame`` and, failing that, by their values.
+Dr.Jit variables of ``si.p`` and ``si.sh_frame`` and, failing that, by their values, until
+``sample`` (the last call at an interaction) releases it.
 
 Frames: Mitsuba hands the BSDF directions in the hit's shading frame ``si.sh_frame``. The plugin
 maps them to world space with that frame, and xylem shades the world point with the frame it
@@ -251,7 +252,7 @@ def _bsdf_class(mi, dr):
             Dr.Jit variables of `si.p` and `si.sh_frame` (held while cached) and, when they
             differ, by their values (an interaction gathered again holds the same numbers in
             new variables); the scalar variant keys by value only. One entry: a new
-            interaction replaces the old one."""
+            interaction replaces the old one, and `sample` releases it."""
             key = held = None
             if not scalar:
                 key, held = jit_key(si)
@@ -289,6 +290,10 @@ def _bsdf_class(mi, dr):
         def sample(self, ctx, si, sample1, sample2, active=True):
             self._check(si.p, si.wi, si.sh_frame.n)
             s = self._hits(si).sample(to_np3(si.wi), to_np1(sample1), to_np2(sample2))
+            # `sample` is the last call Mitsuba's integrators make at an interaction (after
+            # eval_pdf for emitter sampling): the entry (0.5 KB per lane) is released here
+            # rather than held until the next call.
+            self._cache = None
             bs = dr.zeros(mi.BSDFSample3f, dr.width(sample1))
             wo = from_np3(mi.Vector3f, s["wi"])
             pdf = from_np1(s["pdf"])
