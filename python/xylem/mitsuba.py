@@ -27,12 +27,14 @@ and shared by ``eval_pdf``, ``eval``, ``pdf`` and ``sample`` at that interaction
 path integrator calls ``eval_pdf`` for emitter sampling and ``sample`` at every bounce's ``si``):
 the plugin keeps the last interaction's prepared wood (``WoodSurface.prepare``), keyed by the
 Dr.Jit variables of ``si.p`` and ``si.sh_frame`` and, failing that, by their values, until
-``sample`` (the last call at an interaction) releases it.
+``sample`` (the last call at an interaction) releases it. ``share_wood`` (default true) is a
+debug switch: false evaluates the wood again in every call, as before (the tests' control).
 
-Frames: Mitsuba hands the BSDF directions in the hit's shading frame ``si.sh_frame``. The plugin
-maps them to world space with that frame, and xylem shades the world point with the frame it
-builds itself (z = the same shading normal, x along the fibre), exactly as xylem's renderer does,
-so cosines are the same in both frames. Mitsuba's ``si.wi`` is xylem's ``wo`` (towards the
+Frames: Mitsuba hands the BSDF directions in the hit's shading frame ``si.sh_frame``. xylem
+shades the world point with the frame it builds itself (z = the same shading normal, x along the
+fibre), exactly as xylem's renderer does; ``WoodSurface.prepare`` composes the two into one
+rotation per hit (Mitsuba's local -> world -> xylem's local), so cosines are the same in both
+frames. Mitsuba's ``si.wi`` is xylem's ``wo`` (towards the
 viewer) and Mitsuba's ``wo`` is xylem's ``wi`` (towards the light). Mitsuba's ``eval`` includes
 the cosine foreshortening, xylem's does not; ``sample`` returns the weight f cos / pdf.
 
@@ -40,7 +42,10 @@ In the LLVM (JIT) variants the plugin reads its inputs into numpy, so Dr.Jit's s
 calls and conditionals must be off while it renders: render inside ``with
 xylem.mitsuba.evaluated():``, which turns them off for the block and restores them after
 (rendering then runs in evaluated, wavefront mode). ``register()`` changes no global state; a
-plugin call in a symbolic scope raises an error saying so instead.
+plugin call in a symbolic scope raises an error saying so instead. Dr.Jit traces a symbolic
+call for every registered BSDF, so while a ``xylem_wood`` BSDF is alive, symbolic renders of
+other scenes in the same process raise that error too: render them inside ``evaluated()`` as
+well, or in another process.
 
 The plugin is not differentiable (its inputs go through numpy): a call whose inputs carry
 gradients (``dr.grad_enabled``) raises ``NotImplementedError`` rather than returning values
