@@ -108,6 +108,33 @@ pub fn vec2(name: &str, a: &Bound<'_, PyAny>) -> PyResult<Arg<Vec2>> {
     Ok(Arg { lead, data })
 }
 
+/// A 3×3-matrix argument of shape (..., 3, 3) (rows last), as rows.
+pub fn mat3(name: &str, a: &Bound<'_, PyAny>) -> PyResult<Arg<[Vec3; 3]>> {
+    let (rows, flat) = extract(name, a, 3)?;
+    let lead = match rows.split_last() {
+        Some((&3, lead)) => lead.to_vec(),
+        _ => {
+            let mut shape = rows;
+            shape.push(3);
+            return Err(PyValueError::new_err(format!(
+                "{name}: shape {}, expected (..., 3, 3) (3x3 matrices over any leading dimensions)",
+                shape_str(&shape)
+            )));
+        }
+    };
+    let data = flat
+        .chunks_exact(9)
+        .map(|m| {
+            [
+                Vec3::from_slice(&m[0..3]),
+                Vec3::from_slice(&m[3..6]),
+                Vec3::from_slice(&m[6..9]),
+            ]
+        })
+        .collect();
+    Ok(Arg { lead, data })
+}
+
 /// A scalar argument of any shape.
 pub fn scalar(name: &str, a: &Bound<'_, PyAny>) -> PyResult<Arg<f32>> {
     let (lead, data) = extract(name, a, 0)?;

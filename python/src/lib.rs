@@ -17,6 +17,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use xylem::bsdf::{Bsdf, BsdfSample, WoodBsdfParams};
 use xylem::material::{Cutting, Material, MaterialHit, Placement, ShadingSwitches, WoodMaterial};
@@ -594,6 +595,8 @@ struct PyWoodSurface {
     finish: (f32, f32),
     axis: Vec3,
     rotation_deg: f32,
+    /// Shading points evaluated so far, by every method (`shade_count`, a debug counter).
+    shaded: AtomicU64,
 }
 
 impl PyWoodSurface {
@@ -616,6 +619,7 @@ impl PyWoodSurface {
             placement: self.placement,
             footprint: 0.0,
         };
+        self.shaded.fetch_add(1, Ordering::Relaxed);
         self.material.shade(&hit)
     }
 
@@ -716,6 +720,7 @@ impl PyWoodSurface {
             finish: (eta, roughness),
             axis,
             rotation_deg,
+            shaded: AtomicU64::new(0),
         })
     }
 
@@ -733,6 +738,52 @@ impl PyWoodSurface {
             self.rotation_deg,
             p.scale
         )
+    }
+
+    /// How many shading points (evaluations of the wood: the tree point, the texel and the
+    /// BSDF built there) this surface has computed so far, by every method: `shade`, `eval`,
+    /// `pdf` and `sample` count one per element of their broadcast, `prepare` one per point. A
+    /// debug counter: the Mitsuba plugin's tests read it to prove the wood is evaluated once
+    /// per interaction.
+    #[getter]
+    fn shade_count(&self) -> u64 {
+        self.shaded.load(Ordering::Relaxed)
+    }
+
+    /// The wood shaded once at world points `p` (..., 3) in the caller's shading frames `frame`
+    /// (..., 3, 3; rows s, t, n in world space, orthonormal, n the shading normal): a
+    /// `WoodHits` whose `eval`, `pdf`, `eval_pdf` and `sample` take and return directions in
+    /// the caller's frames and evaluate only the BSDF, never the wood again. The values are
+    /// those of `eval` / `pdf` / `sample` here with the directions mapped to world space by
+    /// `frame` (to float rounding).
+    fn prepare(&self, py: Python<'_>, p: ArrayIn<'_>, frame: ArrayIn<'_>) -> PyResult<PyWoodHits> {
+        let (p, fr) = (batch::vec3("p", &p)?, batch::mat3("frame", &frame)?);
+        let b = Broadcast::new(&[("p", &p.lead), ("frame", &fr.lead)])?;
+        // Refused before any shading: a frame that is not orthonormal would rotate the
+        // directions wrongly (its transpose would not be its inverse).
+        if let Some(i) = fr.data.iter().position(|m| !orthonormal(m)) {
+            return Err(value_error(format!(
+                "frame: element {} is not orthonormal (rows s, t, n must be unit and \
+                 perpendicular to 1e-3)",
+                batch::index_str(&fr.lead, i)
+            )));
+        }
+        let m = &b.maps;
+        let hits = py.allow_threads(|| {
+            map_indices(b.len, |i| {
+                let [cs, ct, cn] = fr.data[m[1].get(i)];
+                let s = self.shade_one(p.data[m[0].get(i)], cn);
+                // Caller-local -> world is C^T (C the rows s, t, n), world -> xylem-local is
+                // F (xylem's frame rows): column c of F C^T is axis c of C in xylem's frame.
+                let f = s.frame;
+                let to_xylem = Mat3::from_cols(f.to_local(cs), f.to_local(ct), f.to_local(cn));
+                (s.bsdf, to_xylem)
+            })
+        });
+        Ok(PyWoodHits {
+            hits,
+            shape: b.shape,
+        })
     }
 
     /// The BSDF parameters at world points `p` (..., 3) with shading normals `n` (..., 3), in the
@@ -839,6 +890,143 @@ impl PyWoodSurface {
         sample_dict(py, &s, &b.shape)
     }
 }
+/// True when the rows of `m` are unit and perpendicular (to 1e-3).
+fn orthonormal(m: &[Vec3; 3]) -> bool {
+    let ok = |x: f32, want: f32| (x - want).abs() <= 1e-3;
+    ok(m[0].length_squared(), 1.0)
+        && ok(m[1].length_squared(), 1.0)
+        && ok(m[2].length_squared(), 1.0)
+        && ok(m[0].dot(m[1]), 0.0)
+        && ok(m[0].dot(m[2]), 0.0)
+        && ok(m[1].dot(m[2]), 0.0)
+}
+
+/// A `WoodSurface` shaded once at a batch of hit points (`WoodSurface.prepare(p, frame)`): the
+/// BSDF built from the wood at each point and the rotation from the caller's shading frame to
+/// xylem's. `eval(wo, wi)`, `pdf(wo, wi)`, `eval_pdf(wo, wi)` and `sample(wo, uc, u)` take and
+/// return unit directions in the caller's frame (z = the shading normal), broadcast against the
+/// points as `WoodBsdf`'s do, and evaluate only the BSDF (the wood is not evaluated again:
+/// `WoodSurface.shade_count` does not move). `eval` is f without the cosine.
+#[pyclass(module = "xylem", name = "WoodHits", frozen)]
+struct PyWoodHits {
+    /// The BSDF at each point and the caller-local -> xylem-local rotation there (its
+    /// transpose is the inverse); one vector, as `prepare` collects them.
+    hits: Vec<(xylem::material::SurfaceBsdf, Mat3)>,
+    shape: Vec<usize>,
+}
+
+impl PyWoodHits {
+    /// `f(bsdf, wo, wi)` in xylem's frame at every element of the broadcast (hits, wo, wi).
+    fn at_pairs<T: Send>(
+        &self,
+        py: Python<'_>,
+        wo: &ArrayIn,
+        wi: &ArrayIn,
+        f: impl Fn(&xylem::material::SurfaceBsdf, Vec3, Vec3) -> T + Sync + Send,
+    ) -> PyResult<(Vec<T>, Vec<usize>)> {
+        let (wo, wi) = (batch::vec3("wo", wo)?, batch::vec3("wi", wi)?);
+        let b = Broadcast::new(&[("hits", &self.shape), ("wo", &wo.lead), ("wi", &wi.lead)])?;
+        let m = &b.maps;
+        let v = py.allow_threads(|| {
+            map_indices(b.len, |i| {
+                let (bsdf, r) = &self.hits[m[0].get(i)];
+                f(bsdf, *r * wo.data[m[1].get(i)], *r * wi.data[m[2].get(i)])
+            })
+        });
+        Ok((v, b.shape))
+    }
+}
+
+#[pymethods]
+impl PyWoodHits {
+    /// Number of hit points (the product of `shape`).
+    fn __len__(&self) -> usize {
+        self.hits.len()
+    }
+
+    /// The hit points' shape (the broadcast of `prepare`'s `p` and `frame`).
+    #[getter]
+    fn shape<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyTuple>> {
+        pyo3::types::PyTuple::new(py, &self.shape)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<WoodHits of shape {}: {} hit points>",
+            batch::shape_str(&self.shape),
+            self.hits.len()
+        )
+    }
+
+    /// f(wo, wi) without the cosine, shape (..., 3); directions in the caller's frame.
+    fn eval<'py>(
+        &self,
+        py: Python<'py>,
+        wo: ArrayIn<'py>,
+        wi: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (f, shape) = self.at_pairs(py, &wo, &wi, |b, o, i| b.eval(o, i))?;
+        vec3_out(py, &f, &shape)
+    }
+
+    /// The sampling density of `sample` per unit solid angle, shape (...).
+    fn pdf<'py>(
+        &self,
+        py: Python<'py>,
+        wo: ArrayIn<'py>,
+        wi: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (p, shape) = self.at_pairs(py, &wo, &wi, |b, o, i| b.pdf(o, i))?;
+        out(py, p, &shape)
+    }
+
+    /// `(eval(wo, wi), pdf(wo, wi))` in one pass over the points (the same numbers).
+    fn eval_pdf<'py>(
+        &self,
+        py: Python<'py>,
+        wo: ArrayIn<'py>,
+        wi: ArrayIn<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let (v, shape) = self.at_pairs(py, &wo, &wi, |b, o, i| (b.eval(o, i), b.pdf(o, i)))?;
+        let (f, pdf): (Vec<Vec3>, Vec<f32>) = v.into_iter().unzip();
+        Ok((vec3_out(py, &f, &shape)?, out(py, pdf, &shape)?))
+    }
+
+    /// Importance-samples wi given wo (..., 3), `uc` (...) and `u` (..., 2); as
+    /// `WoodBsdf.sample`, with `wi` in the caller's frame.
+    fn sample<'py>(
+        &self,
+        py: Python<'py>,
+        wo: ArrayIn<'py>,
+        uc: ArrayIn<'py>,
+        u: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let (wo, uc, u) = sample_args(&wo, &uc, &u)?;
+        let b = Broadcast::new(&[
+            ("hits", &self.shape),
+            ("wo", &wo.lead),
+            ("uc", &uc.lead),
+            ("u", &u.lead),
+        ])?;
+        let m = &b.maps;
+        let s = py.allow_threads(|| {
+            map_indices(b.len, |i| {
+                let (bsdf, r) = &self.hits[m[0].get(i)];
+                bsdf.sample(
+                    *r * wo.data[m[1].get(i)],
+                    uc.data[m[2].get(i)],
+                    u.data[m[3].get(i)],
+                )
+                .map(|x| BsdfSample {
+                    wi: r.transpose() * x.wi,
+                    ..x
+                })
+            })
+        });
+        sample_dict(py, &s, &b.shape)
+    }
+}
+
 /// `threads`: 0 (all cores) up to 16 per core, as `--threads`.
 /// A `quality=` keyword (`draft`, `default` or `final`, as `--quality`).
 fn parse_quality(quality: Option<&str>) -> PyResult<Option<xylem::scene::quality::Quality>> {
@@ -1293,6 +1481,7 @@ fn _xylem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyWoodBsdf>()?;
     m.add_class::<PyWoodVolume>()?;
     m.add_class::<PyWoodSurface>()?;
+    m.add_class::<PyWoodHits>()?;
     m.add_class::<PyScene>()?;
     m.add_function(wrap_pyfunction!(load_file, m)?)?;
     m.add_function(wrap_pyfunction!(load_dict, m)?)?;

@@ -188,3 +188,71 @@ def test_render_takes_a_quality_preset_and_restores_a_scene(root):
         xylem.render(scene, quality="best")
     out = xylem.sweep(scene, frames=2, quality="final", **small)
     assert out["frames"].shape == (2, 18, 24, 3)
+
+
+def random_frames(rng, n):
+    """n orthonormal frames (rows s, t, n) with tilted normals, and unit local directions."""
+    normal = rng.normal(size=(n, 3)) * 0.3 + np.array([0, 0, 1.0])
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    s = np.cross(normal, rng.normal(size=(n, 3)))
+    s /= np.linalg.norm(s, axis=1, keepdims=True)
+    t = np.cross(normal, s)
+    return np.stack([s, t, normal], axis=1).astype(np.float32)
+
+
+def local_dirs(rng, n):
+    z = rng.uniform(0.05, 1.0, n)
+    phi = rng.uniform(0, 2 * np.pi, n)
+    r = np.sqrt(1 - z * z)
+    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1).astype(np.float32)
+
+
+def test_prepared_wood_matches_the_surface():
+    """WoodSurface.prepare(p, frame) shades the wood once (shade_count moves by the point count
+    and not again); its eval / pdf / eval_pdf / sample with directions in the caller's frames
+    equal the surface's own world-space calls (to float rounding of the frame change)."""
+    rng = np.random.default_rng(8)
+    n = 40
+    surf = xylem.WoodSurface("african_mahogany", seed=7, eta=1.5, roughness=0.25,
+                             origin=(0, 120, 0), axis=(1, 0, 0), rotation_deg=20.0)
+    p = np.stack([rng.uniform(-80, 80, n), rng.uniform(-40, 40, n), rng.uniform(0, 5, n)], 1)
+    frame = random_frames(rng, n)
+    wo, wi = local_dirs(rng, n), local_dirs(rng, n)
+    uc, u = rng.random(n), rng.random((n, 2))
+    world = lambda d: np.einsum("nij,ni->nj", frame, d)  # local (s, t, n) -> world
+    assert surf.shade_count == 0
+    hits = surf.prepare(p, frame)
+    assert len(hits) == n and hits.shape == (n,) and surf.shade_count == n
+    assert repr(hits) == f"<WoodHits of shape ({n},): {n} hit points>"
+    f, pdf = hits.eval(wo, wi), hits.pdf(wo, wi)
+    f2, pdf2 = hits.eval_pdf(wo, wi)
+    s = hits.sample(wo, uc, u)
+    assert surf.shade_count == n, "the prepared calls evaluated the wood again"
+    np.testing.assert_array_equal(f, f2)
+    np.testing.assert_array_equal(pdf, pdf2)
+    normal = frame[:, 2]
+    np.testing.assert_allclose(f, surf.eval(p, normal, world(wo), world(wi)), rtol=1e-4, atol=1e-6)
+    np.testing.assert_allclose(pdf, surf.pdf(p, normal, world(wo), world(wi)), rtol=1e-4, atol=1e-6)
+    want = surf.sample(p, normal, world(wo), uc, u)
+    np.testing.assert_array_equal(s["valid"], want["valid"])
+    np.testing.assert_allclose(world(s["wi"]), want["wi"], atol=1e-5)
+    np.testing.assert_allclose(s["pdf"], want["pdf"], rtol=1e-4, atol=1e-6)
+    assert f.max() > 0 and s["valid"].any()
+    assert surf.shade_count == 4 * n          # the three surface calls above: one per point each
+    # Broadcasting: one direction pair against every hit.
+    assert hits.eval(wo[0], wi[0]).shape == (n, 3)
+
+
+def test_prepare_errors():
+    surf = xylem.WoodSurface("walnut")
+    frame = np.eye(3, dtype=np.float32)
+    with pytest.raises(ValueError, match=r"frame: shape \(4, 3\), expected \(\.\.\., 3, 3\)"):
+        surf.prepare([0, 0, 0], np.zeros((4, 3)))
+    with pytest.raises(ValueError, match=r"frame: element 1 is not orthonormal"):
+        surf.prepare([0, 0, 0], np.stack([frame, 2 * frame]))
+    with pytest.raises(ValueError, match="does not broadcast"):
+        surf.prepare(np.zeros((3, 3)), np.stack([frame, frame]))
+    assert surf.shade_count == 0, "refused before shading"
+    hits = surf.prepare([0, 0, 0], frame)
+    with pytest.raises(ValueError, match="wo: element"):
+        hits.eval([0, 0, np.nan], [0, 0, 1])

@@ -41,6 +41,7 @@ BOARD = {
     "origin": "0, 120, 0",
     "axis": "1, 0, 0",
     "rotation_deg": 20.0,
+    "units": "mm",
 }
 
 
@@ -104,7 +105,8 @@ CHI2_CASES = [
     ("rough_finish_grazing", dict(BOARD), [0.8, 0.1, 0.59]),
     ("rough_finish_across_fibres", dict(BOARD, roughness=0.5), [0.0, -0.6, 0.8]),
     ("unfinished_oak_rays", {"type": "xylem_wood", "preset": "quartersawn_white_oak", "seed": 2,
-                             "eta": 1.0, "origin": "0, 150, 0", "axis": "0, 1, 0"}, [0.5, 0.0, 0.866]),
+                             "eta": 1.0, "origin": "0, 150, 0", "axis": "0, 1, 0",
+                             "units": "mm"}, [0.5, 0.0, 0.866]),
 ]
 
 
@@ -303,3 +305,187 @@ def test_parameters_are_traversable():
         [10, 5, 0], [0, 0, 1], [0.3, 0.0, 0.954], [-0.4, 0.1, 0.911]) * 0.911
     np.testing.assert_allclose(after, want, rtol=1e-4)
     assert not np.allclose(before, after)
+
+
+def tilted_hits(n, seed=5):
+    """n interactions (LLVM variant) at points of the board with tilted shading frames, a light
+    direction each, and the numbers (p, normals, wi, wo) behind them."""
+    rng = np.random.default_rng(seed)
+    p = np.stack([rng.uniform(-80, 80, n), rng.uniform(-40, 40, n), rng.uniform(0, 5, n)], 1)
+    normals = directions(rng, n) + np.array([0, 0, 2.0])
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    wi_l, wo_l = directions(rng, n), directions(rng, n)
+    si = dr.zeros(mi.SurfaceInteraction3f, n)
+    si.p = mi.Point3f(p.T)
+    si.sh_frame = mi.Frame3f(mi.Vector3f(normals.T))
+    si.wi = mi.Vector3f(wi_l.T)
+    return si, mi.Vector3f(wo_l.T), (p, normals, wi_l, wo_l)
+
+
+def calls(bsdf, si, wo, u1, u2):
+    """eval, pdf, eval_pdf and sample at one interaction, as numpy arrays."""
+    ctx = mi.BSDFContext()
+    f = np.array(bsdf.eval(ctx, si, wo))
+    pdf = np.array(bsdf.pdf(ctx, si, wo))
+    f2, pdf2 = (np.array(x) for x in bsdf.eval_pdf(ctx, si, wo))
+    bs, w = bsdf.sample(ctx, si, u1, u2)
+    return dict(f=f, pdf=pdf, f2=f2, pdf2=pdf2, wo=np.array(bs.wo), bs_pdf=np.array(bs.pdf),
+                weight=np.array(w), type=np.array(bs.sampled_type))
+
+
+def test_shared_wood_gives_the_separate_calls_values():
+    """eval, pdf, eval_pdf and sample at one interaction share one evaluation of the wood
+    (`WoodSurface.shade_count` moves by the lane count once) and give exactly the values of a
+    plugin that evaluates the wood afresh in every call (`share_wood: False`, the negative
+    control: it moves the counter in every call); eval_pdf is (eval, pdf) exactly."""
+    use("llvm_ad_rgb")
+    n = 64
+    si, wo, _ = tilted_hits(n)
+    rng = np.random.default_rng(3)
+    u1, u2 = mi.Float(rng.random(n, dtype=np.float32)), mi.Point2f(rng.random((2, n), dtype=np.float32))
+    shared = mi.load_dict(BOARD)
+    fresh = mi.load_dict(dict(BOARD, share_wood=False))
+    got, want = calls(shared, si, wo, u1, u2), calls(fresh, si, wo, u1, u2)
+    for k in got:
+        np.testing.assert_array_equal(got[k], want[k], err_msg=k)
+    np.testing.assert_array_equal(got["f"], got["f2"])
+    np.testing.assert_array_equal(got["pdf"], got["pdf2"])
+    assert got["f"].max() > 0 and got["bs_pdf"].max() > 0
+    count = lambda b: b.surface.shade_count
+    assert count(shared) == n, "the shared plugin evaluated the wood more than once"
+    assert count(fresh) == 4 * n, "the control plugin should evaluate it in each of 4 calls"
+    # The same interaction again costs nothing until sample releases the entry; a moved point
+    # is shaded anew (no stale wood).
+    ctx = mi.BSDFContext()
+    shared.eval_pdf(ctx, si, wo)
+    assert count(shared) == 2 * n, "sample releases the entry"
+    shared.eval(ctx, si, wo)
+    shared.pdf(ctx, si, wo)
+    assert count(shared) == 2 * n
+    shared.sample(ctx, si, u1, u2)
+    assert shared._cache is None
+    shared.eval(ctx, si, wo)      # an entry for these points, which must not answer for new ones
+    assert count(shared) == 3 * n
+    si.p = si.p + mi.Vector3f(3.0, 1.0, 0.0)
+    moved, control = calls(shared, si, wo, u1, u2), calls(fresh, si, wo, u1, u2)
+    assert count(shared) == 4 * n
+    for k in moved:
+        np.testing.assert_array_equal(moved[k], control[k], err_msg=k)
+    assert not np.array_equal(moved["f"], got["f"]), "the moved points' wood differs"
+
+
+def test_interaction_gathered_again_is_shared_by_value():
+    """An interaction whose variables are new but whose numbers are the same (Dr.Jit gathers
+    the inputs again for each dispatched call) reuses the wood: the cache's value key."""
+    use("llvm_ad_rgb")
+    si, wo, (p, normals, wi_l, _) = tilted_hits(16)
+    bsdf = mi.load_dict(BOARD)
+    ctx = mi.BSDFContext()
+    a = np.array(bsdf.eval(ctx, si, wo))
+    again = dr.zeros(mi.SurfaceInteraction3f, 16)
+    again.p = mi.Point3f(np.ascontiguousarray(p.T))
+    again.sh_frame = mi.Frame3f(mi.Vector3f(np.ascontiguousarray(normals.T)))
+    again.wi = mi.Vector3f(np.ascontiguousarray(wi_l.T))
+    assert again.p.x.index != si.p.x.index
+    b = np.array(bsdf.eval(ctx, again, wo))
+    np.testing.assert_array_equal(a, b)
+    assert bsdf.surface.shade_count == 16
+
+
+def board_render_scene(bsdf, width, height, spp, integrator="path", **extra):
+    """A board filling the view under a directional light and nothing else: every camera ray
+    hits it and every reflected ray escapes, so each path has exactly one interaction."""
+    T = mi.ScalarTransform4f
+    return mi.load_dict({
+        "type": "scene",
+        "integrator": dict({"type": integrator}, **extra),
+        "sensor": {"type": "perspective", "fov": 20.0,
+                   "to_world": T().look_at(origin=[0, -30, 160], target=[0, 0, 0], up=[0, 0, 1]),
+                   "film": {"type": "hdrfilm", "width": width, "height": height,
+                            "pixel_format": "rgb", "rfilter": {"type": "box"}},
+                   "sampler": {"type": "independent", "sample_count": spp}},
+        "light": {"type": "directional", "direction": [0.2, 0.1, -1], "irradiance": 3.0},
+        "board": {"type": "rectangle", "to_world": T().scale([300.0, 300.0, 1.0]),
+                  "bsdf": bsdf},
+    })
+
+
+@pytest.mark.parametrize("variant", ["llvm_ad_rgb", "scalar_rgb"])
+def test_path_render_evaluates_the_wood_once_per_interaction(variant):
+    """In a path-traced render (emitter sampling with eval_pdf, then sample, at each bounce's
+    si) the wood is evaluated once per interaction: shade_count equals the number of paths
+    (one interaction each). The control with `share_wood: False` evaluates it twice (eval_pdf,
+    sample) per interaction."""
+    use(variant)
+    w, h, spp = (8, 6, 4) if variant.startswith("llvm") else (3, 2, 2)
+    counts = {}
+    for share in (True, False):
+        scene = board_render_scene(dict(BOARD, share_wood=share), w, h, spp)
+        bsdf = [s.bsdf() for s in scene.shapes()][0]
+        with xylem.mitsuba.evaluated():
+            img = np.array(mi.render(scene, seed=3))
+        assert np.isfinite(img).all() and img.mean() > 1e-3
+        counts[share] = bsdf.surface.shade_count
+    paths = w * h * spp
+    record(f"wood_evaluations/{variant}", {"paths": paths, "shared": counts[True],
+                                           "not_shared": counts[False]})
+    assert counts[True] == paths, counts
+    assert counts[False] == 2 * paths, counts
+
+
+def ring_contrast(bsdf, width=64):
+    """A top view of a 0.3 m strip of board in a metre-unit scene under a distant light: the
+    spread of the column means of luminance over their mean (growth rings across the strip)."""
+    T = mi.ScalarTransform4f
+    scene = mi.load_dict({
+        "type": "scene",
+        "integrator": {"type": "direct", "emitter_samples": 1, "bsdf_samples": 0},
+        "sensor": {"type": "orthographic",
+                   "to_world": T().look_at(origin=[0, 0, 1], target=[0, 0, 0], up=[1, 0, 0])
+                   @ T().scale([0.15, 0.15, 1.0]),
+                   "film": {"type": "hdrfilm", "width": width, "height": 16,
+                            "pixel_format": "rgb", "rfilter": {"type": "box"}},
+                   "sampler": {"type": "independent", "sample_count": 16}},
+        "light": {"type": "directional", "direction": [0.3, 0.2, -0.9], "irradiance": 3.0},
+        "board": {"type": "rectangle", "to_world": T().scale([0.5, 0.5, 1.0]), "bsdf": bsdf},
+    })
+    with xylem.mitsuba.evaluated():
+        img = np.array(mi.render(scene, seed=1), dtype=np.float64)
+    cols = luminance(img).mean(axis=0)
+    return float((np.percentile(cols, 95) - np.percentile(cols, 5)) / cols.mean())
+
+
+def test_metre_scene_shows_grain():
+    """Units: the default is metres, so a 0.3 m board in a metre-unit scene spans many growth
+    rings (ring contrast across the strip); read as millimetres (`units: "mm"`, the old
+    default) the same board is 0.3 mm of wood inside one ring, and shows only its pores."""
+    use("llvm_ad_rgb")
+    board = {k: v for k, v in BOARD.items() if k != "units"}
+    board["origin"] = "0, 60, 0"
+    metres = ring_contrast(board)
+    explicit = ring_contrast(dict(board, units="m"))
+    as_mm = ring_contrast(dict(board, units="mm"))
+    as_scale = ring_contrast(dict(board, scale=1000.0))
+    record("units", {"contrast_default": metres, "contrast_mm": as_mm})
+    assert metres == explicit == as_scale
+    # Pores and fibres give the 0.3 mm strip some contrast too; the rings give far more.
+    assert metres > 0.25 and as_mm < 0.15 and metres > 3 * as_mm, (metres, as_mm)
+
+
+def error_chain(excinfo):
+    chain, e = [], excinfo.value
+    while e is not None:
+        chain.append(str(e))
+        e = e.__cause__ or e.__context__
+    return " | ".join(chain)
+
+
+@pytest.mark.parametrize("extra,message", [
+    ({"units": "furlong"}, "expected one of mm, cm, m, in, ft"),
+    ({"units": "m", "scale": 1000.0}, "not both"),
+])
+def test_units_errors(extra, message):
+    use("llvm_ad_rgb")
+    with pytest.raises(Exception) as raised:
+        mi.load_dict(dict(BOARD, **extra))
+    assert message in error_chain(raised), error_chain(raised)

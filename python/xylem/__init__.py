@@ -7,7 +7,9 @@ Thin bindings of the Rust library (every number comes from it):
 - ``WoodVolume(preset, seed=...)``: the procedural solid wood, ``eval(points, needs)`` over an
   (N, 3) array of tree-space points (mm), returning named arrays;
 - ``WoodSurface(preset, ...)``: the volume under a finish placed in the tree, shaded in world
-  space as xylem's renderer shades a hit (what the Mitsuba 3 plugin calls);
+  space as xylem's renderer shades a hit; ``prepare(p, frame)`` shades a batch of hits once
+  into a ``WoodHits`` whose BSDF calls do not evaluate the wood again (what the Mitsuba 3
+  plugin calls);
 - ``load_file(path)`` / ``load_dict(dict)``: a scene loaded once (``Scene``), from a file or from
   a dict with the keys of a scene file (as ``mitsuba.load_dict``);
 - ``render(scene, spp=..., res=...)`` and ``sweep(scene, ...)``: a scene (file, built-in name,
@@ -33,6 +35,7 @@ from ._xylem import (
     PRESETS,
     Scene,
     WoodBsdf,
+    WoodHits,
     WoodSurface,
     WoodVolume,
     __version__,
@@ -57,6 +60,7 @@ __all__ = [
     "PRESETS",
     "Scene",
     "WoodBsdf",
+    "WoodHits",
     "WoodSurface",
     "WoodVolume",
     "__version__",

@@ -6,19 +6,35 @@ xylem's finished-wood BSDF at every hit point.
     import xylem.mitsuba
     xylem.mitsuba.register()
     bsdf = mi.load_dict({"type": "xylem_wood", "preset": "african_mahogany", "seed": 7,
-                         "eta": 1.5, "roughness": 0.0,
+                         "eta": 1.5, "roughness": 0.0, "units": "mm",
                          "origin": "0, 120, 0", "axis": "1, 0, 0", "rotation_deg": 0.0})
 
 Parameters: ``preset`` (a built-in name) or ``preset_file`` (a preset TOML), ``seed`` (the tree),
 the finish ``eta`` (1-4) and ``roughness`` (0-1), and the tree placement of xylem's solid cutting
 in world space, ``p_tree = origin + scale * Rz(rotation_deg) * A * p`` with ``A`` turning
-``axis`` onto the pith: ``origin``, ``axis`` (3-vectors, as a "x, y, z" string or a sequence),
-``rotation_deg`` and ``scale`` (tree mm per scene unit).
+``axis`` onto the pith: ``origin`` (tree mm), ``axis`` (3-vectors, as a "x, y, z" string or a
+sequence) and ``rotation_deg``.
 
-Frames: Mitsuba hands the BSDF directions in the hit's shading frame ``si.sh_frame``. The plugin
-maps them to world space with that frame, and xylem shades the world point with the frame it
-builds itself (z = the same shading normal, x along the fibre), exactly as xylem's renderer does,
-so cosines are the same in both frames. Mitsuba's ``si.wi`` is xylem's ``wo`` (towards the
+Units: ``units`` is the length of one scene unit, one of ``"m"`` (the default: Mitsuba scenes are
+usually modelled in metres), ``"cm"``, ``"mm"`` (xylem's own scenes), ``"in"``, ``"ft"``; or give
+``scale``, tree millimetres per scene unit (``units="m"`` is ``scale=1000``; not both). xylem's
+tree is in millimetres (growth rings a few mm apart), so a scene in metres read as millimetres
+would show a 0.3 m board as 0.3 mm of wood: one ring, no grain. ``origin`` is in tree mm
+whatever the units.
+
+Cost: the wood (tree point, texel, BSDF parameters) is evaluated once per surface interaction
+and shared by ``eval_pdf``, ``eval``, ``pdf`` and ``sample`` at that interaction (Mitsuba's
+path integrator calls ``eval_pdf`` for emitter sampling and ``sample`` at every bounce's ``si``):
+the plugin keeps the last interaction's prepared wood (``WoodSurface.prepare``), keyed by the
+Dr.Jit variables of ``si.p`` and ``si.sh_frame`` and, failing that, by their values, until
+``sample`` (the last call at an interaction) releases it. ``share_wood`` (default true) is a
+debug switch: false evaluates the wood again in every call, as before (the tests' control).
+
+Frames: Mitsuba hands the BSDF directions in the hit's shading frame ``si.sh_frame``. xylem
+shades the world point with the frame it builds itself (z = the same shading normal, x along the
+fibre), exactly as xylem's renderer does; ``WoodSurface.prepare`` composes the two into one
+rotation per hit (Mitsuba's local -> world -> xylem's local), so cosines are the same in both
+frames. Mitsuba's ``si.wi`` is xylem's ``wo`` (towards the
 viewer) and Mitsuba's ``wo`` is xylem's ``wi`` (towards the light). Mitsuba's ``eval`` includes
 the cosine foreshortening, xylem's does not; ``sample`` returns the weight f cos / pdf.
 
@@ -26,7 +42,10 @@ In the LLVM (JIT) variants the plugin reads its inputs into numpy, so Dr.Jit's s
 calls and conditionals must be off while it renders: render inside ``with
 xylem.mitsuba.evaluated():``, which turns them off for the block and restores them after
 (rendering then runs in evaluated, wavefront mode). ``register()`` changes no global state; a
-plugin call in a symbolic scope raises an error saying so instead.
+plugin call in a symbolic scope raises an error saying so instead. Dr.Jit traces a symbolic
+call for every registered BSDF, so while a ``xylem_wood`` BSDF is alive, symbolic renders of
+other scenes in the same process raise that error too: render them inside ``evaluated()`` as
+well, or in another process.
 
 The plugin is not differentiable (its inputs go through numpy): a call whose inputs carry
 gradients (``dr.grad_enabled``) raises ``NotImplementedError`` rather than returning values
@@ -61,6 +80,29 @@ def _vector(props, name, default):
     if len(parts) != 3:
         raise ValueError(f"xylem_wood: `{name}` = {value!r}: expected three numbers x, y, z")
     return tuple(float(x) for x in parts)
+
+
+# Tree millimetres per scene unit for `units` (xylem's tree is in mm).
+UNITS = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4, "ft": 304.8}
+DEFAULT_UNITS = "m"
+
+
+def _units(props):
+    """(units, tree mm per scene unit) from `units` (a name in UNITS, default metres) or
+    `scale` (a number; the two together are an error)."""
+    has_units, has_scale = _has(props, "units"), _has(props, "scale")
+    if has_units and has_scale:
+        raise ValueError("xylem_wood: give `units` or `scale` (tree mm per scene unit), not both")
+    if has_scale:
+        scale = float(props.get("scale"))
+        return f"{scale:g} mm", scale
+    units = props.get("units") if has_units else DEFAULT_UNITS
+    if units not in UNITS:
+        raise ValueError(
+            f"xylem_wood: `units` = {units!r}: expected one of {', '.join(UNITS)} "
+            "(or `scale`, tree mm per scene unit)"
+        )
+    return units, UNITS[units]
 
 
 _SYMBOLIC = ("SymbolicLoops", "SymbolicCalls", "SymbolicConditionals")
@@ -107,20 +149,38 @@ def _bsdf_class(mi, dr):
     scalar = key.startswith("scalar")
 
     def to_np3(v):
-        """A Mitsuba 3-vector (scalar or wide) as an (N, 3) float32 array."""
-        return np.ascontiguousarray(np.array(v, dtype=np.float32).reshape(3, -1).T)
+        """A Mitsuba 3-vector (scalar or wide) as an (N, 3) float32 array (a transposed view of
+        Dr.Jit's (3, N) copy; the bindings read strided arrays, so no second copy is made)."""
+        return np.asarray(v, dtype=np.float32).reshape(3, -1).T
+
+    def to_np2(v):
+        return np.asarray(v, dtype=np.float32).reshape(2, -1).T
 
     def to_np1(v):
-        return np.array(v, dtype=np.float32).reshape(-1)
+        return np.asarray(v, dtype=np.float32).reshape(-1)
 
     def from_np3(cls, a):
-        return cls(a[0]) if scalar else cls(np.ascontiguousarray(a.T))
+        return cls(a[0]) if scalar else cls(a.T)
 
     def from_np1(a):
-        return mi.Float(float(a[0])) if scalar else mi.Float(np.ascontiguousarray(a))
+        return mi.Float(float(a[0])) if scalar else mi.Float(a)
 
     def from_bool(a):
-        return mi.Bool(bool(a[0])) if scalar else mi.Bool(np.ascontiguousarray(a))
+        return mi.Bool(bool(a[0])) if scalar else mi.Bool(a)
+
+    def frame_np(frame):
+        """A Mitsuba frame (scalar or wide) as (N, 3, 3) rows s, t, n (a strided view)."""
+        rows = [np.asarray(v, dtype=np.float32).reshape(3, -1) for v in (frame.s, frame.t, frame.n)]
+        return np.stack(rows).transpose(2, 0, 1)
+
+    def jit_key(si):
+        """The Dr.Jit variables of the interaction's point and shading frame: their indices
+        (the cache key) and the arrays themselves (held with the cache entry, so that no index
+        can be freed and reused while it is a key: Dr.Jit variables are immutable and an
+        in-place update of a held one gets a new index)."""
+        fr = si.sh_frame
+        held = [type(c)(c) for v in (si.p, fr.s, fr.t, fr.n) for c in (v.x, v.y, v.z)]
+        return (dr.width(si.p),) + tuple(c.index for c in held), held
 
     class XylemWood(mi.BSDF):
         def __init__(self, props):
@@ -132,13 +192,17 @@ def _bsdf_class(mi, dr):
             self.eta = float(props.get("eta", 1.5))
             self.roughness = float(props.get("roughness", 0.0))
             self.seed = int(props.get("seed", 0))
+            self.units, scale = _units(props)
             self._wood = dict(
                 preset_file=preset_file,
                 origin=_vector(props, "origin", (0, 0, 0)),
                 axis=_vector(props, "axis", (0, 0, 1)),
                 rotation_deg=float(props.get("rotation_deg", 0.0)),
-                scale=float(props.get("scale", 1.0)),
+                scale=scale,
             )
+            # Debug switch for the tests' negative control: False evaluates the wood again in
+            # every call (the behaviour before issue 30's shared evaluation).
+            self.share_wood = bool(props.get("share_wood", True))
             self._preset = preset
             self._build()
             self.name = preset if preset is not None else preset_file
@@ -147,6 +211,7 @@ def _bsdf_class(mi, dr):
             """The WoodSurface and the lobes of the current eta, roughness and seed."""
             self.surface = WoodSurface(self._preset, seed=self.seed, eta=self.eta,
                                        roughness=self.roughness, **self._wood)
+            self._cache = None
             smooth = self.eta > 1.0 and self.roughness < 1e-3
             lobes = (
                 mi.BSDFFlags.DiffuseReflection
@@ -185,36 +250,57 @@ def _bsdf_class(mi, dr):
                     "gradients enabled on the geometry, the sensor or the directions"
                 )
 
-        def _inputs(self, si):
-            frame = self._frame(si)
-            return frame, to_np3(si.p), to_np3(frame.n), to_np3(frame.to_world(si.wi))
+        def _hits(self, si):
+            """The wood at the interaction's points, shaded once (`WoodSurface.prepare`) and
+            shared by every call at the same interaction: the path integrator calls
+            `eval_pdf` (emitter sampling) and `sample` at each bounce's `si`. Cached by the
+            Dr.Jit variables of `si.p` and `si.sh_frame` (held while cached) and, when they
+            differ, by their values (an interaction gathered again holds the same numbers in
+            new variables); the scalar variant keys by value only. One entry: a new
+            interaction replaces the old one, and `sample` releases it."""
+            key = held = None
+            if not scalar:
+                key, held = jit_key(si)
+                if self._cache is not None and self._cache[0] == key:
+                    return self._cache[1]
+            p, frame = to_np3(si.p), frame_np(self._frame(si))
+            if self._cache is not None:
+                _, hits, p0, frame0, _ = self._cache
+                if np.array_equal(p, p0) and np.array_equal(frame, frame0):
+                    self._cache = (key, hits, p0, frame0, held)
+                    return hits
+            hits = self.surface.prepare(p, frame)
+            if self.share_wood:
+                self._cache = (key, hits, p, frame, held)
+            return hits
 
         def eval(self, ctx, si, wo, active=True):
-            self._check(si.p, si.wi, si.sh_frame.n, wo)
-            frame, p, n, wo_x = self._inputs(si)
-            wi_x = to_np3(frame.to_world(wo))
-            f = from_np3(mi.Color3f, self.surface.eval(p, n, wo_x, wi_x))
-            cos_o = mi.Frame3f.cos_theta(wo)
-            ok = active & (mi.Frame3f.cos_theta(si.wi) > 0) & (cos_o > 0)
-            return dr.select(ok, f * cos_o, 0.0)
+            return self.eval_pdf(ctx, si, wo, active)[0]
 
         def pdf(self, ctx, si, wo, active=True):
             self._check(si.p, si.wi, si.sh_frame.n, wo)
-            frame, p, n, wo_x = self._inputs(si)
-            wi_x = to_np3(frame.to_world(wo))
-            pdf = from_np1(self.surface.pdf(p, n, wo_x, wi_x))
+            pdf = from_np1(self._hits(si).pdf(to_np3(si.wi), to_np3(wo)))
             ok = active & (mi.Frame3f.cos_theta(si.wi) > 0) & (mi.Frame3f.cos_theta(wo) > 0)
             return dr.select(ok, pdf, 0.0)
 
         def eval_pdf(self, ctx, si, wo, active=True):
-            return self.eval(ctx, si, wo, active), self.pdf(ctx, si, wo, active)
+            """f cos(theta_o) and the pdf of `wo`: one pass over the shared wood."""
+            self._check(si.p, si.wi, si.sh_frame.n, wo)
+            f, pdf = self._hits(si).eval_pdf(to_np3(si.wi), to_np3(wo))
+            cos_o = mi.Frame3f.cos_theta(wo)
+            ok = active & (mi.Frame3f.cos_theta(si.wi) > 0) & (cos_o > 0)
+            f = from_np3(mi.Color3f, f)
+            return dr.select(ok, f * cos_o, 0.0), dr.select(ok, from_np1(pdf), 0.0)
 
         def sample(self, ctx, si, sample1, sample2, active=True):
             self._check(si.p, si.wi, si.sh_frame.n)
-            frame, p, n, wo_x = self._inputs(si)
-            s = self.surface.sample(p, n, wo_x, to_np1(sample1), to_np3_2(sample2))
+            s = self._hits(si).sample(to_np3(si.wi), to_np1(sample1), to_np2(sample2))
+            # `sample` is the last call Mitsuba's integrators make at an interaction (after
+            # eval_pdf for emitter sampling): the entry (0.5 KB per lane) is released here
+            # rather than held until the next call.
+            self._cache = None
             bs = dr.zeros(mi.BSDFSample3f, dr.width(sample1))
-            wo = frame.to_local(from_np3(mi.Vector3f, s["wi"]))
+            wo = from_np3(mi.Vector3f, s["wi"])
             pdf = from_np1(s["pdf"])
             delta = from_bool(s["is_delta"])
             valid = from_bool(s["valid"]) & (pdf > 0)
@@ -251,11 +337,9 @@ def _bsdf_class(mi, dr):
 
         def to_string(self):
             return (
-                f"XylemWood[preset={self.name}, eta={self.eta}, roughness={self.roughness}]"
+                f"XylemWood[preset={self.name}, eta={self.eta}, roughness={self.roughness}, "
+                f"units={self.units}]"
             )
-
-    def to_np3_2(v):
-        return np.ascontiguousarray(np.array(v, dtype=np.float32).reshape(2, -1).T)
 
     _CLASSES[key] = XylemWood
     return XylemWood

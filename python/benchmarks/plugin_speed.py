@@ -1,0 +1,213 @@
+"""Times the Mitsuba 3 plugin ``xylem_wood`` against Mitsuba's own ``roughplastic`` on the same
+scene (issue 30: goal <= 2x roughplastic in ``llvm_ad_rgb``), interleaved, several repeats, and
+prints medians and spreads.
+
+    DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1 \\
+    PYTHONPATH=target/python-test/site target/python-venv/bin/python \\
+        python/benchmarks/plugin_speed.py [--res 128 96] [--spp 8] [--repeats 5] [--profile]
+        [--before DIR] [--json FILE]
+
+The scene: a 0.3 m board (a rectangle, scene units metres) seen from 0.4 m under one
+directional light and a dim constant environment, Mitsuba's ``path`` integrator (max depth 4).
+Three renders per repeat, in turn:
+
+- ``roughplastic``: the board with Mitsuba's ``roughplastic`` (GGX, alpha 0.25, eta 1.5), Dr.Jit's
+  default (symbolic) modes, i.e. one megakernel per render;
+- ``roughplastic_evaluated``: the same inside ``xylem.mitsuba.evaluated()`` (wavefront mode,
+  what the plugin needs), which separates the plugin's own cost from the mode's;
+- ``xylem_wood``: the board with the plugin (mahogany, eta 1.5, roughness 0.25) inside
+  ``evaluated()``.
+
+Each case runs in its own Python process (a ``xylem_wood`` BSDF alive in a process makes every
+symbolic render there fail: Dr.Jit traces a symbolic call for every registered BSDF instance,
+so the plugin's symbolic-scope error fires even for a scene that does not use it), one process
+per case and repeat, interleaved: case A, B, C, A, B, C, ... Each render is timed from
+``mi.render`` to ``dr.eval`` + ``dr.sync_thread`` of the image, after one untimed warm-up
+render in the same process (Dr.Jit's kernel cache, first-call costs). ``--profile`` adds a cProfile of
+one plugin render: where the time goes (the wood's preparation, the BSDF calls, the numpy and
+Dr.Jit conversions, the integrator).
+"""
+
+import argparse
+import cProfile
+import io
+import json
+import os
+import platform
+import pstats
+import statistics
+import subprocess
+import sys
+import time
+
+import drjit as dr
+import mitsuba as mi
+
+mi.set_variant(os.environ.get("XYLEM_BENCH_VARIANT", "llvm_ad_rgb"))
+
+import xylem  # noqa: E402
+import xylem.mitsuba  # noqa: E402
+
+xylem.mitsuba.register()
+
+BSDFS = {
+    "roughplastic": {"type": "roughplastic", "distribution": "ggx", "alpha": 0.25,
+                     "int_ior": 1.5, "diffuse_reflectance": {"type": "rgb",
+                                                             "value": [0.45, 0.2, 0.1]}},
+    # scale 1000 (tree mm per scene unit) is units "m", the default, spelt so that the plugin
+    # of before issue 30 (no `units`) reads the same wood: PYTHONPATH at an older package
+    # compares the two.
+    "xylem_wood": {"type": "xylem_wood", "preset": "african_mahogany", "seed": 7, "eta": 1.5,
+                   "roughness": 0.25, "origin": "0, 120, 0", "axis": "1, 0, 0",
+                   "rotation_deg": 20.0, "scale": 1000.0},
+}
+
+
+def scene(bsdf, res, spp):
+    T = mi.ScalarTransform4f
+    return mi.load_dict({
+        "type": "scene",
+        "integrator": {"type": "path", "max_depth": 4},
+        "sensor": {
+            "type": "perspective", "fov": 40.0,
+            "to_world": T().look_at(origin=[0, -0.25, 0.32], target=[0, 0, 0], up=[0, 0, 1]),
+            "film": {"type": "hdrfilm", "width": res[0], "height": res[1],
+                     "pixel_format": "rgb"},
+            "sampler": {"type": "independent", "sample_count": spp},
+        },
+        "sun": {"type": "directional", "direction": [-0.3, -0.2, -0.9],
+                "irradiance": {"type": "rgb", "value": [3.0, 3.0, 3.0]}},
+        "sky": {"type": "constant", "radiance": {"type": "rgb", "value": [0.2, 0.2, 0.25]}},
+        "board": {"type": "rectangle", "to_world": T().scale([0.15, 0.15, 1.0]),
+                  "bsdf": dict(BSDFS[bsdf])},
+    })
+
+
+def render(sc, seed, evaluated):
+    """(wall seconds, process CPU seconds: every thread of the process, Dr.Jit's and rayon's)"""
+    start, cpu = time.perf_counter(), time.process_time()
+    if evaluated:
+        with xylem.mitsuba.evaluated():
+            img = mi.render(sc, seed=seed)
+            dr.eval(img)
+    else:
+        img = mi.render(sc, seed=seed)
+        dr.eval(img)
+    dr.sync_thread()
+    return time.perf_counter() - start, time.process_time() - cpu
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--res", type=int, nargs=2, default=(128, 96))
+    ap.add_argument("--spp", type=int, default=8)
+    ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--profile", action="store_true")
+    ap.add_argument("--json", help="write the figures to this file")
+    ap.add_argument("--before", help="a folder holding an older `xylem` package (its plugin "
+                    "runs as the extra case xylem_wood_before, with this folder first on "
+                    "PYTHONPATH)")
+    ap.add_argument("--one", help=argparse.SUPPRESS)         # child process: this case only
+    ap.add_argument("--seed", type=int, default=1, help=argparse.SUPPRESS)
+    args = ap.parse_args()
+
+    cases = [("roughplastic", "roughplastic", False),
+             ("roughplastic_evaluated", "roughplastic", True),
+             ("xylem_wood", "xylem_wood", True)]
+    if args.before or args.one == "xylem_wood_before":
+        cases.append(("xylem_wood_before", "xylem_wood", True))
+    if args.one:                                 # child: one warm-up, one timed render
+        name, b, ev = next(c for c in cases if c[0] == args.one)
+        sc = scene(b, args.res, args.spp)
+        render(sc, 0, ev)
+        if args.profile:
+            prof = cProfile.Profile()
+            prof.enable()
+        t, cpu = render(sc, args.seed, ev)
+        if args.profile:
+            prof.disable()
+            buf = io.StringIO()
+            pstats.Stats(prof, stream=buf).sort_stats("tottime").print_stats(16)
+            print(f"profile of one {name} render ({t:.3f} s under cProfile):\n{buf.getvalue()}",
+                  file=sys.stderr)
+        print(json.dumps({"seconds": t, "cpu_seconds": cpu}))
+        return
+
+    def child(name, seed, profile=False):
+        cmd = [sys.executable, __file__, "--one", name, "--seed", str(seed), "--res",
+               *map(str, args.res), "--spp", str(args.spp)] + (["--profile"] if profile else [])
+        env = dict(os.environ)
+        if name == "xylem_wood_before":
+            env["PYTHONPATH"] = os.pathsep.join([args.before, env.get("PYTHONPATH", "")])
+        out = subprocess.run(cmd, check=True, capture_output=True, text=True, env=env)
+        if profile:
+            print(out.stderr)
+        res = json.loads(out.stdout.strip().splitlines()[-1])
+        return res["seconds"], res["cpu_seconds"]
+
+    times = {name: [] for name, _, _ in cases}
+    cpu_times = {name: [] for name, _, _ in cases}
+    print(f"{mi.variant()}, {args.res[0]}x{args.res[1]}, {args.spp} spp, {args.repeats} repeats, "
+          f"load average {os.getloadavg()[0]:.1f} at the start", flush=True)
+    for r in range(args.repeats):                # interleaved, so load changes hit all alike
+        for name, _, _ in cases:
+            t, cpu = child(name, r + 1)
+            times[name].append(t)
+            cpu_times[name].append(cpu)
+
+    def summary(ts):
+        return {"median_s": statistics.median(ts), "min_s": min(ts), "max_s": max(ts),
+                "times_s": ts}
+
+    out = {"variant": mi.variant(), "res": list(args.res), "spp": args.spp,
+           "repeats": args.repeats, "machine": platform.processor() or platform.machine(),
+           "cpus": os.cpu_count(), "load_avg": os.getloadavg(),
+           "cases": {k: summary(v) for k, v in times.items()},
+           "cpu": {k: summary(v) for k, v in cpu_times.items()}}
+    base = statistics.median(times["roughplastic"])
+    base_ev = statistics.median(times["roughplastic_evaluated"])
+    wood = statistics.median(times["xylem_wood"])
+    # Ratios of medians, and their spread over the repeats (ratio of each repeat's pair).
+    if args.before:
+        before = [w / b for w, b in zip(times["xylem_wood"], times["xylem_wood_before"])]
+        out["ratio_vs_before"] = wood / statistics.median(times["xylem_wood_before"])
+        out["ratio_vs_before_range"] = [min(before), max(before)]
+    pairs = [w / b for w, b in zip(times["xylem_wood"], times["roughplastic"])]
+    pairs_ev = [w / b for w, b in zip(times["xylem_wood"], times["roughplastic_evaluated"])]
+    out["ratio_vs_roughplastic"] = wood / base
+    out["ratio_vs_roughplastic_range"] = [min(pairs), max(pairs)]
+    out["ratio_vs_roughplastic_evaluated"] = wood / base_ev
+    out["ratio_vs_roughplastic_evaluated_range"] = [min(pairs_ev), max(pairs_ev)]
+
+    for name, s in out["cases"].items():
+        c = out["cpu"][name]
+        print(f"{name:24s} wall median {s['median_s']:.3f} s (min {s['min_s']:.3f}, "
+              f"max {s['max_s']:.3f});  CPU median {c['median_s']:.3f} s (min "
+              f"{c['min_s']:.3f}, max {c['max_s']:.3f})")
+    cpu_med = {k: statistics.median(v) for k, v in cpu_times.items()}
+    out["cpu_ratio_vs_roughplastic"] = cpu_med["xylem_wood"] / cpu_med["roughplastic"]
+    out["cpu_ratio_vs_roughplastic_evaluated"] = (cpu_med["xylem_wood"]
+                                                  / cpu_med["roughplastic_evaluated"])
+    print(f"CPU: xylem_wood / roughplastic {out['cpu_ratio_vs_roughplastic']:.2f}x, "
+          f"/ roughplastic evaluated {out['cpu_ratio_vs_roughplastic_evaluated']:.2f}x"
+          + (f", / before {cpu_med['xylem_wood'] / cpu_med['xylem_wood_before']:.2f}x"
+             if args.before else ""))
+    print(f"xylem_wood / roughplastic            {out['ratio_vs_roughplastic']:.2f}x "
+          f"(per repeat {min(pairs):.2f}-{max(pairs):.2f})")
+    print(f"xylem_wood / roughplastic evaluated  {out['ratio_vs_roughplastic_evaluated']:.2f}x "
+          f"(per repeat {min(pairs_ev):.2f}-{max(pairs_ev):.2f})")
+    if args.before:
+        print(f"xylem_wood / xylem_wood_before       {out['ratio_vs_before']:.2f}x "
+              f"(per repeat {min(before):.2f}-{max(before):.2f})")
+    print(f"load average {out['load_avg']}, {out['cpus']} CPUs, {mi.variant()}, "
+          f"{args.res[0]}x{args.res[1]}, {args.spp} spp")
+
+    if args.profile:
+        child("xylem_wood", 99, profile=True)
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(out, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()
