@@ -174,14 +174,19 @@ def test_builtin_scenes_render_by_bare_name_from_an_empty_folder(tmp_path, monke
 
 
 def test_render_takes_a_quality_preset_and_restores_a_scene(root):
-    """`quality=` is `--quality`: the draft preset changes the wood model (the exact distortion
-    Jacobian) and spp, `spp=` overrides its spp, and a loaded `Scene` renders as before
-    afterwards (the preset's rebuilt materials are restored, like its settings)."""
+    """`quality=` is `--quality`: the draft preset renders at its 4 spp (with the exact
+    distortion Jacobian) where the scene asks for 16, `spp=` overrides the preset's, and a loaded
+    `Scene` renders as before afterwards (the preset's rebuilt materials are restored, like its
+    settings)."""
     scene = xylem.load_file(str(root / "scenes" / "sweep_board.toml"))
-    small = dict(spp=1, res=(24, 18), threads=1)
+    small = dict(res=(24, 18), threads=1)
     before = xylem.render(scene, **small)["beauty"]
     draft = xylem.render(scene, quality="draft", **small)["beauty"]
-    assert not np.array_equal(before, draft), "the preset's knobs must change the image"
+    assert np.array_equal(draft, xylem.render(scene, spp=4, **small)["beauty"])
+    assert not np.array_equal(before, draft), "the preset's 4 spp must change the image"
+    assert np.array_equal(
+        xylem.render(scene, quality="draft", spp=16, **small)["beauty"], before
+    ), "spp= overrides the preset's"
     after = xylem.render(scene, **small)["beauty"]
     assert np.array_equal(before, after), "the Scene must come back as it was"
     with pytest.raises(ValueError, match=r"quality: `best` is not a quality \(allowed: draft"):
