@@ -4,8 +4,11 @@ high-spp reference, and the same figures for a xylem image of the scene if one i
 (`xylem bench render` passes its own).
 
 samples/s = width · height · spp / seconds of the render itself: the scene is loaded and rendered
-once (Dr.Jit compiles its kernels then), and the second render of the same scene and seed, which
-reuses the compiled kernels, is timed. The reference is one Mitsuba render of `--reference-spp`
+once (Dr.Jit compiles its kernels then), and later renders of the same scene and seed, which
+reuse the compiled kernels, are timed. With `--serve` (what `xylem bench render` runs) the process
+then times one render per `render` line on stdin, answering each with its seconds, so the caller
+can interleave its own renders with Mitsuba's (a change of machine load then falls on both), and
+a final `score` line (JSON: the xylem image, its spp and its times) gives medians and ranges. The reference is one Mitsuba render of `--reference-spp`
 samples per pixel in chunks of 256 spp, cached in target/crosscheck/; RMSE is over all pixels and
 channels. RMSE at equal time is RMSE · sqrt(seconds / Mitsuba's seconds): Monte Carlo error falls
 as 1/sqrt(samples), so it is the error each renderer would reach in Mitsuba's time.
@@ -18,8 +21,10 @@ survival at 0.95, xylem at 1. The reference keeps Mitsuba's default (5): any unb
 converges to the same image.
 """
 
+import json
 import math
 import os
+import sys
 import time
 
 import numpy as np
@@ -40,6 +45,8 @@ def add_arguments(ap):
     g.add_argument("--xylem-seconds", type=float, default=None,
                    help="its render time (s), for samples/s and RMSE at equal time")
     g.add_argument("--xylem-spp", type=int, default=None, help="its spp (default --spp)")
+    g.add_argument("--serve", action="store_true",
+                   help="time one render per `render` line on stdin, then score (see above)")
 
 
 def reference(mi, folder, meshes, spp):
@@ -90,18 +97,41 @@ def run(mi, args):
     scene = mi.load_dict(scenes.mitsuba_dict(mi, scenes.cornell_lambertian(), meshes, DEPTH,
                                              args.spp, 1, RES, rr_depth=RR_DEPTH))
     load_s = time.perf_counter() - t0
-    times = []
-    for _ in range(2):
+    def timed():
         t0 = time.perf_counter()
         img = mi.render(scene, seed=1, spp=args.spp)
         dr.eval(img)
         dr.sync_thread()
-        times.append(time.perf_counter() - t0)
+        return img, time.perf_counter() - t0
+
+    img, first = timed()  # JIT compilation
+    times, xylem = [], None
+    if args.serve:
+        print("ready", flush=True)
+        for line in sys.stdin:
+            word, _, rest = line.strip().partition(" ")
+            if word == "render":
+                img, t = timed()
+                times.append(t)
+                print(f"{t:.6f}", flush=True)
+            elif word == "score":
+                xylem = json.loads(rest)
+                break
+    else:
+        img, t = timed()
+        times.append(t)
+        if args.xylem_image:
+            xylem = {"image": args.xylem_image, "spp": args.xylem_spp or args.spp,
+                     "seconds": [args.xylem_seconds] if args.xylem_seconds else []}
+    if not times:
+        raise SystemExit("--serve: no `render` line before `score`")
     img = np.array(img, dtype=np.float64)[..., :3]
     samples = RES[0] * RES[1] * args.spp
+    sec = float(np.median(times))
     m = {"renderer": f"Mitsuba {mi.__version__} {mi.variant()}", "threads": args.threads,
-         "spp": args.spp, "seconds": times[1], "first_render_s": times[0], "load_s": load_s,
-         "samples_per_s": samples / times[1], "rmse": rmse(img, ref),
+         "spp": args.spp, "seconds": sec, "seconds_range": [min(times), max(times)],
+         "repeats": len(times), "first_render_s": first, "load_s": load_s,
+         "samples_per_s": samples / sec, "rmse": rmse(img, ref),
          "rmse_surfaces": rmse_surfaces(img, ref)}
     m["rmse_equal_time"] = m["rmse"]
     m["rmse_surfaces_equal_time"] = m["rmse_surfaces"]
@@ -110,16 +140,22 @@ def run(mi, args):
            "reference": os.path.relpath(ref_path), "reference_spp": args.reference_spp,
            "reference_mean": ref.mean(axis=(0, 1)).tolist(), "mitsuba": m,
            "load_average": list(os.getloadavg())}
-    if args.xylem_image:
-        x = render.read_exr_rgb(mi, args.xylem_image)
-        xs = {"renderer": "xylem", "image": args.xylem_image, "rmse": rmse(x, ref),
-              "rmse_surfaces": rmse_surfaces(x, ref), "spp": args.xylem_spp or args.spp}
-        if args.xylem_seconds:
-            xs["seconds"] = args.xylem_seconds
-            xs["samples_per_s"] = RES[0] * RES[1] * xs["spp"] / args.xylem_seconds
-            scale = math.sqrt(args.xylem_seconds / m["seconds"])
+    if xylem:
+        x = render.read_exr_rgb(mi, xylem["image"])
+        xs = {"renderer": "xylem", "image": xylem["image"], "rmse": rmse(x, ref),
+              "rmse_surfaces": rmse_surfaces(x, ref), "spp": xylem["spp"]}
+        if xylem["seconds"]:
+            xsec = float(np.median(xylem["seconds"]))
+            xs["seconds"] = xsec
+            xs["seconds_range"] = [min(xylem["seconds"]), max(xylem["seconds"])]
+            xs["repeats"] = len(xylem["seconds"])
+            xs["samples_per_s"] = RES[0] * RES[1] * xs["spp"] / xsec
+            scale = math.sqrt(xsec / m["seconds"])
             xs["rmse_equal_time"] = xs["rmse"] * scale
             xs["rmse_surfaces_equal_time"] = xs["rmse_surfaces"] * scale
+            # The ratio's spread: each interleaved pair's xylem / Mitsuba samples/s.
+            pairs = [(xylem["spp"] / a) / (args.spp / b) for a, b in zip(xylem["seconds"], times)]
+            xs["ratio_range"] = [min(pairs), max(pairs)]
         out["xylem"] = xs
     return out
 
@@ -129,15 +165,16 @@ def table(out):
              f"(Mitsuba {out['mitsuba_depth']}, rr_depth {out['mitsuba_rr_depth']} = xylem's "
              f"roulette start), reference {out['reference']} "
              f"({out['reference_spp']} spp Mitsuba)",
-             f"{'renderer':<28} {'spp':>5} {'seconds':>8} {'Msamples/s':>11} {'RMSE':>9} "
+             f"{'renderer':<28} {'spp':>5} {'seconds (min-max)':>20} {'Msamples/s':>11} {'RMSE':>9} "
              f"{'RMSE@equal time':>16} {'RMSE surfaces':>14} {'@equal time':>12}"]
     rows = [out["mitsuba"]] + ([out["xylem"]] if "xylem" in out else [])
     for r in rows:
-        sec = f"{r['seconds']:.3f}" if "seconds" in r else "-"
+        sec = (f"{r['seconds']:.3f} ({r['seconds_range'][0]:.3f}-{r['seconds_range'][1]:.3f})"
+               if "seconds_range" in r else "-")
         sps = f"{r['samples_per_s'] / 1e6:.3f}" if "samples_per_s" in r else "-"
         eq = f"{r['rmse_equal_time']:.5f}" if "rmse_equal_time" in r else "-"
         eqs = f"{r['rmse_surfaces_equal_time']:.5f}" if "rmse_surfaces_equal_time" in r else "-"
-        lines.append(f"{r['renderer']:<28} {r['spp']:>5} {sec:>8} {sps:>11} {r['rmse']:>9.5f} "
+        lines.append(f"{r['renderer']:<28} {r['spp']:>5} {sec:>20} {sps:>11} {r['rmse']:>9.5f} "
                      f"{eq:>16} {r['rmse_surfaces']:>14.5f} {eqs:>12}")
     m = out["mitsuba"]
     lines.append(f"Mitsuba: first render (with JIT compilation) {m['first_render_s']:.2f} s, "
@@ -149,5 +186,9 @@ def table(out):
                      f"{x['rmse_equal_time'] / m['rmse_equal_time']:.3f}; off the light: RMSE "
                      f"{x['rmse_surfaces'] / m['rmse_surfaces']:.3f}, at equal time "
                      f"{x['rmse_surfaces_equal_time'] / m['rmse_surfaces_equal_time']:.3f}")
+        if "ratio_range" in x:
+            lo, hi = x["ratio_range"]
+            lines.append(f"samples/s ratio over {x['repeats']} interleaved pairs: "
+                         f"{lo:.3f}-{hi:.3f} (the medians' ratio above)")
     lines.append(f"load average {out['load_average'][0]:.2f}")
     return "\n".join(lines)

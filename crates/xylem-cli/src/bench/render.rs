@@ -3,11 +3,15 @@
 //! it through the library (`render::render`), then `python -m validation.crosscheck --timing`
 //! renders it in Mitsuba (depth 9 in Mitsuba's counting) and scores both images against one
 //! high-spp Mitsuba reference. Both renders are timed after a first, untimed one (scene loading
-//! and Mitsuba's JIT compilation excluded); samples/s = width · height · spp / seconds.
+//! and Mitsuba's JIT compilation excluded), `--repeats` times each, interleaved (xylem, Mitsuba,
+//! xylem, …: Mitsuba's process stays up between its renders, `--serve`), so that a change of
+//! machine load falls on both; medians and ranges are reported. samples/s = width · height ·
+//! spp / seconds.
 
 use anyhow::{bail, Context};
+use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
-use std::process::{Command, ExitCode};
+use std::process::{Command, ExitCode, Stdio};
 use xylem::render::{image_io, render, RunOptions};
 
 #[derive(clap::Args, Debug)]
@@ -31,6 +35,87 @@ pub struct Args {
     /// Only time xylem.
     #[arg(long)]
     no_mitsuba: bool,
+    /// Timed renders of each renderer, 1 to 100, interleaved.
+    #[arg(long, default_value_t = 5)]
+    repeats: u32,
+}
+
+/// The median and range of `v` (not empty).
+fn median_range(v: &[f64]) -> (f64, f64, f64) {
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    let n = s.len();
+    let median = if n % 2 == 1 {
+        s[n / 2]
+    } else {
+        0.5 * (s[n / 2 - 1] + s[n / 2])
+    };
+    (median, s[0], s[n - 1])
+}
+
+/// Mitsuba's timing process (`python -m validation.crosscheck --timing --serve`): one timed
+/// render per request, the scores at the end.
+struct Mitsuba {
+    child: std::process::Child,
+    stdin: std::process::ChildStdin,
+    stdout: BufReader<std::process::ChildStdout>,
+}
+
+impl Mitsuba {
+    fn start(mut cmd: Command) -> anyhow::Result<Mitsuba> {
+        let mut child = cmd
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .spawn()
+            .context("cannot start Python")?;
+        let (stdin, stdout) = (child.stdin.take(), child.stdout.take());
+        let (Some(stdin), Some(stdout)) = (stdin, stdout) else {
+            bail!("Python's pipes are missing");
+        };
+        let mut m = Mitsuba {
+            child,
+            stdin,
+            stdout: BufReader::new(stdout),
+        };
+        let ready = m.line()?;
+        if ready != "ready" {
+            bail!("Mitsuba's timing process said `{ready}` instead of `ready`");
+        }
+        Ok(m)
+    }
+
+    /// The next line it prints; an error if it exited (its own error went to stderr).
+    fn line(&mut self) -> anyhow::Result<String> {
+        let mut l = String::new();
+        if self.stdout.read_line(&mut l)? == 0 {
+            let status = self.child.wait()?;
+            bail!("Mitsuba's timing process exited ({status}); its error is above");
+        }
+        Ok(l.trim().to_string())
+    }
+
+    /// One timed Mitsuba render: its seconds.
+    fn render(&mut self) -> anyhow::Result<f64> {
+        writeln!(self.stdin, "render")?;
+        self.stdin.flush()?;
+        let l = self.line()?;
+        l.parse()
+            .with_context(|| format!("Mitsuba's timing process said `{l}`"))
+    }
+
+    /// Sends xylem's image and times, and returns the table it prints.
+    fn score(mut self, score: serde_json::Value) -> anyhow::Result<String> {
+        writeln!(self.stdin, "score {score}")?;
+        drop(self.stdin);
+        let mut table = String::new();
+        std::io::Read::read_to_string(&mut self.stdout, &mut table)?;
+        let status = self.child.wait()?;
+        anyhow::ensure!(
+            status.success(),
+            "Mitsuba's timing process failed ({status})"
+        );
+        Ok(table)
+    }
 }
 
 /// The repository (validation/crosscheck and the venv live there): the current folder if it
@@ -67,30 +152,71 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         threads: args.threads,
         ..Default::default()
     };
-    render(&loaded.scene, &loaded.settings, &opts)?; // warm-up, untimed
-    let out = render(&loaded.scene, &loaded.settings, &opts)?;
-    let seconds = out.elapsed.as_secs_f64();
+    if !(1..=100).contains(&args.repeats) {
+        bail!("--repeats {}: allowed 1 to 100", args.repeats);
+    }
     let samples = w as f64 * h as f64 * args.spp as f64;
+    let mut mitsuba = if args.no_mitsuba {
+        None
+    } else {
+        mitsuba_process(&args)?
+    };
+    render(&loaded.scene, &loaded.settings, &opts)?; // warm-up, untimed
+    let (mut xylem_s, mut mitsuba_s) = (Vec::new(), Vec::new());
+    let mut last = None;
+    for _ in 0..args.repeats {
+        let out = render(&loaded.scene, &loaded.settings, &opts)?;
+        xylem_s.push(out.elapsed.as_secs_f64());
+        last = Some(out);
+        if let Some(m) = &mut mitsuba {
+            mitsuba_s.push(m.render()?);
+        }
+    }
+    let (median, lo, hi) = median_range(&xylem_s);
     println!(
-        "xylem {}: {}x{}, {} spp, {}, {} threads: {:.3} s, {:.3} M samples/s",
+        "xylem {}: {}x{}, {} spp, {}, {} threads: {:.3} s (median of {}, {:.3}-{:.3}), {:.3} M samples/s",
         loaded.name,
         w,
         h,
         args.spp,
         loaded.settings.integrator,
         args.threads,
-        seconds,
-        samples / seconds / 1e6
+        median,
+        args.repeats,
+        lo,
+        hi,
+        samples / median / 1e6
     );
-    if args.no_mitsuba {
+    let (Some(m), Some(out)) = (mitsuba, last) else {
         return Ok(ExitCode::SUCCESS);
-    }
+    };
+    let (m_median, m_lo, m_hi) = median_range(&mitsuba_s);
+    println!(
+        "Mitsuba: {m_median:.3} s (median of {}, {m_lo:.3}-{m_hi:.3}), interleaved with xylem's",
+        args.repeats
+    );
+    let work = repository()
+        .map(|r| r.join("target/crosscheck/timing"))
+        .context("the repository")?;
+    let exr = work.join("xylem_bench_render.exr");
+    image_io::write_image_exr(&exr, &out.image, &[])?;
+    let score = serde_json::json!({
+        "image": exr, "spp": args.spp, "seconds": xylem_s,
+    });
+    print!("{}", m.score(score)?);
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Mitsuba's timing process, started and past its untimed first render, or None (with the
+/// reason printed) where the repository, its venv or Mitsuba is missing.
+fn mitsuba_process(args: &Args) -> anyhow::Result<Option<Mitsuba>> {
     let Some(repo) = repository() else {
         println!("Mitsuba skipped: validation/crosscheck/ not found (run from the repository)");
-        return Ok(ExitCode::SUCCESS);
+        return Ok(None);
     };
     let python = args
         .python
+        .clone()
         .or_else(|| std::env::var_os("XYLEM_PYTHON").map(PathBuf::from))
         .unwrap_or_else(|| repo.join("target/python-venv/bin/python"));
     if !python.exists() {
@@ -98,41 +224,29 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             "Mitsuba skipped: {} not found (`cargo test --release --test python` makes the venv, or pass --python)",
             python.display()
         );
-        return Ok(ExitCode::SUCCESS);
+        return Ok(None);
     }
     let work = repo.join("target/crosscheck/timing");
     std::fs::create_dir_all(&work).with_context(|| format!("cannot create {}", work.display()))?;
-    let exr = work.join("xylem_bench_render.exr");
-    image_io::write_image_exr(&exr, &out.image, &[])?;
     let mut cmd = Command::new(&python);
-    cmd.args(["-m", "validation.crosscheck", "--timing"])
+    cmd.args(["-m", "validation.crosscheck", "--timing", "--serve"])
         .args(["--threads", &args.threads.to_string()])
         .args(["--spp", &args.spp.to_string()])
         .args(["--reference-spp", &args.reference_spp.to_string()])
-        .arg("--xylem-image")
-        .arg(&exr)
-        .args(["--xylem-seconds", &format!("{seconds}")])
-        .args(["--xylem-spp", &args.spp.to_string()])
         .current_dir(&repo);
     if std::env::var_os("DRJIT_LIBLLVM_PATH").is_none() {
         if let Some(p) = libllvm_19() {
             cmd.env("DRJIT_LIBLLVM_PATH", p);
         }
     }
-    let run = cmd
-        .output()
-        .with_context(|| format!("cannot run {}", python.display()))?;
-    if run.status.success() {
-        print!("{}", String::from_utf8_lossy(&run.stdout));
-    } else {
-        let err = String::from_utf8_lossy(&run.stderr);
-        let tail: Vec<&str> = err.lines().rev().take(3).collect();
-        println!(
-            "Mitsuba skipped: `{} -m validation.crosscheck --timing` failed ({}): {}",
-            python.display(),
-            run.status,
-            tail.into_iter().rev().collect::<Vec<_>>().join(" | ")
-        );
+    match Mitsuba::start(cmd) {
+        Ok(m) => Ok(Some(m)),
+        Err(e) => {
+            println!(
+                "Mitsuba skipped: `{} -m validation.crosscheck --timing` failed: {e:#}",
+                python.display()
+            );
+            Ok(None)
+        }
     }
-    Ok(ExitCode::SUCCESS)
 }
