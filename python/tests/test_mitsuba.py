@@ -363,7 +363,7 @@ def test_shared_wood_gives_the_separate_calls_values():
     shared.pdf(ctx, si, wo)
     assert count(shared) == 2 * n
     shared.sample(ctx, si, u1, u2)
-    assert shared._cache is None
+    assert shared._entries == {}
     shared.eval(ctx, si, wo)      # an entry for these points, which must not answer for new ones
     assert count(shared) == 3 * n
     si.p = si.p + mi.Vector3f(3.0, 1.0, 0.0)

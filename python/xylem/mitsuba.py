@@ -54,6 +54,7 @@ whose derivatives would be silently wrong. ``mi.traverse`` shows ``eta``, ``roug
 """
 
 import contextlib
+import threading
 
 import numpy as np
 
@@ -211,7 +212,11 @@ def _bsdf_class(mi, dr):
             """The WoodSurface and the lobes of the current eta, roughness and seed."""
             self.surface = WoodSurface(self._preset, seed=self.seed, eta=self.eta,
                                        roughness=self.roughness, **self._wood)
-            self._cache = None
+            # One cache entry per calling thread, keyed by its OS thread id: the scalar variant
+            # calls from Mitsuba's render threads, whose eval_pdf and sample at one interaction
+            # must not meet another thread's entry. (Not `threading.local`: a foreign thread's
+            # Python state, and what it holds, may be dropped between two calls.)
+            self._entries = {}
             smooth = self.eta > 1.0 and self.roughness < 1e-3
             lobes = (
                 mi.BSDFFlags.DiffuseReflection
@@ -256,22 +261,24 @@ def _bsdf_class(mi, dr):
             `eval_pdf` (emitter sampling) and `sample` at each bounce's `si`. Cached by the
             Dr.Jit variables of `si.p` and `si.sh_frame` (held while cached) and, when they
             differ, by their values (an interaction gathered again holds the same numbers in
-            new variables); the scalar variant keys by value only. One entry: a new
+            new variables); the scalar variant keys by value only. One entry per thread: a new
             interaction replaces the old one, and `sample` releases it."""
+            thread = threading.get_ident()
+            cached = self._entries.get(thread)
             key = held = None
             if not scalar:
                 key, held = jit_key(si)
-                if self._cache is not None and self._cache[0] == key:
-                    return self._cache[1]
+                if cached is not None and cached[0] == key:
+                    return cached[1]
             p, frame = to_np3(si.p), frame_np(self._frame(si))
-            if self._cache is not None:
-                _, hits, p0, frame0, _ = self._cache
+            if cached is not None:
+                _, hits, p0, frame0, _ = cached
                 if np.array_equal(p, p0) and np.array_equal(frame, frame0):
-                    self._cache = (key, hits, p0, frame0, held)
+                    self._entries[thread] = (key, hits, p0, frame0, held)
                     return hits
             hits = self.surface.prepare(p, frame)
             if self.share_wood:
-                self._cache = (key, hits, p, frame, held)
+                self._entries[thread] = (key, hits, p, frame, held)
             return hits
 
         def eval(self, ctx, si, wo, active=True):
@@ -298,7 +305,7 @@ def _bsdf_class(mi, dr):
             # `sample` is the last call Mitsuba's integrators make at an interaction (after
             # eval_pdf for emitter sampling): the entry (0.5 KB per lane) is released here
             # rather than held until the next call.
-            self._cache = None
+            self._entries.pop(threading.get_ident(), None)
             bs = dr.zeros(mi.BSDFSample3f, dr.width(sample1))
             wo = from_np3(mi.Vector3f, s["wi"])
             pdf = from_np1(s["pdf"])
