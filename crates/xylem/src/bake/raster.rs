@@ -47,7 +47,8 @@ pub struct MeshBake {
     pub maps: BakedMaps,
     /// Per texel, row-major.
     pub coverage: Vec<Coverage>,
-    /// Texels whose centre more than one triangle covers (overlapping UVs; the first wins).
+    /// Texels whose centre lies strictly inside a triangle after an earlier one took it
+    /// (overlapping UVs; the first wins; centres on a shared edge are not counted).
     pub overlapping: usize,
     /// Triangles reaching outside [0, 1]² in UV (the parts outside are not baked; a glTF sampler
     /// repeats the texture there).
@@ -115,7 +116,10 @@ pub fn bake_mesh(
                 }
                 let slot = &mut owner[y as usize * w + x as usize];
                 if slot.is_some() {
-                    overlapping += 1;
+                    // A centre on an edge two triangles share is not an overlap.
+                    if l.min_element() > 1e-5 {
+                        overlapping += 1;
+                    }
                 } else {
                     *slot = Some((
                         k as u32,
