@@ -24,17 +24,17 @@ pub struct Args {
     pub mesh: Option<String>,
     /// With --mesh: the tree point (mm from the pith, pith along +z) of the mesh's origin, X,Y,Z
     /// (default: the built-in's scene placement, else 0,150,0).
-    #[arg(long, value_parser = parse_vec3)]
+    #[arg(long, value_parser = parse_vec3, requires = "mesh")]
     pub origin: Option<[f32; 3]>,
     /// With --mesh: the mesh direction the fibres run along, X,Y,Z (default: the built-in's
     /// scene placement, else 0,0,1).
-    #[arg(long, value_parser = parse_vec3)]
+    #[arg(long, value_parser = parse_vec3, requires = "mesh")]
     pub axis: Option<[f32; 3]>,
     /// With --mesh: texels of padding grown around every UV chart, 0 to 64.
     #[arg(long, default_value_t = PAD_TEXELS)]
     pub pad: u32,
     /// With --mesh: also write preview.png, the mesh drawn with its baked maps.
-    #[arg(long)]
+    #[arg(long, requires = "mesh")]
     pub preview: bool,
     /// Which face of the log the board shows.
     #[arg(long, default_value = "tangential")]

@@ -263,8 +263,8 @@ fn fill_empty(m: &mut BakedMaps, coverage: &[Coverage]) {
         return;
     };
     blend(m, first, &taps);
-    for i in (first + 1)..coverage.len() {
-        if coverage[i] == Coverage::Empty {
+    for (i, c) in coverage.iter().enumerate().skip(first + 1) {
+        if *c == Coverage::Empty {
             blend(m, i, &[(first, 1.0)]);
         }
     }
