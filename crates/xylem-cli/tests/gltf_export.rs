@@ -49,6 +49,93 @@ fn bake(preset: &str, cut: &str, out: &Path) -> PathBuf {
     out.join(format!("{preset}.glb"))
 }
 
+/// Runs `xylem ARGS OUT` and returns its stderr, asserting success.
+fn run_ok(args: &[&str], out: &Path) -> String {
+    let st = Command::new(env!("CARGO_BIN_EXE_xylem"))
+        .args(args)
+        .arg(out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&st.stderr).to_string();
+    assert!(st.status.success(), "{err}");
+    err
+}
+
+/// An OBJ of two triangles (a 40 mm square), with `vt` when `uvs` is given (OBJ v up).
+fn square_obj(path: &Path, uvs: Option<[[f32; 2]; 4]>) {
+    let mut s = String::from("v 0 0 0\nv 40 0 0\nv 40 40 0\nv 0 40 0\n");
+    match uvs {
+        Some(t) => {
+            for [u, v] in t {
+                s += &format!("vt {u} {v}\n");
+            }
+            s += "f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
+        }
+        None => s += "f 1 2 3\nf 1 3 4\n",
+    }
+    std::fs::write(path, s).unwrap();
+}
+
+/// A mesh without UVs is refused naming the file and what is missing; with UVs it bakes
+/// (the control). Overlapping UVs (both triangles on one half of the texture) are baked with
+/// a warning and counted in bake.json; a layout without overlap counts none.
+#[test]
+fn mesh_bakes_need_uvs_and_report_overlaps() {
+    let tmp = tempfile::tempdir().unwrap();
+    let obj = tmp.path().join("square.obj");
+    square_obj(&obj, None);
+    let st = Command::new(env!("CARGO_BIN_EXE_xylem"))
+        .args(["bake", "walnut", "--res", "16", "--mesh"])
+        .arg(&obj)
+        .arg("--out")
+        .arg(tmp.path().join("no_uv"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert!(!st.status.success());
+    assert!(
+        err.contains("square.obj") && err.contains("no texture coordinates"),
+        "{err}"
+    );
+    let record = |dir: &Path| -> serde_json::Value {
+        serde_json::from_slice(&std::fs::read(dir.join("bake.json")).unwrap()).unwrap()
+    };
+    square_obj(&obj, Some([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]));
+    let ok = tmp.path().join("ok");
+    let err = run_ok(
+        &[
+            "bake",
+            "walnut",
+            "--res",
+            "16",
+            "--mesh",
+            obj.to_str().unwrap(),
+            "--out",
+        ],
+        &ok,
+    );
+    assert!(!err.contains("overlapping"), "{err}");
+    assert_eq!(record(&ok)["texels_overlapping"], 0);
+    assert_eq!(record(&ok)["texels_covered"], 256);
+    // Both triangles folded onto the lower-right half: every texel there is covered twice.
+    square_obj(&obj, Some([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [1.0, 0.0]]));
+    let over = tmp.path().join("over");
+    let err = run_ok(
+        &[
+            "bake",
+            "walnut",
+            "--res",
+            "16",
+            "--mesh",
+            obj.to_str().unwrap(),
+            "--out",
+        ],
+        &over,
+    );
+    assert!(err.contains("overlapping"), "{err}");
+    assert!(record(&over)["texels_overlapping"].as_u64().unwrap() > 50);
+}
+
 /// The GLB's JSON document and binary chunk (glTF 2.0 §4.4, read independently of the writer).
 fn split_glb(bytes: &[u8]) -> (serde_json::Value, Vec<u8>) {
     let word = |i: usize| u32::from_le_bytes(bytes[i..i + 4].try_into().unwrap()) as usize;
@@ -89,6 +176,13 @@ fn baked_glb_passes_the_khronos_validator_with_no_errors_or_warnings() {
     for (preset, cut) in [("curly_maple", "radial"), ("red_oak", "tangential")] {
         files.push(bake(preset, cut, &tmp.path().join(preset)));
     }
+    // A mesh bake: the teapot's 32 patch charts (u32-free, 16-bit indices) with its textures.
+    let teapot = tmp.path().join("teapot");
+    run_ok(
+        &["bake", "walnut", "--mesh", "teapot", "--res", "64", "--out"],
+        &teapot,
+    );
+    files.push(teapot.join("walnut.glb"));
     let out = Command::new("node")
         .arg(dir.join("validate.js"))
         .args(&files)

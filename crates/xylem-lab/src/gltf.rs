@@ -384,7 +384,8 @@ mod glb_tests {
             radius: 150.0,
         };
         let maps = xylem::bake::bake(&volume, &board, res);
-        xylem::bake::gltf::glb_bytes(&board, &maps, preset).unwrap()
+        let sides = board.bake_sides(&volume, res).maps;
+        xylem::bake::gltf::glb_bytes(&board, &maps, &sides, preset).unwrap()
     }
 
     /// Regenerates the README's image of a baked `.glb`:

@@ -15,7 +15,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         radius: 150.0,
     };
     let maps = bake(&volume, &board, 256);
-    write_glb(Path::new("board.glb"), &board, &maps, "african_mahogany")?;
+    let sides = board.bake_sides(&volume, 256).maps;
+    write_glb(
+        Path::new("board.glb"),
+        &board,
+        &maps,
+        &sides,
+        "african_mahogany",
+    )?;
     println!("wrote board.glb ({}x{} texels)", maps.width, maps.height);
     Ok(())
 }

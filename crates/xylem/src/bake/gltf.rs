@@ -12,6 +12,7 @@
 //! tangent is +x and the bitangent (normal × tangent, w = +1) is −z: the image's up, as the bake's
 //! tangent space has it.
 
+use super::uv_mesh::UvMesh;
 use super::{BakedMaps, BoardCut};
 use crate::picture::png::{encode_png_rgb8, PngTag};
 use crate::picture::srgb::to_srgb8;
@@ -91,9 +92,10 @@ pub fn write_glb(
     path: &Path,
     board: &BoardCut,
     maps: &BakedMaps,
+    sides: &BakedMaps,
     name: &str,
 ) -> Result<(), GltfError> {
-    stage_glb(path, board, maps, name)?
+    stage_glb(path, board, maps, sides, name)?
         .commit()
         .map_err(|source| GltfError::Io {
             path: path.display().to_string(),
@@ -106,9 +108,10 @@ pub fn stage_glb(
     path: &Path,
     board: &BoardCut,
     maps: &BakedMaps,
+    sides: &BakedMaps,
     name: &str,
 ) -> Result<crate::output::Staged, GltfError> {
-    let bytes = glb_bytes(board, maps, name).map_err(|e| e.at(path))?;
+    let bytes = glb_bytes(board, maps, sides, name).map_err(|e| e.at(path))?;
     crate::output::stage_bytes(path, &bytes).map_err(|source| GltfError::Io {
         path: path.display().to_string(),
         source,
@@ -135,7 +138,7 @@ struct Faces {
     normals: Vec<[f32; 3]>,
     tangents: Vec<[f32; 4]>,
     uvs: Vec<[f32; 2]>,
-    indices: Vec<u16>,
+    indices: Vec<u32>,
 }
 
 impl Faces {
@@ -148,7 +151,7 @@ impl Faces {
             glam::Vec3::from(v),
         );
         let n = v.cross(u).normalize();
-        let base = self.positions.len() as u16;
+        let base = self.positions.len() as u32;
         for (s, t) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
             self.positions.push((o + s * u + t * v).to_array());
             self.normals.push(n.to_array());
@@ -160,23 +163,44 @@ impl Faces {
         }
         // Counter-clockwise seen from +n: (0, 0) → (0, 1) → (1, 1) with n = v × u.
         self.indices
-            .extend([0, 3, 2, 0, 2, 1].map(|i: u16| base + i));
+            .extend([0, 3, 2, 0, 2, 1].map(|i: u32| base + i));
+    }
+
+    /// A UV mesh's vertices (mm) carried into glTF space (metres) by `to_gltf`, a rotation and
+    /// uniform scale, with its tangents ([`UvMesh::tangents`]).
+    fn mesh(mesh: &UvMesh, to_gltf: glam::Affine3A) -> Faces {
+        let rot = glam::Mat3::from(to_gltf.matrix3);
+        let tangents = mesh.tangents();
+        Faces {
+            positions: (mesh.positions.iter())
+                .map(|p| to_gltf.transform_point3(*p).to_array())
+                .collect(),
+            normals: (mesh.normals.iter())
+                .map(|n| unit_or(rot * *n, glam::Vec3::Y).to_array())
+                .collect(),
+            tangents: (tangents.iter())
+                .map(|t| {
+                    let d = unit_or(rot * t.truncate(), glam::Vec3::X);
+                    [d.x, d.y, d.z, t.w]
+                })
+                .collect(),
+            uvs: mesh.uvs.iter().map(|t| t.to_array()).collect(),
+            indices: mesh.indices.iter().flatten().copied().collect(),
+        }
     }
 }
 
-/// The board's top face (the baked maps) and its other five faces (plain), in metres.
-fn board_faces(board: &BoardCut) -> (Faces, Faces) {
+/// `v` normalised, or `fallback` where it has no direction (glTF requires unit normals).
+fn unit_or(v: glam::Vec3, fallback: glam::Vec3) -> glam::Vec3 {
+    v.try_normalize().unwrap_or(fallback)
+}
+
+/// The board's top face (the flat bake's maps), in metres.
+fn board_top(board: &BoardCut) -> Faces {
     let [w, h, t] = board.size.map(|mm| mm / 1000.0);
-    let (x0, y0, z0) = (-w / 2.0, -t / 2.0, -h / 2.0);
     let mut top = Faces::default();
-    top.quad([x0, -y0, z0], [w, 0.0, 0.0], [0.0, 0.0, h]);
-    let mut sides = Faces::default();
-    sides.quad([x0, y0, -z0], [w, 0.0, 0.0], [0.0, 0.0, -h]); // bottom (−y)
-    sides.quad([x0, -y0, -z0], [w, 0.0, 0.0], [0.0, -t, 0.0]); // front (+z)
-    sides.quad([-x0, -y0, z0], [-w, 0.0, 0.0], [0.0, -t, 0.0]); // back (−z)
-    sides.quad([-x0, -y0, -z0], [0.0, 0.0, -h], [0.0, -t, 0.0]); // right (+x)
-    sides.quad([x0, -y0, z0], [0.0, 0.0, h], [0.0, -t, 0.0]); // left (−x)
-    (top, sides)
+    top.quad([-w / 2.0, t / 2.0, -h / 2.0], [w, 0.0, 0.0], [0.0, 0.0, h]);
+    top
 }
 
 /// The binary chunk being filled and the document's views into it.
@@ -293,12 +317,24 @@ impl Bin<'_> {
                 self.floats(&faces.uvs, Type::Vec2, false),
             ));
         }
-        let idx: Vec<u8> = faces.indices.iter().flat_map(|i| i.to_le_bytes()).collect();
+        // 16-bit indices where they fit, else 32-bit (glTF 2.0 §3.7.2.1 allows both).
+        let small = faces.positions.len() <= usize::from(u16::MAX);
+        let idx: Vec<u8> = if small {
+            (faces.indices.iter())
+                .flat_map(|&i| (i as u16).to_le_bytes())
+                .collect()
+        } else {
+            faces.indices.iter().flat_map(|i| i.to_le_bytes()).collect()
+        };
         let view = self.view(&idx, Some(json::buffer::Target::ElementArrayBuffer));
         let indices = self.accessor(
             view,
             faces.indices.len(),
-            json::accessor::ComponentType::U16,
+            if small {
+                json::accessor::ComponentType::U16
+            } else {
+                json::accessor::ComponentType::U32
+            },
             Type::Scalar,
             None,
             None,
@@ -352,8 +388,74 @@ fn png(w: u32, h: u32, rgb: &[u8]) -> Result<Vec<u8>, GltfError> {
     Ok(out)
 }
 
-/// The `.glb` bytes of `maps` over `board`'s top face.
-pub fn glb_bytes(board: &BoardCut, maps: &BakedMaps, name: &str) -> Result<Vec<u8>, GltfError> {
+/// The `.glb` bytes of a board: its top face with the flat bake's `maps` and its other five
+/// faces with `sides`, the bake of their atlas ([`BoardCut::side_atlas`]).
+pub fn glb_bytes(
+    board: &BoardCut,
+    maps: &BakedMaps,
+    sides: &BakedMaps,
+    name: &str,
+) -> Result<Vec<u8>, GltfError> {
+    if board.size.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
+        return Err(GltfError::Invalid {
+            path: String::new(),
+            message: format!("board {:?} mm: allowed sizes above 0", board.size),
+        });
+    }
+    let (atlas, _) = board.side_atlas();
+    document(
+        name,
+        &[
+            (board_top(board), maps, "baked face", ""),
+            (
+                Faces::mesh(&atlas, glam::Affine3A::IDENTITY),
+                sides,
+                "sides",
+                "sides_",
+            ),
+        ],
+    )
+}
+
+/// The `.glb` bytes of `mesh` (object space, mm, z up as xylem's scenes have it) baked into
+/// `maps`: turned into glTF's space (metres, y up: (x, y, z) mm → (x, z, −y) / 1000).
+pub fn mesh_glb_bytes(mesh: &UvMesh, maps: &BakedMaps, name: &str) -> Result<Vec<u8>, GltfError> {
+    let faces = Faces::mesh(mesh, z_up_mm_to_gltf());
+    document(name, &[(faces, maps, "baked", "")])
+}
+
+/// xylem's object space (mm, z up) → glTF's (metres, y up): a rotation of −90° about x and a
+/// scale of 1/1000.
+pub fn z_up_mm_to_gltf() -> glam::Affine3A {
+    glam::Affine3A::from_mat3(glam::Mat3::from_cols(
+        glam::Vec3::new(1e-3, 0.0, 0.0),
+        glam::Vec3::new(0.0, 0.0, -1e-3),
+        glam::Vec3::new(0.0, 1e-3, 0.0),
+    ))
+}
+
+/// Writes the `.glb` of a mesh bake at `path` as a staged file ([`mesh_glb_bytes`]).
+pub fn stage_mesh_glb(
+    path: &Path,
+    mesh: &UvMesh,
+    maps: &BakedMaps,
+    name: &str,
+) -> Result<crate::output::Staged, GltfError> {
+    let bytes = mesh_glb_bytes(mesh, maps, name).map_err(|e| e.at(path))?;
+    crate::output::stage_bytes(path, &bytes).map_err(|source| GltfError::Io {
+        path: path.display().to_string(),
+        source,
+    })
+}
+
+/// The material of `maps` (base colour, normal map, metallic-roughness, anisotropy), its images
+/// named with `prefix`.
+fn material(
+    bin: &mut Bin<'_>,
+    maps: &BakedMaps,
+    label: String,
+    prefix: &str,
+) -> Result<Index<json::Material>, GltfError> {
     let (w, h) = (maps.width, maps.height);
     let n = w as usize * h as usize;
     let sizes = [
@@ -362,45 +464,22 @@ pub fn glb_bytes(board: &BoardCut, maps: &BakedMaps, name: &str) -> Result<Vec<u
         maps.normal.len(),
         maps.highlight_width.len(),
     ];
-    if sizes.iter().any(|&s| s != n)
-        || n == 0
-        || board.size.iter().any(|s| !(s.is_finite() && *s > 0.0))
-    {
+    if sizes.iter().any(|&s| s != n) || n == 0 {
         return Err(GltfError::Invalid {
             path: String::new(),
-            message: format!(
-                "maps of {w}x{h} texels hold {sizes:?} values, board {:?} mm",
-                board.size
-            ),
+            message: format!("maps of {w}x{h} texels hold {sizes:?} values"),
         });
     }
-    let mut root = json::Root {
-        asset: json::Asset {
-            copyright: None,
-            extensions: None,
-            extras: Default::default(),
-            generator: Some(format!("xylem {}", env!("CARGO_PKG_VERSION"))),
-            min_version: None,
-            version: "2.0".into(),
-        },
-        ..Default::default()
-    };
-    root.push(json::texture::Sampler {
-        mag_filter: Some(Valid(json::texture::MagFilter::Linear)),
-        min_filter: Some(Valid(json::texture::MinFilter::LinearMipmapLinear)),
-        ..Default::default()
-    });
-    let mut bin = Bin {
-        root: &mut root,
-        bytes: Vec::new(),
-    };
     let codes = super::textures(maps);
-    let base = bin.texture("base_color", &png(w, h, &to_srgb8(&maps.base_color, 0.0))?);
-    let normal = bin.texture("normal", &png(w, h, &codes.normal)?);
-    let rough = bin.texture("metallic_roughness", &png(w, h, &codes.metallic_roughness)?);
-    let aniso = bin.texture("anisotropy", &png(w, h, &codes.anisotropy)?);
-    let textured = json::Material {
-        name: Some(format!("{name} (baked face)")),
+    let mut tex = |name: &str, rgb: &[u8]| -> Result<json::texture::Info, GltfError> {
+        Ok(bin.texture(&format!("{prefix}{name}"), &png(w, h, rgb)?))
+    };
+    let base = tex("base_color", &to_srgb8(&maps.base_color, 0.0))?;
+    let normal = tex("normal", &codes.normal)?;
+    let rough = tex("metallic_roughness", &codes.metallic_roughness)?;
+    let aniso = tex("anisotropy", &codes.anisotropy)?;
+    Ok(bin.root.push(json::Material {
+        name: Some(label),
         pbr_metallic_roughness: json::material::PbrMetallicRoughness {
             base_color_texture: Some(base),
             metallic_factor: json::material::StrengthFactor(0.0),
@@ -428,26 +507,36 @@ pub fn glb_bytes(board: &BoardCut, maps: &BakedMaps, name: &str) -> Result<Vec<u
             .collect(),
         }),
         ..Default::default()
-    };
-    let textured = bin.root.push(textured);
-    // The other faces were not baked: the face's mean colour and roughness, no anisotropy.
-    let mean = maps.base_color.iter().copied().sum::<glam::Vec3>() / n as f32;
-    let mean_beta = maps.highlight_width.iter().sum::<f32>() / n as f32;
-    let plain = bin.root.push(json::Material {
-        name: Some(format!("{name} (unbaked faces, mean colour)")),
-        pbr_metallic_roughness: json::material::PbrMetallicRoughness {
-            base_color_factor: json::material::PbrBaseColorFactor([mean.x, mean.y, mean.z, 1.0]),
-            metallic_factor: json::material::StrengthFactor(0.0),
-            roughness_factor: json::material::StrengthFactor(gltf_roughness(mean_beta)),
-            ..Default::default()
+    }))
+}
+
+/// One mesh of textured primitives: (faces, maps, material label, image name prefix) each.
+fn document(name: &str, parts: &[(Faces, &BakedMaps, &str, &str)]) -> Result<Vec<u8>, GltfError> {
+    let mut root = json::Root {
+        asset: json::Asset {
+            copyright: None,
+            extensions: None,
+            extras: Default::default(),
+            generator: Some(format!("xylem {}", env!("CARGO_PKG_VERSION"))),
+            min_version: None,
+            version: "2.0".into(),
         },
         ..Default::default()
+    };
+    root.push(json::texture::Sampler {
+        mag_filter: Some(Valid(json::texture::MagFilter::Linear)),
+        min_filter: Some(Valid(json::texture::MinFilter::LinearMipmapLinear)),
+        ..Default::default()
     });
-    let (top, sides) = board_faces(board);
-    let primitives = vec![
-        bin.primitive(&top, textured, true),
-        bin.primitive(&sides, plain, false),
-    ];
+    let mut bin = Bin {
+        root: &mut root,
+        bytes: Vec::new(),
+    };
+    let mut primitives = Vec::new();
+    for (faces, maps, label, prefix) in parts {
+        let m = material(&mut bin, maps, format!("{name} ({label})"), prefix)?;
+        primitives.push(bin.primitive(faces, m, true));
+    }
     let mut bytes = std::mem::take(&mut bin.bytes);
     while !bytes.len().is_multiple_of(4) {
         bytes.push(0);
@@ -534,7 +623,8 @@ mod tests {
             cut: super::super::BakeCut::Radial,
             radius: 100.0,
         };
-        let (top, sides) = board_faces(&board);
+        let top = board_top(&board);
+        let sides = Faces::mesh(&board.side_atlas().0, glam::Affine3A::IDENTITY);
         for f in [&top, &sides] {
             for tri in f.indices.chunks(3) {
                 let p = [tri[0], tri[1], tri[2]].map(|i| glam::Vec3::from(f.positions[i as usize]));

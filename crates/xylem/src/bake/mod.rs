@@ -19,9 +19,12 @@ use crate::render::image_io::{stage_exr_layers, ExrCompression, ExrLayer};
 
 pub mod gltf;
 pub mod materialx;
+pub mod preview;
+pub mod raster;
 pub mod usd;
-use crate::wood::{Needs, WoodVolume};
-use glam::{Affine3A, Vec2, Vec3};
+pub mod uv_mesh;
+use crate::wood::{Needs, WoodTexel, WoodVolume};
+use glam::{Affine3A, Mat3, Vec2, Vec3};
 use rayon::prelude::*;
 
 /// Which face of the log the board shows (Liu et al. 2016 §7.2; the classical sawing terms).
@@ -100,7 +103,82 @@ impl BoardCut {
     pub fn texture_size(&self, res: u32) -> (u32, u32) {
         self.rect().texture_size(res)
     }
+
+    /// The glTF space of the board's `.glb` (metres; length along x, thickness along y, width
+    /// along z, centred) → tree space: x → the top face's right, y → its normal, z → its down,
+    /// ×1000, about the board's centre. A rotation (right · (normal × down) = 1) and a scale, so
+    /// the top face's texel (u, v) lands where [`BoardCut::rect`] puts it.
+    pub fn gltf_to_tree(&self) -> Affine3A {
+        let (_, right, down, normal) = self.face();
+        Affine3A::from_mat3_translation(
+            Mat3::from_cols(1000.0 * right, 1000.0 * normal, 1000.0 * down),
+            Vec3::new(0.0, self.radius, 0.0),
+        )
+    }
+
+    /// The five faces other than the baked top as one UV mesh in the `.glb`'s space (metres),
+    /// each face its own chart of a shelf-packed atlas at one scale (square texels): the bottom,
+    /// then front and back (W × T), then right and left (H × T) side by side where they fit,
+    /// with a gutter of `ATLAS_GUTTER` of the atlas width around every chart for padding. Also
+    /// the atlas's size in mm.
+    pub fn side_atlas(&self) -> (uv_mesh::UvMesh, Vec2) {
+        let [w, h, t] = self.size;
+        let g = ATLAS_GUTTER * w.max(h);
+        // (origin, u edge, v edge) in mm, glTF axes, and the chart's (width, height) = (|u|, |v|).
+        let (x0, y0, z0) = (-w / 2.0, -t / 2.0, -h / 2.0);
+        let quads = [
+            ([x0, y0, -z0], [w, 0.0, 0.0], [0.0, 0.0, -h]), // bottom (−y)
+            ([x0, -y0, -z0], [w, 0.0, 0.0], [0.0, -t, 0.0]), // front (+z)
+            ([-x0, -y0, z0], [-w, 0.0, 0.0], [0.0, -t, 0.0]), // back (−z)
+            ([-x0, -y0, -z0], [0.0, 0.0, -h], [0.0, -t, 0.0]), // right (+x)
+            ([x0, -y0, z0], [0.0, 0.0, h], [0.0, -t, 0.0]), // left (−x)
+        ];
+        let width = g + w.max(2.0 * h + g) + g;
+        // Shelf packing, left to right, a new shelf when the next chart does not fit.
+        let (mut at, mut shelf, mut mins) = (Vec2::splat(g), 0.0f32, Vec::new());
+        for (_, u, v) in &quads {
+            let size = Vec2::new(Vec3::from(*u).length(), Vec3::from(*v).length());
+            if at.x + size.x + g > width + 1e-3 {
+                at = Vec2::new(g, at.y + shelf + g);
+                shelf = 0.0;
+            }
+            mins.push((at, size));
+            at.x += size.x + g;
+            shelf = shelf.max(size.y);
+        }
+        let atlas = Vec2::new(width, at.y + shelf + g);
+        let mut m = uv_mesh::UvMesh::default();
+        for ((o, u, v), (min, size)) in quads.iter().zip(mins) {
+            let (o, u, v) = (Vec3::from(*o), Vec3::from(*u), Vec3::from(*v));
+            let n = v.cross(u).normalize();
+            let base = m.positions.len() as u32;
+            for (a, b) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
+                m.positions.push((o + a * u + b * v) / 1000.0);
+                m.normals.push(n);
+                m.uvs.push((min + Vec2::new(a, b) * size) / atlas);
+            }
+            m.indices.push([base, base + 3, base + 2]);
+            m.indices.push([base, base + 2, base + 1]);
+        }
+        (m, atlas)
+    }
+
+    /// The five other faces baked through [`BoardCut::side_atlas`], `res` texels along the
+    /// atlas's width, padded [`PAD_TEXELS`].
+    pub fn bake_sides(&self, volume: &WoodVolume, res: u32) -> raster::MeshBake {
+        let (mesh, atlas) = self.side_atlas();
+        let w = res.max(1);
+        let h = ((res as f32 * atlas.y / atlas.x).round() as u32).max(1);
+        raster::bake_mesh(volume, &mesh, self.gltf_to_tree(), w, h, PAD_TEXELS)
+    }
 }
+
+/// The gutter around each chart of a board's side atlas, as a fraction of its longer face side.
+const ATLAS_GUTTER: f32 = 0.02;
+
+/// Texels of padding grown around every chart of a mesh bake (a bilinear tap reaches 1 texel,
+/// the 4th mip level 8 texels of the base level: 4 covers bilinear lookup to the 2nd level).
+pub const PAD_TEXELS: u32 = 4;
 
 /// The anisotropy texel of a fibre direction `f` on a face with tangent-space axes `right`, `up`.
 /// KHR_materials_anisotropy's direction is the one in which the highlight *stretches* (its
@@ -147,38 +225,71 @@ pub fn bake(volume: &WoodVolume, board: &BoardCut, res: u32) -> BakedMaps {
 /// gradient covariantly (Lᵀ g), as the renderer's materials transport them (Liu et al. 2016 §6.2).
 pub fn bake_face(volume: &WoodVolume, face: &FaceRect, to_tree: Affine3A, res: u32) -> BakedMaps {
     let (w, h) = face.texture_size(res);
-    let l = glam::Mat3::from(to_tree.matrix3);
-    let l_inv = l.inverse();
+    let (right, up) = (face.right, -face.down);
+    let frame = TexelFrame {
+        right,
+        up,
+        normal: right.cross(up),
+    };
     let texels: Vec<_> = (0..h)
         .into_par_iter()
         .flat_map_iter(|y| {
             (0..w).map(move |x| {
                 let uv = Vec2::new((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
-                volume.eval(to_tree.transform_point3(face.point(uv)), Needs::ALL)
+                let p = to_tree.transform_point3(face.point(uv));
+                Some((volume.eval(p, Needs::ALL), frame))
             })
         })
         .collect();
-    let (right, up) = (face.right, -face.down);
-    let normal = right.cross(up);
-    let tangent = |f: Vec3| {
-        let f = (l_inv * f).normalize_or_zero();
-        Vec3::new(f.dot(right), f.dot(up), f.dot(normal))
+    texel_values(w, h, &texels, Mat3::from(to_tree.matrix3))
+}
+
+/// A texel's tangent space in object space: x to the image's right (+u), y to its up (−v), z out
+/// of the surface (unit, right-handed up to the mesh's handedness).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct TexelFrame {
+    pub right: Vec3,
+    pub up: Vec3,
+    pub normal: Vec3,
+}
+
+/// The maps of `w` × `h` texels from the wood at each texel (`None`: not on the surface, zeros
+/// for the caller to fill) seen in its frame. `l` is the linear part of the object → tree map:
+/// fibre directions go back contravariantly (L⁻¹ f) and the bump gradient covariantly (Lᵀ g), as
+/// the renderer's materials transport them (Liu et al. 2016 §6.2).
+pub(crate) fn texel_values(
+    w: u32,
+    h: u32,
+    texels: &[Option<(WoodTexel, TexelFrame)>],
+    l: Mat3,
+) -> BakedMaps {
+    let l_inv = l.inverse();
+    let each = |f: &dyn Fn(&WoodTexel, &TexelFrame) -> Vec3| -> Vec<Vec3> {
+        texels
+            .iter()
+            .map(|t| t.as_ref().map_or(Vec3::ZERO, |(t, fr)| f(t, fr)))
+            .collect()
     };
+    let scalar = |f: &dyn Fn(&WoodTexel) -> f32| -> Vec<f32> {
+        texels
+            .iter()
+            .map(|t| t.as_ref().map_or(0.0, |(t, _)| f(t)))
+            .collect()
+    };
+    let obj_fiber = |t: &WoodTexel| (l_inv * t.fiber_dir).normalize_or_zero();
     BakedMaps {
-        fiber: texels.iter().map(|t| tangent(t.fiber_dir)).collect(),
         width: w,
         height: h,
-        base_color: texels.iter().map(|t| t.diffuse).collect(),
-        anisotropy: texels
-            .iter()
-            .map(|t| anisotropy_texel((l_inv * t.fiber_dir).normalize_or_zero(), right, up))
-            .collect(),
-        highlight_width: texels.iter().map(|t| t.highlight_width).collect(),
-        ray_mask: texels.iter().map(|t| t.ray_mask).collect(),
-        normal: texels
-            .iter()
-            .map(|t| bump_normal(l.transpose() * t.bump_grad, right, up))
-            .collect(),
+        base_color: each(&|t, _| t.diffuse),
+        fiber_color: each(&|t, _| t.fiber_color),
+        fiber: each(&|t, fr| {
+            let f = obj_fiber(t);
+            Vec3::new(f.dot(fr.right), f.dot(fr.up), f.dot(fr.normal))
+        }),
+        anisotropy: each(&|t, fr| anisotropy_texel(obj_fiber(t), fr.right, fr.up)),
+        highlight_width: scalar(&|t| t.highlight_width),
+        ray_mask: scalar(&|t| t.ray_mask),
+        normal: each(&|t, fr| bump_normal(l.transpose() * t.bump_grad, fr.right, fr.up)),
     }
 }
 
@@ -226,18 +337,26 @@ pub(crate) fn textures(m: &BakedMaps) -> DataCodes {
 
 /// Stages every map as `NAME.png` and `NAME.exr` in `dir`, to commit as one set
 /// ([`crate::output::commit_set`]; `xylem bake` adds the `.glb` and the record `bake.json`).
-/// PNG: base colour in sRGB (tagged so); the data maps (`DataCodes`: anisotropy, normal,
+/// PNG: base and fibre colour in sRGB (tagged so); the data maps (`DataCodes`: anisotropy, normal,
 /// metallic-roughness, highlight width, ray mask, fibre direction) as linear codes with no
 /// colour-space chunk. EXR: the same maps as 32-bit floats, with the anisotropy and normal maps
 /// *decoded* (direction components in [−1, 1], strength; unit normal) and β in radians.
 pub fn stage_maps(dir: &std::path::Path, m: &BakedMaps) -> Result<Vec<Staged>, ImageError> {
     let (w, h) = (m.width, m.height);
-    let mut files = vec![stage_png_rgb8(
-        &dir.join("base_color.png"),
-        w,
-        h,
-        &to_srgb8(&m.base_color, 0.0),
-    )?];
+    let mut files = vec![
+        stage_png_rgb8(
+            &dir.join("base_color.png"),
+            w,
+            h,
+            &to_srgb8(&m.base_color, 0.0),
+        )?,
+        stage_png_rgb8(
+            &dir.join("fiber_color.png"),
+            w,
+            h,
+            &to_srgb8(&m.fiber_color, 0.0),
+        )?,
+    ];
     let c = textures(m);
     let pngs: [(&str, Vec<u8>); 6] = [
         ("anisotropy", c.anisotropy),
@@ -257,8 +376,9 @@ pub fn stage_maps(dir: &std::path::Path, m: &BakedMaps) -> Result<Vec<Staged>, I
         .iter()
         .map(|a| Vec3::new(2.0 * a.x - 1.0, 2.0 * a.y - 1.0, a.z))
         .collect();
-    let exrs: [(&str, &[&str], Vec<f32>); 6] = [
+    let exrs: [(&str, &[&str], Vec<f32>); 7] = [
         ("base_color", &["R", "G", "B"], flat(&m.base_color)),
+        ("fiber_color", &["R", "G", "B"], flat(&m.fiber_color)),
         ("anisotropy", &["R", "G", "B"], flat(&aniso)),
         ("highlight_width", &["Y"], m.highlight_width.clone()),
         ("ray_mask", &["Y"], m.ray_mask.clone()),

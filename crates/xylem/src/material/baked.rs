@@ -26,6 +26,9 @@ pub struct BakedMaps {
     pub height: u32,
     /// Diffuse colour (linear RGB).
     pub base_color: Vec<Vec3>,
+    /// Fibre highlight colour k_f (linear RGB; Marschner et al. 2005 eq. 3's tint of the fibre
+    /// lobe), as the volume gives it.
+    pub fiber_color: Vec<Vec3>,
     /// KHR_materials_anisotropy texel: the direction the highlight stretches (across the fibre,
     /// [`across_fiber`]) in [−1, 1] stored as 0.5 + 0.5·d, and the strength.
     pub anisotropy: Vec<Vec3>,
@@ -201,6 +204,7 @@ mod tests {
             width: 2,
             height: 1,
             base_color: vec![Vec3::new(0.2, 0.1, 0.0), Vec3::new(0.6, 0.3, 0.2)],
+            fiber_color: vec![Vec3::splat(0.5); 2],
             anisotropy: vec![Vec3::new(0.5, 1.0, 1.0); 2],
             highlight_width: vec![0.1, 0.3],
             ray_mask: vec![0.0, 1.0],

@@ -38,6 +38,13 @@ fn bad(path: &Path, message: impl Into<String>) -> MeshError {
 /// refused), or the embedded copy of a built-in scene's mesh where the disk has none
 /// (`crate::builtin`).
 pub fn load_mesh(path: &Path) -> Result<TriMesh, MeshError> {
+    load_mesh_uv(path).map(|(m, _)| m)
+}
+
+/// [`load_mesh`], and the texture coordinates of every vertex where the file gives every face
+/// corner one (an OBJ's `vt`; glTF's orientation: v = 1 − the OBJ's v, so v runs down the
+/// image). `None` for a PLY, or an OBJ with a face corner without `vt`.
+pub fn load_mesh_uv(path: &Path) -> Result<(TriMesh, Option<Vec<glam::Vec2>>), MeshError> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -54,13 +61,13 @@ pub fn load_mesh(path: &Path) -> Result<TriMesh, MeshError> {
             ext.as_deref() == Some("obj"),
         )?)),
     };
-    let mesh = if ext.as_deref() == Some("obj") {
+    let (mesh, uvs) = if ext.as_deref() == Some("obj") {
         parse_obj(&mut input, path)?
     } else {
-        parse_ply(input).map_err(|m| bad(path, m))?
+        (parse_ply(input).map_err(|m| bad(path, m))?, None)
     };
     check_finite(path, &mesh)?;
-    Ok(mesh)
+    Ok((mesh, uvs))
 }
 
 /// Peak memory of reading an OBJ, per byte of the file: tobj's positions, its per-corner index
@@ -154,12 +161,16 @@ fn open_mesh(path: &Path, obj: bool) -> Result<std::io::Take<std::fs::File>, Mes
 /// Reads an OBJ mesh (a regular file within the mesh size limit, as [`load_mesh`] reads).
 pub fn load_obj(path: &Path) -> Result<TriMesh, MeshError> {
     let file = open_mesh(path, true)?;
-    parse_obj(&mut BufReader::new(file), path)
+    parse_obj(&mut BufReader::new(file), path).map(|(m, _)| m)
 }
 
 /// All models of an OBJ stream merged into one mesh (normals kept when every model has them);
 /// `mtllib` lines are not followed (xylem's materials come from the scene file).
-fn parse_obj(input: &mut dyn BufRead, path: &Path) -> Result<TriMesh, MeshError> {
+/// With the texture coordinates when every model has one per vertex (v flipped to run down).
+fn parse_obj(
+    input: &mut dyn BufRead,
+    path: &Path,
+) -> Result<(TriMesh, Option<Vec<glam::Vec2>>), MeshError> {
     let opts = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
@@ -170,6 +181,7 @@ fn parse_obj(input: &mut dyn BufRead, path: &Path) -> Result<TriMesh, MeshError>
     })
     .map_err(|e| bad(path, e.to_string()))?;
     let mut out = TriMesh::default();
+    let mut uvs = Some(Vec::new());
     for m in models {
         let mesh = &m.mesh;
         if mesh.positions.len() % 3 != 0 || mesh.indices.len() % 3 != 0 {
@@ -181,6 +193,11 @@ fn parse_obj(input: &mut dyn BufRead, path: &Path) -> Result<TriMesh, MeshError>
                 .collect::<Vec<_>>()
         };
         let positions = v3(&mesh.positions);
+        uvs = uvs.filter(|_| mesh.texcoords.len() / 2 == positions.len());
+        if let Some(uv) = &mut uvs {
+            let t = mesh.texcoords.chunks_exact(2);
+            uv.extend(t.map(|c| glam::Vec2::new(c[0], 1.0 - c[1])));
+        }
         let normals = (mesh.normals.len() == mesh.positions.len()).then(|| v3(&mesh.normals));
         let part = TriMesh {
             positions,
@@ -196,7 +213,7 @@ fn parse_obj(input: &mut dyn BufRead, path: &Path) -> Result<TriMesh, MeshError>
     if out.indices.is_empty() {
         return Err(bad(path, "no triangles"));
     }
-    Ok(out)
+    Ok((out, uvs))
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]

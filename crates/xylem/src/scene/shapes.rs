@@ -113,6 +113,24 @@ pub(crate) fn make_lathe(profile: &[Vec2], segments: u32) -> TriMesh {
     revolve(profile, Some(&normals), segments)
 }
 
+/// Texture coordinates of [`make_lathe`]'s vertices, in its vertex order: u = φ / 2π around the
+/// axis (the seam at φ = 0 has its own column of vertices at u = 0 and u = 1) and v the arc length
+/// along the profile over the whole profile's length (0 at its first point).
+pub(crate) fn lathe_uvs(profile: &[Vec2], segments: u32) -> Vec<Vec2> {
+    let segments = segments.max(3);
+    let mut arc = vec![0.0f32];
+    for w in profile.windows(2) {
+        arc.push(arc[arc.len() - 1] + (w[1] - w[0]).length());
+    }
+    let total = arc.last().copied().unwrap_or(0.0).max(f32::MIN_POSITIVE);
+    (0..=segments)
+        .flat_map(|j| {
+            let arc = &arc;
+            (0..profile.len()).map(move |i| Vec2::new(j as f32 / segments as f32, arc[i] / total))
+        })
+        .collect()
+}
+
 /// Revolves a (r, z) polyline about z; `normals` are (n_r, n_z) per profile point.
 fn revolve(profile: &[Vec2], normals: Option<&[Vec2]>, segments: u32) -> TriMesh {
     let segments = segments.max(3);

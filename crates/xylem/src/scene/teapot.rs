@@ -156,6 +156,29 @@ pub(crate) fn make_teapot(size: f32, resolution: u32) -> TriMesh {
     m
 }
 
+/// Texture coordinates of [`make_teapot`]'s vertices, in its vertex order: each of the 32 patches
+/// gets its own cell of an 8 × 4 atlas (patch k in column k mod 8, row k div 8), its (u, v)
+/// parameter square mapped onto the cell inset by `UV_GUTTER` of the cell on every side, so a
+/// baked map can pad each chart outward without touching its neighbours.
+pub(crate) fn teapot_uvs(resolution: u32) -> Vec<Vec2> {
+    let n = resolution.max(1);
+    let cell = Vec2::new(1.0 / 8.0, 1.0 / 4.0);
+    let mut out = Vec::with_capacity(32 * (n as usize + 1).pow(2));
+    for k in 0..32u32 {
+        let origin = Vec2::new((k % 8) as f32, (k / 8) as f32) * cell;
+        for i in 0..=n {
+            for j in 0..=n {
+                let t = Vec2::new(i as f32, j as f32) / n as f32;
+                out.push(origin + cell * (UV_GUTTER + (1.0 - 2.0 * UV_GUTTER) * t));
+            }
+        }
+    }
+    out
+}
+
+/// The gutter around each patch's chart in [`teapot_uvs`], as a fraction of its cell.
+const UV_GUTTER: f32 = 0.04;
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -173,6 +196,7 @@ mod tests {
             assert!((ps[k][3][3] - ps[k + 1][3][0]).length() < 1e-5);
         }
         let m = make_teapot(10.0, 6);
+        assert_eq!(teapot_uvs(6).len(), m.positions.len());
         let ns = m.normals.as_ref().unwrap();
         let mut agree = 0;
         for t in &m.indices {
