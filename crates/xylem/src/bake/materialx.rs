@@ -3,11 +3,11 @@
 //! the specular lobe's tangent) and two maps made here, the OpenPBR specular roughness and
 //! roughness anisotropy of the fibre lobe, under a coat for the finish.
 //!
-//! Sources: [OpenPBR] Andersson et al., *OpenPBR Surface* specification v1.1 (§ Specular:
+//! Sources: \[OpenPBR\] Andersson et al., *OpenPBR Surface* specification v1.1 (§ Specular:
 //! α_t = r² √(2 / (1 + (1 − a)²)) along the tangent, α_b = (1 − a) α_t; § Coat: the base's
 //! specular IOR is taken relative to the coat, η_s / η_c, inverted where below 1); MaterialX 1.39
 //! `ND_open_pbr_surface_surfaceshader` and its `NG_open_pbr_anisotropy` graph, which compute the
-//! same. [MTLX] *MaterialX Specification* v1.39 (document and node syntax; `image`,
+//! same. \[MTLX\] *MaterialX Specification* v1.39 (document and node syntax; `image`,
 //! `normalmap`, `tangent`/`bitangent` geometric nodes; texture coordinates with (0, 0) at the
 //! image's lower left). The mapping and its limits are in notes/gltf.md ("MaterialX / OpenPBR").
 //!
@@ -29,7 +29,7 @@ pub const COAT_IOR: f32 = FINISH_IOR;
 pub const COAT_ROUGHNESS: f32 = 0.0;
 
 /// OpenPBR's `specular_ior`. Under a coat OpenPBR reflects at the base with the ratio
-/// η_s / η_c ([OpenPBR] § Coat), so η_s = η_c would remove the fibre highlight entirely. The
+/// η_s / η_c (\[OpenPBR\] § Coat), so η_s = η_c would remove the fibre highlight entirely. The
 /// fibre lobe is no Fresnel interface; it is given the ratio 1.5 (F0 = 0.04 under the coat),
 /// the strength the `.glb` gives it in air, so both exports show the same lobe.
 pub const SPECULAR_IOR: f32 = COAT_IOR * 1.5;
@@ -50,7 +50,7 @@ pub const ROUGHNESS_ANISOTROPY_PNG: &str = "openpbr_specular_anisotropy.png";
 ///
 /// Targets: along the fibre α_b = (G.1) (notes/gltf.md, `gltf::ggx_alpha_along_fiber`); along the
 /// tangent (across the fibre) α_t = mix(α_b, 1, s²), as KHR_materials_anisotropy gives the `.glb`.
-/// Inverting [OpenPBR]'s α_t = r² √(2 / (1 + (1 − a)²)), α_b = (1 − a) α_t:
+/// Inverting \[OpenPBR\]'s α_t = r² √(2 / (1 + (1 − a)²)), α_b = (1 − a) α_t:
 /// 1 − a = α_b / α_t and r = ((α_t² + α_b²) / 2)^¼. Both α clamp to [10⁻⁴, 1].
 pub fn openpbr_specular(beta: f32, strength: f32) -> (f32, f32) {
     let a_b = ggx_alpha_along_fiber(beta);
@@ -88,7 +88,7 @@ pub enum MaterialXError {
     EmptyName,
 }
 
-/// A valid MaterialX element name made from `name` ([MTLX] "Element names": letters, digits and
+/// A valid MaterialX element name made from `name` (\[MTLX\] "Element names": letters, digits and
 /// underscores, not starting with a digit): every other character becomes `_`.
 pub fn element_name(name: &str) -> String {
     let mut s: String = name
@@ -159,7 +159,7 @@ pub fn materialx_document(name: &str) -> Result<String, MaterialXError> {
         ROUGHNESS_ANISOTROPY_PNG,
         None,
     ));
-    // The bump: tangent-space normal map → world normal ([MTLX] `normalmap`).
+    // The bump: tangent-space normal map → world normal (\[MTLX\] `normalmap`).
     w(&image("normal_texel", "vector3", NORMAL_PNG, None));
     w(r#"    <normalmap name="normal" type="vector3">
       <input name="in" type="vector3" nodename="normal_texel" />
@@ -315,7 +315,7 @@ pub fn stage_materialx(
 mod tests {
     use super::*;
 
-    /// [OpenPBR]'s α pair of (r, a), as `NG_open_pbr_anisotropy` computes it.
+    /// \[OpenPBR\]'s α pair of (r, a), as `NG_open_pbr_anisotropy` computes it.
     fn alphas(r: f32, a: f32) -> (f32, f32) {
         let at = r * r * (2.0 / (1.0 + (1.0 - a).powi(2))).sqrt();
         (at, (1.0 - a) * at)

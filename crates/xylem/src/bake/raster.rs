@@ -2,7 +2,7 @@
 //! covers it, its barycentric coordinates give the surface point, normal and tangent frame
 //! (interpolated as a glTF renderer interpolates the vertex attributes), and the wood volume is
 //! evaluated at that point carried into the tree by the object's placement — the same
-//! [`super::texel_values`] the flat bake uses, so a flat chart reproduces the flat bake.
+//! `texel_values` the flat bake uses, so a flat chart reproduces the flat bake.
 //! Texels next to a chart are then padded by dilation, so bilinear and mip-mapped lookups near a
 //! seam read wood and not background; texels no triangle reaches take the covered texels' mean.
 //!

@@ -1,7 +1,7 @@
 //! A baked board as a USD stage (`DIR/<name>.usda`, USD's text format) that binds the MaterialX
 //! material of [`super::materialx`] to the baked face, for USD pipelines.
 //!
-//! Sources: [USD] Pixar, *Universal Scene Description* documentation: the `.usda` layer syntax,
+//! Sources: \[USD\] Pixar, *Universal Scene Description* documentation: the `.usda` layer syntax,
 //! `UsdGeomMesh` (faceVertexCounts / faceVertexIndices, `orientation = rightHanded`: a face is
 //! counter-clockwise seen from the side its normal points to; `primvars:st`, (0, 0) at the
 //! image's lower left as UsdUVTexture reads it), `UsdShadeMaterialBindingAPI`
