@@ -14,12 +14,35 @@ use xylem::scene::LoadedScene;
 
 /// Relative mean squared error Σ|x − r|² / Σ|r|² over RGB.
 pub fn relative_mse(x: &[glam::Vec3], r: &[glam::Vec3]) -> f64 {
+    relative_mse_net(x, r, 0.0)
+}
+
+/// The reference as two independent halves `a` and `b` (same spp, other seeds): their mean,
+/// the reference, and Σ Var(r), its own Monte Carlo noise summed over pixels and RGB. With a and
+/// b independent and unbiased, E|a − b|² = Var(a) + Var(b) per channel and Var((a + b)/2) = that
+/// over 4, so Σ|a − b|² / 4 estimates it without bias.
+pub fn reference_from_halves(a: &[glam::Vec3], b: &[glam::Vec3]) -> (Vec<glam::Vec3>, f64) {
+    let mean = a.iter().zip(b).map(|(x, y)| 0.5 * (*x + *y)).collect();
+    let noise = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (*x - *y).length_squared() as f64)
+        .sum::<f64>()
+        / 4.0;
+    (mean, noise)
+}
+
+/// [`relative_mse`] against the converged image rather than the reference: a render x
+/// independent of the reference r has E Σ|x − r|² = Σ(|bias|² + Var x) + Σ Var r, so the
+/// reference's own noise `reference_noise` ([`reference_from_halves`]) is taken off the sum
+/// (floored at 0: a render as good as the reference can come out below it).
+pub fn relative_mse_net(x: &[glam::Vec3], r: &[glam::Vec3], reference_noise: f64) -> f64 {
     let (mut num, mut den) = (0.0f64, 0.0f64);
     for (a, b) in x.iter().zip(r) {
         num += (*a - *b).length_squared() as f64;
         den += b.length_squared() as f64;
     }
-    num / den.max(1e-30)
+    ((num - reference_noise) / den.max(1e-30)).max(0.0)
 }
 
 /// Mean SSIM (Wang, Bovik, Sheikh, Simoncelli 2004, eq. 13, C1 = (0.01 L)², C2 = (0.03 L)², L = 1)
@@ -96,7 +119,9 @@ pub struct Measurement {
     pub repeats: u32,
     /// Time to prepare the scene for these knobs (rebuilding volumes, baking maps).
     pub prep_seconds: f64,
-    /// [`relative_mse`] against the reference render ([`Knobs::reference`] at `--reference-spp`).
+    /// [`relative_mse_net`] against the reference render ([`Knobs::reference`] at
+    /// `--reference-spp`, other seeds than the rows'): the error against the converged image,
+    /// the reference's own noise taken off.
     pub relative_mse: f64,
     /// [`ssim`] against the reference render.
     pub ssim: f64,
@@ -321,6 +346,47 @@ mod tests {
         assert!(ssim(&noisy, &img, 64, 32, 0.0) < 0.9);
         let e = relative_mse(&noisy, &img);
         assert!(e > 0.0 && e < 0.1, "{e}");
+    }
+
+    /// A synthetic truth t; a render x = t + bias + noise of variance σx²; a reference in two
+    /// independent halves of noise σh² each (so Var r = σh²/2). The net relative MSE must
+    /// recover Σ(bias² + σx²) / Σ|r|² (the error against t), where the raw one (the control)
+    /// also counts the reference's σh²/2 and misses by it. Uniform noise of half-width w has
+    /// variance w²/3; 64k pixels, fixed seed, so the estimates sit within 2 % of their means.
+    #[test]
+    fn the_reference_noise_comes_off_the_error() {
+        let n = 256 * 256;
+        let mut rng = xylem::math::Pcg32::new(7, 3);
+        let mut noise = |w: f32| Vec3::splat(w * (2.0 * rng.next_f32() - 1.0));
+        let truth: Vec<Vec3> = (0..n)
+            .map(|i| Vec3::splat(0.2 + 0.3 * (i % 97) as f32 / 97.0))
+            .collect();
+        let (wx, wh, bias) = (0.05f32, 0.08f32, 0.01f32);
+        let x: Vec<Vec3> = truth
+            .iter()
+            .map(|t| *t + Vec3::splat(bias) + noise(wx))
+            .collect();
+        let a: Vec<Vec3> = truth.iter().map(|t| *t + noise(wh)).collect();
+        let b: Vec<Vec3> = truth.iter().map(|t| *t + noise(wh)).collect();
+        let (r, ref_noise) = reference_from_halves(&a, &b);
+        let den: f64 = r.iter().map(|c| c.length_squared() as f64).sum();
+        // Per pixel and channel: var of uniform(−w, w) is w²/3; the reference's is half a half's.
+        let per = |w: f32| (w as f64).powi(2) / 3.0;
+        let want_noise = 3.0 * n as f64 * per(wh) / 2.0;
+        assert!(
+            (ref_noise / want_noise - 1.0).abs() < 0.02,
+            "{ref_noise} vs {want_noise}"
+        );
+        let want = 3.0 * n as f64 * ((bias as f64).powi(2) + per(wx)) / den;
+        let net = relative_mse_net(&x, &r, ref_noise);
+        let raw = relative_mse(&x, &r);
+        assert!((net / want - 1.0).abs() < 0.02, "net {net} vs {want}");
+        assert!(
+            raw / want > 1.5,
+            "the raw error counts the reference's noise: {raw} vs {want}"
+        );
+        // Floored at zero: the reference against itself.
+        assert_eq!(relative_mse_net(&r, &r, ref_noise), 0.0);
     }
 
     #[test]
