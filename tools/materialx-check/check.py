@@ -155,7 +155,8 @@ def check_mtlx(path: str, preset: str, coat_ior: float, fail: list[str], report:
             fail.append(f"GLSL generation: {e}")
 
 
-def check_usda(path: str, mtlx: str, preset: str, fail: list[str], report: dict) -> None:
+def check_usda(path: str, mtlx: str, preset: str, prim: str, fail: list[str],
+               report: dict) -> None:
     from pxr import Usd, UsdGeom, UsdShade
 
     if not os.path.isfile(path):
@@ -167,15 +168,15 @@ def check_usda(path: str, mtlx: str, preset: str, fail: list[str], report: dict)
         return
     report["up_axis"] = UsdGeom.GetStageUpAxis(stage)
     report["meters_per_unit"] = UsdGeom.GetStageMetersPerUnit(stage)
-    top = stage.GetPrimAtPath("/Board/top")
+    top = stage.GetPrimAtPath(prim)
     if not top or top.GetTypeName() != "Mesh":
-        fail.append("/Board/top: no Mesh")
+        fail.append(f"{prim}: no Mesh")
         return
     if not UsdGeom.PrimvarsAPI(top).GetPrimvar("st").HasValue():
-        fail.append("/Board/top: no primvars:st")
+        fail.append(f"{prim}: no primvars:st")
     bound, _ = UsdShade.MaterialBindingAPI(top).ComputeBoundMaterial()
     if not bound:
-        fail.append("/Board/top: no material binding")
+        fail.append(f"{prim}: no material binding")
         return
     report["binding"] = str(bound.GetPath())
     refs = []
@@ -195,6 +196,8 @@ def main() -> int:
     ap.add_argument("dir")
     ap.add_argument("preset")
     ap.add_argument("--coat-ior", type=float, required=True)
+    ap.add_argument("--prim", default="/Board/top",
+                    help="the baked Mesh prim (/Board/top; /Object/mesh for a mesh bake)")
     a = ap.parse_args()
     fail: list[str] = []
     report: dict = {"materialx": mx.getVersionString()}
@@ -204,7 +207,7 @@ def main() -> int:
         from pxr import Usd
 
         report["usd"] = ".".join(map(str, Usd.GetVersion()))
-        check_usda(os.path.join(a.dir, f"{a.preset}.usda"), mtlx, a.preset, fail, report)
+        check_usda(os.path.join(a.dir, f"{a.preset}.usda"), mtlx, a.preset, a.prim, fail, report)
     except ImportError as e:
         fail.append(f"pxr (usd-core) not importable: {e}")
     report["failures"] = fail

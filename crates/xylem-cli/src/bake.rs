@@ -56,8 +56,9 @@ pub struct Args {
     pub out: PathBuf,
     /// Also write the material as an OpenPBR MaterialX document (`PRESET.mtlx`, with its
     /// specular roughness and anisotropy maps) and the board as a USD stage (`PRESET.usda`)
-    /// that binds it (notes/gltf.md, "MaterialX / OpenPBR"); boards only.
-    #[arg(long, conflicts_with = "mesh")]
+    /// that binds it (notes/gltf.md, "MaterialX / OpenPBR"); with `--mesh`, the stage holds
+    /// the mesh (`/Object/mesh`).
+    #[arg(long)]
     pub materialx: bool,
 }
 
@@ -269,9 +270,19 @@ fn run_mesh(args: &Args, volume: &xylem::wood::WoodVolume) -> anyhow::Result<Exi
             &xylem::picture::srgb::to_srgb8(&px, 0.0),
         )?);
     }
+    if args.materialx {
+        staged.extend(stage_materialx(&args.out, maps, name)?);
+        let usda = args.out.join(format!("{name}.usda"));
+        let text = xylem::bake::usd::usda_mesh_stage(&mesh, name, &format!("{name}.mtlx"));
+        staged.push(
+            xylem::output::stage_bytes(&usda, text.as_bytes())
+                .with_context(|| format!("writing {}", usda.display()))?,
+        );
+    }
     let record = serde_json::json!({
         "preset": name,
         "mesh": spec,
+        "materialx": args.materialx,
         "triangles": mesh.indices.len(),
         "tree_origin_mm": origin,
         "tree_axis": axis,

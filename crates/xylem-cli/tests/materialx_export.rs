@@ -18,16 +18,13 @@ fn root() -> PathBuf {
     PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
 }
 
-fn bake(preset: &str, out: &Path) {
+/// The board of these tests.
+const BOARD: [&str; 4] = ["--board", "120x40x20", "--cut", "tangential"];
+
+fn bake(preset: &str, shape: &[&str], out: &Path) {
     let st = Command::new(env!("CARGO_BIN_EXE_xylem"))
-        .args([
-            "bake",
-            preset,
-            "--board",
-            "120x40x20",
-            "--cut",
-            "tangential",
-        ])
+        .args(["bake", preset])
+        .args(shape)
         .args(["--res", "24", "--seed", "3", "--materialx", "--out"])
         .arg(out)
         .output()
@@ -43,12 +40,12 @@ fn bake(preset: &str, out: &Path) {
 type Edit = Box<dyn Fn(&str) -> String>;
 
 /// The checker's report and whether it passed.
-fn check(dir: &Path, preset: &str, coat_ior: f32) -> (bool, Value) {
+fn check(dir: &Path, preset: &str, coat_ior: f32, prim: &str) -> (bool, Value) {
     let out = Command::new(venv().join("bin/python"))
         .arg(root().join("tools/materialx-check/check.py"))
         .arg(dir)
         .arg(preset)
-        .args(["--coat-ior", &coat_ior.to_string()])
+        .args(["--coat-ior", &coat_ior.to_string(), "--prim", prim])
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -81,7 +78,7 @@ fn broken(src: &Path, dir: &Path, file: &str, edit: impl Fn(&str) -> String) -> 
 fn baked_materialx_and_usd_pass_the_materialx_and_usd_checks() {
     let tmp = tempfile::tempdir().unwrap();
     let good = tmp.path().join("good");
-    bake("curly_maple", &good);
+    bake("curly_maple", &BOARD, &good);
     for f in [
         "curly_maple.mtlx",
         "curly_maple.usda",
@@ -98,7 +95,7 @@ fn baked_materialx_and_usd_pass_the_materialx_and_usd_checks() {
         assert!(listed.contains(f), "bake.json lists {f}: {listed}");
     }
     let coat = xylem::bake::materialx::COAT_IOR;
-    let (ok, r) = check(&good, "curly_maple", coat);
+    let (ok, r) = check(&good, "curly_maple", coat, "/Board/top");
     assert!(ok, "{r}");
     assert_eq!(r["validate"], true);
     assert_eq!(r["shader"]["category"], "open_pbr_surface");
@@ -153,7 +150,7 @@ fn baked_materialx_and_usd_pass_the_materialx_and_usd_checks() {
     ];
     for (name, file, edit, reason) in controls {
         let dir = broken(&good, &tmp.path().join(name), file, edit);
-        let (ok, r) = check(&dir, "curly_maple", coat);
+        let (ok, r) = check(&dir, "curly_maple", coat, "/Board/top");
         assert!(!ok, "{name}: the checker passed a broken bake: {r}");
         let why = r["failures"].to_string();
         assert!(
@@ -161,4 +158,21 @@ fn baked_materialx_and_usd_pass_the_materialx_and_usd_checks() {
             "{name}: failed for another reason: {why}"
         );
     }
+}
+
+/// A mesh bake with `--materialx`: the same document over the mesh's maps, and a stage whose
+/// `/Object/mesh` (triangles, per-vertex normals and st) is bound to it; checked by the same
+/// checker, which fails it when asked for the board's prim (the control).
+#[test]
+fn a_mesh_bake_carries_its_materialx_material_into_usd() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("teapot");
+    bake("walnut", &["--mesh", "teapot"], &dir);
+    let coat = xylem::bake::materialx::COAT_IOR;
+    let (ok, r) = check(&dir, "walnut", coat, "/Object/mesh");
+    assert!(ok, "{r}");
+    assert_eq!(r["validate"], true);
+    assert_eq!(r["binding"], "/Object/Materials/wood");
+    let (ok, r) = check(&dir, "walnut", coat, "/Board/top");
+    assert!(!ok, "the board's prim in a mesh stage: {r}");
 }

@@ -1,5 +1,5 @@
-//! A baked board as a USD stage (`DIR/<name>.usda`, USD's text format) that binds the MaterialX
-//! material of [`super::materialx`] to the baked face, for USD pipelines.
+//! A baked board or mesh as a USD stage (`DIR/<name>.usda`, USD's text format) that binds the
+//! MaterialX material of [`super::materialx`] to the baked surface, for USD pipelines.
 //!
 //! Sources: \[USD\] Pixar, *Universal Scene Description* documentation: the `.usda` layer syntax,
 //! `UsdGeomMesh` (faceVertexCounts / faceVertexIndices, `orientation = rightHanded`: a face is
@@ -16,29 +16,56 @@
 
 use super::gltf::gltf_roughness;
 use super::materialx::{element_name, material_name};
+use super::uv_mesh::UvMesh;
 use super::{BakedMaps, BoardCut};
 use crate::output::Staged;
 use glam::Vec3;
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// One mesh of the stage: quads with a normal per face and, on the baked face, texture
-/// coordinates per vertex.
+/// One mesh of the stage: quads, then triangles, and, on a baked surface, texture coordinates
+/// per vertex.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct UsdMesh {
     /// Prim name (a valid identifier).
     pub name: String,
     /// Vertex positions (metres).
     pub points: Vec<Vec3>,
-    /// One unit normal per face (`uniform` interpolation).
+    /// Unit normals: one per face (`uniform`), or one per vertex (`vertex`) when
+    /// `normals_per_vertex`.
     pub normals: Vec<Vec3>,
+    /// Whether `normals` has one per vertex (a smooth mesh) rather than one per face.
+    pub normals_per_vertex: bool,
     /// Texture coordinates per vertex (`primvars:st`), or none.
     pub st: Vec<[f32; 2]>,
     /// Vertex indices, four per quad, counter-clockwise seen from outside.
     pub quads: Vec<[u32; 4]>,
+    /// Vertex indices, three per triangle, counter-clockwise seen from outside.
+    pub triangles: Vec<[u32; 3]>,
 }
 
 impl UsdMesh {
+    /// A baked UV mesh (object space: mm, z up) in the stage's space as the `.glb` has it
+    /// (metres, y up: [`super::gltf::z_up_mm_to_gltf`]), st = (u, 1 − v).
+    pub fn from_uv_mesh(mesh: &UvMesh, name: &str) -> UsdMesh {
+        let to = super::gltf::z_up_mm_to_gltf();
+        UsdMesh {
+            name: name.into(),
+            points: mesh
+                .positions
+                .iter()
+                .map(|p| to.transform_point3(*p))
+                .collect(),
+            normals: (mesh.normals.iter())
+                .map(|n| to.transform_vector3(*n).normalize_or_zero())
+                .collect(),
+            normals_per_vertex: true,
+            st: mesh.uvs.iter().map(|uv| [uv.x, 1.0 - uv.y]).collect(),
+            quads: Vec::new(),
+            triangles: mesh.indices.clone(),
+        }
+    }
+
     /// Adds the quad with corner `o` and edges `u` (texture s) and `v` (the bake's v, down the
     /// image), facing v × u (as `gltf`'s faces); st = (s, 1 − v) when `textured`.
     fn quad(&mut self, o: Vec3, u: Vec3, v: Vec3, textured: bool) {
@@ -103,15 +130,17 @@ fn mesh_prim(x: &mut String, m: &UsdMesh, material: &str) {
         "    def Mesh \"{}\" (\n        prepend apiSchemas = [\"MaterialBindingAPI\"]\n    )\n    {{",
         element_name(&m.name)
     );
+    let counts = (m.quads.iter().map(|_| "4")).chain(m.triangles.iter().map(|_| "3"));
     let _ = writeln!(
         x,
         "        int[] faceVertexCounts = {}",
-        list(m.quads.iter().map(|_| "4".to_string()))
+        list(counts.map(str::to_string))
     );
+    let indices = (m.quads.iter().flatten()).chain(m.triangles.iter().flatten());
     let _ = writeln!(
         x,
         "        int[] faceVertexIndices = {}",
-        list(m.quads.iter().flatten().map(|i| i.to_string()))
+        list(indices.map(|i| i.to_string()))
     );
     let _ = writeln!(
         x,
@@ -120,8 +149,13 @@ fn mesh_prim(x: &mut String, m: &UsdMesh, material: &str) {
     );
     let _ = writeln!(
         x,
-        "        normal3f[] normals = {} (\n            interpolation = \"uniform\"\n        )",
-        list(m.normals.iter().map(|n| tuple(&n.to_array())))
+        "        normal3f[] normals = {} (\n            interpolation = \"{}\"\n        )",
+        list(m.normals.iter().map(|n| tuple(&n.to_array()))),
+        if m.normals_per_vertex {
+            "vertex"
+        } else {
+            "uniform"
+        }
     );
     if !m.st.is_empty() {
         let _ = writeln!(
@@ -136,6 +170,27 @@ fn mesh_prim(x: &mut String, m: &UsdMesh, material: &str) {
     let _ = writeln!(x, "    }}");
 }
 
+/// The layer's header: `root` the default prim, y up, metres.
+fn header(x: &mut String, root: &str, name: &str, mtlx_file: &str) {
+    let _ = writeln!(
+        x,
+        "#usda 1.0\n(\n    defaultPrim = \"{root}\"\n    doc = \"xylem bake: preset {}; the baked surface's material is the OpenPBR MaterialX document {}\"\n    metersPerUnit = 1\n    upAxis = \"Y\"\n)\n",
+        element_name(name),
+        mtlx_file.replace(['"', '\\', '@'], "_")
+    );
+}
+
+/// The Material prim `wood`, referencing `mtlx_file` (relative to the stage) at
+/// `/MaterialX/Materials/M_<name>`.
+fn wood_material(x: &mut String, name: &str, mtlx_file: &str) {
+    let _ = writeln!(
+        x,
+        "        def Material \"wood\" (\n            prepend references = @./{}@</MaterialX/Materials/{}>\n        )\n        {{\n        }}\n",
+        mtlx_file.replace(['"', '\\', '@'], "_"),
+        material_name(name)
+    );
+}
+
 /// The `.usda` text: `/Board` (the default prim) with the meshes of [`board_meshes`]; the top
 /// face bound to `/Board/Materials/wood`, which references `mtlx_file` (relative to the stage)
 /// at `/MaterialX/Materials/M_<name>`; the other faces bound to a `UsdPreviewSurface` of the
@@ -147,28 +202,36 @@ pub fn usda_stage(board: &BoardCut, maps: &BakedMaps, name: &str, mtlx_file: &st
     let mean = maps.base_color.iter().copied().sum::<Vec3>() / n;
     let mean_beta = maps.highlight_width.iter().sum::<f32>() / n;
     let mut x = String::new();
-    let _ = writeln!(
-        x,
-        "#usda 1.0\n(\n    defaultPrim = \"Board\"\n    doc = \"xylem bake: preset {}; the top face's material is the OpenPBR MaterialX document {}\"\n    metersPerUnit = 1\n    upAxis = \"Y\"\n)\n",
-        element_name(name),
-        mtlx_file.replace(['"', '\\', '@'], "_")
-    );
+    header(&mut x, "Board", name, mtlx_file);
     let _ = writeln!(x, "def Xform \"Board\" (\n    kind = \"component\"\n)\n{{");
     mesh_prim(&mut x, &top, "/Board/Materials/wood");
     mesh_prim(&mut x, &sides, "/Board/Materials/unbaked_faces");
     let _ = writeln!(x, "\n    def Scope \"Materials\"\n    {{");
-    let _ = writeln!(
-        x,
-        "        def Material \"wood\" (\n            prepend references = @./{}@</MaterialX/Materials/{}>\n        )\n        {{\n        }}\n",
-        mtlx_file.replace(['"', '\\', '@'], "_"),
-        material_name(name)
-    );
+    wood_material(&mut x, name, mtlx_file);
     let _ = writeln!(
         x,
         "        def Material \"unbaked_faces\"\n        {{\n            token outputs:surface.connect = </Board/Materials/unbaked_faces/PreviewSurface.outputs:surface>\n\n            def Shader \"PreviewSurface\"\n            {{\n                uniform token info:id = \"UsdPreviewSurface\"\n                color3f inputs:diffuseColor = {}\n                float inputs:metallic = 0\n                float inputs:roughness = {}\n                token outputs:surface\n            }}\n        }}",
         tuple(&mean.to_array()),
         gltf_roughness(mean_beta)
     );
+    let _ = writeln!(x, "    }}\n}}");
+    x
+}
+
+/// The `.usda` text of a mesh bake: `/Object` (the default prim) with the mesh as `/Object/mesh`
+/// ([`UsdMesh::from_uv_mesh`]) bound to `/Object/Materials/wood`, which references `mtlx_file`
+/// as [`usda_stage`]'s does. Deterministic.
+pub fn usda_mesh_stage(mesh: &UvMesh, name: &str, mtlx_file: &str) -> String {
+    let mut x = String::new();
+    header(&mut x, "Object", name, mtlx_file);
+    let _ = writeln!(x, "def Xform \"Object\" (\n    kind = \"component\"\n)\n{{");
+    mesh_prim(
+        &mut x,
+        &UsdMesh::from_uv_mesh(mesh, "mesh"),
+        "/Object/Materials/wood",
+    );
+    let _ = writeln!(x, "\n    def Scope \"Materials\"\n    {{");
+    wood_material(&mut x, name, mtlx_file);
     let _ = writeln!(x, "    }}\n}}");
     x
 }
