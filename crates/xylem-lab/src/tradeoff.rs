@@ -238,7 +238,8 @@ pub fn weak_reference(reference_spp: u32, max_spp: u32) -> Option<String> {
         format!(
             "--reference-spp {reference_spp} is under {MIN_REFERENCE_FACTOR}× the highest \
              measured {max_spp} spp: rows near it are scored against a reference about as noisy \
-             as they are (a row at the reference's spp and seeds matches it exactly); use \
+             as they are (its noise, taken off each row's error, is then estimated from two \
+             halves as noisy as the rows); use \
              --reference-spp {need} or more"
         )
     })
