@@ -23,7 +23,7 @@ use glam::{Vec2, Vec3};
 use xylem::material::Material;
 use xylem::math::{luminance, Frame};
 use xylem::render::{
-    integrator::nearest_light, render_frames, Image, Light, LightFrames, PointLight, RenderError,
+    light::nearest_light, render_frames, Image, Light, LightFrames, PointLight, RenderError,
     RenderSettings, RunOptions, Scene, SphereLight, SpotLight,
 };
 

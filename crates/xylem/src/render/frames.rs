@@ -8,9 +8,8 @@
 //! lights that do not move, the box the moving light stays in, and a sphere light's centres by
 //! component for sampling all frames in SIMD lanes.
 
-use super::integrator::{nearest_light, segment_misses_box};
-use super::light::LightHit;
-use super::light::{sphere_line_misses, Light, SphereLight};
+use super::geometry::segment_misses_box;
+use super::light::{nearest_light, sphere_line_misses, Light, LightHit, SphereLight};
 use super::Ray;
 use glam::{Vec3, Vec3A};
 

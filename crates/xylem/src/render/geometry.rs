@@ -642,6 +642,41 @@ pub fn brute_force_closest(accel: &Accel, ray: &Ray, t_max: f32) -> Option<f32> 
         .min_by(|a, b| a.total_cmp(b))
 }
 
+/// Slab test (Kay & Kajiya 1986) of the segment `o + t·d`, t in [0, t_max], against a box, with
+/// `inv` = 1/d per axis (±∞ for d = 0): true only when the segment surely misses. A NaN (an
+/// origin exactly on a slab plane of an axis the ray runs parallel to) answers "may hit".
+#[inline]
+pub(crate) fn segment_misses_box(o: Vec3A, inv: Vec3A, t_max: f32, lo: Vec3A, hi: Vec3A) -> bool {
+    slab_misses(
+        o.to_array(),
+        inv.to_array(),
+        t_max,
+        lo.to_array(),
+        hi.to_array(),
+    )
+}
+
+/// [`segment_misses_box`] on plain arrays, written with comparisons and selects only so that a
+/// loop of it over many segments vectorises.
+#[inline(always)]
+pub(crate) fn slab_misses(
+    o: [f32; 3],
+    inv: [f32; 3],
+    t_max: f32,
+    lo: [f32; 3],
+    hi: [f32; 3],
+) -> bool {
+    let (mut t0, mut t1, mut nan) = (0.0f32, t_max, false);
+    for a in 0..3 {
+        let (ta, tb) = ((lo[a] - o[a]) * inv[a], (hi[a] - o[a]) * inv[a]);
+        nan |= ta.is_nan() | tb.is_nan();
+        let (near, far) = if ta < tb { (ta, tb) } else { (tb, ta) };
+        t0 = if near > t0 { near } else { t0 };
+        t1 = if far < t1 { far } else { t1 };
+    }
+    !nan & (t0 > t1)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -12,8 +12,8 @@
 
 use super::film::Aov;
 use super::frames::LightFrames;
-use super::geometry::{Accel, Hit, Ray};
-use super::light::{Light, LightHit, LightSample, LightSamples, LightU};
+use super::geometry::{segment_misses_box, slab_misses, Accel, Hit, Ray};
+use super::light::{LightSample, LightSamples, LightU};
 use super::Scene;
 use crate::bsdf::{Bsdf, WoodAtWo};
 use crate::material::{MaterialHit, SurfaceBsdf};
@@ -228,22 +228,6 @@ pub(crate) fn light_rng(scene: &Scene, pixel: UVec2, sample: u32, seed: u64) -> 
     sample_rngs(seed, index, sample).1
 }
 
-/// The nearest light a ray meets before `t_max`: its index in `lights` and where it is met.
-pub fn nearest_light(lights: &[Light], ray: &Ray, t_max: f32) -> Option<(usize, LightHit)> {
-    let mut best: Option<(usize, LightHit)> = None;
-    for (i, l) in lights.iter().enumerate() {
-        if let Some(hit) = l.hit(ray) {
-            let t = hit.distance;
-            let limit = best.map_or(t_max, |b| b.1.distance);
-            // Environment lights (t = ∞) count only when nothing else was hit.
-            if t < limit || (t.is_infinite() && t_max.is_infinite() && best.is_none()) {
-                best = Some((i, hit));
-            }
-        }
-    }
-    best
-}
-
 /// Origin of a ray leaving `sp` along `dir`: the hit point moved `eps` along the geometric
 /// normal, to the side `dir` points to, so the ray does not hit the surface it starts on.
 pub(crate) fn offset_origin(sp: &ShadingPoint, dir: Vec3) -> Vec3 {
@@ -448,35 +432,6 @@ pub struct Segments {
     o: [Vec<f32>; 3],
     inv: [Vec<f32>; 3],
     t_max: Vec<f32>,
-}
-
-/// Slab test (Kay & Kajiya 1986) of the segment `o + t·d`, t in [0, t_max], against a box, with
-/// `inv` = 1/d per axis (±∞ for d = 0): true only when the segment surely misses. A NaN (an
-/// origin exactly on a slab plane of an axis the ray runs parallel to) answers "may hit".
-#[inline]
-pub(crate) fn segment_misses_box(o: Vec3A, inv: Vec3A, t_max: f32, lo: Vec3A, hi: Vec3A) -> bool {
-    slab_misses(
-        o.to_array(),
-        inv.to_array(),
-        t_max,
-        lo.to_array(),
-        hi.to_array(),
-    )
-}
-
-/// [`segment_misses_box`] on plain arrays, written with comparisons and selects only so that a
-/// loop of it over many segments vectorises.
-#[inline(always)]
-fn slab_misses(o: [f32; 3], inv: [f32; 3], t_max: f32, lo: [f32; 3], hi: [f32; 3]) -> bool {
-    let (mut t0, mut t1, mut nan) = (0.0f32, t_max, false);
-    for a in 0..3 {
-        let (ta, tb) = ((lo[a] - o[a]) * inv[a], (hi[a] - o[a]) * inv[a]);
-        nan |= ta.is_nan() | tb.is_nan();
-        let (near, far) = if ta < tb { (ta, tb) } else { (tb, ta) };
-        t0 = if near > t0 { near } else { t0 };
-        t1 = if far < t1 { far } else { t1 };
-    }
-    !nan & (t0 > t1)
 }
 
 /// The term of one light sample `ls` in next-event estimation: f · Li · |cos θi| · w / pdf when

@@ -767,6 +767,22 @@ impl Distribution2D {
     }
 }
 
+/// The nearest light a ray meets before `t_max`: its index in `lights` and where it is met.
+pub fn nearest_light(lights: &[Light], ray: &Ray, t_max: f32) -> Option<(usize, LightHit)> {
+    let mut best: Option<(usize, LightHit)> = None;
+    for (i, l) in lights.iter().enumerate() {
+        if let Some(hit) = l.hit(ray) {
+            let t = hit.distance;
+            let limit = best.map_or(t_max, |b| b.1.distance);
+            // Environment lights (t = ∞) count only when nothing else was hit.
+            if t < limit || (t.is_infinite() && t_max.is_infinite() && best.is_none()) {
+                best = Some((i, hit));
+            }
+        }
+    }
+    best
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
