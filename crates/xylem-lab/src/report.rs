@@ -41,9 +41,7 @@ pub fn update_report_section(path: &Path, name: &str, markdown: &str) -> io::Res
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir)?;
     }
-    let tmp = path.with_extension("md.partial");
-    std::fs::write(&tmp, new)?;
-    std::fs::rename(&tmp, path)
+    xylem::output::write_atomic(path, new.as_bytes())
 }
 
 /// A Markdown table from a header row and body rows.

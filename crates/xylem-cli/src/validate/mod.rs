@@ -25,12 +25,12 @@ enum What {
     Fit(fit::Args),
 }
 
-/// Writes a report (through a temporary name), prints it and turns `ok` into the exit code.
+/// Writes a report (staged under a unique temporary name, `output::write_atomic`), prints it and
+/// turns `ok` into the exit code.
 fn finish_report(report: &std::path::Path, md: &str, ok: bool) -> anyhow::Result<ExitCode> {
     use anyhow::Context;
-    let tmp = report.with_extension("md.partial");
-    std::fs::write(&tmp, md).with_context(|| format!("writing {}", tmp.display()))?;
-    std::fs::rename(&tmp, report).with_context(|| format!("writing {}", report.display()))?;
+    xylem::output::write_atomic(report, md.as_bytes())
+        .with_context(|| format!("writing {}", report.display()))?;
     println!("{md}");
     println!("report: {}", report.display());
     Ok(if ok {
