@@ -405,7 +405,7 @@ fn markdown(
         match cheapest(rows, t) {
             Some(r) => {
                 s += &format!(
-                    "- **{label}** (cheapest with SSIM ≥ {t}): {} {} — {:.3} CPU s, SSIM {:.4}\n",
+                    "- **{label}** (SSIM ≥ {t}): {} {} — {:.3} CPU s, SSIM {:.4}\n",
                     r.knob, r.setting, r.cpu_seconds, r.ssim
                 )
             }
