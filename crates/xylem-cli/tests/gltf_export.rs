@@ -100,10 +100,8 @@ fn mesh_bakes_need_uvs_and_report_overlaps() {
     let record = |dir: &Path| -> serde_json::Value {
         serde_json::from_slice(&std::fs::read(dir.join("bake.json")).unwrap()).unwrap()
     };
-    square_obj(&obj, Some([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]));
-    let ok = tmp.path().join("ok");
-    let err = run_ok(
-        &[
+    let bake_obj = |out: &Path| {
+        let args = [
             "bake",
             "walnut",
             "--res",
@@ -111,27 +109,19 @@ fn mesh_bakes_need_uvs_and_report_overlaps() {
             "--mesh",
             obj.to_str().unwrap(),
             "--out",
-        ],
-        &ok,
-    );
+        ];
+        run_ok(&args, out)
+    };
+    square_obj(&obj, Some([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]));
+    let ok = tmp.path().join("ok");
+    let err = bake_obj(&ok);
     assert!(!err.contains("overlapping"), "{err}");
     assert_eq!(record(&ok)["texels_overlapping"], 0);
     assert_eq!(record(&ok)["texels_covered"], 256);
     // Both triangles folded onto the lower-right half: every texel there is covered twice.
     square_obj(&obj, Some([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [1.0, 0.0]]));
     let over = tmp.path().join("over");
-    let err = run_ok(
-        &[
-            "bake",
-            "walnut",
-            "--res",
-            "16",
-            "--mesh",
-            obj.to_str().unwrap(),
-            "--out",
-        ],
-        &over,
-    );
+    let err = bake_obj(&over);
     assert!(err.contains("overlapping"), "{err}");
     assert!(record(&over)["texels_overlapping"].as_u64().unwrap() > 50);
 }

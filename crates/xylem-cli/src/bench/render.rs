@@ -13,6 +13,7 @@ use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode, Stdio};
 use xylem::render::{image_io, render, RunOptions};
+use xylem_lab::tradeoff::median_range;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -38,19 +39,6 @@ pub struct Args {
     /// Timed renders of each renderer, 1 to 100, interleaved.
     #[arg(long, default_value_t = 5)]
     repeats: u32,
-}
-
-/// The median and range of `v` (not empty).
-fn median_range(v: &[f64]) -> (f64, f64, f64) {
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    let n = s.len();
-    let median = if n % 2 == 1 {
-        s[n / 2]
-    } else {
-        0.5 * (s[n / 2 - 1] + s[n / 2])
-    };
-    (median, s[0], s[n - 1])
 }
 
 /// Mitsuba's timing process (`python -m validation.crosscheck --timing --serve`): one timed

@@ -105,12 +105,6 @@ impl Slice {
             .par_chunks_mut(n.max(1))
             .enumerate()
             .for_each(|(j, row)| {
-                if k == 1 {
-                    let points: Vec<Vec3> =
-                        (0..n).map(|i| self.point(i as u32, j as u32)).collect();
-                    f(&points, row);
-                    return;
-                }
                 // The sub-pixel grid's row `sy`: k points per pixel, the pixels side by side.
                 let mut points = vec![Vec3::ZERO; n * k];
                 let mut colours = vec![Vec3::ZERO; n * k];
