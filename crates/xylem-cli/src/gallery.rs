@@ -48,7 +48,7 @@ fn parse_frames(s: &str) -> Result<usize, String> {
 }
 
 /// The built-in scenes the gallery shows (scenes/NAME.toml), hero renders first.
-pub const SCENES: [&str; 11] = [
+pub const SCENES: [&str; 12] = [
     "cornell_bunny",
     "carved_bunny",
     "dovetail",
@@ -59,6 +59,7 @@ pub const SCENES: [&str; 11] = [
     "teapot",
     "cornell_wood_marble",
     "cornell_bunny_black",
+    "grazing_oak",
     "sweep_board",
 ];
 

@@ -22,7 +22,7 @@ use xylem_lab::scenes::{measure, measure_rendered, Measure};
 /// scene rendered without its background (cooler by ≥ 5 standard errors; the broken version is
 /// `blue_variant_check_fails_with_a_black_background`).
 #[allow(clippy::type_complexity)]
-const CASES: [(&str, u32, Option<u32>, &[&str]); 15] = [
+const CASES: [(&str, u32, Option<u32>, &[&str]); 16] = [
     ("cornell_box", 2, None, &[]),
     ("sweep_board", 4, Some(8), &[]),
     ("parquet_floor", 1, Some(4), &[]),
@@ -38,6 +38,7 @@ const CASES: [(&str, u32, Option<u32>, &[&str]); 15] = [
     ("cornell_bunny_black", 2, Some(16), &["rings", "light on"]),
     ("dovetail", 2, Some(8), &[]),
     ("carved_bunny", 2, Some(16), &[]),
+    ("grazing_oak", 2, Some(4), &[]),
 ];
 
 fn object_names(text: &str) -> Vec<Option<String>> {
@@ -226,6 +227,20 @@ fn bowl_check_fails_without_the_curl() {
     );
     let bands = m.iter().find(|m| m.what.starts_with("curl bands")).unwrap();
     assert!(!bands.pass(), "{bands}");
+}
+
+/// The pore-relief check needs the pore bump: `grazing_oak` with `bump = 0` (the old default)
+/// shows almost nothing change when the raking light changes sides.
+#[test]
+fn pore_relief_fails_without_the_bump() {
+    let m = measured("grazing_oak", 2, Some(4), |text| {
+        text.replace("roughness = 0.2\n", "roughness = 0.2\nbump = 0.0\n")
+    });
+    let relief = m
+        .iter()
+        .find(|m| m.what.starts_with("pore relief"))
+        .unwrap();
+    assert!(!relief.pass(), "{relief}");
 }
 
 /// The Cornell rings check needs the rings: the same scene with knotty pine's latewood the

@@ -17,7 +17,7 @@ macro_rules! embed {
 }
 
 /// (path relative to the repository root, contents).
-const FILES: [(&str, &[u8]); 29] = embed![
+const FILES: [(&str, &[u8]); 30] = embed![
     "scenes/box_joint.toml",
     "scenes/carved_bunny.toml",
     "scenes/cornell_box.toml",
@@ -27,6 +27,7 @@ const FILES: [(&str, &[u8]); 29] = embed![
     "scenes/cube_carved_vs_veneer.toml",
     "scenes/dovetail.toml",
     "scenes/fit_maple_sweep.toml",
+    "scenes/grazing_oak.toml",
     "scenes/measured_maple_sweep.toml",
     "scenes/measured_padauk_sweep.toml",
     "scenes/parquet_floor.toml",

@@ -374,9 +374,9 @@ pub enum MaterialTable {
         /// GGX roughness of the finish (0–1, default 0 = smooth).
         #[serde(default)]
         roughness: f32,
-        /// Pore bump strength (0 = off).
-        #[serde(default)]
-        bump: f32,
+        /// Pore bump strength (0 = off, 1 = the preset's pore depth); absent: the preset's
+        /// [`default_bump`](crate::wood::WoodParams::default_bump), on for open grain.
+        bump: Option<f32>,
     },
     /// A board measured by Marschner et al. 2005: per-texel BSDF parameters from image maps (in
     /// the encoding of data/marschner2005/) on one face of the object. Paths relative to the scene.

@@ -721,13 +721,17 @@ impl Builder<'_> {
                             ))
                         }
                     };
+                    let bump = match bump {
+                        Some(b) => self.range(&f("bump"), *b, 0.0, 100.0)?,
+                        None => params.default_bump(),
+                    };
                     let volume = crate::wood::WoodVolume::new(params, *seed)
                         .map_err(|e| self.invalid(f("preset"), e.to_string()))?;
                     Material::Wood(Box::new(WoodMaterial {
                         volume: Arc::new(volume),
                         eta: self.range(&f("eta"), *eta, 1.0, 4.0)?,
                         roughness: self.range(&f("roughness"), *roughness, 0.0, 1.0)?,
-                        bump: self.range(&f("bump"), *bump, 0.0, 100.0)?,
+                        bump,
                         switches: Default::default(),
                     }))
                 }

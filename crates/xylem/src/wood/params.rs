@@ -212,6 +212,20 @@ pub struct PoreParams {
     pub depth: f32,
 }
 
+impl PoreParams {
+    /// Narrowest vessel, mm across, that we call open grain: the coarse-textured woods whose
+    /// pores a film finish leaves as dimples unless they are filled (oak, walnut, mahogany,
+    /// padauk: 0.18–0.30 mm in the presets) against the fine-textured closed-grain ones (maple,
+    /// cherry, yellowheart: 0.06–0.12 mm); texture by vessel size as in Hoadley, "Understanding
+    /// Wood", ch. 5.
+    pub const OPEN_DIAMETER: f32 = 0.15;
+
+    /// Whether these pores are open grain ([`Self::OPEN_DIAMETER`] or wider).
+    pub fn open(&self) -> bool {
+        2.0 * self.radius >= Self::OPEN_DIAMETER
+    }
+}
+
 /// Rays (§3.2, §6.1.6): bump-kernel noise in cylindrical cells, thin in θ, tall in z, long in r.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -508,6 +522,17 @@ impl Checker<'_> {
 }
 
 impl WoodParams {
+    /// The pore bump a scene gets when it names none: the pores at their anatomical depth
+    /// ([`PoreParams::depth`], strength 1) where the grain is open ([`PoreParams::open`]), none
+    /// where it is closed or has no pores (issue 28: Liu et al. 2016 §6.1.7 render open-pore
+    /// woods with their pore bump).
+    pub fn default_bump(&self) -> f32 {
+        match &self.pores {
+            Some(p) if p.open() => 1.0,
+            _ => 0.0,
+        }
+    }
+
     /// Parse TOML text; `file` names the source in error messages.
     pub fn from_toml_str(text: &str, file: &str) -> Result<WoodParams, WoodError> {
         let params: WoodParams = toml::from_str(text).map_err(|e| WoodError::Parse {
