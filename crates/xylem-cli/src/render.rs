@@ -85,7 +85,7 @@ pub(crate) fn explain(scene: &xylem::render::Scene, spp: u32) -> String {
                 ),
                 Detail::Kept => format!("kept: {:.3} mm, shown where the footprint is smaller", f.size),
             };
-            s += &format!("explain:   {:<16}{why}\n", f.name);
+            s += &format!("explain:   {:<18}{why}\n", f.name);
         }
     }
     s

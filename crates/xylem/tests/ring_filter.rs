@@ -4,29 +4,17 @@
 //! point-sampled rings as the negative control that must fail.
 
 use xylem::math::{Pcg32, Vec3};
-use xylem::wood::{preset, Footprint, Needs, WoodParams, WoodVolume};
+#[path = "common/bare.rs"]
+mod bare;
+
+use bare::rings_only;
+use xylem::wood::{preset, Footprint, Needs, WoodVolume};
 
 const COLOR: Needs = Needs {
     color: true,
     fibers: false,
     bump: false,
 };
-
-/// A preset with everything but the rings (and the 1D growth variation that sets their widths)
-/// switched off, so that the rings are the only feature under the footprint.
-fn rings_only(name: &str) -> WoodParams {
-    let mut p = preset(name).unwrap();
-    p.pores = None;
-    p.rays = None;
-    p.texture = None;
-    p.eyes = None;
-    p.knots = None;
-    p.fibre_wander = None;
-    p.distortion.radial = None;
-    p.distortion.tangential = None;
-    p.distortion.longitudinal = None;
-    p
-}
 
 /// The unfiltered colour averaged over a `w` × `w` square spanned by the unit vectors `u`, `v`
 /// around `c` (32 × 32 midpoints): the supersampled reference.

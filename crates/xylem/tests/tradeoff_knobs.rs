@@ -228,12 +228,25 @@ fn footprint_below_the_smallest_feature_changes_nothing() {
         let p = preset(name).unwrap();
         let f = 0.99 * smallest_feature(&p);
         let v = WoodVolume::new(p, 9).unwrap();
+        let wander = v.params().fibre_wander.is_some();
         for q in sample_points(300, 2) {
-            assert_eq!(
-                v.eval_filtered(q, Needs::ALL, f),
-                v.eval(q, Needs::ALL),
-                "{name} {q}"
-            );
+            let mut filtered = v.eval_filtered(q, Needs::ALL, f);
+            let point = v.eval(q, Needs::ALL);
+            if wander {
+                // The fibre wander has no such size: any footprint averages some of it into the
+                // highlight's width (continuously, from 0; checked in wander_filter.rs).
+                assert!(
+                    filtered.fiber_dir.dot(point.fiber_dir) > 0.999,
+                    "{name} {q}"
+                );
+                assert!(
+                    filtered.highlight_width >= point.highlight_width,
+                    "{name} {q}"
+                );
+                filtered.fiber_dir = point.fiber_dir;
+                filtered.highlight_width = point.highlight_width;
+            }
+            assert_eq!(filtered, point, "{name} {q}");
         }
     }
 }

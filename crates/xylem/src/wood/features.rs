@@ -317,6 +317,9 @@ impl Rays {
 pub struct FibreWander {
     /// Per scale, tilt towards r̂ and towards θ̂ (None: that angle is zero at that scale).
     angles: Vec<[Option<SeededSparse>; 2]>,
+    /// Per scale, the two angles' variances (rad²) and correlation lengths (mm, 1/e lag):
+    /// across the grain and each angle's along it ([`FibreWander::band_limited`]).
+    scales: Vec<WanderSpread>,
     /// Pore deflection strength (fibres pushed out by this × pore radius × mask).
     pub pore_deflection: f32,
 }
@@ -334,12 +337,16 @@ impl FibreWander {
     /// The wander of `p`; `seeds` gives each noise field its own (coarse r, coarse θ, fine r,
     /// fine θ).
     pub fn new(p: &FibreWanderParams, seeds: [u32; 4]) -> Self {
-        let mut angles = vec![Self::scale(&p.coarse(), [seeds[0], seeds[1]])];
+        let coarse = p.coarse();
+        let mut angles = vec![Self::scale(&coarse, [seeds[0], seeds[1]])];
+        let mut scales = vec![Self::variances(&coarse)];
         if let Some(f) = &p.fine {
             angles.push(Self::scale(f, [seeds[2], seeds[3]]));
+            scales.push(Self::variances(f));
         }
         FibreWander {
             angles,
+            scales,
             pore_deflection: p.pore_deflection,
         }
     }
@@ -359,25 +366,90 @@ impl FibreWander {
         ]
     }
 
-    /// The two tilt angles (radians) at `q`: towards r̂ and towards θ̂, kernels along `cyl`
-    /// (the cylindrical frame at `q`).
-    #[inline]
-    pub fn angles(&self, q: Vec3, cyl: &Frame) -> (f32, f32) {
-        let a = |n: &Option<SeededSparse>| {
-            n.as_ref()
-                .map_or(0.0, |n| n.eval_oriented_with::<false>(q, cyl, 1, 1.0).0)
-        };
-        self.angles
-            .iter()
-            .fold((0.0, 0.0), |(r, t), [nr, nt]| (r + a(nr), t + a(nt)))
+    /// One scale's angle variances and correlation lengths.
+    fn variances(p: &WanderScale) -> WanderSpread {
+        WanderSpread {
+            var: [p.radial, p.tangential].map(|deg| deg.to_radians().powi(2)),
+            across: p.across,
+            along: [p.along, p.tangential_along.unwrap_or(p.along)],
+        }
     }
 
-    /// The fibre of `fiber` (s = r̂, t across, n along the fibre) tilted at `q`: n + tan(a_r) s +
-    /// tan(a_t) t, normalised, so its projection on the (s, n) plane makes exactly a_r with n and
-    /// that on the (t, n) plane exactly a_t.
+    /// The wander band-limited by a footprint `footprint` mm wide on a face of tree-space normal
+    /// `normal` (zero: unknown). Each angle a of variance σ² is estimated by its best linear
+    /// predictor from the centre value, C·a, C the centre's mean correlation with the footprint
+    /// ([`centre_correlation`] across and along the grain), and the variance this leaves,
+    /// (1 − C²) σ², is returned as the variance of the fibre's dip out of that face,
+    /// σr² (r̂·n)² + σθ² (θ̂·n)² (both when the face is unknown): the unresolved tilts that widen
+    /// the highlight instead of aliasing it (notes/wood.md §9e). An angle with C² below
+    /// [`FibreWander::NEGLIGIBLE_SHARE`] is not evaluated.
     #[inline]
-    pub fn tilt(&self, q: Vec3, fiber: &Frame) -> Vec3 {
-        let (ar, at) = self.angles(q, &crate::field::cylinder_frame(q));
+    pub fn band_limited(
+        &self,
+        q: Vec3,
+        fiber: &Frame,
+        footprint: f32,
+        normal: Vec3,
+    ) -> (Vec3, f32) {
+        let cyl = crate::field::cylinder_frame(q);
+        let (mut angle, mut lost) = ([0.0f32; 2], [0.0f32; 2]);
+        for (noises, spread) in self.angles.iter().zip(&self.scales) {
+            for k in 0..2 {
+                let Some(n) = &noises[k] else { continue };
+                let share = if footprint > 0.0 {
+                    centre_correlation(footprint / spread.across)
+                        * centre_correlation(footprint / spread.along[k])
+                } else {
+                    1.0
+                };
+                if share * share >= Self::NEGLIGIBLE_SHARE {
+                    let a = n.eval_oriented_with::<false>(q, &cyl, 1, 1.0).0;
+                    angle[k] += if share < 1.0 { share * a } else { a };
+                    lost[k] += (1.0 - share * share) * spread.var[k];
+                } else {
+                    lost[k] += spread.var[k];
+                }
+            }
+        }
+        let dip = if normal == Vec3::ZERO {
+            lost[0] + lost[1]
+        } else {
+            lost[0] * fiber.s.dot(normal).powi(2) + lost[1] * fiber.t.dot(normal).powi(2)
+        };
+        (Self::tilted(fiber, angle[0], angle[1]), dip)
+    }
+
+    /// The share C² of an angle's variance below which its estimate is left out (its standard
+    /// deviation an eighth of the angle's).
+    pub const NEGLIGIBLE_SHARE: f32 = 1.0 / 64.0;
+
+    /// The narrowest footprint (mm) under which every angle of the wander falls below
+    /// [`FibreWander::NEGLIGIBLE_SHARE`] and is no longer evaluated, for the scale `p`.
+    pub fn skipped_from(p: &WanderScale) -> f32 {
+        let s = Self::variances(p);
+        let share = |w: f32| {
+            (centre_correlation(w / s.across) * centre_correlation(w / s.along[0].min(s.along[1])))
+                .powi(2)
+        };
+        // The share falls monotonically with the width: bisect between the across length and
+        // 10⁴ of it.
+        let (mut lo, mut hi) = (s.across, 1e4 * s.across);
+        for _ in 0..60 {
+            let mid = (lo * hi).sqrt();
+            if share(mid) < Self::NEGLIGIBLE_SHARE {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        hi
+    }
+
+    /// The fibre of `fiber` (s = r̂, t across, n along the fibre) tilted by a_r and a_t:
+    /// n + tan(a_r) s + tan(a_t) t, normalised: its projection on the (s, n) plane makes exactly
+    /// a_r with n and that on the (t, n) plane exactly a_t.
+    #[inline]
+    fn tilted(fiber: &Frame, ar: f32, at: f32) -> Vec3 {
         (fiber.n + ar.tan() * fiber.s + at.tan() * fiber.t).normalize()
     }
 
@@ -396,6 +468,29 @@ impl FibreWander {
         }
         (fiber - (self.pore_deflection * radius * dn / len) * across).normalize()
     }
+}
+
+/// One scale of the wander as a footprint sees it.
+#[derive(Clone, Copy, Debug)]
+struct WanderSpread {
+    /// Variances of the tilts towards r̂ and θ̂, rad².
+    var: [f32; 2],
+    /// Correlation length across the grain, mm (1/e lag).
+    across: f32,
+    /// Each tilt's correlation length along the grain, mm.
+    along: [f32; 2],
+}
+
+/// The mean correlation of a field's value at the centre of a segment `u` correlation lengths
+/// long with its values over the segment, for the autocorrelation exp(−d²/ℓ²):
+/// (1/u) ∫ exp(−x²) dx over [−u/2, u/2] = (√π / u) erf(u/2): the factor of the best linear
+/// estimate of the segment's mean from the centre value.
+pub(crate) fn centre_correlation(u: f32) -> f32 {
+    let u = u as f64;
+    if u < 1e-3 {
+        return (1.0 - u * u / 12.0) as f32;
+    }
+    (std::f64::consts::PI.sqrt() / u * statrs::function::erf::erf(0.5 * u)) as f32
 }
 
 /// Zero-mean noise of standard deviation `std` with 1/e correlation lengths (`along`, `across`)

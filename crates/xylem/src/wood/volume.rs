@@ -566,8 +566,10 @@ impl WoodVolume {
         }
         if needs.fibers {
             let mut fiber = frame.n;
+            // The fibres' dip out of the face that the footprint averages (rad²).
+            let mut unresolved_dip = 0.0;
             if let Some(w) = &self.wander {
-                fiber = w.tilt(q, &frame);
+                (fiber, unresolved_dip) = w.band_limited(q, &frame, footprint, fp.normal);
                 if let Some(pores) = self.pores.as_ref().filter(|_| w.pore_deflection > 0.0) {
                     let fade = footprint_weight(pores.diameter, footprint);
                     if fade > 0.0 {
@@ -583,8 +585,16 @@ impl WoodVolume {
             let inv = c.dist.inverse_jacobian();
             texel.fiber_dir = normalize_or(inv * fiber, Vec3::Z);
             texel.ray_dir = normalize_or(inv * frame.s, Vec3::X);
-            // The highlight width is the ring wave between two levels: the same filtered mean.
-            texel.highlight_width = self.highlight.level(g);
+            // The highlight width is the ring wave between two levels: the same filtered mean,
+            // widened by the dip the footprint leaves unresolved: a tilt a moves ψi + ψr by ≈ 2a
+            // (both interior directions near the normal), so g(β, ψi + ψr) averaged over
+            // a ~ N(0, σ²) is g(√(β² + 4σ²), ·) (notes/wood.md §9e).
+            let beta = self.highlight.level(g);
+            texel.highlight_width = if unresolved_dip > 0.0 {
+                (beta * beta + 4.0 * unresolved_dip).sqrt()
+            } else {
+                beta
+            };
         }
         texel
     }
@@ -606,6 +616,14 @@ impl WoodVolume {
         if let Some(t) = &self.texture {
             for (i, across) in t.widths().enumerate() {
                 v.push((["cell texture", "texture streaks"][i.min(1)], 2.0 * across));
+            }
+        }
+        if let Some(w) = &self.params.fibre_wander {
+            // Faded into the highlight's width rather than dropped (FibreWander::band_limited);
+            // the size is half the footprint from which it is not evaluated.
+            v.push(("fibre wander", 0.5 * FibreWander::skipped_from(&w.coarse())));
+            if let Some(f) = &w.fine {
+                v.push(("fine fibre wander", 0.5 * FibreWander::skipped_from(f)));
             }
         }
         v
