@@ -94,7 +94,48 @@ fn reduced_runs_never_overwrite_the_full_results() {
         &["--reduce 50", "allowed 1 to 24", "chi-square"],
     );
     refused(&["validate", "bsdf", "--reduce", "0"], &["allowed 1 to 24"]);
+    refused(
+        &["validate", "aliasing", "--div", "16"],
+        &[&full[..], &["validation/ALIASING.md", "--report"]].concat(),
+    );
+    refused(
+        &[
+            "validate",
+            "aliasing",
+            "--reference-spp",
+            "32",
+            "--report",
+            "a.md",
+        ],
+        &["--reference-spp 32", "at least 4×"],
+    );
     assert!(files(dir).is_empty(), "{:?}", files(dir));
+}
+
+/// `validate aliasing` on one small scene writes its table (the footprint filter against point
+/// sampling, issue 28) and nothing else.
+#[test]
+fn validate_aliasing_writes_its_table() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let args = [
+        "validate",
+        "aliasing",
+        "--scene",
+        "grazing_oak",
+        "--div",
+        "16",
+        "--reference-spp",
+        "64",
+        "--report",
+        "out/A.md",
+    ];
+    let o = xylem(&args, dir);
+    // A missed goal is a failing exit, not an error: the table is written either way.
+    assert!(o.status.code().is_some_and(|c| c <= 1), "{o:?}");
+    let md = std::fs::read_to_string(dir.join("out/A.md")).unwrap();
+    assert!(md.contains("| `grazing_oak` | 16×16, 16 (64) |"), "{md}");
+    assert_eq!(files(dir), ["out/A.md"]);
 }
 
 /// `gallery --quality` renders every scene at the preset's settings (the draft's 4 spp where

@@ -16,8 +16,11 @@
 //!   coherence, dark streaks, rings, fibre-field correlation), measured against preset (issue 25);
 //! - [`report`]: validation/REPORT.md, one replaceable section per suite;
 //! - [`tradeoff`]: error and time of every quality knob (validation/TRADEOFF.md);
+//! - [`aliasing`]: aliasing energy and error at equal time with and without the footprint
+//!   filter (validation/ALIASING.md);
 //! - [`mod@bench`]: the tracing benchmark against obvhs's own traversal and Embree 3.
 
+pub mod aliasing;
 pub mod appearance;
 pub mod bench;
 pub mod bsdf;

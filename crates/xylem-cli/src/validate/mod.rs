@@ -1,7 +1,8 @@
-//! `xylem validate [bsdf|sweep|appearance|fit]`: runs the validation suite; exits non-zero when a check fails.
+//! `xylem validate [bsdf|sweep|appearance|fit|aliasing]`: runs the validation suite; exits non-zero when a check fails.
 
 use std::process::ExitCode;
 
+mod aliasing;
 mod appearance;
 mod bsdf;
 mod fit;
@@ -23,6 +24,9 @@ enum What {
     Appearance(appearance::Args),
     /// `xylem fit` by round trip on known boards → validation/FIT.md.
     Fit(fit::Args),
+    /// The wood scenes with and without the footprint filter: aliasing energy and error at
+    /// equal time → validation/ALIASING.md.
+    Aliasing(aliasing::Args),
 }
 
 /// Writes a report (staged under a unique temporary name, `output::write_atomic`), prints it and
@@ -46,6 +50,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Some(What::Sweep(a)) => sweep::run(a),
         Some(What::Appearance(a)) => appearance::run(a),
         Some(What::Fit(a)) => fit::run(a),
+        Some(What::Aliasing(a)) => aliasing::run(a),
         None => {
             let b = bsdf::run(bsdf::Args::default())?;
             let s = sweep::run(sweep::Args::default())?;

@@ -1,0 +1,85 @@
+//! `xylem validate aliasing`: the wood scenes with and without the footprint filter against a
+//! converged reference → validation/ALIASING.md (aliasing energy, error at equal time; issue 28).
+//! Exits non-zero when a goal is missed.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use xylem_lab::aliasing::{measure, report_md};
+
+/// The built-in scenes with procedural wood, judged by default.
+const SCENES: [&str; 9] = [
+    "sweep_board",
+    "parquet_floor",
+    "box_joint",
+    "dovetail",
+    "cube_carved_vs_veneer",
+    "carved_bunny",
+    "turned_bowl",
+    "teapot",
+    "grazing_oak",
+];
+const DIVISOR: u32 = 4;
+const REFERENCE_SPP: u32 = 256;
+
+#[derive(clap::Args, Debug, Default)]
+pub struct Args {
+    /// Report to write [default: validation/ALIASING.md]; a reduced run (other scenes, divisor
+    /// or reference spp) must name it.
+    #[arg(long)]
+    report: Option<PathBuf>,
+    /// Only these built-in scenes (file stems) [default: every scene with procedural wood].
+    #[arg(long)]
+    scene: Vec<String>,
+    /// Render at 1/N of each scene's size, 1 to 16 [default: 4].
+    #[arg(long)]
+    div: Option<u32>,
+    /// Samples per pixel of the reference (two halves), at least 4× the scene's [default: 256].
+    #[arg(long)]
+    reference_spp: Option<u32>,
+}
+
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let div = args.div.unwrap_or(DIVISOR);
+    anyhow::ensure!((1..=16).contains(&div), "--div {div}: allowed 1 to 16");
+    let reference_spp = args.reference_spp.unwrap_or(REFERENCE_SPP);
+    let scenes: Vec<String> = if args.scene.is_empty() {
+        SCENES.iter().map(|s| s.to_string()).collect()
+    } else {
+        args.scene.clone()
+    };
+    let reduced = (div != DIVISOR || reference_spp != REFERENCE_SPP || !args.scene.is_empty())
+        .then(|| "a run with --scene, --div or --reference-spp".to_string());
+    let report = crate::output_path(args.report, "validation/ALIASING.md", "--report", reduced)?;
+    if let Some(dir) = report.parent().filter(|d| !d.as_os_str().is_empty()) {
+        use anyhow::Context;
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    let run = xylem::render::RunOptions::default();
+    let bar = crate::progress::Steps::new("validate aliasing", scenes.len() as u64, "scenes");
+    let mut rows = Vec::new();
+    for name in &scenes {
+        bar.step(name);
+        let path = Path::new("scenes").join(format!("{name}.toml"));
+        let probe = xylem::scene::load(&path)?;
+        let spp = probe.settings.spp;
+        anyhow::ensure!(
+            reference_spp >= 4 * spp,
+            "--reference-spp {reference_spp}: at least 4× {name}'s {spp} spp"
+        );
+        let (w, h) = (probe.scene.camera.width, probe.scene.camera.height);
+        drop(probe);
+        let base = || -> Result<xylem::scene::LoadedScene, String> {
+            let mut l = xylem::scene::load(&path).map_err(|e| e.to_string())?;
+            l.scene.camera = l
+                .scene
+                .camera
+                .with_resolution((w / div).max(8), (h / div).max(8));
+            Ok(l)
+        };
+        rows.push(measure(name, &base, spp, reference_spp, &run).map_err(anyhow::Error::msg)?);
+    }
+    bar.finish();
+    let command = std::env::args().collect::<Vec<_>>().join(" ");
+    let (md, ok) = report_md(&rows, &command);
+    super::finish_report(&report, &md, ok)
+}
