@@ -3,7 +3,7 @@
 use anyhow::Context;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use xylem::render::image_io::ExrCompression;
+use xylem::picture::exr::ExrCompression;
 use xylem::scene::quality::Quality;
 use xylem::sweep::batch::PrimaryMode;
 use xylem::sweep::job::{run_job, SweepJob};

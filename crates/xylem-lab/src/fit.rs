@@ -20,7 +20,7 @@ use xylem::math::Pcg32;
 use xylem::picture::file::commit;
 use xylem::picture::png::stage_png_rgb8;
 use xylem::picture::srgb::Srgb8;
-use xylem::render::image_io::read_exr_rgb;
+use xylem::picture::Image;
 use xylem::render::RunOptions;
 use xylem::scene;
 use xylem::sweep::job::{run_job, SweepJob};
@@ -385,12 +385,13 @@ pub enum Exposure {
 
 /// The brightest value (any channel) of the frames' pixels that see the board outside the
 /// glint of that frame's light.
-fn wood_peak(src: &Path, frames: &[(usize, usize, Vec<Vec3>)]) -> Result<f32, String> {
+fn wood_peak(src: &Path, frames: &[Image]) -> Result<f32, String> {
     let capture = Capture::open(src).map_err(|e| e.to_string())?;
     let (cam, board) = (&capture.camera, &capture.board);
     let mut peak = 0.0f32;
-    for (f, (w, _, px)) in capture.frames.iter().zip(frames) {
-        for (i, p) in px.iter().enumerate() {
+    for (f, img) in capture.frames.iter().zip(frames) {
+        let w = img.width as usize;
+        for (i, p) in img.pixels.iter().enumerate() {
             let (x, y) = ((i % w) as f32 + 0.5, (i / w) as f32 + 0.5);
             let (o, d) = cam.ray(x, y);
             let Some(q) = board.hit(o, d) else { continue };
@@ -418,24 +419,23 @@ pub fn to_camera_frames(
     let text =
         xylem::sweep::manifest::read_text(&src.join(MANIFEST_FILE)).map_err(|e| e.to_string())?;
     let mut m: Manifest = serde_json::from_str(&text).map_err(|e| e.to_string())?;
-    let frames: Vec<(usize, usize, Vec<Vec3>)> = m
+    let frames: Vec<Image> = m
         .frames
         .iter()
-        .map(|f| read_exr_rgb(&src.join(&f.image)).map_err(|e| e.to_string()))
+        .map(|f| Image::read(&src.join(&f.image)).map_err(|e| e.to_string()))
         .collect::<Result<_, _>>()?;
     let peak = match exposure {
         Exposure::Wood => wood_peak(src, &frames)?,
         Exposure::BrightestPixel => frames
             .iter()
-            .flat_map(|f| f.2.iter().map(|p| p.max_element()))
+            .flat_map(|f| f.pixels.iter().map(|p| p.max_element()))
             .fold(0.0f32, f32::max),
     };
     let exposure = 0.9 / peak.max(1e-12);
     let enc = Srgb8::new();
-    for (k, (f, (w, h, px))) in m.frames.iter_mut().zip(&frames).enumerate() {
+    for (k, (f, img)) in m.frames.iter_mut().zip(&frames).enumerate() {
         let mut rng = Pcg32::new(seed, k as u64);
-        let bytes: Vec<u8> = px
-            .iter()
+        let bytes: Vec<u8> = (img.pixels.iter())
             .flat_map(|p| (*p * exposure).to_array())
             .map(|v| {
                 let v = match full_well {
@@ -453,7 +453,7 @@ pub fn to_camera_frames(
             .collect();
         let name = format!("frame_{k:04}.png");
         commit(
-            stage_png_rgb8(&dst.join(&name), *w as u32, *h as u32, &bytes)
+            stage_png_rgb8(&dst.join(&name), img.width, img.height, &bytes)
                 .map_err(|e| e.to_string())?,
         )
         .map_err(|e| e.to_string())?;
@@ -531,8 +531,9 @@ fn plot_png(
 }
 
 /// Fitted and true maps side by side (diffuse, fibre colour, axis as colour), 2× enlarged.
-fn side_by_side(truth: &MeasuredBoard, fitted: &FittedMaps) -> xylem::picture::contact::Rgb8 {
-    use xylem::picture::contact::{contact_sheet_rows, Rgb8};
+fn side_by_side(truth: &MeasuredBoard, fitted: &FittedMaps) -> xylem::picture::Rgb8 {
+    use xylem::picture::contact::contact_sheet_rows;
+    use xylem::picture::Rgb8;
     let n = truth.width;
     let img = |v: &[Vec3], f: &dyn Fn(Vec3) -> Vec3| Rgb8 {
         width: n,
@@ -776,7 +777,8 @@ pub fn readme_figure(
     spec: &SweepSpec,
     path: &Path,
 ) -> Result<(), String> {
-    use xylem::picture::contact::{contact_sheet_rows, Rgb8};
+    use xylem::picture::contact::contact_sheet_rows;
+    use xylem::picture::Rgb8;
     let w = work.join("readme");
     let source = Source::Measured {
         dir: "data/marschner2005/maple".into(),
@@ -801,12 +803,8 @@ pub fn readme_figure(
             ..SweepJob::default()
         };
         run_job(&loaded, &job).map_err(|e| e.to_string())?;
-        let (fw, fh, px) = read_exr_rgb(&out.join("frame_0003.exr")).map_err(|e| e.to_string())?;
-        Ok(Rgb8 {
-            width: fw as u32,
-            height: fh as u32,
-            data: xylem::picture::srgb::to_srgb8(&px, 0.0),
-        })
+        let img = Image::read(&out.join("frame_0003.exr")).map_err(|e| e.to_string())?;
+        Ok(img.to_rgb8(0.0))
     };
     let measured = frame(&w.join("truth"), &w.join("render_truth"))?;
     let refit = frame(&fit_dir, &w.join("render_fit"))?;

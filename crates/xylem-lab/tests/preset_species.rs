@@ -57,19 +57,10 @@ fn lum(c: Vec3) -> f64 {
     xylem::math::luminance(c) as f64
 }
 
-fn srgb(x: f64) -> f64 {
-    let x = x.clamp(0.0, 1.0);
-    if x <= 0.003_130_8 {
-        12.92 * x
-    } else {
-        1.055 * x.powf(1.0 / 2.4) - 0.055
-    }
-}
-
 /// HSV hue (degrees) and saturation of a linear colour, taken on its sRGB encoding (the hue a
 /// woodworker names: 0 red, 30 orange-brown, 60 yellow).
 fn hue_sat(c: Vec3) -> (f64, f64) {
-    let [r, g, b] = [c.x, c.y, c.z].map(|v| srgb(v as f64));
+    let [r, g, b] = [c.x, c.y, c.z].map(|v| xylem::picture::srgb::linear_to_srgb(v) as f64);
     let (mx, mn) = (r.max(g).max(b), r.min(g).min(b));
     let d = mx - mn;
     let h = if d <= 0.0 {

@@ -3,7 +3,8 @@
 //! axis titles beside them and a legend of the labelled series in the top-right corner. Longer
 //! captions live in the Markdown that embeds the plot.
 
-use super::contact::{draw_label, Rgb8};
+use super::contact::draw_label;
+use super::image::Rgb8;
 
 /// One curve of a plot.
 #[derive(Clone, Debug)]

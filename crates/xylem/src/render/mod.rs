@@ -65,7 +65,7 @@ pub struct RenderSettings {
 impl RenderSettings {
     /// The EXR header attributes that say how an image of `scene` (its name and file) seen by
     /// `camera` was made: scene, file, spp, seed, integrator and camera (the software attribute
-    /// carries xylem's version; [`image_io::stage_exr_layers`]). Camera axes as [`Camera`] has
+    /// carries xylem's version; [`crate::picture::exr::stage_exr_layers`]). Camera axes as [`Camera`] has
     /// them: right, up and view direction; lengths in mm.
     pub fn exr_meta(
         &self,

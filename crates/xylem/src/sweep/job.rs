@@ -13,12 +13,11 @@ use super::sequence::{
     AssembleOptions, Assembled, FrameRecord, Region, SequenceError, SweepSettings,
 };
 use crate::output::{remove_if_present, FolderLock, LockError, LockMode};
+use crate::picture::exr::{stage_exr_layers, write_exr_layers, ExrCompression, ExrLayer};
 use crate::picture::file::commit;
 use crate::picture::png::stage_png_linear;
 use crate::picture::ImageError;
-use crate::render::image_io::{
-    aov_layers, beauty_rgba, stage_exr_layers, write_exr_layers, ExrCompression, ExrLayer,
-};
+use crate::render::image_io::{aov_layers, beauty_rgba};
 use crate::render::resources::{ResourceError, Resources};
 use crate::render::{render_frames_reusing, Frames, Primaries};
 use crate::render::{RenderError, RunOptions};

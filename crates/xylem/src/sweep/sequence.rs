@@ -7,11 +7,13 @@ use super::path::MAX_FRAMES;
 use super::viewer::viewer_html;
 use crate::math::{luminance, Vec3};
 use crate::output::{remove_if_present, write_atomic};
-use crate::picture::contact::{sheet_band, sheet_columns, shrunk_size, Rgb8};
+use crate::picture::contact::{sheet_band, sheet_columns};
+use crate::picture::image::shrunk_size;
 use crate::picture::png::{
     read_png_rgb8_checked, write_apng_streamed, write_png_bands, write_png_linear,
 };
 use crate::picture::ImageError;
+use crate::picture::Rgb8;
 use crate::render::resources::read_text_bounded;
 use serde::{Deserialize, Serialize};
 use std::ops::Range;
