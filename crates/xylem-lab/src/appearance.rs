@@ -1158,6 +1158,23 @@ fn pair_section(r: &PairReport, dir: &Path, sweep: SweepSettings) -> Result<Stri
         sweep.res,
         sweep.spp
     );
+    md += &pair_tables(r);
+    pair_plots(r, dir)?;
+    md += &format!(
+        "\nBlue: preset, red: measured. Fibre dip histogram (−20…20°), dip profile along the \
+         grain (mean over the width, position 0…1), chatoyance histogram (1…12):\n\n\
+         ![dips](plots/appearance_{tag}_dips.png) ![profile](plots/appearance_{tag}_dip_profile.png) \
+         ![chatoyance](plots/appearance_{tag}_chatoyance.png)\n\n\
+         Sweep frames at −40°, 0° and +40°, preset (top) and measured board (bottom), same cut, \
+         same light, one exposure:\n\n![frames](plots/appearance_{tag}_frames.png)\n"
+    );
+    Ok(md)
+}
+
+/// The tables of a pair's section: the board rows and the pattern rows, with how many pass,
+/// and the rows not reached.
+fn pair_tables(r: &PairReport) -> String {
+    let mut md = String::new();
     md += &comparison_table("statistic", &r.rows);
     let by_leg = r.rows.iter().filter(|c| c.passes() && !c.in_band()).count();
     md += &format!(
@@ -1186,6 +1203,13 @@ fn pair_section(r: &PairReport, dir: &Path, sweep: SweepSettings) -> Result<Stri
             md += &format!("- **{}**\n", c.name);
         }
     }
+    md
+}
+
+/// The plots of a pair's section (written into `dir/plots/`): fibre dips, the dip profile and
+/// chatoyance, preset against measured, and the side-by-side sweep frames.
+fn pair_plots(r: &PairReport, dir: &Path) -> Result<(), String> {
+    let tag = r.pair.preset_name();
     let dips =
         |m: &BoardMaps| -> Vec<f64> { (0..m.board.diffuse.len()).map(|i| m.dip_deg(i)).collect() };
     // Preset (blue) against measured (red), one plot per statistic.
@@ -1234,15 +1258,7 @@ fn pair_section(r: &PairReport, dir: &Path, sweep: SweepSettings) -> Result<Stri
         &format!("plots/appearance_{tag}_frames.png"),
         &side_by_side(r),
     )?;
-    md += &format!(
-        "\nBlue: preset, red: measured. Fibre dip histogram (−20…20°), dip profile along the \
-         grain (mean over the width, position 0…1), chatoyance histogram (1…12):\n\n\
-         ![dips](plots/appearance_{tag}_dips.png) ![profile](plots/appearance_{tag}_dip_profile.png) \
-         ![chatoyance](plots/appearance_{tag}_chatoyance.png)\n\n\
-         Sweep frames at −40°, 0° and +40°, preset (top) and measured board (bottom), same cut, \
-         same light, one exposure:\n\n![frames](plots/appearance_{tag}_frames.png)\n"
-    );
-    Ok(md)
+    Ok(())
 }
 
 /// Trees (seeds) of each preset the generalisation check compares, besides the report's seed 7.
@@ -1335,36 +1351,73 @@ pub fn run_report(
     let mut ok = true;
     if builtin {
         progress("white light");
-        md += "## Rendered brightness follows the albedo (uniform white environment)\n\n\
-                Each preset's showcase board (the gallery's cut), 200 × 100 mm at 1 mm pixels, \
-                16 spp, smooth finish η 1.5, under a uniform white environment: Pearson \
-                correlation of rendered luminance with the preset's diffuse-albedo luminance \
-                over the pixels, and the mean rendered luminance of the palest and darkest thirds \
-                of the pixels by albedo. Criterion: correlation > 0 and the palest third renders \
-                paler.\n\n";
-        let mut rows = Vec::new();
-        for name in xylem::wood::PRESET_NAMES {
-            let w = white_light_ring_order(name, 16)?;
-            ok &= w.keeps_order();
-            rows.push(vec![
-                name.to_string(),
-                format!("{:.3}", w.correlation),
-                format!("{:.4}", w.pale_third),
-                format!("{:.4}", w.dark_third),
-                if w.keeps_order() { "pass" } else { "FAIL" }.into(),
-            ]);
-        }
-        md += &markdown_table(
-            &[
-                "preset",
-                "correlation",
-                "palest third",
-                "darkest third",
-                "result",
-            ],
-            &rows,
-        );
+        let (section, passed) = white_light_section()?;
+        (md, ok) = (md + &section, ok && passed);
     }
+    let (section, passed) = pairs_section(pairs, base, preset_dir, dir, sweep, progress)?;
+    (md, ok) = (md + &section, ok && passed);
+    if builtin {
+        progress("other trees");
+        md += &generalisation_section(pairs, base, preset_dir, sweep)?;
+        progress("walnut");
+        let (section, passed) = walnut_section(base, preset_dir)?;
+        (md, ok) = (md + &section, ok && passed);
+        progress("preset sheet");
+        md += &preset_sheet_section(base, preset_dir, dir, sweep)?;
+    }
+    md += &format!("\nOverall: **{}**.\n", if ok { "PASS" } else { "FAIL" });
+    Ok((md, ok))
+}
+
+/// The white-light check of every preset: rendered brightness follows the albedo. Returns its
+/// Markdown and whether every preset passed.
+fn white_light_section() -> Result<(String, bool), String> {
+    let mut ok = true;
+    let mut md = String::new();
+    md += "## Rendered brightness follows the albedo (uniform white environment)\n\n\
+            Each preset's showcase board (the gallery's cut), 200 × 100 mm at 1 mm pixels, \
+            16 spp, smooth finish η 1.5, under a uniform white environment: Pearson \
+            correlation of rendered luminance with the preset's diffuse-albedo luminance \
+            over the pixels, and the mean rendered luminance of the palest and darkest thirds \
+            of the pixels by albedo. Criterion: correlation > 0 and the palest third renders \
+            paler.\n\n";
+    let mut rows = Vec::new();
+    for name in xylem::wood::PRESET_NAMES {
+        let w = white_light_ring_order(name, 16)?;
+        ok &= w.keeps_order();
+        rows.push(vec![
+            name.to_string(),
+            format!("{:.3}", w.correlation),
+            format!("{:.4}", w.pale_third),
+            format!("{:.4}", w.dark_third),
+            if w.keeps_order() { "pass" } else { "FAIL" }.into(),
+        ]);
+    }
+    md += &markdown_table(
+        &[
+            "preset",
+            "correlation",
+            "palest third",
+            "darkest third",
+            "result",
+        ],
+        &rows,
+    );
+    Ok((md, ok))
+}
+
+/// Each pair's section ([`pair_section`]) and the share of rows passing only by the 25 % leg.
+/// Returns the Markdown and whether every pair passed.
+fn pairs_section(
+    pairs: &[Pair],
+    base: &Path,
+    preset_dir: Option<&Path>,
+    dir: &Path,
+    sweep: SweepSettings,
+    progress: &dyn Fn(&str),
+) -> Result<(String, bool), String> {
+    let mut ok = true;
+    let mut md = String::new();
     let (mut rows, mut by_leg) = (0, 0);
     for pair in pairs {
         progress(&pair.preset);
@@ -1384,45 +1437,51 @@ pub fn run_report(
             if leg_ok { "pass" } else { "FAIL" }
         );
     }
-    if builtin {
-        progress("other trees");
-        md += &generalisation_section(pairs, base, preset_dir, sweep)?;
-        progress("walnut");
-        let w = walnut_character(base, preset_dir)?;
-        ok &= w.passes();
-        md += &format!(
-            "\n## `walnut` against its published character\n\n\
-             Chocolate brown (chromaticity r > g > b), much darker than maple (mean diffuse \
-             luminance < 0.5 × curly maple's), and varying more in lightness than in hue \
-             (coefficient of variation of luminance above that of chromaticity r), as measured on \
-             black walnut veneer by Phelps et al. and Nelson et al. (Wood and Fiber Science; \
-             sources in notes/presets.md).\n\n\
-             | chromaticity r, g, b | luminance / maple's | CV luminance | CV chromaticity r | result |\n\
-             | --- | --- | --- | --- | --- |\n\
-             | {:.3}, {:.3}, {:.3} | {:.3} | {:.3} | {:.3} | {} |\n",
-            w.chromaticity[0],
-            w.chromaticity[1],
-            w.chromaticity[2],
-            w.luminance_vs_maple,
-            w.luminance_cv,
-            w.hue_cv,
-            if w.passes() { "pass" } else { "FAIL" }
-        );
-        progress("preset sheet");
-        let sheet = preset_sheet(base, preset_dir, sweep.res, sweep.spp)?;
-        write_png(dir, "plots/appearance_presets.png", &sheet)?;
-        md += &format!(
-            "\n## Every preset on true cuts\n\n\
-             Each preset (rows) flat-sawn (face tangential to the rings, sloped {:.0}° along the \
-             grain) and quartersawn (face radial), {:.0} mm from the pith, 97.5 mm square, seen \
-             straight down under a distant light at −40°, 0° and +40° along the grain, one \
-             exposure:\n\n![presets](plots/appearance_presets.png)\n",
-            xylem::wood::SHOWCASE_SLOPE_DEG,
-            xylem::wood::SHOWCASE_PITH_DISTANCE_MM
-        );
-    }
-    md += &format!("\nOverall: **{}**.\n", if ok { "PASS" } else { "FAIL" });
     Ok((md, ok))
+}
+
+/// Walnut against its published character. Returns the Markdown and whether it passed.
+fn walnut_section(base: &Path, preset_dir: Option<&Path>) -> Result<(String, bool), String> {
+    let w = walnut_character(base, preset_dir)?;
+    let md = format!(
+        "\n## `walnut` against its published character\n\n\
+         Chocolate brown (chromaticity r > g > b), much darker than maple (mean diffuse \
+         luminance < 0.5 × curly maple's), and varying more in lightness than in hue \
+         (coefficient of variation of luminance above that of chromaticity r), as measured on \
+         black walnut veneer by Phelps et al. and Nelson et al. (Wood and Fiber Science; \
+         sources in notes/presets.md).\n\n\
+         | chromaticity r, g, b | luminance / maple's | CV luminance | CV chromaticity r | result |\n\
+         | --- | --- | --- | --- | --- |\n\
+         | {:.3}, {:.3}, {:.3} | {:.3} | {:.3} | {:.3} | {} |\n",
+        w.chromaticity[0],
+        w.chromaticity[1],
+        w.chromaticity[2],
+        w.luminance_vs_maple,
+        w.luminance_cv,
+        w.hue_cv,
+        if w.passes() { "pass" } else { "FAIL" }
+    );
+    Ok((md, w.passes()))
+}
+
+/// Every preset on true cuts: the sheet (written to `dir/plots/`) and its Markdown.
+fn preset_sheet_section(
+    base: &Path,
+    preset_dir: Option<&Path>,
+    dir: &Path,
+    sweep: SweepSettings,
+) -> Result<String, String> {
+    let sheet = preset_sheet(base, preset_dir, sweep.res, sweep.spp)?;
+    write_png(dir, "plots/appearance_presets.png", &sheet)?;
+    Ok(format!(
+        "\n## Every preset on true cuts\n\n\
+         Each preset (rows) flat-sawn (face tangential to the rings, sloped {:.0}° along the \
+         grain) and quartersawn (face radial), {:.0} mm from the pith, 97.5 mm square, seen \
+         straight down under a distant light at −40°, 0° and +40° along the grain, one \
+         exposure:\n\n![presets](plots/appearance_presets.png)\n",
+        xylem::wood::SHOWCASE_SLOPE_DEG,
+        xylem::wood::SHOWCASE_PITH_DISTANCE_MM
+    ))
 }
 
 /// What [`detect_board`] reads from a measured board's maps.

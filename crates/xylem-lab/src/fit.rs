@@ -584,7 +584,6 @@ pub fn run_report(
     progress: &dyn Fn(&str),
 ) -> Result<(String, bool), String> {
     use crate::report::markdown_table;
-    use xylem::picture::plot::{Series, PALETTE};
     let plots = dir.join("plots");
     std::fs::create_dir_all(&plots).map_err(|e| format!("{}: {e}", plots.display()))?;
     let header = [
@@ -600,70 +599,187 @@ pub fn run_report(
     ];
     let mut rows = Vec::new();
     let mut all_ok = true;
-    let (mut frames_curve, mut arcs_curve, mut noise_curve) = (Vec::new(), Vec::new(), Vec::new());
-    let per_arc = spec.frames_per_arc;
-    let arcs = spec.azimuths_deg.len();
+    let mut curves = Curves::default();
     for (k, (name, source)) in sources().into_iter().enumerate() {
         progress(name);
         let w = work.join(format!("board{k}"));
         let rt = render_round_trip(&source, spec, base, &w)?;
-        let (e, maps, t) = fit_and_compare(&rt.sweep_dir, None, true, &rt)?;
-        let ok = e.meets(&GOALS);
+        let (board_rows, ok) = board_rows(name, &rt, &w, spec, &plots)?;
+        rows.extend(board_rows);
         all_ok &= ok;
-        let mut row = vec![name.to_string(), format!("EXR, {} spp", spec.spp)];
+        curves.add(name, &rt, &w, spec)?;
+    }
+    progress("re-render");
+    readme_figure(base, work, spec, &plots.join(README_FIGURE))?;
+    let mut md = report_intro(spec);
+    md += &markdown_table(&header, &rows);
+    md += &format!(
+        "\n**All goals {}.**\n\n",
+        if all_ok { "met" } else { "NOT met" }
+    );
+    md += &curves.section(&plots)?;
+    md += &maps_section();
+    Ok((md, all_ok))
+}
+
+/// A board's two rows of FIT.md's table, the EXR capture's and the camera PNG's, and whether
+/// both met the goals; writes the board's maps, truth over fit, to `plots/`.
+fn board_rows(
+    name: &str,
+    rt: &RoundTrip,
+    w: &Path,
+    spec: &SweepSpec,
+    plots: &Path,
+) -> Result<(Vec<Vec<String>>, bool), String> {
+    let row = |capture: String, e: &FitErrors, t: f64, ok: bool| {
+        let mut row = vec![name.to_string(), capture];
         row.extend(e.cells());
         row.push(format!("{t:.2}"));
         row.push(if ok { "met" } else { "**missed**" }.into());
-        rows.push(row);
-        let sheet = side_by_side(&rt.truth, &maps);
-        let file = format!("fit_{}.png", name.replace(' ', "_"));
-        xylem::picture::png::write_png_rgb8(
-            &plots.join(&file),
-            sheet.width,
-            sheet.height,
-            &sheet.data,
-        )
+        row
+    };
+    let (e, maps, t) = fit_and_compare(&rt.sweep_dir, None, true, rt)?;
+    let exr_ok = e.meets(&GOALS);
+    let exr_row = row(format!("EXR, {} spp", spec.spp), &e, t, exr_ok);
+    let sheet = side_by_side(&rt.truth, &maps);
+    let file = format!("fit_{}.png", name.replace(' ', "_"));
+    xylem::picture::png::write_png_rgb8(&plots.join(&file), sheet.width, sheet.height, &sheet.data)
         .map_err(|e| e.to_string())?;
-        let png = w.join("camera");
-        to_camera_frames(&rt.sweep_dir, &png, Some(FULL_WELL), 17, Exposure::Wood)?;
-        let (e, _, t) = fit_and_compare(&png, None, true, &rt)?;
-        let ok = e.meets(&GOALS);
-        all_ok &= ok;
-        let mut row = vec![
-            name.to_string(),
-            format!("8-bit sRGB PNG, shot noise {FULL_WELL} e⁻"),
-        ];
-        row.extend(e.cells());
-        row.push(format!("{t:.2}"));
-        row.push(if ok { "met" } else { "**missed**" }.into());
-        rows.push(row);
-        // Curves: fewer frames per arc, fewer arcs, more noise.
+    let png = w.join("camera");
+    to_camera_frames(&rt.sweep_dir, &png, Some(FULL_WELL), 17, Exposure::Wood)?;
+    let (e, _, t) = fit_and_compare(&png, None, true, rt)?;
+    let png_ok = e.meets(&GOALS);
+    let capture = format!("8-bit sRGB PNG, shot noise {FULL_WELL} e⁻");
+    let png_row = row(capture, &e, t, png_ok);
+    Ok((vec![exr_row, png_row], exr_ok && png_ok))
+}
+
+/// One board's errors along a curve: (abscissa, errors) per point.
+type Curve<'a> = (&'a str, Vec<(f64, FitErrors)>);
+
+/// How the errors grow: each board's curves over fewer frames, fewer arcs and more noise.
+#[derive(Default)]
+struct Curves<'a> {
+    frames: Vec<Curve<'a>>,
+    arcs: Vec<Curve<'a>>,
+    noise: Vec<Curve<'a>>,
+}
+
+impl<'a> Curves<'a> {
+    /// Fits board `name`'s round trip again with fewer frames per arc, fewer arcs, and as
+    /// camera frames of smaller full wells (written under `w`).
+    fn add(
+        &mut self,
+        name: &'a str,
+        rt: &RoundTrip,
+        w: &Path,
+        spec: &SweepSpec,
+    ) -> Result<(), String> {
+        let per_arc = spec.frames_per_arc;
+        let arcs = spec.azimuths_deg.len();
         let mut fc = Vec::new();
         for stride in [1usize, 2, 4, 8] {
             let keep = frame_selection(per_arc, arcs, stride);
-            let (e, _, _) = fit_and_compare(&rt.sweep_dir, Some(&keep), true, &rt)?;
+            let (e, _, _) = fit_and_compare(&rt.sweep_dir, Some(&keep), true, rt)?;
             fc.push((keep.len() as f64, e));
         }
-        frames_curve.push((name, fc));
+        self.frames.push((name, fc));
         let mut ac = Vec::new();
         for use_arcs in 1..=arcs {
             let keep = frame_selection(per_arc, use_arcs, 1);
-            let (e, _, _) = fit_and_compare(&rt.sweep_dir, Some(&keep), false, &rt)?;
+            let (e, _, _) = fit_and_compare(&rt.sweep_dir, Some(&keep), false, rt)?;
             ac.push((use_arcs as f64, e));
         }
-        arcs_curve.push((name, ac));
+        self.arcs.push((name, ac));
         let mut nc = Vec::new();
         for fw in [16000.0f32, 4000.0, 1000.0, 250.0] {
             let d = w.join(format!("noise{fw}"));
             to_camera_frames(&rt.sweep_dir, &d, Some(fw), 23, Exposure::Wood)?;
-            let (e, _, _) = fit_and_compare(&d, None, true, &rt)?;
+            let (e, _, _) = fit_and_compare(&d, None, true, rt)?;
             nc.push((fw as f64, e));
         }
-        noise_curve.push((name, nc));
+        self.noise.push((name, nc));
+        Ok(())
     }
-    progress("re-render");
-    readme_figure(base, work, spec, &plots.join(README_FIGURE))?;
-    let mut md = format!(
+
+    /// FIT.md's "How the errors grow": a table and a plot (written to `plots/`) per curve.
+    fn section(&self, plots: &Path) -> Result<String, String> {
+        curve_plot(plots, "fit_frames.png", &self.frames, true)?;
+        curve_plot(plots, "fit_arcs.png", &self.arcs, false)?;
+        curve_plot(plots, "fit_noise.png", &self.noise, true)?;
+        let mut md = String::from(
+            "## How the errors grow\n\nPlots: fibre-axis p90 (degrees) against the abscissa, one line per board in the table's order \
+             (colours: the plot palette's first four).\n\n",
+        );
+        md += &curve_table(
+            "Fewer frames (every arc, every 1st/2nd/4th/8th frame; EXR)",
+            "frames",
+            &self.frames,
+        );
+        md += "\n![axis p90 against frames](plots/fit_frames.png)\n\n";
+        md += &curve_table(
+            "Fewer arcs (the first N arcs of 0°, 60°, 120°, every frame; EXR). `xylem fit` refuses fewer than 3 (notes/fit.md §3); fitted here without that check to show why",
+            "arcs",
+            &self.arcs,
+        );
+        md += "\n![axis p90 against arcs](plots/fit_arcs.png)\n\n";
+        md += &curve_table(
+            "More noise (8-bit sRGB PNG, full well in electrons at full scale; fewer = noisier)",
+            "full well (e⁻)",
+            &self.noise,
+        );
+        md += "\n![axis p90 against full well](plots/fit_noise.png)\n\n";
+        Ok(md)
+    }
+}
+
+/// A curve's Markdown table: a row per board and abscissa `xname`.
+fn curve_table(title: &str, xname: &str, c: &[Curve]) -> String {
+    let mut s = format!("### {title}\n\n");
+    let mut rows = Vec::new();
+    for (name, pts) in c {
+        for (x, e) in pts {
+            let mut r = vec![name.to_string(), format!("{x}")];
+            r.extend(e.cells());
+            rows.push(r);
+        }
+    }
+    s += &crate::report::markdown_table(
+        &[
+            "board",
+            xname,
+            "axis median",
+            "axis p90",
+            "diffuse median",
+            "fibre colour median",
+            "β median",
+        ],
+        &rows,
+    );
+    s
+}
+
+/// A curve's plot, fibre-axis p90 against the abscissa, a line per board, as `plots/file`.
+fn curve_plot(plots: &Path, file: &str, c: &[Curve], log_x: bool) -> Result<(), String> {
+    use xylem::picture::plot::{Series, PALETTE};
+    let series: Vec<Series> = c
+        .iter()
+        .enumerate()
+        .map(|(i, (name, pts))| Series {
+            points: pts.iter().map(|(x, e)| (*x, e.axis_p90_deg)).collect(),
+            color: PALETTE[i % PALETTE.len()],
+            markers: true,
+            label: name.to_string(),
+        })
+        .collect();
+    plot_png(plots, file, &series, log_x)
+}
+
+/// FIT.md's opening: what was rendered and fitted, and the goals.
+fn report_intro(spec: &SweepSpec) -> String {
+    let per_arc = spec.frames_per_arc;
+    let arcs = spec.azimuths_deg.len();
+    format!(
         "# Fit validation: per-texel fibre-BSDF parameters measured back from light sweeps\n\n\
          Written by `cargo run --release -- validate fit` (crates/xylem-lab/src/fit.rs; derivations in \
          notes/fit.md). Each board — {n}×{n} texels of 0.25 mm, the centre crop of Marschner et \
@@ -686,73 +802,15 @@ pub fn run_report(
         r = spec.light_radius_mm,
         px = spec.px_per_texel,
         fw = FULL_WELL,
+    )
+}
+
+/// FIT.md's closing sections: each board's maps, and the README's figure.
+fn maps_section() -> String {
+    let mut md = String::from(
+        "## Maps: truth (top) and fit (bottom)\n\n\
+         Diffuse, fibre colour (×3) and fibre axis ((u + 1)/2 as RGB), EXR capture.\n\n",
     );
-    md += &markdown_table(&header, &rows);
-    md += &format!(
-        "\n**All goals {}.**\n\n",
-        if all_ok { "met" } else { "NOT met" }
-    );
-    let curve_table = |title: &str, xname: &str, c: &[(&str, Vec<(f64, FitErrors)>)]| {
-        let mut s = format!("### {title}\n\n");
-        let mut rows = Vec::new();
-        for (name, pts) in c {
-            for (x, e) in pts {
-                let mut r = vec![name.to_string(), format!("{x}")];
-                r.extend(e.cells());
-                rows.push(r);
-            }
-        }
-        s += &markdown_table(
-            &[
-                "board",
-                xname,
-                "axis median",
-                "axis p90",
-                "diffuse median",
-                "fibre colour median",
-                "β median",
-            ],
-            &rows,
-        );
-        s
-    };
-    let plot = |file: &str, c: &[(&str, Vec<(f64, FitErrors)>)], log_x: bool| {
-        let series: Vec<Series> = c
-            .iter()
-            .enumerate()
-            .map(|(i, (name, pts))| Series {
-                points: pts.iter().map(|(x, e)| (*x, e.axis_p90_deg)).collect(),
-                color: PALETTE[i % PALETTE.len()],
-                markers: true,
-                label: name.to_string(),
-            })
-            .collect();
-        plot_png(&plots, file, &series, log_x)
-    };
-    plot("fit_frames.png", &frames_curve, true)?;
-    plot("fit_arcs.png", &arcs_curve, false)?;
-    plot("fit_noise.png", &noise_curve, true)?;
-    md += "## How the errors grow\n\nPlots: fibre-axis p90 (degrees) against the abscissa, one line per board in the table's order \
-           (colours: the plot palette's first four).\n\n";
-    md += &curve_table(
-        "Fewer frames (every arc, every 1st/2nd/4th/8th frame; EXR)",
-        "frames",
-        &frames_curve,
-    );
-    md += "\n![axis p90 against frames](plots/fit_frames.png)\n\n";
-    md += &curve_table(
-        "Fewer arcs (the first N arcs of 0°, 60°, 120°, every frame; EXR). `xylem fit` refuses fewer than 3 (notes/fit.md §3); fitted here without that check to show why",
-        "arcs",
-        &arcs_curve,
-    );
-    md += "\n![axis p90 against arcs](plots/fit_arcs.png)\n\n";
-    md += &curve_table(
-        "More noise (8-bit sRGB PNG, full well in electrons at full scale; fewer = noisier)",
-        "full well (e⁻)",
-        &noise_curve,
-    );
-    md += "\n![axis p90 against full well](plots/fit_noise.png)\n\n## Maps: truth (top) and fit (bottom)\n\n\
-           Diffuse, fibre colour (×3) and fibre axis ((u + 1)/2 as RGB), EXR capture.\n\n";
     for (name, _) in sources() {
         md += &format!(
             "{name}:\n\n![{name}](plots/fit_{}.png)\n\n",
@@ -762,7 +820,7 @@ pub fn run_report(
     md += &format!(
         "## The README's figure\n\nThe measured maple crop rendered (light 20° from the zenith along the grain), its fitted maps (diffuse, fibre colour, axis) and the fit re-rendered under the same light.\n\n![measured maple, fitted maps, re-rendered fit](plots/{README_FIGURE})\n"
     );
-    Ok((md, all_ok))
+    md
 }
 
 /// The README's figure of the fit, written beside the report's plots (`plots/fit_maple.png`).

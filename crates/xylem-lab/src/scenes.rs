@@ -860,151 +860,27 @@ pub fn measure(
     companion: Option<&Image>,
     exposure: f32,
 ) -> Vec<Measure> {
-    let hits = pixel_hits(scene);
-    let on = |objs: &[&str]| mask(&hits, &objects(names, objs), None);
-    let fig = |what: &str, objs: &[&str]| Measure {
-        what: format!("{what} local contrast"),
-        value: figure_contrast(img, &on(objs)),
-        limit: Limit::AtLeast(VISIBLE_FIGURE),
-    };
-    let lit = |what: &str, objs: &[&str]| Measure {
-        what: format!("{what} median sRGB"),
-        value: median_srgb(img, &on(objs), exposure),
-        limit: Limit::AtLeast(LIT_SRGB),
-    };
-    let rings = |objs: &[&str]| -> Vec<Measure> {
-        (objs.iter())
-            .flat_map(|o| visible(&format!("{o} rings"), &ring_contrast(img, &on(&[o]))))
-            .collect()
+    let s = Subject {
+        scene,
+        names,
+        img,
+        hits: pixel_hits(scene),
+        companion,
+        exposure,
     };
     match name {
-        "cornell_box" => {
-            let white = mask(
-                &hits,
-                &objects(
-                    names,
-                    &["floor", "ceiling", "back", "short_box", "tall_box"],
-                ),
-                None,
-            );
-            let expected = scene.lights.iter().find_map(|l| match l {
-                Light::Rect(r) => Some(r.radiance),
-                Light::Point(_)
-                | Light::Spot(_)
-                | Light::Distant(_)
-                | Light::Sphere(_)
-                | Light::Environment(_) => None,
-            });
-            vec![
-                Measure {
-                    what: "light seen directly, largest |mean / (radiance × color) − 1|".into(),
-                    value: expected.map_or(f64::INFINITY, |e| light_error(scene, img, &hits, e)),
-                    limit: Limit::AtMost(MAX_LIGHT_ERROR),
-                },
-                Measure {
-                    what: "red bleeding: R/G of white surfaces, left third over middle".into(),
-                    value: bleed_ratio(img, &white, 0, 0, 1),
-                    limit: Limit::AtLeast(MIN_BLEED_RATIO),
-                },
-                Measure {
-                    what: "green bleeding: G/R of white surfaces, right third over middle".into(),
-                    value: bleed_ratio(img, &white, 2, 1, 0),
-                    limit: Limit::AtLeast(MIN_BLEED_RATIO),
-                },
-            ]
-        }
-        n if n.starts_with("cornell") => {
-            let keep: Vec<bool> = (hits.iter())
-                .map(|h| matches!(h, PixelHit::Surface { delta: false, .. }))
-                .collect();
-            let mut m = vec![Measure {
-                what: "firefly ratio (pixel / 3×3 median)".into(),
-                value: firefly_ratio(img, &keep).0,
-                limit: Limit::AtMost(MAX_FIREFLY_RATIO),
-            }];
-            if n == "cornell_wood_marble" {
-                m.extend(rings(&["floor", "left", "right"]));
-            } else {
-                m.extend(rings(&["floor", "back"]));
-                m.push(light_colour(
-                    scene,
-                    img,
-                    &on(&["floor", "back"]),
-                    n.ends_with("_black"),
-                    companion,
-                ));
-            }
-            m
-        }
-        "turned_bowl" => {
-            let bowl = objects(names, &["bowl"]);
-            // The curl's extent along the fibre: the tangential distortion's z semi-axis.
-            let band_mm = bowl.first().and_then(|&o| {
-                let material =
-                    &scene.materials[scene.accel.instances[o as usize].material as usize];
-                let Material::Wood(w) = material else {
-                    return None;
-                };
-                Some(w.volume.params().distortion.tangential.as_ref()?.size[2])
-            });
-            let flip = match (companion, band_mm) {
-                (Some(b), Some(mm)) => {
-                    let lights: Vec<Light> = (scene.lights.iter().cloned())
-                        .chain(mirrored_x(&scene.lights))
-                        .collect();
-                    // Judged on the bowl's floor (faces within 25° of up): the face the scene
-                    // cuts quartersawn, normal along θ̂, where the curl's tangential dips tilt
-                    // the fibre out of the surface. On the walls the face turns towards r̂ (where
-                    // the radial distortion's wander tilts the fibre out of it as well) and
-                    // towards the fibre, and the coat's highlights and the rim sit there.
-                    let floor = mask(&hits, &bowl, Some(Vec3::Z));
-                    let set = without_glints(scene, &hits, &floor, &lights);
-                    curl_flip(img, b, &hits, &set, &scene.camera.frame, mm as f64)
-                }
-                _ => CurlFlip {
-                    weber: 0.0,
-                    correlation: f64::NAN,
-                    pixels: 0,
-                },
-            };
-            vec![
-                lit("bowl", &["bowl"]),
-                Measure {
-                    what: "curl bands on the floor flipping with the light, Weber contrast".into(),
-                    value: flip.weber,
-                    limit: Limit::AtLeast(VISIBLE_WEBER),
-                },
-                Measure {
-                    what: "curl band patterns on the floor, light on either side, correlation"
-                        .into(),
-                    value: flip.correlation,
-                    limit: Limit::AtMost(MAX_CURL_CORRELATION),
-                },
-            ]
-        }
-        "parquet_floor" => step(
-            img,
-            &hits,
-            names,
-            "strips against seams",
-            &["floor"],
-            &["seams"],
-            None,
-        ),
+        "cornell_box" => s.cornell_box(),
+        n if n.starts_with("cornell") => s.cornell_variant(n),
+        "turned_bowl" => s.turned_bowl(),
+        "parquet_floor" => s.step("strips against seams", &["floor"], &["seams"], None),
         "box_joint" => [
-            step(
-                img,
-                &hits,
-                names,
+            s.step(
                 "fingers on the front face",
                 &["a_"],
                 &["b_finger"],
                 Some(-Vec3::Y),
             ),
-            step(
-                img,
-                &hits,
-                names,
+            s.step(
                 "fingers on the side face",
                 &["b_"],
                 &["a_finger"],
@@ -1012,34 +888,198 @@ pub fn measure(
             ),
         ]
         .concat(),
-        "dovetail" => step(
-            img,
-            &hits,
-            names,
-            "tails against pins",
-            &["tails"],
-            &["pins"],
-            Some(-Vec3::Y),
-        ),
-        "cube_carved_vs_veneer" => {
-            let id = |n: &str| objects(names, &[n]).first().copied().unwrap_or(u32::MAX);
-            let carved = edge_jump(img, &hits, id("carved"));
-            let veneered = edge_jump(img, &hits, id("veneered"));
-            vec![
-                lit("carved cube", &["carved"]),
-                lit("veneered cube", &["veneered"]),
-                Measure {
-                    what: "edge jump of the veneer over the carved cube's".into(),
-                    value: veneered / carved,
-                    limit: Limit::AtLeast(MIN_SEAM_RATIO),
-                },
-            ]
-        }
-        "carved_bunny" => vec![lit("bunny", &["bunny"]), fig("bunny rings", &["bunny"])],
+        "dovetail" => s.step("tails against pins", &["tails"], &["pins"], Some(-Vec3::Y)),
+        "cube_carved_vs_veneer" => s.carved_vs_veneer(),
+        "carved_bunny" => vec![s.lit("bunny", &["bunny"]), s.fig("bunny rings", &["bunny"])],
         // Walnut is dark by nature (median sRGB ≈ 0.16 here): only its grain is checked.
-        "teapot" => vec![fig("teapot grain", &["teapot"])],
-        "sweep_board" => vec![fig("board stripes", &["board"])],
+        "teapot" => vec![s.fig("teapot grain", &["teapot"])],
+        "sweep_board" => vec![s.fig("board stripes", &["board"])],
         _ => Vec::new(),
+    }
+}
+
+/// A rendered scene with each pixel's first hit: what [`measure`]'s checks look at.
+struct Subject<'a> {
+    scene: &'a Scene,
+    names: &'a [Option<String>],
+    img: &'a Image,
+    hits: Vec<PixelHit>,
+    companion: Option<&'a Image>,
+    exposure: f32,
+}
+
+impl Subject<'_> {
+    /// The pixels whose first hit is an object named with one of `prefixes`.
+    fn on(&self, prefixes: &[&str]) -> Vec<bool> {
+        mask(&self.hits, &objects(self.names, prefixes), None)
+    }
+
+    /// The figure's local contrast on `objs`.
+    fn fig(&self, what: &str, objs: &[&str]) -> Measure {
+        Measure {
+            what: format!("{what} local contrast"),
+            value: figure_contrast(self.img, &self.on(objs)),
+            limit: Limit::AtLeast(VISIBLE_FIGURE),
+        }
+    }
+
+    /// Whether `objs` are lit: their median sRGB.
+    fn lit(&self, what: &str, objs: &[&str]) -> Measure {
+        Measure {
+            what: format!("{what} median sRGB"),
+            value: median_srgb(self.img, &self.on(objs), self.exposure),
+            limit: Limit::AtLeast(LIT_SRGB),
+        }
+    }
+
+    /// The ring contrast of each of `objs`.
+    fn rings(&self, objs: &[&str]) -> Vec<Measure> {
+        (objs.iter())
+            .flat_map(|o| {
+                visible(
+                    &format!("{o} rings"),
+                    &ring_contrast(self.img, &self.on(&[o])),
+                )
+            })
+            .collect()
+    }
+
+    /// [`step`] between the objects named `a` and `b`.
+    fn step(&self, what: &str, a: &[&str], b: &[&str], face: Option<Vec3>) -> Vec<Measure> {
+        step(self.img, &self.hits, self.names, what, a, b, face)
+    }
+
+    /// The classic box: its light seen directly, and colour bleeding from both walls.
+    fn cornell_box(&self) -> Vec<Measure> {
+        let white = self.on(&["floor", "ceiling", "back", "short_box", "tall_box"]);
+        let expected = self.scene.lights.iter().find_map(|l| match l {
+            Light::Rect(r) => Some(r.radiance),
+            Light::Point(_)
+            | Light::Spot(_)
+            | Light::Distant(_)
+            | Light::Sphere(_)
+            | Light::Environment(_) => None,
+        });
+        let light_error = |e| light_error(self.scene, self.img, &self.hits, e);
+        vec![
+            Measure {
+                what: "light seen directly, largest |mean / (radiance × color) − 1|".into(),
+                value: expected.map_or(f64::INFINITY, light_error),
+                limit: Limit::AtMost(MAX_LIGHT_ERROR),
+            },
+            Measure {
+                what: "red bleeding: R/G of white surfaces, left third over middle".into(),
+                value: bleed_ratio(self.img, &white, 0, 0, 1),
+                limit: Limit::AtLeast(MIN_BLEED_RATIO),
+            },
+            Measure {
+                what: "green bleeding: G/R of white surfaces, right third over middle".into(),
+                value: bleed_ratio(self.img, &white, 2, 1, 0),
+                limit: Limit::AtLeast(MIN_BLEED_RATIO),
+            },
+        ]
+    }
+
+    /// The wooden boxes (`cornell_*` but the classic one): no fireflies, visible rings, and
+    /// the lighting variant's colour on the wood.
+    fn cornell_variant(&self, name: &str) -> Vec<Measure> {
+        let keep: Vec<bool> = (self.hits.iter())
+            .map(|h| matches!(h, PixelHit::Surface { delta: false, .. }))
+            .collect();
+        let mut m = vec![Measure {
+            what: "firefly ratio (pixel / 3×3 median)".into(),
+            value: firefly_ratio(self.img, &keep).0,
+            limit: Limit::AtMost(MAX_FIREFLY_RATIO),
+        }];
+        if name == "cornell_wood_marble" {
+            m.extend(self.rings(&["floor", "left", "right"]));
+        } else {
+            m.extend(self.rings(&["floor", "back"]));
+            m.push(light_colour(
+                self.scene,
+                self.img,
+                &self.on(&["floor", "back"]),
+                name.ends_with("_black"),
+                self.companion,
+            ));
+        }
+        m
+    }
+
+    /// The bowl: lit, and its curl bands flipping with the light (the companion render has
+    /// the light mirrored).
+    fn turned_bowl(&self) -> Vec<Measure> {
+        let bowl = objects(self.names, &["bowl"]);
+        let flip = match (self.companion, self.curl_band_mm(&bowl)) {
+            (Some(b), Some(mm)) => {
+                let scene = self.scene;
+                let lights: Vec<Light> = (scene.lights.iter().cloned())
+                    .chain(mirrored_x(&scene.lights))
+                    .collect();
+                // Judged on the bowl's floor (faces within 25° of up): the face the scene
+                // cuts quartersawn, normal along θ̂, where the curl's tangential dips tilt
+                // the fibre out of the surface. On the walls the face turns towards r̂ (where
+                // the radial distortion's wander tilts the fibre out of it as well) and
+                // towards the fibre, and the coat's highlights and the rim sit there.
+                let floor = mask(&self.hits, &bowl, Some(Vec3::Z));
+                let set = without_glints(scene, &self.hits, &floor, &lights);
+                curl_flip(
+                    self.img,
+                    b,
+                    &self.hits,
+                    &set,
+                    &scene.camera.frame,
+                    mm as f64,
+                )
+            }
+            _ => CurlFlip {
+                weber: 0.0,
+                correlation: f64::NAN,
+                pixels: 0,
+            },
+        };
+        vec![
+            self.lit("bowl", &["bowl"]),
+            Measure {
+                what: "curl bands on the floor flipping with the light, Weber contrast".into(),
+                value: flip.weber,
+                limit: Limit::AtLeast(VISIBLE_WEBER),
+            },
+            Measure {
+                what: "curl band patterns on the floor, light on either side, correlation".into(),
+                value: flip.correlation,
+                limit: Limit::AtMost(MAX_CURL_CORRELATION),
+            },
+        ]
+    }
+
+    /// The curl's extent along the fibre on the first of `objects` (the tangential
+    /// distortion's z semi-axis), if it is wood with a curl.
+    fn curl_band_mm(&self, objects: &[u32]) -> Option<f32> {
+        let scene = self.scene;
+        let o = *objects.first()?;
+        let material = &scene.materials[scene.accel.instances[o as usize].material as usize];
+        let Material::Wood(w) = material else {
+            return None;
+        };
+        Some(w.volume.params().distortion.tangential.as_ref()?.size[2])
+    }
+
+    /// The carved and the veneered cube: both lit, and the veneer's edge jump against the
+    /// carved cube's.
+    fn carved_vs_veneer(&self) -> Vec<Measure> {
+        let id = |n: &str| (objects(self.names, &[n]).first().copied()).unwrap_or(u32::MAX);
+        let carved = edge_jump(self.img, &self.hits, id("carved"));
+        let veneered = edge_jump(self.img, &self.hits, id("veneered"));
+        vec![
+            self.lit("carved cube", &["carved"]),
+            self.lit("veneered cube", &["veneered"]),
+            Measure {
+                what: "edge jump of the veneer over the carved cube's".into(),
+                value: veneered / carved,
+                limit: Limit::AtLeast(MIN_SEAM_RATIO),
+            },
+        ]
     }
 }
 
