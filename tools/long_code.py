@@ -2,7 +2,8 @@
 """Lists the Rust files over 800 lines and the functions over 100 lines (issue 27's goal: none,
 tables and generated code excepted), longest first, with the counts on the last line.
 
-Usage: python3 tools/long_code.py [--files N] [--fns N] [PATH ...]   (default: crates python/src)
+Usage: python3 tools/long_code.py [--files N] [--fns N] [PATH ...]   (files or folders;
+default: crates python/src)
 
 A function is counted from its `fn` line to the line of its closing brace (doc comments and
 attributes not included), found by counting braces outside strings, chars and comments. Files
@@ -58,6 +59,8 @@ def main():
     a = ap.parse_args()
     files = []
     for root in a.paths:
+        if os.path.isfile(root):
+            files.append(root)
         for d, _, names in os.walk(root):
             files += [os.path.join(d, n) for n in names if n.endswith(".rs")]
     files = sorted(f for f in files if not EXCEPT.search(f))
