@@ -10,7 +10,7 @@
 
 use super::hash::{cell3, cell3_offset, floor_i32, mix32, pcg3d, seed_offsets, unit_f32};
 use crate::math::Frame;
-use crate::simd::{simd_level, Simd};
+use crate::simd::{simd_wide, Simd};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 use std::f32::consts::PI;
@@ -838,18 +838,8 @@ impl Band {
         acc
     }
 
-    simd_level! { Avx2
-        unsafe fn cartesian_avx2<const GRAD: bool>(
-            &self,
-            q: &CartesianQuery,
-            upright: bool,
-        ) -> (f32, Vec3) {
-            self.cartesian_block::<GRAD>(q, upright)
-        }
-    }
-
-    simd_level! { Avx512
-        unsafe fn cartesian_avx512<const GRAD: bool>(
+    simd_wide! {
+        unsafe fn cartesian_avx2 / cartesian_avx512<const GRAD: bool>(
             &self,
             q: &CartesianQuery,
             upright: bool,

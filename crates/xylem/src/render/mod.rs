@@ -29,7 +29,7 @@ pub use light::{
 
 use crate::material::Material;
 use crate::progress::{NoProgress, Progress};
-use crate::simd::{simd_level, Simd};
+use crate::simd::{simd_wide, Simd};
 use glam::{UVec2, Vec3};
 use integrator::{radiance_frames, FirstBounce, FramesScratch, KeptSample, RayCount, ShadowTest};
 use rayon::prelude::*;
@@ -480,21 +480,8 @@ fn render_tile(
     render_tile_in(scene, lights, shadow, settings, origin, primary)
 }
 
-simd_level! { Avx512
-    unsafe fn render_tile_avx512(
-        scene: &Scene,
-        lights: &LightFrames,
-        shadow: &ShadowTest,
-        settings: &RenderSettings,
-        origin: UVec2,
-        primary: Primary,
-    ) -> TileFrames {
-        render_tile_in(scene, lights, shadow, settings, origin, primary)
-    }
-}
-
-simd_level! { Avx2
-    unsafe fn render_tile_avx2(
+simd_wide! {
+    unsafe fn render_tile_avx2 / render_tile_avx512(
         scene: &Scene,
         lights: &LightFrames,
         shadow: &ShadowTest,
