@@ -486,6 +486,22 @@ fn a_whole_sweep_refuses_a_folder_another_run_holds() {
     assert!(o.status.success(), "{}", stderr(&o));
 }
 
+/// `xylem sweep SCENE --out OUT --frames-range 2..4 --arc -30..30`: a slice of another arc than
+/// the scene's.
+fn other_arc_slice(scene: &str, out: &str) -> Output {
+    run(&[
+        "sweep",
+        scene,
+        "--quiet",
+        "--out",
+        out,
+        "--frames-range",
+        "2..4",
+        "--arc",
+        "-30..30",
+    ])
+}
+
 #[test]
 fn assemble_refuses_slices_that_disagree_and_absurd_records() {
     let dir = tempfile::tempdir().unwrap();
@@ -528,33 +544,13 @@ fn assemble_refuses_slices_that_disagree_and_absurd_records() {
     std::fs::write(&p, &text).unwrap();
     // A slice of another arc is refused before it renders: the folder's manifest is of the
     // scene's arc (issue 26) ...
-    let o = run(&[
-        "sweep",
-        s,
-        "--quiet",
-        "--out",
-        o_,
-        "--frames-range",
-        "2..4",
-        "--arc",
-        "-30..30",
-    ]);
+    let o = other_arc_slice(s, o_);
     assert_clean_error(&o, "manifest.json");
     // ... and where neither manifest nor claim says so, the records do; `--assemble` refuses
     // records of two arcs.
     std::fs::remove_file(out.join("manifest.json")).unwrap();
     std::fs::remove_file(out.join("sweep.json")).unwrap();
-    let o = run(&[
-        "sweep",
-        s,
-        "--quiet",
-        "--out",
-        o_,
-        "--frames-range",
-        "2..4",
-        "--arc",
-        "-30..30",
-    ]);
+    let o = other_arc_slice(s, o_);
     assert_clean_error(
         &o,
         ".json: this folder holds a sweep of other settings (arc_deg",
