@@ -214,9 +214,10 @@ pub(super) fn gallery(
     only: &[String],
     presets: Option<&Path>,
 ) -> anyhow::Result<()> {
-    use xylem::picture::contact::{contact_sheet_rows, Rgb8};
+    use xylem::picture::contact::contact_sheet_rows;
     use xylem::picture::png::write_png_rgb8;
     use xylem::picture::srgb::to_srgb8;
+    use xylem::picture::Rgb8;
     use xylem::sweep::{render_sweep, SweepPath};
     let bar = super::progress::Bar::new(true);
     if angles.is_empty() || angles.iter().any(|a| !(-89.0..=89.0).contains(a)) {

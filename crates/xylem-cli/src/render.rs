@@ -248,7 +248,7 @@ fn write_outputs(
     exr: &Path,
     png: &Path,
     exposure: f32,
-    meta: xylem::render::image_io::ExrMeta,
+    meta: xylem::picture::exr::ExrMeta,
 ) -> anyhow::Result<()> {
     use xylem::picture::file::commit;
     use xylem::picture::png::stage_png_linear;

@@ -3,7 +3,7 @@
 use anyhow::Context;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use xylem::render::image_io::ExrCompression;
+use xylem::picture::exr::ExrCompression;
 use xylem::scene::quality::Quality;
 use xylem::sweep::batch::PrimaryMode;
 use xylem::sweep::job::{run_job, SweepJob};
@@ -130,6 +130,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             args.quality.map_or("none".to_string(), |q| q.to_string())
         ),
     };
+    announce(&loaded, &job);
+    let report = run_job(&loaded, &job).with_context(|| format!("sweep of {}", scene.display()))?;
+    print_summary(&report, &job.out);
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Says on stderr what is about to be rendered: scene, size, spp, integrator, cache.
+fn announce(loaded: &xylem::scene::LoadedScene, job: &SweepJob) {
     let cam = &loaded.scene.camera;
     eprintln!(
         "{}: {}x{}, {} spp, {}, {}",
@@ -144,7 +152,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             "cached primary samples"
         }
     );
-    let report = run_job(&loaded, &job).with_context(|| format!("sweep of {}", scene.display()))?;
+}
+
+/// Prints which frames were rendered, how fast, and what the folder holds now.
+fn print_summary(report: &xylem::sweep::job::JobReport, out: &Path) {
     let n = report.rendered.len();
     println!(
         "rendered frames {}..{} of {} in {:.2} s ({:.3} s per frame; {} batch{} of up to {}{}) into {}",
@@ -161,27 +172,26 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         } else {
             ""
         },
-        job.out.display()
+        out.display()
     );
-    match report.assembled {
+    match &report.assembled {
         Some(a) => {
             for f in &a.files {
                 println!("  {}", f.display());
             }
         }
         // A slice: the folder may be complete now (this was the last slice) or not yet.
-        None if xylem::sweep::sequence::read_records(&job.out).is_ok() => println!(
+        None if xylem::sweep::sequence::read_records(out).is_ok() => println!(
             "every frame is in {} now; assemble them: xylem sweep --assemble {}",
-            job.out.display(),
-            job.out.display()
+            out.display(),
+            out.display()
         ),
         None => println!(
             "not every frame is in {} yet; when all are: xylem sweep --assemble {}",
-            job.out.display(),
-            job.out.display()
+            out.display(),
+            out.display()
         ),
     }
-    Ok(ExitCode::SUCCESS)
 }
 
 /// Writes the sweep's Open Job Description template: every render task gets the options that

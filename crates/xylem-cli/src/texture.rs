@@ -8,8 +8,8 @@ use anyhow::{bail, Context};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use xylem::picture::exr::{write_exr_layers_with, ExrCompression, ExrLayer};
 use xylem::picture::png::write_png_linear;
-use xylem::render::image_io::{write_exr_layers_with, ExrCompression, ExrLayer};
 use xylem::texture::{
     self, first_non_finite, Plane, Slice, SolidTexture, DEFAULT_SLICE_SAMPLES, MAX_SLICE_SAMPLES,
 };
@@ -192,7 +192,7 @@ fn animate(args: &Args, slice: &Slice, out: &std::path::Path, seconds: f32) -> a
         if let Some((x, y)) = first_non_finite(&pixels, slice.res) {
             bail!("frame {i}: non-finite colour at pixel ({x}, {y}); nothing written");
         }
-        frames.push(xylem::picture::contact::Rgb8 {
+        frames.push(xylem::picture::Rgb8 {
             width: slice.res,
             height: slice.res,
             data: xylem::picture::srgb::to_srgb8(&pixels, args.exposure),

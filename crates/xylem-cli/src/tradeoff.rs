@@ -48,6 +48,49 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let all = settings();
+    let weak = check_args(&args, &all)?;
+    let probe = xylem::scene::load(&args.scene)?;
+    let (w0, h0) = (probe.scene.camera.width, probe.scene.camera.height);
+    let (w, h) = (
+        args.width,
+        ((args.width as f32 * h0 as f32 / w0 as f32).round() as u32).max(1),
+    );
+    let (exposure, name) = (probe.exposure, probe.name.clone());
+    drop(probe);
+    let base = scene_maker(&args, (w, h))?;
+    let study = Study {
+        args: &args,
+        base: &base,
+        run: xylem::render::RunOptions {
+            threads: args.threads,
+            ..Default::default()
+        },
+        size: (w, h),
+        exposure,
+        bar: indicatif::ProgressBar::new(all.len() as u64 * args.repeats as u64 + 1).with_style(
+            indicatif::ProgressStyle::with_template("tradeoff {bar:40} {pos}/{len} {msg}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        ),
+    };
+    let reference = study.reference()?;
+    let mut rows = study.measure(&all, &reference)?;
+    study.time(&all, &mut rows)?;
+    study.bar.finish_and_clear();
+    write_report(
+        &args,
+        &name,
+        (w, h),
+        reference.seconds,
+        &rows,
+        weak.as_deref(),
+    )?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Refuses arguments out of range, and a weak reference unless `--allow-weak-reference`;
+/// returns why the reference is weak, if it is.
+fn check_args(args: &Args, all: &[(String, String, Knobs)]) -> anyhow::Result<Option<String>> {
     anyhow::ensure!(
         (8..=4096).contains(&args.width),
         "--width {}: allowed 8 to 4096",
@@ -57,7 +100,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         args.reference_spp >= 1,
         "--reference-spp must be at least 1"
     );
-    let all = settings();
     let max_spp = all.iter().map(|(_, _, k)| k.spp).max().unwrap_or(1);
     let weak = weak_reference(args.reference_spp, max_spp);
     if let Some(why) = &weak {
@@ -67,21 +109,21 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         );
         eprintln!("warning: {why}");
     }
-    let probe = xylem::scene::load(&args.scene)?;
-    let (w0, h0) = (probe.scene.camera.width, probe.scene.camera.height);
-    let (w, h) = (
-        args.width,
-        ((args.width as f32 * h0 as f32 / w0 as f32).round() as u32).max(1),
-    );
-    let exposure = probe.exposure;
-    let name = probe.name.clone();
-    drop(probe);
+    Ok(weak)
+}
+
+/// Loads the scene afresh for each render, at the measurement size `(w, h)`, with `--preset`'s
+/// wood in every wood material.
+fn scene_maker(
+    args: &Args,
+    (w, h): (u32, u32),
+) -> anyhow::Result<impl Fn() -> Result<xylem::scene::LoadedScene, String>> {
     let preset = match &args.preset {
         Some(p) => Some(xylem::wood::preset(p).with_context(|| format!("--preset {p}"))?),
         None => None,
     };
     let scene_path = args.scene.clone();
-    let base = move || -> Result<xylem::scene::LoadedScene, String> {
+    Ok(move || -> Result<xylem::scene::LoadedScene, String> {
         let mut l = xylem::scene::load(&scene_path).map_err(|e| e.to_string())?;
         l.scene.camera = l.scene.camera.with_resolution(w, h);
         if let Some(params) = &preset {
@@ -94,115 +136,164 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             }
         }
         Ok(l)
-    };
-    let run = xylem::render::RunOptions {
-        threads: args.threads,
-        ..Default::default()
-    };
-    let bar = indicatif::ProgressBar::new(all.len() as u64 * args.repeats as u64 + 1).with_style(
-        indicatif::ProgressStyle::with_template("tradeoff {bar:40} {pos}/{len} {msg}")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
-    bar.set_message(format!("reference, {} spp", args.reference_spp));
-    // The reference in two halves of other seeds than the rows' (which share the scene's): the
-    // rows are then independent of it, and the halves' difference measures its own noise,
-    // taken off each row's error (`relative_mse_net`).
-    let half = |k: u64| -> anyhow::Result<xylem_lab::tradeoff::Rendered> {
-        let seeded = || {
-            base().map(|mut l| {
-                l.settings.seed = l.settings.seed.wrapping_add(REFERENCE_SEED_OFFSET * k);
-                l
-            })
+    })
+}
+
+/// The reference render: the mean of two halves, the noise their difference measures, and
+/// their render time.
+struct Reference {
+    image: Vec<glam::Vec3>,
+    noise: f64,
+    seconds: f64,
+}
+
+/// What every render of the study shares: the scene, the run options, the size and exposure
+/// of the images, and the progress bar.
+struct Study<'a> {
+    args: &'a Args,
+    base: &'a dyn Fn() -> Result<xylem::scene::LoadedScene, String>,
+    run: xylem::render::RunOptions<'a>,
+    size: (u32, u32),
+    exposure: f32,
+    bar: indicatif::ProgressBar,
+}
+
+impl Study<'_> {
+    /// Renders `knobs`; `what` names the render in the error.
+    fn render(&self, knobs: &Knobs, what: &str) -> anyhow::Result<xylem_lab::tradeoff::Rendered> {
+        render_with(self.base, knobs, &self.run)
+            .map_err(anyhow::Error::msg)
+            .with_context(|| what.to_string())
+    }
+
+    /// The reference in two halves of other seeds than the rows' (which share the scene's):
+    /// the rows are then independent of it, and the halves' difference measures its own
+    /// noise, taken off each row's error (`relative_mse_net`).
+    fn reference(&self) -> anyhow::Result<Reference> {
+        let spp = self.args.reference_spp;
+        self.bar.set_message(format!("reference, {spp} spp"));
+        let half = |k: u64| -> anyhow::Result<xylem_lab::tradeoff::Rendered> {
+            let seeded = || {
+                (self.base)().map(|mut l| {
+                    l.settings.seed = l.settings.seed.wrapping_add(REFERENCE_SEED_OFFSET * k);
+                    l
+                })
+            };
+            render_with(&seeded, &Knobs::reference(spp.div_ceil(2)), &self.run)
+                .map_err(anyhow::Error::msg)
+                .context("reference render")
         };
-        render_with(
-            &seeded,
-            &Knobs::reference(args.reference_spp.div_ceil(2)),
-            &run,
-        )
-        .map_err(anyhow::Error::msg)
-        .context("reference render")
-    };
-    let (a, b) = (half(1)?, half(2)?);
-    let ref_secs = a.seconds + b.seconds;
-    let (reference, reference_noise) = reference_from_halves(&a.image, &b.image);
-    bar.inc(1);
-    let save = |name: &str, img: &[glam::Vec3]| -> anyhow::Result<()> {
-        if let Some(dir) = &args.images {
-            std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-            let file: String = name
-                .chars()
-                .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
-                .collect();
-            xylem::picture::png::write_png_linear(
-                &dir.join(format!("{file}.png")),
-                w,
-                h,
-                img,
-                exposure,
-            )?;
+        let (a, b) = (half(1)?, half(2)?);
+        let (image, noise) = reference_from_halves(&a.image, &b.image);
+        self.bar.inc(1);
+        self.save("reference", &image)?;
+        Ok(Reference {
+            image,
+            noise,
+            seconds: a.seconds + b.seconds,
+        })
+    }
+
+    /// With `--images`, writes `img` as a PNG named after `name`.
+    fn save(&self, name: &str, img: &[glam::Vec3]) -> anyhow::Result<()> {
+        let Some(dir) = &self.args.images else {
+            return Ok(());
+        };
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        let file: String = name
+            .chars()
+            .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+            .collect();
+        let (w, h) = self.size;
+        let path = dir.join(format!("{file}.png"));
+        xylem::picture::png::write_png_linear(&path, w, h, img, self.exposure)?;
+        Ok(())
+    }
+
+    /// Renders every setting once and measures its error against the reference and against
+    /// the reference model at the same spp (same seeds, rendered once per spp). Times are
+    /// filled in by [`Study::time`].
+    fn measure(
+        &self,
+        all: &[(String, String, Knobs)],
+        reference: &Reference,
+    ) -> anyhow::Result<Vec<Measurement>> {
+        let (w, h) = (self.size.0 as usize, self.size.1 as usize);
+        let mut rows = Vec::new();
+        let mut same_spp: Vec<(u32, Vec<glam::Vec3>)> = Vec::new();
+        for (knob, setting, knobs) in all.iter().cloned() {
+            self.bar.set_message(setting.clone());
+            let r = self.render(&knobs, &format!("render with {setting}"))?;
+            if !same_spp.iter().any(|(s, _)| *s == knobs.spp) {
+                let what = format!("reference model at {} spp", knobs.spp);
+                let m = self.render(&Knobs::reference(knobs.spp), &what)?;
+                same_spp.push((knobs.spp, m.image));
+            }
+            self.save(&format!("{knob} {setting}"), &r.image)?;
+            let model_ref = &(same_spp.iter().find(|(s, _)| *s == knobs.spp))
+                .expect("pushed")
+                .1;
+            let img = &r.image;
+            rows.push(Measurement {
+                knob,
+                setting,
+                knobs,
+                // The first timing round.
+                seconds: r.seconds,
+                cpu_seconds: r.cpu_seconds,
+                cpu_min: f64::NAN,
+                cpu_max: f64::NAN,
+                repeats: self.args.repeats,
+                prep_seconds: r.prep_seconds,
+                relative_mse: relative_mse_net(img, &reference.image, reference.noise),
+                ssim: ssim(img, &reference.image, w, h, self.exposure),
+                model_mse: relative_mse(img, model_ref),
+                model_ssim: ssim(img, model_ref, w, h, self.exposure),
+            });
+            self.bar.inc(1);
+        }
+        Ok(rows)
+    }
+
+    /// The timing repeats, interleaved (every setting once per round, so that a change in the
+    /// machine's load falls on every setting alike); each row's times become the median and
+    /// range over its rounds, the first being [`Study::measure`]'s render.
+    fn time(
+        &self,
+        all: &[(String, String, Knobs)],
+        rows: &mut [Measurement],
+    ) -> anyhow::Result<()> {
+        let mut times: Vec<(Vec<f64>, Vec<f64>)> = (rows.iter())
+            .map(|r| (vec![r.seconds], vec![r.cpu_seconds]))
+            .collect();
+        for round in 1..self.args.repeats {
+            for (i, (_, setting, knobs)) in all.iter().enumerate() {
+                self.bar
+                    .set_message(format!("timing round {}: {setting}", round + 1));
+                let r = self.render(knobs, &format!("render with {setting}"))?;
+                times[i].0.push(r.seconds);
+                times[i].1.push(r.cpu_seconds);
+                self.bar.inc(1);
+            }
+        }
+        for (row, (wall, cpu)) in rows.iter_mut().zip(&times) {
+            row.seconds = median_range(wall).0;
+            (row.cpu_seconds, row.cpu_min, row.cpu_max) = median_range(cpu);
         }
         Ok(())
-    };
-    save("reference", &reference)?;
-    let mut rows = Vec::new();
-    // The reference model at each measured spp (same seeds), rendered once per spp.
-    let mut same_spp: Vec<(u32, Vec<glam::Vec3>)> = Vec::new();
-    // Wall and CPU seconds of every render of each setting, over the rounds.
-    let mut times: Vec<(Vec<f64>, Vec<f64>)> = vec![(Vec::new(), Vec::new()); all.len()];
-    for (i, (knob, setting, knobs)) in all.iter().cloned().enumerate() {
-        bar.set_message(setting.clone());
-        let r = render_with(&base, &knobs, &run)
-            .map_err(anyhow::Error::msg)
-            .with_context(|| format!("render with {setting}"))?;
-        let (img, prep) = (r.image, r.prep_seconds);
-        times[i].0.push(r.seconds);
-        times[i].1.push(r.cpu_seconds);
-        if !same_spp.iter().any(|(s, _)| *s == knobs.spp) {
-            let r = render_with(&base, &Knobs::reference(knobs.spp), &run)
-                .map_err(anyhow::Error::msg)
-                .with_context(|| format!("reference model at {} spp", knobs.spp))?;
-            same_spp.push((knobs.spp, r.image));
-        }
-        save(&format!("{knob} {setting}"), &img)?;
-        let model_ref = &same_spp
-            .iter()
-            .find(|(s, _)| *s == knobs.spp)
-            .expect("pushed")
-            .1;
-        rows.push(Measurement {
-            knob,
-            setting,
-            knobs,
-            seconds: f64::NAN,
-            cpu_seconds: f64::NAN,
-            cpu_min: f64::NAN,
-            cpu_max: f64::NAN,
-            repeats: args.repeats,
-            prep_seconds: prep,
-            relative_mse: relative_mse_net(&img, &reference, reference_noise),
-            ssim: ssim(&img, &reference, w as usize, h as usize, exposure),
-            model_mse: relative_mse(&img, model_ref),
-            model_ssim: ssim(&img, model_ref, w as usize, h as usize, exposure),
-        });
-        bar.inc(1);
     }
-    // The timing repeats, interleaved: every setting once per round.
-    for round in 1..args.repeats {
-        for (i, (_, setting, knobs)) in all.iter().enumerate() {
-            bar.set_message(format!("timing round {}: {setting}", round + 1));
-            let r = render_with(&base, knobs, &run)
-                .map_err(anyhow::Error::msg)
-                .with_context(|| format!("render with {setting}"))?;
-            times[i].0.push(r.seconds);
-            times[i].1.push(r.cpu_seconds);
-            bar.inc(1);
-        }
-    }
-    for (row, (wall, cpu)) in rows.iter_mut().zip(&times) {
-        row.seconds = median_range(wall).0;
-        (row.cpu_seconds, row.cpu_min, row.cpu_max) = median_range(cpu);
-    }
-    bar.finish_and_clear();
+}
+
+/// Writes the report (`--out`, with its plot beside it under `plots/`), prints each row, and
+/// with `--json` writes every number.
+fn write_report(
+    args: &Args,
+    name: &str,
+    size: (u32, u32),
+    ref_secs: f64,
+    rows: &[Measurement],
+    weak: Option<&str>,
+) -> anyhow::Result<()> {
     let dir = args.out.parent().map(Path::to_path_buf).unwrap_or_default();
     let stem = args
         .out
@@ -210,15 +301,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         .map(|s| s.to_string_lossy().to_lowercase())
         .unwrap_or_else(|| "tradeoff".into());
     let plot_rel = format!("plots/{stem}_error_vs_time.png");
-    write_plot(&dir.join(&plot_rel), &rows)?;
-    let mut md = markdown(&name, &args, (w, h), ref_secs, &rows, &plot_rel);
-    if let Some(why) = &weak {
+    write_plot(&dir.join(&plot_rel), rows)?;
+    let mut md = markdown(name, args, size, ref_secs, rows, &plot_rel);
+    if let Some(why) = weak {
         // Right under the title, before any number.
         let at = md.find("\n\n").map_or(0, |i| i + 2);
         md.insert_str(at, &format!("> **Weak reference**: {why}.\n\n"));
     }
     xylem::sweep::sequence::write_text_atomic(&args.out, &md)?;
-    for r in &rows {
+    for r in rows {
         println!(
             "{:<20} {:<28} {:>8.3} s CPU ({:.3}–{:.3}), {:.3} s wall (+{:.3} s)  rel. MSE {:>10.3e}  SSIM {:.4}  model {:>10.3e} {:.4}",
             r.knob, r.setting, r.cpu_seconds, r.cpu_min, r.cpu_max, r.seconds, r.prep_seconds, r.relative_mse, r.ssim, r.model_mse, r.model_ssim
@@ -229,7 +320,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         let text = serde_json::to_string_pretty(&rows)?;
         xylem::sweep::sequence::write_text_atomic(p, &text)?;
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(())
 }
 
 /// One colour per knob (the plot's series, in the table's order), with its name for the legend.

@@ -144,8 +144,7 @@ fn render_json_summary_matches_the_image() {
     assert!(v["seconds"].as_f64().unwrap() > 0.0 && v["rays"].as_u64().unwrap() > 0);
     assert_eq!(v["outputs"][0], "o/sweep_board.exr");
     // The mean is the EXR's mean, channel by channel.
-    let ch =
-        xylem::render::image_io::read_exr_channels(&tmp.path().join("o/sweep_board.exr")).unwrap();
+    let ch = xylem::picture::exr::read_exr_channels(&tmp.path().join("o/sweep_board.exr")).unwrap();
     for (k, c) in ["R", "G", "B"].iter().enumerate() {
         let data = &ch.iter().find(|(n, _)| n == c).unwrap().1;
         let mean = data.iter().map(|&x| x as f64).sum::<f64>() / data.len() as f64;
@@ -190,13 +189,10 @@ fn sweep_res_and_frame_headers() {
     );
     ok(&o);
     let dir = tmp.path().join("sw");
-    let png = std::fs::File::open(dir.join("frame_0000.png")).unwrap();
-    let info = png::Decoder::new(std::io::BufReader::new(png))
-        .read_info()
-        .unwrap();
-    assert_eq!((info.info().width, info.info().height), (32, 24));
+    let png = xylem::picture::png::read_png_rgb8(&dir.join("frame_0000.png")).unwrap();
+    assert_eq!((png.width, png.height), (32, 24));
     let header = |f: &str| {
-        let h = xylem::render::image_io::read_exr_text(&dir.join(f)).unwrap();
+        let h = xylem::picture::exr::read_exr_text(&dir.join(f)).unwrap();
         h.into_iter()
             .find(|(k, _)| k == "sweep_frame")
             .expect("sweep_frame attribute")

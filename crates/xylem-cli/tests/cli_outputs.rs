@@ -16,7 +16,7 @@ fn xylem(args: &[&str], dir: &Path) -> std::process::Output {
 
 /// The EXR's header text attributes (with `software`).
 fn header(path: &Path) -> Vec<(String, String)> {
-    xylem::render::image_io::read_exr_text(path).unwrap()
+    xylem::picture::exr::read_exr_text(path).unwrap()
 }
 
 fn text(h: &[(String, String)], key: &str) -> String {
@@ -25,15 +25,6 @@ fn text(h: &[(String, String)], key: &str) -> String {
         .unwrap_or_else(|| panic!("{key} not in {h:?}"))
         .1
         .clone()
-}
-
-/// The sRGB decoding curve (IEC 61966-2-1), written here independently of the encoder.
-fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
 }
 
 #[test]
@@ -56,20 +47,18 @@ fn texture_out_exr_is_a_linear_float_image_matching_the_png() {
     // The EXR really is an EXR (magic 76 2f 31 01), not a PNG under that name.
     let exr_bytes = std::fs::read(tmp.path().join("m.exr")).unwrap();
     assert_eq!(&exr_bytes[..4], &[0x76, 0x2f, 0x31, 0x01]);
-    let ch = xylem::render::image_io::read_exr_channels(&tmp.path().join("m.exr")).unwrap();
+    let ch = xylem::picture::exr::read_exr_channels(&tmp.path().join("m.exr")).unwrap();
     let names: Vec<&str> = ch.iter().map(|(n, _)| n.as_str()).collect();
     assert_eq!(names, ["B", "G", "R"]);
-    let mut r = png::Decoder::new(std::fs::File::open(tmp.path().join("m.png")).unwrap())
-        .read_info()
-        .unwrap();
-    let mut buf = vec![0; r.output_buffer_size()];
-    r.next_frame(&mut buf).unwrap();
+    let buf = xylem::picture::png::read_png_rgb8(&tmp.path().join("m.png"))
+        .unwrap()
+        .data;
     let red = &ch[2].1;
     assert_eq!(red.len(), 24 * 24);
     for (i, &v) in red.iter().enumerate() {
         // 8-bit sRGB codes differ from the float by at most half a code step.
-        let lo = srgb_to_linear((buf[3 * i] as f32 - 0.5).max(0.0) / 255.0);
-        let hi = srgb_to_linear((buf[3 * i] as f32 + 0.5).min(255.0) / 255.0);
+        let lo = xylem::picture::srgb::srgb_to_linear((buf[3 * i] as f32 - 0.5).max(0.0) / 255.0);
+        let hi = xylem::picture::srgb::srgb_to_linear((buf[3 * i] as f32 + 0.5).min(255.0) / 255.0);
         assert!(
             v >= lo - 1e-6 && v <= hi + 1e-6,
             "texel {i}: {v} vs code {}",
@@ -148,7 +137,7 @@ material = "grey"
     );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let exr = tmp.path().join("o/block.exr");
-    let ch = xylem::render::image_io::read_exr_channels(&exr).unwrap();
+    let ch = xylem::picture::exr::read_exr_channels(&exr).unwrap();
     let get = |n: &str| &ch.iter().find(|(c, _)| c == n).unwrap().1;
     let (alpha, depth) = (get("A"), get("depth.Z"));
     let (mut hits, mut misses) = (0, 0);

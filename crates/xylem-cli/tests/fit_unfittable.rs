@@ -8,7 +8,7 @@ mod common_capture;
 
 use common_capture::{small_capture as capture, xylem};
 use std::path::Path;
-use xylem::render::image_io::{write_exr_layers, ExrLayer};
+use xylem::picture::exr::{write_exr_layers, ExrLayer};
 
 fn edit(cap: &Path, f: impl Fn(&mut serde_json::Value)) {
     let m = cap.join("manifest.json");
@@ -110,7 +110,7 @@ fn a_frame_of_huge_values_leaves_no_nan_in_any_output() {
     let text = std::fs::read_to_string(dir.join("fitted/fit.json")).unwrap();
     assert!(!text.contains("null"), "{text}");
     for (name, data) in
-        xylem::render::image_io::read_exr_channels(&dir.join("fitted/maps.exr")).unwrap()
+        xylem::picture::exr::read_exr_channels(&dir.join("fitted/maps.exr")).unwrap()
     {
         assert!(
             data.iter().all(|v| v.is_finite()),

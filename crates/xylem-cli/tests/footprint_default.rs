@@ -125,9 +125,8 @@ fn render_takes_quality_and_footprint_filter() {
         all.extend_from_slice(args);
         let o = xylem(&all, tmp.path());
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        let h =
-            xylem::render::image_io::read_exr_text(&tmp.path().join(out).join("sweep_board.exr"))
-                .unwrap();
+        let h = xylem::picture::exr::read_exr_text(&tmp.path().join(out).join("sweep_board.exr"))
+            .unwrap();
         h.iter().find(|(k, _)| k == "spp").unwrap().1.clone()
     };
     // The presets' sample counts (Quality::knobs: 4 / 16 / 64); --spp still overrides.
@@ -138,7 +137,7 @@ fn render_takes_quality_and_footprint_filter() {
     spp_of(&["--spp", "2", "--footprint-filter", "on"], "on");
     let beauty = |d: &str| {
         let ch =
-            xylem::render::image_io::read_exr_channels(&tmp.path().join(d).join("sweep_board.exr"))
+            xylem::picture::exr::read_exr_channels(&tmp.path().join(d).join("sweep_board.exr"))
                 .unwrap();
         ch.into_iter().find(|(c, _)| c == "R").unwrap().1
     };

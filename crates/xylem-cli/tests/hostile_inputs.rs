@@ -250,7 +250,7 @@ fn images_of_the_wrong_size_are_refused_on_their_header() {
         (side, side),
         (side / band_rows) as usize,
         |_| {
-            Ok(xylem::picture::contact::Rgb8 {
+            Ok(xylem::picture::Rgb8 {
                 width: side,
                 height: band_rows,
                 data: vec![64; (side * band_rows * 3) as usize],

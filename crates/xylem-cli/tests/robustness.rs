@@ -6,9 +6,10 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
+use xylem::picture::exr::read_exr_channels;
 use xylem::picture::png::read_png_rgb8;
 use xylem::picture::srgb::to_srgb8;
-use xylem::render::image_io::{read_exr_channels, read_exr_rgb};
+use xylem::picture::Image;
 use xylem::sweep::sequence::{read_records, FrameRecord, CSV, VIEWER};
 
 fn xylem() -> Command {
@@ -152,11 +153,11 @@ fn resources_beyond_the_machine_are_refused_up_front() {
 
 /// Checks that the render's PNG is the sRGB preview of its EXR (so both come from one run).
 fn assert_pair_matches(exr: &Path, png: &Path) {
-    let (w, h, px) = read_exr_rgb(exr).unwrap();
+    let linear = Image::read(exr).unwrap();
     let img = read_png_rgb8(png).unwrap();
-    assert_eq!((img.width as usize, img.height as usize), (w, h));
+    assert_eq!((img.width, img.height), (linear.width, linear.height));
     assert!(
-        img.data == to_srgb8(&px, 0.0),
+        img == linear.to_rgb8(0.0),
         "{} is not the preview of {}",
         png.display(),
         exr.display()
@@ -247,8 +248,9 @@ fn assert_nothing_looks_complete_that_is_not(dir: &Path) {
             let rec: FrameRecord =
                 serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
             let exr = p.with_extension("exr");
-            let (_, _, px) = read_exr_rgb(&exr)
-                .unwrap_or_else(|e| panic!("{name} is there but its EXR is not: {e}"));
+            let px = Image::read(&exr)
+                .unwrap_or_else(|e| panic!("{name} is there but its EXR is not: {e}"))
+                .pixels;
             let n = px.len() as f64;
             for c in 0..3 {
                 let mean = px.iter().map(|v| v[c] as f64).sum::<f64>() / n;
@@ -484,6 +486,22 @@ fn a_whole_sweep_refuses_a_folder_another_run_holds() {
     assert!(o.status.success(), "{}", stderr(&o));
 }
 
+/// `xylem sweep SCENE --out OUT --frames-range 2..4 --arc -30..30`: a slice of another arc than
+/// the scene's.
+fn other_arc_slice(scene: &str, out: &str) -> Output {
+    run(&[
+        "sweep",
+        scene,
+        "--quiet",
+        "--out",
+        out,
+        "--frames-range",
+        "2..4",
+        "--arc",
+        "-30..30",
+    ])
+}
+
 #[test]
 fn assemble_refuses_slices_that_disagree_and_absurd_records() {
     let dir = tempfile::tempdir().unwrap();
@@ -526,33 +544,13 @@ fn assemble_refuses_slices_that_disagree_and_absurd_records() {
     std::fs::write(&p, &text).unwrap();
     // A slice of another arc is refused before it renders: the folder's manifest is of the
     // scene's arc (issue 26) ...
-    let o = run(&[
-        "sweep",
-        s,
-        "--quiet",
-        "--out",
-        o_,
-        "--frames-range",
-        "2..4",
-        "--arc",
-        "-30..30",
-    ]);
+    let o = other_arc_slice(s, o_);
     assert_clean_error(&o, "manifest.json");
     // ... and where neither manifest nor claim says so, the records do; `--assemble` refuses
     // records of two arcs.
     std::fs::remove_file(out.join("manifest.json")).unwrap();
     std::fs::remove_file(out.join("sweep.json")).unwrap();
-    let o = run(&[
-        "sweep",
-        s,
-        "--quiet",
-        "--out",
-        o_,
-        "--frames-range",
-        "2..4",
-        "--arc",
-        "-30..30",
-    ]);
+    let o = other_arc_slice(s, o_);
     assert_clean_error(
         &o,
         ".json: this folder holds a sweep of other settings (arc_deg",

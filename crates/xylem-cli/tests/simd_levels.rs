@@ -53,7 +53,7 @@ fn images(level: &str, dir: &Path) -> Vec<(String, Vec<u32>)> {
         );
     }
     for file in ["r/carved_bunny.exr", "wood.exr", "fbm.exr"] {
-        for (name, values) in xylem::render::image_io::read_exr_channels(&dir.join(file)).unwrap() {
+        for (name, values) in xylem::picture::exr::read_exr_channels(&dir.join(file)).unwrap() {
             out.push((
                 format!("{file} {name}"),
                 values.iter().map(|v| v.to_bits()).collect(),

@@ -186,13 +186,9 @@ fn preset_gallery_renders_a_row_per_preset() {
     };
     let o = run(&[]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let file = std::fs::File::open(out.path().join("walnut.png")).unwrap();
-    let info = png::Decoder::new(std::io::BufReader::new(file))
-        .read_info()
-        .unwrap()
-        .info()
-        .clone();
-    assert!(info.width >= 3 * 40 && info.height >= 20, "{info:?}");
+    let img = xylem::picture::png::read_png_rgb8(&out.path().join("walnut.png")).unwrap();
+    let (w, h) = (img.width, img.height);
+    assert!(w >= 3 * 40 && h >= 20, "{w}x{h}");
     let o = run(&["--angles", "95"]);
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("--angles"));

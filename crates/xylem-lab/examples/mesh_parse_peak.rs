@@ -25,20 +25,10 @@ fn status_kib(field: &str) -> u64 {
         .unwrap()
 }
 
-fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let (format, n) = match args.as_slice() {
-        [f, n, ..] => (f.as_str(), n.parse::<u32>().expect("N: a whole number")),
-        _ => panic!("usage: mesh_parse_peak ply-binary|ply-ascii|ply-quads|obj N [DIR]"),
-    };
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = args.get(2).map_or(tmp.path().to_path_buf(), Into::into);
-    let path = dir.join(if format == "obj" {
-        "grid.obj"
-    } else {
-        "grid.ply"
-    });
-    let mut w = std::io::BufWriter::new(std::fs::File::create(&path).unwrap());
+/// Writes an `n × n` vertex grid (a gentle bump in z) in `format` to `path`: OBJ, or PLY with
+/// binary or ASCII triangles, or binary quads.
+fn write_grid(path: &std::path::Path, format: &str, n: u32) {
+    let mut w = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
     let vertex = |i: u32, j: u32| {
         let z = ((i * 7 + j * 13) % 17) as f32 / 1700.0;
         [i as f32 / n as f32, j as f32 / n as f32, z]
@@ -108,7 +98,22 @@ fn main() {
             }
         }
     }
-    drop(w);
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let (format, n) = match args.as_slice() {
+        [f, n, ..] => (f.as_str(), n.parse::<u32>().expect("N: a whole number")),
+        _ => panic!("usage: mesh_parse_peak ply-binary|ply-ascii|ply-quads|obj N [DIR]"),
+    };
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = args.get(2).map_or(tmp.path().to_path_buf(), Into::into);
+    let path = dir.join(if format == "obj" {
+        "grid.obj"
+    } else {
+        "grid.ply"
+    });
+    write_grid(&path, format, n);
     let bytes = std::fs::metadata(&path).unwrap().len();
     let before = [status_kib("VmRSS:"), status_kib("VmSize:")];
     let mesh = xylem::scene::mesh_io::load_mesh(&path).unwrap();

@@ -8,6 +8,7 @@ use glam::{Vec2, Vec3};
 use xylem::bake::gltf::gltf_roughness;
 use xylem::bsdf::{Bsdf, WoodBsdf, WoodBsdfParams};
 use xylem::math::PI;
+use xylem::picture::{Image, Rgb8};
 use xylem::render::{Camera, Projection};
 
 /// Schlick's Fresnel with f90 = 1 ([glTF] Appendix B.3.3).
@@ -183,10 +184,10 @@ pub fn compare(beta: f32) -> Approximation {
     }
 }
 
-/// The images of a `.glb` by name, decoded to RGB8 (width, height, texels), and the board's size
+/// The images of a `.glb` by name, decoded to 8-bit RGB, and the board's size
 /// (metres, from the POSITION accessor's bounds).
 struct GlbBoard {
-    images: Vec<(String, u32, u32, Vec<u8>)>,
+    images: Vec<(String, Rgb8)>,
     size: Vec3,
 }
 
@@ -212,14 +213,8 @@ fn read_glb(bytes: &[u8]) -> Result<GlbBoard, String> {
         let off = view.byte_offset.map_or(0, |o| o.0 as usize);
         let png = &bin[off..off + view.byte_length.0 as usize];
         let name = img.name.clone().unwrap_or_default();
-        let (info, buf) = xylem::picture::png::decode_png(
-            std::path::Path::new(&name),
-            png,
-            png::Transformations::IDENTITY,
-            0,
-            &xylem::render::resources::any_size,
-        )?;
-        images.push((name, info.width, info.height, buf));
+        let img = xylem::picture::png::decode_png_rgb8(std::path::Path::new(&name), png)?;
+        images.push((name, img));
     }
     let pos = root.meshes[0].primitives[0]
         .attributes
@@ -249,14 +244,15 @@ fn read_glb(bytes: &[u8]) -> Result<GlbBoard, String> {
 
 /// Renders the top face of a baked `.glb` with the KHR reference shader ([`khr_brdf`], per
 /// colour channel, normal map applied) under one point light, seen from above and in front: a
-/// preview of what a glTF viewer shows. Returns (width, height, linear RGB).
-pub fn render_glb(bytes: &[u8], width: u32) -> Result<(u32, u32, Vec<Vec3>), String> {
+/// preview of what a glTF viewer shows.
+pub fn render_glb(bytes: &[u8], width: u32) -> Result<Image, String> {
     let board = read_glb(bytes)?;
     let map = |name: &str| {
         board
             .images
             .iter()
             .find(|i| i.0 == name)
+            .map(|i| &i.1)
             .ok_or(format!("no image {name}"))
     };
     let (base, normal, rough, aniso) = (
@@ -265,12 +261,16 @@ pub fn render_glb(bytes: &[u8], width: u32) -> Result<(u32, u32, Vec<Vec3>), Str
         map("metallic_roughness")?,
         map("anisotropy")?,
     );
-    let (tw, th) = (base.1 as usize, base.2 as usize);
-    let texel = |img: &(String, u32, u32, Vec<u8>), u: f32, v: f32| -> Vec3 {
+    let (tw, th) = (base.width as usize, base.height as usize);
+    let texel = |img: &Rgb8, u: f32, v: f32| -> Vec3 {
         let x = ((u * tw as f32) as usize).min(tw - 1);
         let y = ((v * th as f32) as usize).min(th - 1);
         let i = 3 * (y * tw + x);
-        Vec3::new(img.3[i] as f32, img.3[i + 1] as f32, img.3[i + 2] as f32) / 255.0
+        Vec3::new(
+            img.data[i] as f32,
+            img.data[i + 1] as f32,
+            img.data[i + 2] as f32,
+        ) / 255.0
     };
     let srgb = xylem::picture::srgb::srgb_to_linear;
     // glTF space (y up, metres): the face is y = top, x ∈ ±W/2 (u), z ∈ ±H/2 (v).
@@ -321,7 +321,7 @@ pub fn render_glb(bytes: &[u8], width: u32) -> Result<(u32, u32, Vec<Vec3>), Str
                 .into()
         })
         .collect();
-    Ok((width, height, pixels))
+    Ok(Image::new(width, height, pixels))
 }
 
 #[cfg(test)]
@@ -399,10 +399,10 @@ mod glb_tests {
             xylem::bake::BakeCut::Radial,
             512,
         );
-        let (w, h, px) = render_glb(&glb, 480).unwrap();
+        let img = render_glb(&glb, 480).unwrap();
         let out = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
             .join("notes/images/gltf_board.png");
-        xylem::picture::png::write_png_linear(&out, w, h, &px, 0.0).unwrap();
+        img.write(&out).unwrap();
     }
 
     #[test]
@@ -413,7 +413,11 @@ mod glb_tests {
             xylem::bake::BakeCut::Tangential,
             48,
         );
-        let (w, h, px) = render_glb(&glb, 64).unwrap();
+        let Image {
+            width: w,
+            height: h,
+            pixels: px,
+        } = render_glb(&glb, 64).unwrap();
         assert_eq!(px.len(), (w * h) as usize);
         assert!(px.iter().all(|c| c.is_finite() && c.min_element() >= 0.0));
         let board_px = px.iter().filter(|c| c.x != 0.02).count();

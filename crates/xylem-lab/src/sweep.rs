@@ -438,22 +438,7 @@ pub fn mahogany_stripes(
         &preset_board_toml("african_mahogany", frames, arc, (96, 64)),
     )?;
     let (r, path) = sweep_all(&loaded, run)?;
-    // Fibre axes are unsigned: orient each along +x (the grain), then split by the sign of its
-    // component along the normal (+z): rising out of the face or dipping into it.
-    let tilt: Vec<f32> = r
-        .aov
-        .iter()
-        .map(|a| {
-            if a.fiber.x < 0.0 {
-                -a.fiber.z
-            } else {
-                a.fiber.z
-            }
-        })
-        .collect();
-    let threshold = 0.5f32.to_radians().sin();
-    let fam_a: Vec<usize> = (0..tilt.len()).filter(|&i| tilt[i] > threshold).collect();
-    let fam_b: Vec<usize> = (0..tilt.len()).filter(|&i| tilt[i] < -threshold).collect();
+    let (fam_a, fam_b) = stripe_families(&r.aov);
     let mean = |idx: &[usize]| -> Vec<f64> {
         r.frames
             .iter()
@@ -479,7 +464,7 @@ pub fn mahogany_stripes(
             .collect()
     };
     let (ca, cb) = (divide(&raw_a), divide(&raw_b));
-    let min_pixels = tilt.len() / 20;
+    let min_pixels = r.aov.len() / 20;
     let enough = fam_a.len() >= min_pixels && fam_b.len() >= min_pixels;
     let rho = pearson(&ca, &cb);
     let rho_raw = pearson(&raw_a, &raw_b);
@@ -488,31 +473,10 @@ pub fn mahogany_stripes(
         path.arc
             .angle_deg(argmax(&c.iter().map(|v| *v as f32).collect::<Vec<_>>()))
     };
-    let mut plot = None;
-    if let Some(dir) = plots {
-        let rel = "plots/sweep_mahogany_stripes.png".to_string();
-        let series: Vec<Series> = [&ca, &cb]
-            .iter()
-            .enumerate()
-            .map(|(k, c)| Series {
-                points: c
-                    .iter()
-                    .enumerate()
-                    .map(|(i, v)| (path.arc.angle_deg(i) as f64, *v))
-                    .collect(),
-                color: PALETTE[k],
-                markers: false,
-                label: format!("stripe {}", ["a", "b"][k]),
-            })
-            .collect();
-        let opts = PlotOptions {
-            x_title: "light angle °",
-            y_title: "radiance",
-            ..PlotOptions::default()
-        };
-        write_plot(dir, &rel, &series, &opts)?;
-        plot = Some(rel);
-    }
+    let plot = match plots {
+        Some(dir) => Some(stripes_plot(dir, &path, [&ca, &cb])?),
+        None => None,
+    };
     Ok(CheckOutcome {
         check: "African mahogany: stripe families brighten at different light angles".into(),
         passed,
@@ -534,6 +498,58 @@ pub fn mahogany_stripes(
             "curve_rising": raw_a, "curve_dipping": raw_b, "diffuse_shape": shape,
         }),
     })
+}
+
+/// The pixels of the two stripe families of an interlocked board, by their first hits' fibre
+/// axes: (rising out of the face, dipping into it) by more than 0.5°.
+fn stripe_families(aov: &[xylem::render::Aov]) -> (Vec<usize>, Vec<usize>) {
+    // Fibre axes are unsigned: orient each along +x (the grain), then split by the sign of its
+    // component along the normal (+z): rising out of the face or dipping into it.
+    let tilt: Vec<f32> = aov
+        .iter()
+        .map(|a| {
+            if a.fiber.x < 0.0 {
+                -a.fiber.z
+            } else {
+                a.fiber.z
+            }
+        })
+        .collect();
+    let threshold = 0.5f32.to_radians().sin();
+    let fam_a: Vec<usize> = (0..tilt.len()).filter(|&i| tilt[i] > threshold).collect();
+    let fam_b: Vec<usize> = (0..tilt.len()).filter(|&i| tilt[i] < -threshold).collect();
+    (fam_a, fam_b)
+}
+
+/// The plot of the two families' curves (divided by the diffuse shape) against the light
+/// angle, written into `dir`; returns its path relative to `dir`.
+fn stripes_plot(
+    dir: &Path,
+    path: &SweepPath,
+    curves: [&[f64]; 2],
+) -> Result<String, SweepCheckError> {
+    let rel = "plots/sweep_mahogany_stripes.png".to_string();
+    let series: Vec<Series> = curves
+        .iter()
+        .enumerate()
+        .map(|(k, c)| Series {
+            points: c
+                .iter()
+                .enumerate()
+                .map(|(i, v)| (path.arc.angle_deg(i) as f64, *v))
+                .collect(),
+            color: PALETTE[k],
+            markers: false,
+            label: format!("stripe {}", ["a", "b"][k]),
+        })
+        .collect();
+    let opts = PlotOptions {
+        x_title: "light angle °",
+        y_title: "radiance",
+        ..PlotOptions::default()
+    };
+    write_plot(dir, &rel, &series, &opts)?;
+    Ok(rel)
 }
 
 /// Check 3b: curly maple's bright bands move along the grain as the light moves.

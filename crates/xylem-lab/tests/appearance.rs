@@ -86,8 +86,10 @@ fn measured_boards_grain_and_cut_are_detected() {
         // Turned a quarter: x and y swap in the images and in the fibre axis.
         let dir = tempfile::tempdir().unwrap();
         for map in ["diffuse", "fiber_color", "fiber_axis"] {
-            let img = image_rgb8(&base.join(board).join(format!("{map}.png")));
-            let (w, h, px) = img;
+            let img =
+                xylem::picture::png::read_png_rgb8(&base.join(board).join(format!("{map}.png")))
+                    .unwrap();
+            let (w, h, px) = (img.width as usize, img.height as usize, img.data);
             let mut t = vec![0u8; px.len()];
             for y in 0..h {
                 for x in 0..w {
@@ -110,15 +112,4 @@ fn measured_boards_grain_and_cut_are_detected() {
         assert_eq!(turned.grain_along_x, !along_x, "{board} turned: {turned:?}");
         assert_eq!(turned.ring_angle_deg, d.ring_angle_deg, "{board} turned");
     }
-}
-
-/// An 8-bit RGB PNG as (width, height, pixels).
-fn image_rgb8(path: &std::path::Path) -> (usize, usize, Vec<u8>) {
-    let decoder = png::Decoder::new(std::fs::File::open(path).unwrap());
-    let mut reader = decoder.read_info().unwrap();
-    let mut buf = vec![0; reader.output_buffer_size()];
-    let info = reader.next_frame(&mut buf).unwrap();
-    assert_eq!(info.color_type, png::ColorType::Rgb);
-    buf.truncate(info.buffer_size());
-    (info.width as usize, info.height as usize, buf)
 }

@@ -57,19 +57,10 @@ fn lum(c: Vec3) -> f64 {
     xylem::math::luminance(c) as f64
 }
 
-fn srgb(x: f64) -> f64 {
-    let x = x.clamp(0.0, 1.0);
-    if x <= 0.003_130_8 {
-        12.92 * x
-    } else {
-        1.055 * x.powf(1.0 / 2.4) - 0.055
-    }
-}
-
 /// HSV hue (degrees) and saturation of a linear colour, taken on its sRGB encoding (the hue a
 /// woodworker names: 0 red, 30 orange-brown, 60 yellow).
 fn hue_sat(c: Vec3) -> (f64, f64) {
-    let [r, g, b] = [c.x, c.y, c.z].map(|v| srgb(v as f64));
+    let [r, g, b] = [c.x, c.y, c.z].map(|v| xylem::picture::srgb::linear_to_srgb(v) as f64);
     let (mx, mn) = (r.max(g).max(b), r.min(g).min(b));
     let d = mx - mn;
     let h = if d <= 0.0 {
@@ -493,118 +484,138 @@ fn soft_transition(f: &[f64]) -> bool {
     f[0] >= 0.12
 }
 
-fn checks(preset: &str) -> Vec<Check> {
-    let all = vec![
-        // Cherry.
-        Check {
-            preset: "cherry",
-            fact: "reddish brown, medium: sRGB hue 12–26°, luminance 0.4–0.8 of maple's",
-            measure: colour_figures,
-            holds: |f| within(f[0], (12.0, 26.0)) && within(f[2], (0.4, 0.8)),
-            control: Control::Edit(
-                "yellow",
-                &[
-                    ("earlywood = [0.46, 0.17, 0.08]", "earlywood = [0.78, 0.64, 0.075]"),
-                    ("latewood = [0.38, 0.13, 0.06]", "latewood = [0.71, 0.565, 0.062]"),
-                ],
-            ),
-        },
-        Check {
-            preset: "cherry",
-            fact: "satin lustre, not copper: chatoyance median and p90/p10 within the measured boards'",
-            measure: chatoyance_figures,
-            holds: chatoyance_holds,
-            control: Control::Before,
-        },
-        Check {
-            preset: "cherry",
-            fact: "highlight coloured by the wood, paler than the body as on the measured boards",
-            measure: fibre_saturation_figures,
-            holds: |f| within(f[0], FIBRE_SATURATION_RATIO),
-            control: Control::Edit(
-                "white_highlight",
-                &[("fiber_saturation = [0.9, 0.8, 0.7]", "fiber_saturation = 0.15")],
-            ),
-        },
-        Check {
-            preset: "cherry",
-            fact: "growth rings a band, not a ruled line: latewood half ≥ 0.35 of the ring",
-            measure: late_share_figures,
-            holds: |f| f[0] >= 0.35,
-            control: Control::Before,
-        },
-        // Yellowheart.
-        Check {
-            preset: "yellowheart",
-            fact: "bright yellow: sRGB hue 44–56°, saturation ≥ 0.6, luminance ≥ 1.3 × maple's",
-            measure: colour_figures,
-            holds: |f| within(f[0], (44.0, 56.0)) && f[1] >= 0.6 && f[2] >= 1.3,
-            control: Control::Edit(
-                "brown",
-                &[
-                    ("earlywood = [0.78, 0.64, 0.075]", "earlywood = [0.46, 0.17, 0.08]"),
-                    ("latewood = [0.71, 0.565, 0.062]", "latewood = [0.38, 0.13, 0.06]"),
-                ],
-            ),
-        },
-        Check {
-            preset: "yellowheart",
-            fact: "lustrous, not brass: chatoyance median and p90/p10 within the measured boards'",
-            measure: chatoyance_figures,
-            holds: chatoyance_holds,
-            control: Control::Before,
-        },
-        Check {
-            preset: "yellowheart",
-            fact: "highlight coloured by the wood, paler than the body as on the measured boards",
-            measure: fibre_saturation_figures,
-            holds: |f| within(f[0], FIBRE_SATURATION_RATIO),
-            control: Control::Before,
-        },
-        Check {
-            preset: "yellowheart",
-            fact: "interlocked grain, mild ribbon on the quartersawn face: dip sd 2–6.5°, period 2–20 mm",
-            measure: ribbon_figures,
-            holds: |f| within(f[0], (2.0, 6.5)) && within(f[1], (2.0, 20.0)),
-            control: Control::Edit("straight", &[("angle = 13.6", "angle = 0.0")]),
-        },
-        // Red oak.
-        Check {
-            preset: "red_oak",
-            fact: "reddish tan, redder than white oak: hue 18–30°, ≥ 5° below white oak's",
-            measure: hue_gap_figures,
-            holds: |f| within(f[0], (18.0, 30.0)) && f[1] >= 5.0,
-            control: Control::Edit(
-                "white_oak_colour",
-                &[
-                    ("earlywood = [0.55, 0.32, 0.19]", "earlywood = [0.50, 0.37, 0.20]"),
-                    ("latewood = [0.42, 0.22, 0.12]", "latewood = [0.40, 0.28, 0.14]"),
-                ],
-            ),
-        },
-        Check {
-            preset: "red_oak",
-            fact: "rays shorter along the grain than white oak's: median fleck height ≤ 0.67 × white oak's",
-            measure: fleck_figures,
-            holds: |f| f[2] <= 0.67,
-            control: Control::Edit("tall_rays", &[("height = 12.0", "height = 25.0")]),
-        },
-        // Quartersawn white oak.
-        Check {
-            preset: "quartersawn_white_oak",
-            fact: "light olive-tan to greyish brown: hue 33–45°, saturation ≤ 0.42, luminance ≥ 0.8 × maple's",
-            measure: colour_figures,
-            holds: |f| within(f[0], (33.0, 45.0)) && f[1] <= 0.42 && f[2] >= 0.8,
-            control: Control::Before,
-        },
-        Check {
-            preset: "quartersawn_white_oak",
-            fact: "ray fleck on the quartersawn face: ≥ 10 % of the face, flecks ≥ 10 mm tall",
-            measure: fleck_figures,
-            holds: |f| f[0] >= 0.10 && f[1] >= 10.0,
-            control: Control::Edit("short_rays", &[("height = 30.0", "height = 6.0")]),
-        },
-        // African mahogany.
+/// Cherry: what the literature says it looks like, each fact with its control.
+fn cherry_checks() -> Vec<Check> {
+    vec![
+    Check {
+        preset: "cherry",
+        fact: "reddish brown, medium: sRGB hue 12–26°, luminance 0.4–0.8 of maple's",
+        measure: colour_figures,
+        holds: |f| within(f[0], (12.0, 26.0)) && within(f[2], (0.4, 0.8)),
+        control: Control::Edit(
+            "yellow",
+            &[
+                ("earlywood = [0.46, 0.17, 0.08]", "earlywood = [0.78, 0.64, 0.075]"),
+                ("latewood = [0.38, 0.13, 0.06]", "latewood = [0.71, 0.565, 0.062]"),
+            ],
+        ),
+    },
+    Check {
+        preset: "cherry",
+        fact: "satin lustre, not copper: chatoyance median and p90/p10 within the measured boards'",
+        measure: chatoyance_figures,
+        holds: chatoyance_holds,
+        control: Control::Before,
+    },
+    Check {
+        preset: "cherry",
+        fact: "highlight coloured by the wood, paler than the body as on the measured boards",
+        measure: fibre_saturation_figures,
+        holds: |f| within(f[0], FIBRE_SATURATION_RATIO),
+        control: Control::Edit(
+            "white_highlight",
+            &[("fiber_saturation = [0.9, 0.8, 0.7]", "fiber_saturation = 0.15")],
+        ),
+    },
+    Check {
+        preset: "cherry",
+        fact: "growth rings a band, not a ruled line: latewood half ≥ 0.35 of the ring",
+        measure: late_share_figures,
+        holds: |f| f[0] >= 0.35,
+        control: Control::Before,
+    },
+    ]
+}
+
+/// Yellowheart: what the literature says it looks like, each fact with its control.
+fn yellowheart_checks() -> Vec<Check> {
+    vec![
+    Check {
+        preset: "yellowheart",
+        fact: "bright yellow: sRGB hue 44–56°, saturation ≥ 0.6, luminance ≥ 1.3 × maple's",
+        measure: colour_figures,
+        holds: |f| within(f[0], (44.0, 56.0)) && f[1] >= 0.6 && f[2] >= 1.3,
+        control: Control::Edit(
+            "brown",
+            &[
+                ("earlywood = [0.78, 0.64, 0.075]", "earlywood = [0.46, 0.17, 0.08]"),
+                ("latewood = [0.71, 0.565, 0.062]", "latewood = [0.38, 0.13, 0.06]"),
+            ],
+        ),
+    },
+    Check {
+        preset: "yellowheart",
+        fact: "lustrous, not brass: chatoyance median and p90/p10 within the measured boards'",
+        measure: chatoyance_figures,
+        holds: chatoyance_holds,
+        control: Control::Before,
+    },
+    Check {
+        preset: "yellowheart",
+        fact: "highlight coloured by the wood, paler than the body as on the measured boards",
+        measure: fibre_saturation_figures,
+        holds: |f| within(f[0], FIBRE_SATURATION_RATIO),
+        control: Control::Before,
+    },
+    Check {
+        preset: "yellowheart",
+        fact: "interlocked grain, mild ribbon on the quartersawn face: dip sd 2–6.5°, period 2–20 mm",
+        measure: ribbon_figures,
+        holds: |f| within(f[0], (2.0, 6.5)) && within(f[1], (2.0, 20.0)),
+        control: Control::Edit("straight", &[("angle = 13.6", "angle = 0.0")]),
+    },
+    ]
+}
+
+/// Red oak: what the literature says it looks like, each fact with its control.
+fn red_oak_checks() -> Vec<Check> {
+    vec![
+    Check {
+        preset: "red_oak",
+        fact: "reddish tan, redder than white oak: hue 18–30°, ≥ 5° below white oak's",
+        measure: hue_gap_figures,
+        holds: |f| within(f[0], (18.0, 30.0)) && f[1] >= 5.0,
+        control: Control::Edit(
+            "white_oak_colour",
+            &[
+                ("earlywood = [0.55, 0.32, 0.19]", "earlywood = [0.50, 0.37, 0.20]"),
+                ("latewood = [0.42, 0.22, 0.12]", "latewood = [0.40, 0.28, 0.14]"),
+            ],
+        ),
+    },
+    Check {
+        preset: "red_oak",
+        fact: "rays shorter along the grain than white oak's: median fleck height ≤ 0.67 × white oak's",
+        measure: fleck_figures,
+        holds: |f| f[2] <= 0.67,
+        control: Control::Edit("tall_rays", &[("height = 12.0", "height = 25.0")]),
+    },
+    ]
+}
+
+/// Quartersawn white oak: what the literature says it looks like, each fact with its control.
+fn quartersawn_white_oak_checks() -> Vec<Check> {
+    vec![
+    Check {
+        preset: "quartersawn_white_oak",
+        fact: "light olive-tan to greyish brown: hue 33–45°, saturation ≤ 0.42, luminance ≥ 0.8 × maple's",
+        measure: colour_figures,
+        holds: |f| within(f[0], (33.0, 45.0)) && f[1] <= 0.42 && f[2] >= 0.8,
+        control: Control::Before,
+    },
+    Check {
+        preset: "quartersawn_white_oak",
+        fact: "ray fleck on the quartersawn face: ≥ 10 % of the face, flecks ≥ 10 mm tall",
+        measure: fleck_figures,
+        holds: |f| f[0] >= 0.10 && f[1] >= 10.0,
+        control: Control::Edit("short_rays", &[("height = 30.0", "height = 6.0")]),
+    },
+    ]
+}
+
+/// African mahogany: what the literature says it looks like, each fact with its control.
+fn african_mahogany_checks() -> Vec<Check> {
+    vec![
         Check {
             preset: "african_mahogany",
             fact: "reddish brown, darker than cherry: hue 10–25°, luminance ≤ 0.5 × maple's",
@@ -613,8 +624,14 @@ fn checks(preset: &str) -> Vec<Check> {
             control: Control::Edit(
                 "cherry_colour",
                 &[
-                    ("earlywood = [0.30, 0.095, 0.045]", "earlywood = [0.46, 0.17, 0.08]"),
-                    ("latewood = [0.24, 0.075, 0.035]", "latewood = [0.38, 0.13, 0.06]"),
+                    (
+                        "earlywood = [0.30, 0.095, 0.045]",
+                        "earlywood = [0.46, 0.17, 0.08]",
+                    ),
+                    (
+                        "latewood = [0.24, 0.075, 0.035]",
+                        "latewood = [0.38, 0.13, 0.06]",
+                    ),
                 ],
             ),
         },
@@ -632,7 +649,12 @@ fn checks(preset: &str) -> Vec<Check> {
             holds: |f| f[0] >= 4.0 && within(f[1], (8.0, 40.0)),
             control: Control::Before,
         },
-    ];
+    ]
+}
+
+/// The checks every preset gets: ring widths that vary, and its pores ring-porous or diffuse
+/// as its species is.
+fn shared_checks(preset: &str) -> Vec<Check> {
     let ring_porous_woods = ["red_oak", "quartersawn_white_oak"];
     let mut shared = vec![Check {
         preset: "",
@@ -668,12 +690,25 @@ fn checks(preset: &str) -> Vec<Check> {
             ),
         });
     }
+    shared
+}
+
+fn checks(preset: &str) -> Vec<Check> {
+    let all = [
+        cherry_checks(),
+        yellowheart_checks(),
+        red_oak_checks(),
+        quartersawn_white_oak_checks(),
+        african_mahogany_checks(),
+    ]
+    .into_iter()
+    .flatten();
+    let shared = shared_checks(preset);
     let preset: &'static str = PRESETS
         .iter()
         .find(|p| **p == preset)
         .expect("one of PRESETS");
-    all.into_iter()
-        .filter(|c| c.preset == preset)
+    all.filter(|c| c.preset == preset)
         .chain(shared.into_iter().map(|c| Check { preset, ..c }))
         .collect()
 }

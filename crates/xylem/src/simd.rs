@@ -38,6 +38,36 @@ macro_rules! simd_level {
 }
 pub(crate) use simd_level;
 
+/// One function compiled for AVX2 and for AVX-512 (each through [`simd_level!`]): the two
+/// trampolines a dispatch site calls share their signature and body, so they are written once.
+/// With `where lanes = L` the body names the level's register type as `L` (`__m256`,
+/// `__m512`), for the lane-generic kernels of `noise::lanes`.
+macro_rules! simd_wide {
+    (
+        $(#[$meta:meta])*
+        unsafe fn $avx2:ident / $avx512:ident $(<$(const $cg:ident: $ct:ty),+>)?
+        ($($args:tt)*) $(-> $ret:ty)?
+        $(where lanes = $lanes:ident)?
+        $body:block
+    ) => {
+        $crate::simd::simd_level! { Avx2
+            $(#[$meta])*
+            unsafe fn $avx2 $(<$(const $cg: $ct),+>)? ($($args)*) $(-> $ret)? {
+                $(type $lanes = std::arch::x86_64::__m256;)?
+                $body
+            }
+        }
+        $crate::simd::simd_level! { Avx512
+            $(#[$meta])*
+            unsafe fn $avx512 $(<$(const $cg: $ct),+>)? ($($args)*) $(-> $ret)? {
+                $(type $lanes = std::arch::x86_64::__m512;)?
+                $body
+            }
+        }
+    };
+}
+pub(crate) use simd_wide;
+
 /// The three uses of a feature list (see [`simd_level!`]).
 macro_rules! with_features {
     ([$($f:tt),+] names) => { &[$($f),+] };

@@ -90,12 +90,12 @@ fn furnace_with_constant_environment_map() {
     let dir = temp_dir("envmap");
     let (w, h) = (16u32, 8u32);
     let px = vec![Vec3::ONE; (w * h) as usize];
-    let layers = [xylem::render::image_io::ExrLayer {
+    let layers = [xylem::picture::exr::ExrLayer {
         name: "",
         channels: &["R", "G", "B"],
         data: px.iter().flat_map(|c| c.to_array()).collect(),
     }];
-    xylem::render::image_io::write_exr_layers(&dir.join("env.exr"), w, h, &layers).unwrap();
+    xylem::picture::exr::write_exr_layers(&dir.join("env.exr"), w, h, &layers).unwrap();
     let text = r#"
 [render]
 width = 8
@@ -143,12 +143,12 @@ fn environment_rotation_is_exact_not_rounded_to_columns() {
     let px: Vec<Vec3> = (0..w * h)
         .map(|i| Vec3::splat(1.0 + (i % w) as f32))
         .collect();
-    let layers = [xylem::render::image_io::ExrLayer {
+    let layers = [xylem::picture::exr::ExrLayer {
         name: "",
         channels: &["R", "G", "B"],
         data: px.iter().flat_map(|c| c.to_array()).collect(),
     }];
-    xylem::render::image_io::write_exr_layers(&dir.join("env.exr"), w, h, &layers).unwrap();
+    xylem::picture::exr::write_exr_layers(&dir.join("env.exr"), w, h, &layers).unwrap();
     let text = "[camera]\neye = [0.0, -4.0, 0.0]\ntarget = [0.0, 0.0, 0.0]\n\
         [[lights]]\ntype = \"environment\"\nmap = \"env.exr\"\nrotate_deg = 30.0\n\
         [materials.white]\ntype = \"lambertian\"\nalbedo = [1.0, 1.0, 1.0]\n\

@@ -118,7 +118,8 @@ fn records_from_different_sweeps_are_refused() {
 /// (gap + column·(w + gap), gap + row·(h + gap)) with its label, and every frame in the APNG.
 #[test]
 fn the_streamed_sheet_and_animation_hold_every_frame_where_the_layout_puts_it() {
-    use xylem::picture::contact::{draw_label, sheet_columns, Rgb8};
+    use xylem::picture::contact::{draw_label, sheet_columns};
+    use xylem::picture::Rgb8;
     let arc = LightArc::new(-60.0, 60.0, 30).unwrap();
     let dir = temp_dir("streamed-sheet");
     render_slice(&dir, &arc, 0..30);

@@ -138,6 +138,28 @@ pub fn materialx_document(name: &str) -> Result<String, MaterialXError> {
         "  <!-- xylem bake: preset {} as an OpenPBR Surface. Mapping and limits: notes/gltf.md. -->",
         attr(name).replace("--", "- -")
     ));
+    w(&nodegraph(&n));
+    w(&surface_shader(&n));
+    w(&format!(
+        r#"  <surfacematerial name="{}" type="material">"#,
+        material_name(name)
+    ));
+    w(&format!(
+        r#"    <input name="surfaceshader" type="surfaceshader" nodename="SR_{n}" />"#
+    ));
+    w("  </surfacematerial>");
+    w("</materialx>");
+    Ok(x)
+}
+
+/// The node graph `NG_{n}`: the baked maps as image nodes, the normal map, and the tangent
+/// across the fibre from the anisotropy map, with one output per shader input they feed.
+fn nodegraph(n: &str) -> String {
+    let mut x = String::new();
+    let mut w = |s: &str| {
+        x.push_str(s);
+        x.push('\n');
+    };
     w(&format!(r#"  <nodegraph name="NG_{n}">"#));
     let image = |node: &str, ty: &str, file: &str, colorspace: Option<&str>| {
         let cs = colorspace.map_or(String::new(), |c| format!(r#" colorspace="{c}""#));
@@ -217,6 +239,17 @@ pub fn materialx_document(name: &str) -> Result<String, MaterialXError> {
         ));
     }
     w("  </nodegraph>");
+    x.pop();
+    x
+}
+
+/// The OpenPBR surface shader `SR_{n}`: constants and inputs from the node graph `NG_{n}`.
+fn surface_shader(n: &str) -> String {
+    let mut x = String::new();
+    let mut w = |s: &str| {
+        x.push_str(s);
+        x.push('\n');
+    };
     w(&format!(
         r#"  <open_pbr_surface name="SR_{n}" type="surfaceshader">"#
     ));
@@ -253,16 +286,8 @@ pub fn materialx_document(name: &str) -> Result<String, MaterialXError> {
     w(&from_graph("geometry_normal", "vector3", "normal_out"));
     w(&from_graph("geometry_tangent", "vector3", "tangent_out"));
     w("  </open_pbr_surface>");
-    w(&format!(
-        r#"  <surfacematerial name="{}" type="material">"#,
-        material_name(name)
-    ));
-    w(&format!(
-        r#"    <input name="surfaceshader" type="surfaceshader" nodename="SR_{n}" />"#
-    ));
-    w("  </surfacematerial>");
-    w("</materialx>");
-    Ok(x)
+    x.pop();
+    x
 }
 
 /// Grey 8-bit linear codes of `v` in [0, 1] (round(255 v) in R, G and B).

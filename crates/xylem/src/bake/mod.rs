@@ -4,7 +4,7 @@
 //! hold the sign of the fibre's tilt out of the face), over the top face of a board cut from the
 //! tree. `xylem tradeoff` renders from these maps (`material::BakedWoodMaterial`, via
 //! [`bake_face`]) as the "baked texture" alternative to the procedural volume. Uses `wood`,
-//! `material` (the map type) and `render::image_io`.
+//! `material` (the map type) and `picture` (the files).
 //!
 //! Conventions (as glTF 2.0 and KHR_materials_anisotropy use them): texel (0, 0) is the top-left
 //! corner; tangent-space x points to the image's right (+u, along the board's length), y to the
@@ -12,10 +12,10 @@
 
 pub use crate::material::{across_fiber, BakedMaps, FaceRect};
 use crate::output::Staged;
+use crate::picture::exr::{stage_exr_layers, ExrCompression, ExrLayer};
 use crate::picture::png::{stage_png_rgb8, stage_png_tagged, PngTag};
 use crate::picture::srgb::to_srgb8;
 use crate::picture::ImageError;
-use crate::render::image_io::{stage_exr_layers, ExrCompression, ExrLayer};
 
 pub mod gltf;
 pub mod materialx;

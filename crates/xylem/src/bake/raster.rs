@@ -83,52 +83,7 @@ pub fn bake_mesh(
     pad: u32,
 ) -> MeshBake {
     let (w, h) = (width.max(1) as usize, height.max(1) as usize);
-    let size = Vec2::new(w as f32, h as f32);
-    // Texel → (triangle, barycentrics) of the first triangle covering its centre.
-    let mut owner: Vec<Option<(u32, Vec3)>> = vec![None; w * h];
-    let (mut overlapping, mut outside) = (0, 0);
-    for (k, t) in mesh.indices.iter().enumerate() {
-        let [a, b, c] = t.map(|i| mesh.uvs[i as usize] * size);
-        if [a, b, c]
-            .iter()
-            .any(|p| p.min_element() < 0.0 || p.x > size.x || p.y > size.y)
-        {
-            outside += 1;
-        }
-        let det = (b - a).perp_dot(c - a);
-        if det.abs() < 1e-12 || !det.is_finite() {
-            continue;
-        }
-        let lo = a.min(b).min(c);
-        let hi = a.max(b).max(c);
-        let x0 = (lo.x - 0.5).ceil().max(0.0) as usize;
-        let y0 = (lo.y - 0.5).ceil().max(0.0) as usize;
-        let x1 = ((hi.x - 0.5).floor().min(size.x - 1.0)).max(-1.0) as i64;
-        let y1 = ((hi.y - 0.5).floor().min(size.y - 1.0)).max(-1.0) as i64;
-        for y in y0 as i64..=y1 {
-            for x in x0 as i64..=x1 {
-                let p = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-                let l1 = (p - a).perp_dot(c - a) / det;
-                let l2 = (b - a).perp_dot(p - a) / det;
-                let l = Vec3::new(1.0 - l1 - l2, l1, l2);
-                if l.min_element() < -1e-6 {
-                    continue;
-                }
-                let slot = &mut owner[y as usize * w + x as usize];
-                if slot.is_some() {
-                    // A centre on an edge two triangles share is not an overlap.
-                    if l.min_element() > 1e-5 {
-                        overlapping += 1;
-                    }
-                } else {
-                    *slot = Some((
-                        k as u32,
-                        l.max(Vec3::ZERO) / l.max(Vec3::ZERO).element_sum(),
-                    ));
-                }
-            }
-        }
-    }
+    let (owner, overlapping, outside) = texel_owners(mesh, w, h);
     let tangents = mesh.tangents();
     let l = Mat3::from(to_tree.matrix3);
     let texels: Vec<Option<_>> = owner
@@ -180,6 +135,58 @@ pub fn bake_mesh(
         overlapping,
         outside,
     }
+}
+
+/// Texel → (triangle, barycentrics) of the first triangle covering its centre, for a `w × h`
+/// texture of `mesh`'s UV layout; with the count of texel centres a second triangle covers
+/// inside (overlapping charts) and of triangles reaching outside the unit square.
+fn texel_owners(mesh: &UvMesh, w: usize, h: usize) -> (Vec<Option<(u32, Vec3)>>, usize, usize) {
+    let size = Vec2::new(w as f32, h as f32);
+    let mut owner: Vec<Option<(u32, Vec3)>> = vec![None; w * h];
+    let (mut overlapping, mut outside) = (0, 0);
+    for (k, t) in mesh.indices.iter().enumerate() {
+        let [a, b, c] = t.map(|i| mesh.uvs[i as usize] * size);
+        if [a, b, c]
+            .iter()
+            .any(|p| p.min_element() < 0.0 || p.x > size.x || p.y > size.y)
+        {
+            outside += 1;
+        }
+        let det = (b - a).perp_dot(c - a);
+        if det.abs() < 1e-12 || !det.is_finite() {
+            continue;
+        }
+        let lo = a.min(b).min(c);
+        let hi = a.max(b).max(c);
+        let x0 = (lo.x - 0.5).ceil().max(0.0) as usize;
+        let y0 = (lo.y - 0.5).ceil().max(0.0) as usize;
+        let x1 = ((hi.x - 0.5).floor().min(size.x - 1.0)).max(-1.0) as i64;
+        let y1 = ((hi.y - 0.5).floor().min(size.y - 1.0)).max(-1.0) as i64;
+        for y in y0 as i64..=y1 {
+            for x in x0 as i64..=x1 {
+                let p = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+                let l1 = (p - a).perp_dot(c - a) / det;
+                let l2 = (b - a).perp_dot(p - a) / det;
+                let l = Vec3::new(1.0 - l1 - l2, l1, l2);
+                if l.min_element() < -1e-6 {
+                    continue;
+                }
+                let slot = &mut owner[y as usize * w + x as usize];
+                if slot.is_some() {
+                    // A centre on an edge two triangles share is not an overlap.
+                    if l.min_element() > 1e-5 {
+                        overlapping += 1;
+                    }
+                } else {
+                    *slot = Some((
+                        k as u32,
+                        l.max(Vec3::ZERO) / l.max(Vec3::ZERO).element_sum(),
+                    ));
+                }
+            }
+        }
+    }
+    (owner, overlapping, outside)
 }
 
 /// Every map's texel `i` set to the weighted sum Σ k·texel(j) over `taps`.

@@ -5,7 +5,7 @@
 
 use crate::math::Vec3;
 use crate::picture::srgb::srgb_to_linear;
-use crate::render::image_io::read_exr_rgb_checked;
+use crate::picture::Image;
 use crate::sweep::claim::CLAIM_FILE;
 use crate::sweep::manifest::{
     BoardManifest, CameraManifest, FrameManifest, Manifest, MANIFEST_FILE,
@@ -454,12 +454,12 @@ impl Capture {
                 )),
             }
         };
-        let (w, h, mut px) = match ext.as_str() {
-            "exr" => {
-                let (w, h, px) =
-                    read_exr_rgb_checked(path, &size_ok).map_err(|e| fail(e.to_string()))?;
-                (w as u32, h as u32, px)
-            }
+        let Image {
+            width: w,
+            height: h,
+            pixels: mut px,
+        } = match ext.as_str() {
+            "exr" => Image::read_checked(path, &size_ok).map_err(|e| fail(e.to_string()))?,
             "png" => read_png(path, self.srgb, &size_ok).map_err(fail)?,
             other => return Err(fail(format!("extension `{other}` (allowed .exr, .png)"))),
         };
@@ -482,13 +482,14 @@ impl Capture {
 }
 
 /// An 8- or 16-bit PNG as linear RGB (sRGB decoded when `srgb`, IEC 61966-2-1), each channel
-/// v / (2^bits − 1) first.
+/// v / (2^bits − 1) first; a pixel with a channel at the top code is clipped (NaN): its true
+/// value is unknown.
 fn read_png(
     path: &Path,
     srgb: bool,
     size_ok: crate::render::resources::SizeCheck,
-) -> Result<(u32, u32, Vec<Vec3>), String> {
-    use crate::picture::png::{decode_png, open_png};
+) -> Result<Image, String> {
+    use crate::picture::png::{decode_png, open_png, rgb_samples, sample_max};
     let px_bytes = std::mem::size_of::<Vec3>() as u64;
     let (info, buf) = decode_png(
         path,
@@ -497,40 +498,18 @@ fn read_png(
         px_bytes,
         size_ok,
     )?;
-    let channels = info.color_type.samples();
-    let sixteen = info.bit_depth == png::BitDepth::Sixteen;
-    let bytes = if sixteen { 2 } else { 1 };
-    let max = if sixteen { 65535.0 } else { 255.0 };
-    let decode = |v: f32| {
-        if srgb {
-            srgb_to_linear(v / max)
-        } else {
-            v / max
-        }
+    let max = sample_max(&info);
+    let decode = |v: f32| match srgb {
+        true => srgb_to_linear(v / max),
+        false => v / max,
     };
-    let px = buf
-        .chunks_exact(channels * bytes)
-        .map(|p| {
-            let ch = |i: usize| -> f32 {
-                if sixteen {
-                    u16::from_be_bytes([p[2 * i], p[2 * i + 1]]) as f32
-                } else {
-                    p[i] as f32
-                }
-            };
-            let (r, g, b) = match channels {
-                1 | 2 => (ch(0), ch(0), ch(0)),
-                _ => (ch(0), ch(1), ch(2)),
-            };
-            // A channel at the top code is clipped: its true value is unknown.
-            if r >= max || g >= max || b >= max {
-                Vec3::NAN
-            } else {
-                Vec3::new(decode(r), decode(g), decode(b))
-            }
+    let px = rgb_samples(&info, &buf)
+        .map(|p| match p.map(|v| v as f32) {
+            [r, g, b] if r >= max || g >= max || b >= max => Vec3::NAN,
+            [r, g, b] => Vec3::new(decode(r), decode(g), decode(b)),
         })
         .collect();
-    Ok((info.width, info.height, px))
+    Ok(Image::new(info.width, info.height, px))
 }
 /// Where a manifest's errors point: its file, and the field named by each check.
 struct ManifestChecker {

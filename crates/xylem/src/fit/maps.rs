@@ -10,9 +10,9 @@
 use super::model::TexelFit;
 use crate::material::MeasuredBoard;
 use crate::output::{FolderLock, LockError, LockMode, Staged};
+use crate::picture::exr::{stage_exr_layers, ExrCompression, ExrLayer};
 use crate::picture::png::{stage_png_rgb8, stage_png_rgb8_text};
 use crate::picture::ImageError;
-use crate::render::image_io::{stage_exr_layers, ExrCompression, ExrLayer};
 use glam::Vec3;
 use std::path::Path;
 

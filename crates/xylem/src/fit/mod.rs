@@ -422,20 +422,16 @@ pub fn fit(capture: &Capture, opts: &FitOptions) -> Result<(FittedMaps, FitStats
     pool.install(|| fit_in_pool(capture, opts, w, h))
 }
 
-fn fit_in_pool(
+/// Where each texel's centre `points[i]` falls on the film, refusing a board that leaves the
+/// camera's view.
+fn film_positions(
     capture: &Capture,
-    opts: &FitOptions,
+    points: &[Vec3],
     w: usize,
     h: usize,
-) -> Result<(FittedMaps, FitStats), FitError> {
-    let start = Instant::now();
+) -> Result<Vec<(f32, f32)>, FitError> {
     let cam = &capture.camera;
-    let board = &capture.board;
-    let n = w * h;
-    let points: Vec<Vec3> = (0..n)
-        .map(|i| board.texel_point(i % w, i / w, w, h))
-        .collect();
-    let mut film = Vec::with_capacity(n);
+    let mut film = Vec::with_capacity(points.len());
     for (i, p) in points.iter().enumerate() {
         let f = cam.project(*p).filter(|(x, y)| {
             (0.0..=cam.width as f32).contains(x) && (0.0..=cam.height as f32).contains(y)
@@ -458,6 +454,68 @@ fn fit_in_pool(
             }
         }
     }
+    Ok(film)
+}
+
+/// Fills `d` with texel `i`'s view, and per frame its light direction and reflectance factor
+/// (`samples` over the irradiance) where the frame is usable, weight 0 where not; returns why
+/// each frame was used or not.
+fn texel_data(
+    capture: &Capture,
+    samples: &[Vec<Vec3>],
+    p: Vec3,
+    i: usize,
+    d: &mut TexelData,
+) -> Rejections {
+    let (cam, board) = (&capture.camera, &capture.board);
+    let wo_world = cam.view_dir(p);
+    d.wo = board.local(wo_world);
+    d.wi.clear();
+    d.z.clear();
+    d.w.clear();
+    let mut why = Rejections::default();
+    for (k, f) in capture.frames.iter().enumerate() {
+        let (l, irr) = f.light_at(p);
+        let wi = board.local(l);
+        let z = samples[k][i] / irr;
+        let cause = if d.wo.z <= MIN_COS {
+            Cause::ViewGrazing
+        } else if wi.z <= MIN_COS {
+            Cause::LightGrazing
+        } else if irr.min_element() < f32::MIN_POSITIVE || !irr.is_finite() {
+            Cause::NoLight
+        } else if !samples[k][i].is_finite() {
+            Cause::Clipped
+        } else if !z.is_finite() || z.max_element() > MAX_REFLECTANCE_FACTOR {
+            Cause::TooBright
+        } else if f.glint(p, wo_world, board.z) {
+            Cause::Glint
+        } else {
+            Cause::Used
+        };
+        why.count(cause);
+        let ok = cause == Cause::Used;
+        d.wi.push(wi);
+        d.z.push(if ok { z } else { Vec3::ZERO });
+        d.w.push(if ok { 1.0 } else { 0.0 });
+    }
+    why
+}
+
+fn fit_in_pool(
+    capture: &Capture,
+    opts: &FitOptions,
+    w: usize,
+    h: usize,
+) -> Result<(FittedMaps, FitStats), FitError> {
+    let start = Instant::now();
+    let cam = &capture.camera;
+    let board = &capture.board;
+    let n = w * h;
+    let points: Vec<Vec3> = (0..n)
+        .map(|i| board.texel_point(i % w, i / w, w, h))
+        .collect();
+    let film = film_positions(capture, &points, w, h)?;
     // Frames in parallel, each sampled at every texel and dropped: memory is the samples.
     let black = capture.black()?;
     let read: Vec<Result<Vec<Vec3>, CaptureError>> = (0..capture.frames.len())
@@ -482,38 +540,7 @@ fn fit_in_pool(
         .map_init(
             || (Scratch::default(), TexelData::default()),
             |(scratch, d), i| {
-                let p = points[i];
-                let wo_world = cam.view_dir(p);
-                d.wo = board.local(wo_world);
-                d.wi.clear();
-                d.z.clear();
-                d.w.clear();
-                let mut why = Rejections::default();
-                for (k, f) in capture.frames.iter().enumerate() {
-                    let (l, irr) = f.light_at(p);
-                    let wi = board.local(l);
-                    let z = samples[k][i] / irr;
-                    let cause = if d.wo.z <= MIN_COS {
-                        Cause::ViewGrazing
-                    } else if wi.z <= MIN_COS {
-                        Cause::LightGrazing
-                    } else if irr.min_element() < f32::MIN_POSITIVE || !irr.is_finite() {
-                        Cause::NoLight
-                    } else if !samples[k][i].is_finite() {
-                        Cause::Clipped
-                    } else if !z.is_finite() || z.max_element() > MAX_REFLECTANCE_FACTOR {
-                        Cause::TooBright
-                    } else if f.glint(p, wo_world, board.z) {
-                        Cause::Glint
-                    } else {
-                        Cause::Used
-                    };
-                    why.count(cause);
-                    let ok = cause == Cause::Used;
-                    d.wi.push(wi);
-                    d.z.push(if ok { z } else { Vec3::ZERO });
-                    d.w.push(if ok { 1.0 } else { 0.0 });
-                }
+                let why = texel_data(capture, &samples, points[i], i, d);
                 if i % 256 == 0 {
                     let step = 256.min((n - i) as u64);
                     let d = done.fetch_add(step, Ordering::Relaxed) + step;

@@ -10,7 +10,8 @@
 use super::face::{bilinear_taps, face_shading, FaceRect, FaceTexel};
 use super::{MaterialHit, Shading};
 use crate::bsdf::FinishModel;
-use crate::picture::png::{decode_png, decode_png_text, open_png};
+use crate::picture::png::{decode_png, decode_png_text, decoded_rgb8, open_png};
+use crate::picture::Rgb8;
 use glam::{Vec2, Vec3};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -137,9 +138,6 @@ pub struct MeasuredBoard {
     pub highlight_width: Option<Vec<f32>>,
 }
 
-/// An 8-bit image: width, height, RGB texels (grey expanded, alpha dropped).
-type Rgb8 = (u32, u32, Vec<[u8; 3]>);
-
 /// The memory a board needs per texel while its maps are read and converted (the decoded
 /// samples and 8-bit copies of each map, then three maps of linear `Vec3`s, and β): measured
 /// 45 bytes (three 4096² maps: peak RSS 798 MB, 46 MB of it the process before reading).
@@ -202,15 +200,7 @@ fn read_png8(
     if info.bit_depth != png::BitDepth::Eight {
         return Err(fail(format!("{:?} bits per channel", info.bit_depth)));
     }
-    let channels = info.color_type.samples();
-    let texels = buf
-        .chunks_exact(channels)
-        .map(|p| match channels {
-            1 | 2 => [p[0]; 3],
-            _ => [p[0], p[1], p[2]],
-        })
-        .collect();
-    Ok((info.width, info.height, texels))
+    Ok(decoded_rgb8(&info, buf))
 }
 
 /// A map beside a fit's record (`fit.json`) must be the file it lists, and a map `xylem fit`
@@ -249,9 +239,10 @@ impl MeasuredBoard {
         files: &MeasuredFiles,
         colors: ColorSpace,
     ) -> Result<MeasuredBoard, MeasuredError> {
-        let (width, height, diffuse) = read_png8("diffuse", &files.diffuse, None)?;
-        let same_size = |field: &'static str, path: &Path| -> Result<Vec<[u8; 3]>, MeasuredError> {
-            Ok(read_png8(field, path, Some((width, height)))?.2)
+        let diffuse = read_png8("diffuse", &files.diffuse, None)?;
+        let (width, height) = (diffuse.width, diffuse.height);
+        let same_size = |field: &'static str, path: &Path| -> Result<Rgb8, MeasuredError> {
+            read_png8(field, path, Some((width, height)))
         };
         let bad = |field: &'static str, path: &Path, i: usize, what: String, allowed| {
             MeasuredError::Value {
@@ -266,8 +257,8 @@ impl MeasuredBoard {
         let color = |t: &[u8; 3]| Vec3::from_array(t.map(|v| colors.decode(v)));
         let fiber_color = same_size("fiber_color", &files.fiber_color)?;
         let axes = same_size("fiber_axis", &files.fiber_axis)?;
-        let mut fiber_axis = Vec::with_capacity(axes.len());
-        for (i, t) in axes.iter().enumerate() {
+        let mut fiber_axis = Vec::with_capacity(axes.pixels().len());
+        for (i, t) in axes.pixels().enumerate() {
             let u = Vec3::from_array(t.map(|v| 2.0 * v as f32 / 255.0 - 1.0));
             let len = u.length();
             if !(0.95..=1.05).contains(&len) {
@@ -284,8 +275,8 @@ impl MeasuredBoard {
         let highlight_width = match &files.highlight_width {
             None => None,
             Some(path) => {
-                let mut beta = Vec::with_capacity(axes.len());
-                for (i, t) in same_size("highlight_width", path)?.iter().enumerate() {
+                let mut beta = Vec::with_capacity(axes.pixels().len());
+                for (i, t) in same_size("highlight_width", path)?.pixels().enumerate() {
                     let deg = 90.0 * t[0] as f32 / 255.0;
                     if deg < 0.06 {
                         return Err(bad(
@@ -304,8 +295,8 @@ impl MeasuredBoard {
         Ok(MeasuredBoard {
             width,
             height,
-            diffuse: diffuse.iter().map(color).collect(),
-            fiber_color: fiber_color.iter().map(color).collect(),
+            diffuse: diffuse.pixels().map(|t| color(&t)).collect(),
+            fiber_color: fiber_color.pixels().map(|t| color(&t)).collect(),
             fiber_axis,
             highlight_width,
         })

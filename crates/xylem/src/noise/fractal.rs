@@ -12,7 +12,7 @@ use super::hash::mix32;
 #[cfg(target_arch = "x86_64")]
 use super::lanes::Lanes;
 use super::value::value3_grad_s;
-use crate::simd::{simd_level, Simd};
+use crate::simd::{simd_wide, Simd};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
@@ -346,27 +346,19 @@ impl Octaves {
     }
 }
 
-simd_level! { Avx2
-    unsafe fn octaves_avx2(o: &mut Octaves, p: Vec3, fold: &impl Fn(f32) -> f32) {
-        o.lanes::<std::arch::x86_64::__m256>(p, fold)
+simd_wide! {
+    unsafe fn octaves_avx2 / octaves_avx512(o: &mut Octaves, p: Vec3, fold: &impl Fn(f32) -> f32)
+    where lanes = L
+    {
+        o.lanes::<L>(p, fold)
     }
 }
 
-simd_level! { Avx512
-    unsafe fn octaves_avx512(o: &mut Octaves, p: Vec3, fold: &impl Fn(f32) -> f32) {
-        o.lanes::<std::arch::x86_64::__m512>(p, fold)
-    }
-}
-
-simd_level! { Avx2
-    unsafe fn many_avx2(f: &Fractal, points: &[Vec3], seed: u32, out: &mut [f32]) -> usize {
-        f.many::<std::arch::x86_64::__m256>(points, seed, out)
-    }
-}
-
-simd_level! { Avx512
-    unsafe fn many_avx512(f: &Fractal, points: &[Vec3], seed: u32, out: &mut [f32]) -> usize {
-        f.many::<std::arch::x86_64::__m512>(points, seed, out)
+simd_wide! {
+    unsafe fn many_avx2 / many_avx512(f: &Fractal, points: &[Vec3], seed: u32, out: &mut [f32]) -> usize
+    where lanes = L
+    {
+        f.many::<L>(points, seed, out)
     }
 }
 

@@ -11,7 +11,7 @@ use super::hash::{KNUTH, PRIME_X, PRIME_Y, PRIME_Z};
 #[cfg(target_arch = "x86_64")]
 use super::lanes::Lanes;
 use super::lattice::{corner_hashes, end_values, trilinear, trilinear_grad};
-use crate::simd::{simd_level, Simd};
+use crate::simd::{simd_wide, Simd};
 use glam::Vec3;
 
 /// Perlin 2002 quintic fade.
@@ -222,15 +222,11 @@ unsafe fn many_sse2(points: &[Vec3], s: u32, out: &mut [f32]) -> usize {
     many::<std::arch::x86_64::__m128>(points, s, out)
 }
 
-simd_level! { Avx2
-    unsafe fn many_avx2(points: &[Vec3], s: u32, out: &mut [f32]) -> usize {
-        many::<std::arch::x86_64::__m256>(points, s, out)
-    }
-}
-
-simd_level! { Avx512
-    unsafe fn many_avx512(points: &[Vec3], s: u32, out: &mut [f32]) -> usize {
-        many::<std::arch::x86_64::__m512>(points, s, out)
+simd_wide! {
+    unsafe fn many_avx2 / many_avx512(points: &[Vec3], s: u32, out: &mut [f32]) -> usize
+    where lanes = L
+    {
+        many::<L>(points, s, out)
     }
 }
 

@@ -10,7 +10,7 @@
 
 use super::hash::{cell3, cell3_offset, floor_i32, mix32, pcg3d, seed_offsets, unit_f32};
 use crate::math::Frame;
-use crate::simd::{simd_level, Simd};
+use crate::simd::{simd_wide, Simd};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 use std::f32::consts::PI;
@@ -838,18 +838,8 @@ impl Band {
         acc
     }
 
-    simd_level! { Avx2
-        unsafe fn cartesian_avx2<const GRAD: bool>(
-            &self,
-            q: &CartesianQuery,
-            upright: bool,
-        ) -> (f32, Vec3) {
-            self.cartesian_block::<GRAD>(q, upright)
-        }
-    }
-
-    simd_level! { Avx512
-        unsafe fn cartesian_avx512<const GRAD: bool>(
+    simd_wide! {
+        unsafe fn cartesian_avx2 / cartesian_avx512<const GRAD: bool>(
             &self,
             q: &CartesianQuery,
             upright: bool,
@@ -1022,28 +1012,11 @@ impl Band {
             let width = 2.0 * PI / n as f32;
             let volume = PI * (2 * j + 1) as f32 * cr * cr * cz / n as f32;
             let counts = PoissonTable::new((self.intensity * volume) as f64);
-            let (a_lo, a_hi) = if dtheta >= PI {
-                (0, n - 1)
-            } else {
-                let lo = floor_i32((theta - dtheta) / width);
-                let hi = floor_i32((theta + dtheta) / width);
-                if hi - lo + 1 >= n {
-                    (0, n - 1)
-                } else {
-                    (lo, hi)
-                }
-            };
+            let (a_lo, a_hi) = arc_window(theta, dtheta, width, n);
             let (r0, r1) = (j as f32 * cr, (j + 1) as f32 * cr);
             for oz in z_lo..=z_hi {
                 for a in a_lo..=a_hi {
-                    // a ∈ [−n, 2n) (θ ∈ [0, 2π), window ≤ π/2 each side): wrap without a division.
-                    let cell_a = if a < 0 {
-                        a + n
-                    } else if a >= n {
-                        a - n
-                    } else {
-                        a
-                    };
+                    let cell_a = wrap_arc(a, n);
                     let h = cell3_offset(j, cell_a, bz.wrapping_add(oz), &self.offsets);
                     for k in 0..counts.count(h[0]) {
                         let (u, w) = impulse(h, k);
@@ -1062,6 +1035,36 @@ impl Band {
             }
         }
         acc
+    }
+}
+
+/// The cells of a band of `n` cells, each `width` radians, that a kernel reaching the point at
+/// angle `theta` can sit in: within `dtheta` of it (every cell when that is π, or covers the
+/// band). The ends may lie outside [0, n) ([`wrap_arc`] brings them back).
+#[inline]
+fn arc_window(theta: f32, dtheta: f32, width: f32, n: i32) -> (i32, i32) {
+    if dtheta >= PI {
+        return (0, n - 1);
+    }
+    let lo = floor_i32((theta - dtheta) / width);
+    let hi = floor_i32((theta + dtheta) / width);
+    if hi - lo + 1 >= n {
+        (0, n - 1)
+    } else {
+        (lo, hi)
+    }
+}
+
+/// Cell `a` of an [`arc_window`] in a band of `n` cells: a ∈ [−n, 2n) (θ ∈ [0, 2π), window ≤
+/// π/2 each side), so it wraps without a division.
+#[inline(always)]
+fn wrap_arc(a: i32, n: i32) -> i32 {
+    if a < 0 {
+        a + n
+    } else if a >= n {
+        a - n
+    } else {
+        a
     }
 }
 

@@ -3,7 +3,8 @@
 //! axis titles beside them and a legend of the labelled series in the top-right corner. Longer
 //! captions live in the Markdown that embeds the plot.
 
-use super::contact::{draw_label, Rgb8};
+use super::contact::draw_label;
+use super::image::Rgb8;
 
 /// One curve of a plot.
 #[derive(Clone, Debug)]
@@ -74,9 +75,30 @@ fn number_label(v: f64) -> String {
 pub fn line_plot(series: &[Series], opts: &PlotOptions) -> Rgb8 {
     let (w, h) = (opts.width.max(64), opts.height.max(48));
     let mut img = Rgb8::filled(w, h, [255, 255, 255]);
+    let pts = axis_points(series, opts);
+    let axes = Axes::new(&pts, w, h);
+    let grey = [150, 150, 150];
+    let (left, right, top, bottom) = (axes.left, axes.right, axes.top, axes.bottom);
+    line(&mut img, left, bottom, right, bottom, grey);
+    line(&mut img, left, top, left, bottom, grey);
+    if axes.y0 < 0.0 && axes.y1 > 0.0 && !opts.log_y {
+        let z = axes.py(0.0).round() as i64;
+        line(&mut img, left, z, right, z, [220, 220, 220]);
+    }
+    for (s, p) in series.iter().zip(&pts) {
+        draw_series(&mut img, &axes, s, p);
+    }
+    draw_axis_labels(&mut img, &axes, opts);
+    draw_legend(&mut img, &axes, series);
+    img
+}
+
+/// Each series' drawable points on the plot's axes: finite, positive on a log axis, and
+/// `log10` of the value there.
+fn axis_points(series: &[Series], opts: &PlotOptions) -> Vec<Vec<(f64, f64)>> {
     let tx = |v: f64| if opts.log_x { v.log10() } else { v };
     let ty = |v: f64| if opts.log_y { v.log10() } else { v };
-    let pts: Vec<Vec<(f64, f64)>> = series
+    series
         .iter()
         .map(|s| {
             s.points
@@ -87,121 +109,139 @@ pub fn line_plot(series: &[Series], opts: &PlotOptions) -> Rgb8 {
                 .map(|&(x, y)| (tx(x), ty(y)))
                 .collect()
         })
-        .collect();
-    let all = pts.iter().flatten();
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for &(x, y) in all {
-        x0 = x0.min(x);
-        x1 = x1.max(x);
-        y0 = y0.min(y);
-        y1 = y1.max(y);
-    }
-    if x0 > x1 {
-        (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
-    }
-    if x1 - x0 < 1e-12 {
-        (x0, x1) = (x0 - 0.5, x1 + 0.5);
-    }
-    if y1 - y0 < 1e-12 {
-        (y0, y1) = (y0 - 0.5, y1 + 0.5);
-    }
-    let pad = 0.05 * (y1 - y0);
-    // Pad the range, but never below zero for data that has none (radiance, errors).
-    let (y0, y1) = (
-        if y0 >= 0.0 {
-            (y0 - pad).max(0.0)
-        } else {
-            y0 - pad
-        },
-        y1 + pad,
-    );
-    let (left, right, top, bottom) = (8i64, w as i64 - 8, 14i64, h as i64 - 14);
-    let px = |x: f64| left as f64 + (x - x0) / (x1 - x0) * (right - left) as f64;
-    let py = |y: f64| bottom as f64 - (y - y0) / (y1 - y0) * (bottom - top) as f64;
-    let grey = [150, 150, 150];
-    line(&mut img, left, bottom, right, bottom, grey);
-    line(&mut img, left, top, left, bottom, grey);
-    if y0 < 0.0 && y1 > 0.0 && !opts.log_y {
-        let z = py(0.0).round() as i64;
-        line(&mut img, left, z, right, z, [220, 220, 220]);
-    }
-    for (s, p) in series.iter().zip(&pts) {
-        for pair in p.windows(2) {
-            let (a, b) = (pair[0], pair[1]);
-            line(
-                &mut img,
-                px(a.0).round() as i64,
-                py(a.1).round() as i64,
-                px(b.0).round() as i64,
-                py(b.1).round() as i64,
-                s.color,
-            );
+        .collect()
+}
+
+/// The data ranges (on the axes' scale) and the pixel box they map to.
+struct Axes {
+    x0: f64,
+    x1: f64,
+    y0: f64,
+    y1: f64,
+    left: i64,
+    right: i64,
+    top: i64,
+    bottom: i64,
+}
+
+impl Axes {
+    /// The ranges of `pts` (a unit square when empty; a degenerate range widened by ±0.5; y
+    /// padded by 5 %, never below zero for data that has none) in a `w × h` image.
+    fn new(pts: &[Vec<(f64, f64)>], w: u32, h: u32) -> Axes {
+        let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+        for &(x, y) in pts.iter().flatten() {
+            x0 = x0.min(x);
+            x1 = x1.max(x);
+            y0 = y0.min(y);
+            y1 = y1.max(y);
         }
-        if s.markers {
-            for &(x, y) in p {
-                let (cx, cy) = (px(x).round() as i64, py(y).round() as i64);
-                for dy in -2..=2 {
-                    for dx in -2..=2 {
-                        set(&mut img, cx + dx, cy + dy, s.color);
-                    }
+        if x0 > x1 {
+            (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
+        }
+        if x1 - x0 < 1e-12 {
+            (x0, x1) = (x0 - 0.5, x1 + 0.5);
+        }
+        if y1 - y0 < 1e-12 {
+            (y0, y1) = (y0 - 0.5, y1 + 0.5);
+        }
+        let pad = 0.05 * (y1 - y0);
+        // Pad the range, but never below zero for data that has none (radiance, errors).
+        let (y0, y1) = (
+            if y0 >= 0.0 {
+                (y0 - pad).max(0.0)
+            } else {
+                y0 - pad
+            },
+            y1 + pad,
+        );
+        Axes {
+            x0,
+            x1,
+            y0,
+            y1,
+            left: 8,
+            right: w as i64 - 8,
+            top: 14,
+            bottom: h as i64 - 14,
+        }
+    }
+
+    /// The pixel column of x.
+    fn px(&self, x: f64) -> f64 {
+        self.left as f64 + (x - self.x0) / (self.x1 - self.x0) * (self.right - self.left) as f64
+    }
+
+    /// The pixel row of y.
+    fn py(&self, y: f64) -> f64 {
+        self.bottom as f64 - (y - self.y0) / (self.y1 - self.y0) * (self.bottom - self.top) as f64
+    }
+}
+
+/// One series' polyline through `p`, with a 5×5 square on every point if it has markers.
+fn draw_series(img: &mut Rgb8, axes: &Axes, s: &Series, p: &[(f64, f64)]) {
+    let at = |(x, y): (f64, f64)| (axes.px(x).round() as i64, axes.py(y).round() as i64);
+    for pair in p.windows(2) {
+        let ((ax, ay), (bx, by)) = (at(pair[0]), at(pair[1]));
+        line(img, ax, ay, bx, by, s.color);
+    }
+    if s.markers {
+        for &q in p {
+            let (cx, cy) = at(q);
+            for dy in -2..=2 {
+                for dx in -2..=2 {
+                    set(img, cx + dx, cy + dy, s.color);
                 }
             }
         }
     }
+}
+
+/// Width in pixels of `t` in the 3×5 font.
+fn text_width(t: &str) -> u32 {
+    4 * t.chars().count() as u32 + 1
+}
+
+/// The axis ranges at the corners and the axis titles beside them.
+fn draw_axis_labels(img: &mut Rgb8, axes: &Axes, opts: &PlotOptions) {
+    let (w, h) = (img.width, img.height);
+    let (left, right, bottom) = (axes.left as u32, axes.right as u32, axes.bottom as u32);
     let un = |v: f64, log: bool| if log { 10f64.powf(v) } else { v };
-    let xl = number_label(un(x0, opts.log_x));
-    let xr = number_label(un(x1, opts.log_x));
-    draw_label(&mut img, &xl, left as u32, h - 8, 1);
+    let xl = number_label(un(axes.x0, opts.log_x));
+    let xr = number_label(un(axes.x1, opts.log_x));
+    draw_label(img, &xl, left, h - 8, 1);
     draw_label(
-        &mut img,
+        img,
         &xr,
-        (right as u32).saturating_sub(4 * xr.len() as u32 + 1),
+        right.saturating_sub(4 * xr.len() as u32 + 1),
         h - 8,
         1,
     );
-    draw_label(
-        &mut img,
-        &number_label(un(y1, opts.log_y)),
-        left as u32 + 2,
-        2,
-        1,
-    );
-    draw_label(
-        &mut img,
-        &number_label(un(y0, opts.log_y)),
-        left as u32 + 2,
-        bottom as u32 - 8,
-        1,
-    );
-    let text_width = |t: &str| 4 * t.chars().count() as u32 + 1;
+    let y_max = number_label(un(axes.y1, opts.log_y));
+    draw_label(img, &y_max, left + 2, 2, 1);
+    let y_min = number_label(un(axes.y0, opts.log_y));
+    draw_label(img, &y_min, left + 2, bottom - 8, 1);
     if !opts.x_title.is_empty() {
         let x = (w / 2).saturating_sub(text_width(opts.x_title) / 2);
-        draw_label(&mut img, opts.x_title, x, h - 8, 1);
+        draw_label(img, opts.x_title, x, h - 8, 1);
     }
-    let y_max = number_label(un(y1, opts.log_y));
     if !opts.y_title.is_empty() {
-        draw_label(
-            &mut img,
-            opts.y_title,
-            left as u32 + 6 + text_width(&y_max),
-            2,
-            1,
-        );
+        draw_label(img, opts.y_title, left + 6 + text_width(&y_max), 2, 1);
     }
-    // Legend: a swatch and the label per labelled series, right-aligned, top down.
-    let mut row = top as u32 + 2;
+}
+
+/// The legend: a swatch and the label per labelled series, right-aligned, top down.
+fn draw_legend(img: &mut Rgb8, axes: &Axes, series: &[Series]) {
+    let mut row = axes.top as u32 + 2;
     for s in series.iter().filter(|s| !s.label.is_empty()) {
-        let tw = text_width(&s.label);
-        let x = (right as u32).saturating_sub(tw + 8);
+        let x = (axes.right as u32).saturating_sub(text_width(&s.label) + 8);
         for dy in 1..6 {
             for dx in 0..5 {
-                set(&mut img, (x + dx) as i64, (row + dy) as i64, s.color);
+                set(img, (x + dx) as i64, (row + dy) as i64, s.color);
             }
         }
-        draw_label(&mut img, &s.label, x + 7, row, 1);
+        draw_label(img, &s.label, x + 7, row, 1);
         row += 8;
     }
-    img
 }
 
 fn set(img: &mut Rgb8, x: i64, y: i64, c: [u8; 3]) {

@@ -2,9 +2,9 @@
 //! buffers, looping animated PNGs (APNG), and reading 8-bit PNGs back. Every file is written
 //! whole or not at all through [`super::file::stage`].
 
-use super::contact::Rgb8;
 use super::file::{commit, stage, ImageError};
-use super::srgb::to_srgb8;
+use super::image::{Image, Rgb8};
+use super::srgb::{srgb_to_linear, to_srgb8};
 use crate::output::Staged;
 use crate::render::resources::{any_size, SizeCheck};
 use glam::Vec3;
@@ -317,7 +317,7 @@ const PNG_DECODER_BYTES: usize = 64 << 20;
 /// decoded buffer plus `extra_bytes_per_pixel` (what the caller builds from it) must pass
 /// [`check_image`](crate::render::resources::check_image), before anything is allocated.
 /// Errors name no file: callers do.
-pub fn decode_png(
+pub(crate) fn decode_png(
     path: &Path,
     input: impl std::io::Read,
     transformations: png::Transformations,
@@ -387,37 +387,96 @@ pub fn read_png_rgb8(path: &Path) -> Result<Rgb8, ImageError> {
 
 /// [`read_png_rgb8`] refusing, before decoding, a declared size that fails `size_ok`.
 pub(crate) fn read_png_rgb8_checked(path: &Path, size_ok: SizeCheck) -> Result<Rgb8, ImageError> {
-    let name = path.display().to_string();
     let invalid = |what: String| ImageError::Invalid {
-        path: name.clone(),
+        path: path.display().to_string(),
         what,
     };
-    let (info, buf) = decode_png(
-        path,
-        open_png(path).map_err(invalid)?,
-        png::Transformations::EXPAND | png::Transformations::STRIP_16,
-        3,
-        size_ok,
-    )
-    .map_err(invalid)?;
+    let file = open_png(path).map_err(invalid)?;
+    decode_rgb8(path, file, size_ok).map_err(invalid)
+}
+
+/// A PNG held in memory (e.g. one a glTF binary embeds) as 8-bit RGB, as [`read_png_rgb8`]
+/// reads a file; `name` names it in errors.
+pub fn decode_png_rgb8(name: &Path, bytes: &[u8]) -> Result<Rgb8, String> {
+    decode_rgb8(name, bytes, &any_size)
+}
+
+/// [`read_png_rgb8`] of any byte source.
+fn decode_rgb8(path: &Path, input: impl std::io::Read, size_ok: SizeCheck) -> Result<Rgb8, String> {
+    let expand = png::Transformations::EXPAND | png::Transformations::STRIP_16;
+    let (info, buf) = decode_png(path, input, expand, 3, size_ok)?;
+    Ok(decoded_rgb8(&info, buf))
+}
+
+/// A decoded 8-bit PNG (`Transformations::EXPAND`) as an [`Rgb8`], through [`rgb_samples`].
+pub(crate) fn decoded_rgb8(info: &png::OutputInfo, buf: Vec<u8>) -> Rgb8 {
     let data = match info.color_type {
+        // Already what an `Rgb8` holds: no copy.
         png::ColorType::Rgb => buf,
-        png::ColorType::Rgba => buf
-            .chunks_exact(4)
-            .flat_map(|p| [p[0], p[1], p[2]])
+        _ => rgb_samples(info, &buf)
+            .flat_map(|p| p.map(|v| v as u8))
             .collect(),
-        png::ColorType::Grayscale => buf.iter().flat_map(|&g| [g, g, g]).collect(),
-        png::ColorType::GrayscaleAlpha => buf
-            .chunks_exact(2)
-            .flat_map(|p| [p[0], p[0], p[0]])
-            .collect(),
-        png::ColorType::Indexed => return Err(invalid("indexed colour was not expanded".into())),
     };
-    Ok(Rgb8 {
+    Rgb8 {
         width: info.width,
         height: info.height,
         data,
+    }
+}
+
+/// The pixels of a PNG decoded with `Transformations::EXPAND` (so grey, grey and alpha, RGB or
+/// RGBA, of 8 or 16 bits) as RGB samples: grey repeated in R, G and B, alpha dropped, 16-bit
+/// samples whole. Every reader of PNG pixels goes through it.
+pub(crate) fn rgb_samples<'a>(
+    info: &png::OutputInfo,
+    buf: &'a [u8],
+) -> impl Iterator<Item = [u16; 3]> + 'a {
+    let channels = info.color_type.samples();
+    let sixteen = info.bit_depth == png::BitDepth::Sixteen;
+    let bytes = if sixteen { 2 } else { 1 };
+    buf.chunks_exact(channels * bytes).map(move |p| {
+        let ch = |i: usize| match sixteen {
+            true => u16::from_be_bytes([p[2 * i], p[2 * i + 1]]),
+            false => p[i] as u16,
+        };
+        match channels {
+            1 | 2 => [ch(0); 3],
+            _ => [ch(0), ch(1), ch(2)],
+        }
     })
+}
+
+/// The largest sample of a decoded PNG: 255, or 65535 for 16 bits.
+pub(crate) fn sample_max(info: &png::OutputInfo) -> f32 {
+    match info.bit_depth {
+        png::BitDepth::Sixteen => 65535.0,
+        _ => 255.0,
+    }
+}
+
+/// An 8- or 16-bit PNG as a linear image, each sample v / (2^bits − 1), sRGB-decoded
+/// (IEC 61966-2-1) when `srgb`. The declared size must pass `size_ok`.
+pub(crate) fn read_png_linear(
+    path: &Path,
+    srgb: bool,
+    size_ok: SizeCheck,
+) -> Result<Image, String> {
+    let (info, buf) = decode_png(
+        path,
+        open_png(path)?,
+        png::Transformations::EXPAND,
+        std::mem::size_of::<Vec3>() as u64,
+        size_ok,
+    )?;
+    let max = sample_max(&info);
+    let decode = |v: u16| match srgb {
+        true => srgb_to_linear(v as f32 / max),
+        false => v as f32 / max,
+    };
+    let pixels = (rgb_samples(&info, &buf))
+        .map(|p| Vec3::from_array(p.map(decode)))
+        .collect();
+    Ok(Image::new(info.width, info.height, pixels))
 }
 
 /// The chunk types of a PNG byte stream in order (PNG spec §5.3: after the 8-byte signature,

@@ -29,7 +29,7 @@ pub use light::{
 
 use crate::material::Material;
 use crate::progress::{NoProgress, Progress};
-use crate::simd::{simd_level, Simd};
+use crate::simd::{simd_wide, Simd};
 use glam::{UVec2, Vec3};
 use integrator::{radiance_frames, FirstBounce, FramesScratch, KeptSample, RayCount, ShadowTest};
 use rayon::prelude::*;
@@ -65,7 +65,7 @@ pub struct RenderSettings {
 impl RenderSettings {
     /// The EXR header attributes that say how an image of `scene` (its name and file) seen by
     /// `camera` was made: scene, file, spp, seed, integrator and camera (the software attribute
-    /// carries xylem's version; [`image_io::stage_exr_layers`]). Camera axes as [`Camera`] has
+    /// carries xylem's version; [`crate::picture::exr::stage_exr_layers`]). Camera axes as [`Camera`] has
     /// them: right, up and view direction; lengths in mm.
     pub fn exr_meta(
         &self,
@@ -321,9 +321,7 @@ pub fn render_frames_reusing(
             threads: run.threads,
             message: e.to_string(),
         })?;
-    let tiles: Vec<UVec2> = (0..h.div_ceil(TILE))
-        .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| UVec2::new(tx, ty) * TILE))
-        .collect();
+    let tiles = tile_origins(w, h);
     let keep = primaries.as_ref().is_some_and(|p| p.is_empty());
     let reuse = primaries.as_deref().filter(|p| !p.is_empty());
     if let Some(p) = reuse {
@@ -376,8 +374,34 @@ pub fn render_frames_reusing(
                 .collect();
         }
     }
+    let (aov, frames) = place_tiles(w, h, lights.len(), results);
+    Ok(Frames {
+        width: w,
+        height: h,
+        aov,
+        frames,
+        elapsed: start.elapsed(),
+        rays: total_rays.into_inner(),
+    })
+}
+
+/// The top-left corners of the `TILE × TILE` tiles covering a `w × h` image, row by row.
+fn tile_origins(w: u32, h: u32) -> Vec<UVec2> {
+    (0..h.div_ceil(TILE))
+        .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| UVec2::new(tx, ty) * TILE))
+        .collect()
+}
+
+/// The finished tiles put together into a `w × h` image: the AOVs and each of `n_frames`
+/// frames.
+fn place_tiles(
+    w: u32,
+    h: u32,
+    n_frames: usize,
+    results: Vec<(UVec2, TileFrames)>,
+) -> (Vec<Aov>, Vec<FrameImage>) {
     let n = (w * h) as usize;
-    let mut frames: Vec<FrameImage> = (0..lights.len())
+    let mut frames: Vec<FrameImage> = (0..n_frames)
         .map(|_| FrameImage {
             beauty: vec![Vec3::ZERO; n],
             std_error: vec![0.0; n],
@@ -402,14 +426,7 @@ pub fn render_frames_reusing(
             f.nonfinite += img.nonfinite;
         }
     }
-    Ok(Frames {
-        width: w,
-        height: h,
-        aov,
-        frames,
-        elapsed: start.elapsed(),
-        rays: total_rays.into_inner(),
-    })
+    (aov, frames)
 }
 
 /// What a render's progress counts: `tiles`, or `tiles × 48 frames` for a sweep.
@@ -463,21 +480,8 @@ fn render_tile(
     render_tile_in(scene, lights, shadow, settings, origin, primary)
 }
 
-simd_level! { Avx512
-    unsafe fn render_tile_avx512(
-        scene: &Scene,
-        lights: &LightFrames,
-        shadow: &ShadowTest,
-        settings: &RenderSettings,
-        origin: UVec2,
-        primary: Primary,
-    ) -> TileFrames {
-        render_tile_in(scene, lights, shadow, settings, origin, primary)
-    }
-}
-
-simd_level! { Avx2
-    unsafe fn render_tile_avx2(
+simd_wide! {
+    unsafe fn render_tile_avx2 / render_tile_avx512(
         scene: &Scene,
         lights: &LightFrames,
         shadow: &ShadowTest,

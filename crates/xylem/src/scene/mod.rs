@@ -643,8 +643,9 @@ impl Builder<'_> {
 
     fn env_map(&self, field: &str, file: &str, rotate_deg: f32) -> Result<EnvMap, SceneError> {
         let p = self.base.join(file);
-        let (w, h, texels) =
-            render::image_io::read_exr_rgb(&p).map_err(|e| self.invalid(field, e.to_string()))?;
+        let img = crate::picture::exr::read_exr_rgb(&p)
+            .map_err(|e| self.invalid(field, e.to_string()))?;
+        let (w, h, texels) = (img.width as usize, img.height as usize, img.pixels);
         if w < 2 || h < 1 {
             return Err(self.invalid(field, format!("{} is too small ({w}x{h})", p.display())));
         }

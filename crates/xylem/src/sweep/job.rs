@@ -2,7 +2,7 @@
 //! or naive), write each frame's EXR, PNG and record, and assemble the sequence once every frame
 //! of the sweep is in the output folder.
 
-use super::batch::{batches, default_plan, plan, BudgetError, PrimaryMode, SweepSize};
+use super::batch::{batches, default_plan, plan, BudgetError, Plan, PrimaryMode, SweepSize};
 use super::claim::{claim_for_slice, replace_claim, Claim};
 use super::manifest::{Manifest, MANIFEST_FILE};
 use super::path::{parse_frames_range, PathError};
@@ -13,12 +13,11 @@ use super::sequence::{
     AssembleOptions, Assembled, FrameRecord, Region, SequenceError, SweepSettings,
 };
 use crate::output::{remove_if_present, FolderLock, LockError, LockMode};
+use crate::picture::exr::{stage_exr_layers, write_exr_layers, ExrCompression, ExrLayer};
 use crate::picture::file::commit;
 use crate::picture::png::stage_png_linear;
 use crate::picture::ImageError;
-use crate::render::image_io::{
-    aov_layers, beauty_rgba, stage_exr_layers, write_exr_layers, ExrCompression, ExrLayer,
-};
+use crate::render::image_io::{aov_layers, beauty_rgba};
 use crate::render::resources::{ResourceError, Resources};
 use crate::render::{render_frames_reusing, Frames, Primaries};
 use crate::render::{RenderError, RunOptions};
@@ -294,25 +293,9 @@ pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepE
         threads: job.run.threads,
         frames: range.len(),
     };
-    let mut plan = match job.memory {
-        Some(budget) => plan(&size, budget, job.primaries)?,
-        None => default_plan(&size, job.primaries)?,
-    };
-    plan.keep &= !job.naive;
+    let plan = batch_plan(job, &size)?;
     let batch = plan.batch.max(1);
-    let mut need = Resources::sweep(size.width, size.height, size.frames, batch, size.threads);
-    need.memory = plan.memory(&size);
-    need.check(&job.out, job.ignore_limits)?;
-    std::fs::create_dir_all(&job.out).map_err(|cause| SweepError::OutDir {
-        path: job.out.display().to_string(),
-        cause,
-    })?;
-    let mode = if job.range.is_some() {
-        LockMode::Shared
-    } else {
-        LockMode::Exclusive
-    };
-    let _lock = FolderLock::try_new(&job.out, mode)?;
+    let _lock = lock_out(job)?;
     let manifest = Manifest::of_sweep(loaded, &path, moving);
     let settings = SweepSettings {
         scene: loaded.name.clone(),
@@ -327,24 +310,7 @@ pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepE
         camera: format!("{}x{}", cam.width, cam.height),
         manifest_crc32: format!("{:08x}", crc32fast::hash(manifest.text().as_bytes())),
     };
-    if job.range.is_some() {
-        check_same_sweep(&job.out, &manifest)?;
-        claim_for_slice(&job.out, &claim)?;
-    }
-    // The manifest (what `xylem fit` takes as a complete capture) and the old viewer, CSV and
-    // sheet describe frames about to change: they go before any frame, and come back only
-    // once every frame is there.
-    clear_assembled(&job.out)?;
-    let manifest_path = job.out.join(MANIFEST_FILE);
-    let out_error = |path: &Path, cause| SweepError::OutDir {
-        path: path.display().to_string(),
-        cause,
-    };
-    remove_if_present(&manifest_path).map_err(|e| out_error(&manifest_path, e))?;
-    if job.range.is_none() {
-        clear_frames(&job.out)?;
-        replace_claim(&job.out, &claim)?;
-    }
+    prepare_out(job, &manifest, &claim)?;
     let regions = scene_regions(loaded);
     let header = frame_header(loaded, &path, moving);
     let (mut render_time, mut n_batches) = (Duration::ZERO, 0);
@@ -380,9 +346,11 @@ pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepE
     // only once every frame of the sweep is in the folder: the slice that completes it writes
     // it (each slice looks after writing its own records, so the last to look sees them all).
     if job.range.is_none() || read_records(&job.out).is_ok() {
-        manifest
-            .write(&job.out)
-            .map_err(|e| out_error(&manifest_path, e))?;
+        let manifest_path = job.out.join(MANIFEST_FILE);
+        (manifest.write(&job.out)).map_err(|cause| SweepError::OutDir {
+            path: manifest_path.display().to_string(),
+            cause,
+        })?;
     }
     let assembled = if job.range.is_none() {
         Some(assemble(&job.out, &AssembleOptions::default())?)
@@ -398,6 +366,61 @@ pub fn run_job(loaded: &LoadedScene, job: &SweepJob) -> Result<JobReport, SweepE
         kept_primaries: plan.keep,
         assembled,
     })
+}
+
+/// The job's batch plan: within `--memory` if given, else the default budget; primary samples
+/// are never kept for a naive sweep. The output folder's disk and the plan's memory are
+/// checked (unless the job ignores limits).
+fn batch_plan(job: &SweepJob, size: &SweepSize) -> Result<Plan, SweepError> {
+    let mut plan = match job.memory {
+        Some(budget) => plan(size, budget, job.primaries)?,
+        None => default_plan(size, job.primaries)?,
+    };
+    plan.keep &= !job.naive;
+    let batch = plan.batch.max(1);
+    let mut need = Resources::sweep(size.width, size.height, size.frames, batch, size.threads);
+    need.memory = plan.memory(size);
+    need.check(&job.out, job.ignore_limits)?;
+    Ok(plan)
+}
+
+/// Creates the output folder and locks it: shared for a slice (`--frames-range`, other slices
+/// may render beside it), exclusive for a whole sweep.
+fn lock_out(job: &SweepJob) -> Result<FolderLock, SweepError> {
+    std::fs::create_dir_all(&job.out).map_err(|cause| SweepError::OutDir {
+        path: job.out.display().to_string(),
+        cause,
+    })?;
+    let mode = if job.range.is_some() {
+        LockMode::Shared
+    } else {
+        LockMode::Exclusive
+    };
+    Ok(FolderLock::try_new(&job.out, mode)?)
+}
+
+/// Makes the output folder ready for the job's frames: a slice must belong to the sweep
+/// already there (its manifest and claim); a whole sweep clears old frames and claims the
+/// folder. Either way what describes the finished sweep goes first.
+fn prepare_out(job: &SweepJob, manifest: &Manifest, claim: &Claim) -> Result<(), SweepError> {
+    if job.range.is_some() {
+        check_same_sweep(&job.out, manifest)?;
+        claim_for_slice(&job.out, claim)?;
+    }
+    // The manifest (what `xylem fit` takes as a complete capture) and the old viewer, CSV and
+    // sheet describe frames about to change: they go before any frame, and come back only
+    // once every frame is there.
+    clear_assembled(&job.out)?;
+    let manifest_path = job.out.join(MANIFEST_FILE);
+    remove_if_present(&manifest_path).map_err(|cause| SweepError::OutDir {
+        path: manifest_path.display().to_string(),
+        cause,
+    })?;
+    if job.range.is_none() {
+        clear_frames(&job.out)?;
+        replace_claim(&job.out, claim)?;
+    }
+    Ok(())
 }
 
 /// Hands the pages a written batch freed back to the system. glibc keeps them in the arenas of

@@ -7,11 +7,13 @@ use super::path::MAX_FRAMES;
 use super::viewer::viewer_html;
 use crate::math::{luminance, Vec3};
 use crate::output::{remove_if_present, write_atomic};
-use crate::picture::contact::{sheet_band, sheet_columns, shrunk_size, Rgb8};
+use crate::picture::contact::{sheet_band, sheet_columns};
+use crate::picture::image::shrunk_size;
 use crate::picture::png::{
     read_png_rgb8_checked, write_apng_streamed, write_png_bands, write_png_linear,
 };
 use crate::picture::ImageError;
+use crate::picture::Rgb8;
 use crate::render::resources::read_text_bounded;
 use serde::{Deserialize, Serialize};
 use std::ops::Range;
@@ -319,6 +321,27 @@ pub(crate) const MAX_RECORD_BYTES: u64 = 1 << 20;
 /// Reads every `frame_NNNN.json` in `dir`, sorted by frame index, and checks that they describe
 /// one complete sweep (same frame count and size, every frame present exactly once).
 pub fn read_records(dir: &Path) -> Result<Vec<FrameRecord>, SequenceError> {
+    let records = read_record_files(dir)?;
+    let Some((_, first)) = records.first() else {
+        return Err(SequenceError::Empty {
+            dir: dir.display().to_string(),
+        });
+    };
+    for (k, (path, r)) in records.iter().enumerate() {
+        let previous = k.checked_sub(1).map(|p| &records[p]);
+        if let Some(what) = record_mismatch(path, r, first, previous) {
+            return Err(SequenceError::Mismatch {
+                path: path.display().to_string(),
+                what,
+            });
+        }
+    }
+    check_every_frame(dir, &records, first.frames)?;
+    Ok(records.into_iter().map(|(_, r)| r).collect())
+}
+
+/// Every `frame_*.json` in `dir` with its path, parsed, sorted by frame index.
+fn read_record_files(dir: &Path) -> Result<Vec<(PathBuf, FrameRecord)>, SequenceError> {
     let io = |cause| SequenceError::Io {
         path: dir.display().to_string(),
         cause,
@@ -344,87 +367,93 @@ pub fn read_records(dir: &Path) -> Result<Vec<FrameRecord>, SequenceError> {
         records.push((path, rec));
     }
     records.sort_by_key(|(_, r)| r.index);
-    let Some((_, first)) = records.first() else {
-        return Err(SequenceError::Empty {
-            dir: dir.display().to_string(),
-        });
-    };
+    Ok(records)
+}
+
+/// What is wrong with record `r` (read from `path`) in a sweep whose first record is `first`,
+/// `previous` the record before it in index order; `None` if it fits.
+fn record_mismatch(
+    path: &Path,
+    r: &FrameRecord,
+    first: &FrameRecord,
+    previous: Option<&(PathBuf, FrameRecord)>,
+) -> Option<String> {
     let (frames, size) = (first.frames, (first.width, first.height));
-    let settings = first.sweep.clone();
-    for (k, (path, r)) in records.iter().enumerate() {
-        let stem = path.file_stem().and_then(|n| n.to_str()).unwrap_or("");
-        let what = if !(1..=MAX_FRAMES).contains(&r.frames) {
-            Some(format!(
-                "claims a {}-frame sweep (allowed 1 to {MAX_FRAMES})",
-                r.frames
-            ))
-        } else if stem != frame_stem(r.index) {
-            Some(format!(
-                "holds the record of frame {} (its file would be {}.json)",
-                r.index,
-                frame_stem(r.index)
-            ))
-        } else if k > 0 && records[k - 1].1.index == r.index {
-            Some(format!(
-                "is a second record of frame {} (the other: {})",
-                r.index,
-                records[k - 1].0.display()
-            ))
-        } else if let Some(d) = r.sweep.difference(&settings) {
-            Some(format!(
-                "belongs to a sweep with {d}; every slice must be rendered with the same settings"
-            ))
-        } else if r.frames != frames {
-            Some(format!(
-                "belongs to a {}-frame sweep, the others to a {frames}-frame one",
-                r.frames
-            ))
-        } else if (r.width, r.height) != size {
-            Some(format!(
-                "is {}x{}, the others {}x{}",
-                r.width, r.height, size.0, size.1
-            ))
-        } else if r.index >= frames {
-            Some(format!(
-                "frame {} is past the sweep's end ({frames} frames)",
-                r.index
-            ))
-        } else {
-            None
-        };
-        if let Some(what) = what {
-            return Err(SequenceError::Mismatch {
-                path: path.display().to_string(),
-                what,
-            });
-        }
+    let stem = path.file_stem().and_then(|n| n.to_str()).unwrap_or("");
+    if !(1..=MAX_FRAMES).contains(&r.frames) {
+        Some(format!(
+            "claims a {}-frame sweep (allowed 1 to {MAX_FRAMES})",
+            r.frames
+        ))
+    } else if stem != frame_stem(r.index) {
+        Some(format!(
+            "holds the record of frame {} (its file would be {}.json)",
+            r.index,
+            frame_stem(r.index)
+        ))
+    } else if let Some((other, _)) = previous.filter(|(_, p)| p.index == r.index) {
+        Some(format!(
+            "is a second record of frame {} (the other: {})",
+            r.index,
+            other.display()
+        ))
+    } else if let Some(d) = r.sweep.difference(&first.sweep) {
+        Some(format!(
+            "belongs to a sweep with {d}; every slice must be rendered with the same settings"
+        ))
+    } else if r.frames != frames {
+        Some(format!(
+            "belongs to a {}-frame sweep, the others to a {frames}-frame one",
+            r.frames
+        ))
+    } else if (r.width, r.height) != size {
+        Some(format!(
+            "is {}x{}, the others {}x{}",
+            r.width, r.height, size.0, size.1
+        ))
+    } else if r.index >= frames {
+        Some(format!(
+            "frame {} is past the sweep's end ({frames} frames)",
+            r.index
+        ))
+    } else {
+        None
     }
+}
+
+/// Refuses a set of records (sorted by index) that misses any of the sweep's `frames`, naming
+/// the missing ones as runs and the first run as a `--frames-range` to render.
+fn check_every_frame(
+    dir: &Path,
+    records: &[(PathBuf, FrameRecord)],
+    frames: usize,
+) -> Result<(), SequenceError> {
     let present: Vec<usize> = records.iter().map(|(_, r)| r.index).collect();
     let missing: Vec<usize> = (0..frames)
         .filter(|i| present.binary_search(i).is_err())
         .collect();
-    if !missing.is_empty() {
-        let runs = runs(&missing);
-        let hint = format!("{}..{}", runs[0].start, runs[0].end);
-        let missing = runs
-            .iter()
-            .map(|r| {
-                if r.len() == 1 {
-                    r.start.to_string()
-                } else {
-                    format!("{}..={}", r.start, r.end - 1)
-                }
-            })
-            .collect::<Vec<_>>()
-            .join(", ");
-        return Err(SequenceError::Missing {
-            dir: dir.display().to_string(),
-            frames,
-            missing,
-            hint,
-        });
+    if missing.is_empty() {
+        return Ok(());
     }
-    Ok(records.into_iter().map(|(_, r)| r).collect())
+    let runs = runs(&missing);
+    let hint = format!("{}..{}", runs[0].start, runs[0].end);
+    let missing = runs
+        .iter()
+        .map(|r| {
+            if r.len() == 1 {
+                r.start.to_string()
+            } else {
+                format!("{}..={}", r.start, r.end - 1)
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
+    Err(SequenceError::Missing {
+        dir: dir.display().to_string(),
+        frames,
+        missing,
+        hint,
+    })
 }
 
 /// Groups sorted indices into runs of consecutive values.

@@ -20,12 +20,15 @@ use xylem::math::Pcg32;
 use xylem::picture::file::commit;
 use xylem::picture::png::stage_png_rgb8;
 use xylem::picture::srgb::Srgb8;
-use xylem::render::image_io::read_exr_rgb;
+use xylem::picture::Image;
 use xylem::render::RunOptions;
 use xylem::scene;
 use xylem::sweep::job::{run_job, SweepJob};
 use xylem::sweep::manifest::{Manifest, MANIFEST_FILE};
 use xylem::wood::WoodVolume;
+
+mod report;
+pub use report::*;
 
 /// Texel pitch of every round-trip board: 0.25 mm, the pitch notes/measured.md assumes.
 pub const PITCH_MM: f32 = 0.25;
@@ -385,12 +388,13 @@ pub enum Exposure {
 
 /// The brightest value (any channel) of the frames' pixels that see the board outside the
 /// glint of that frame's light.
-fn wood_peak(src: &Path, frames: &[(usize, usize, Vec<Vec3>)]) -> Result<f32, String> {
+fn wood_peak(src: &Path, frames: &[Image]) -> Result<f32, String> {
     let capture = Capture::open(src).map_err(|e| e.to_string())?;
     let (cam, board) = (&capture.camera, &capture.board);
     let mut peak = 0.0f32;
-    for (f, (w, _, px)) in capture.frames.iter().zip(frames) {
-        for (i, p) in px.iter().enumerate() {
+    for (f, img) in capture.frames.iter().zip(frames) {
+        let w = img.width as usize;
+        for (i, p) in img.pixels.iter().enumerate() {
             let (x, y) = ((i % w) as f32 + 0.5, (i / w) as f32 + 0.5);
             let (o, d) = cam.ray(x, y);
             let Some(q) = board.hit(o, d) else { continue };
@@ -418,24 +422,23 @@ pub fn to_camera_frames(
     let text =
         xylem::sweep::manifest::read_text(&src.join(MANIFEST_FILE)).map_err(|e| e.to_string())?;
     let mut m: Manifest = serde_json::from_str(&text).map_err(|e| e.to_string())?;
-    let frames: Vec<(usize, usize, Vec<Vec3>)> = m
+    let frames: Vec<Image> = m
         .frames
         .iter()
-        .map(|f| read_exr_rgb(&src.join(&f.image)).map_err(|e| e.to_string()))
+        .map(|f| Image::read(&src.join(&f.image)).map_err(|e| e.to_string()))
         .collect::<Result<_, _>>()?;
     let peak = match exposure {
         Exposure::Wood => wood_peak(src, &frames)?,
         Exposure::BrightestPixel => frames
             .iter()
-            .flat_map(|f| f.2.iter().map(|p| p.max_element()))
+            .flat_map(|f| f.pixels.iter().map(|p| p.max_element()))
             .fold(0.0f32, f32::max),
     };
     let exposure = 0.9 / peak.max(1e-12);
     let enc = Srgb8::new();
-    for (k, (f, (w, h, px))) in m.frames.iter_mut().zip(&frames).enumerate() {
+    for (k, (f, img)) in m.frames.iter_mut().zip(&frames).enumerate() {
         let mut rng = Pcg32::new(seed, k as u64);
-        let bytes: Vec<u8> = px
-            .iter()
+        let bytes: Vec<u8> = (img.pixels.iter())
             .flat_map(|p| (*p * exposure).to_array())
             .map(|v| {
                 let v = match full_well {
@@ -453,7 +456,7 @@ pub fn to_camera_frames(
             .collect();
         let name = format!("frame_{k:04}.png");
         commit(
-            stage_png_rgb8(&dst.join(&name), *w as u32, *h as u32, &bytes)
+            stage_png_rgb8(&dst.join(&name), img.width, img.height, &bytes)
                 .map_err(|e| e.to_string())?,
         )
         .map_err(|e| e.to_string())?;
@@ -510,341 +513,3 @@ pub fn sources() -> Vec<(&'static str, Source)> {
 
 /// Full well (electrons at full scale) of the camera capture the goals are checked on.
 pub const FULL_WELL: f32 = 4000.0;
-
-fn plot_png(
-    dir: &Path,
-    name: &str,
-    series: &[xylem::picture::plot::Series],
-    log_x: bool,
-) -> Result<(), String> {
-    use xylem::picture::plot::{line_plot, PlotOptions};
-    let img = line_plot(
-        series,
-        &PlotOptions {
-            log_x,
-            ..PlotOptions::default()
-        },
-    );
-    let path = dir.join(name);
-    xylem::picture::png::write_png_rgb8(&path, img.width, img.height, &img.data)
-        .map_err(|e| format!("{}: {e}", path.display()))
-}
-
-/// Fitted and true maps side by side (diffuse, fibre colour, axis as colour), 2× enlarged.
-fn side_by_side(truth: &MeasuredBoard, fitted: &FittedMaps) -> xylem::picture::contact::Rgb8 {
-    use xylem::picture::contact::{contact_sheet_rows, Rgb8};
-    let n = truth.width;
-    let img = |v: &[Vec3], f: &dyn Fn(Vec3) -> Vec3| Rgb8 {
-        width: n,
-        height: n,
-        data: v
-            .iter()
-            .flat_map(|c| f(*c).to_array())
-            .map(|x| (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8)
-            .collect(),
-    };
-    let axis = |u: Vec3| {
-        let u = if u.x < 0.0 { -u } else { u };
-        0.5 * (u + Vec3::ONE)
-    };
-    let bright = |c: Vec3| c * 3.0;
-    let id = |c: Vec3| c;
-    let thumbs = vec![
-        img(&truth.diffuse, &id),
-        img(&truth.fiber_color, &bright),
-        img(&truth.fiber_axis, &axis),
-        img(&fitted.diffuse, &id),
-        img(&fitted.fiber_color, &bright),
-        img(&fitted.fiber_axis, &axis),
-    ];
-    let labels: Vec<String> = [
-        "TRUE RHO",
-        "TRUE KF",
-        "TRUE AXIS",
-        "FIT RHO",
-        "FIT KF",
-        "FIT AXIS",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .collect();
-    contact_sheet_rows(&thumbs, &labels, 3, 4)
-}
-
-/// Runs the round trips of every board (EXR and camera PNG), the curves over frames, arcs and
-/// noise, and returns validation/FIT.md's Markdown and whether every goal was met. Plots go to
-/// `dir/plots/` with the README's figure ([`README_FIGURE`]), the captures to `work`; nothing
-/// is written anywhere else.
-pub fn run_report(
-    base: &Path,
-    dir: &Path,
-    work: &Path,
-    spec: &SweepSpec,
-    progress: &dyn Fn(&str),
-) -> Result<(String, bool), String> {
-    use crate::report::markdown_table;
-    use xylem::picture::plot::{Series, PALETTE};
-    let plots = dir.join("plots");
-    std::fs::create_dir_all(&plots).map_err(|e| format!("{}: {e}", plots.display()))?;
-    let header = [
-        "board",
-        "capture",
-        "axis median",
-        "axis p90",
-        "diffuse median",
-        "fibre colour median",
-        "β median",
-        "fit time (s)",
-        "goals",
-    ];
-    let mut rows = Vec::new();
-    let mut all_ok = true;
-    let (mut frames_curve, mut arcs_curve, mut noise_curve) = (Vec::new(), Vec::new(), Vec::new());
-    let per_arc = spec.frames_per_arc;
-    let arcs = spec.azimuths_deg.len();
-    for (k, (name, source)) in sources().into_iter().enumerate() {
-        progress(name);
-        let w = work.join(format!("board{k}"));
-        let rt = render_round_trip(&source, spec, base, &w)?;
-        let (e, maps, t) = fit_and_compare(&rt.sweep_dir, None, true, &rt)?;
-        let ok = e.meets(&GOALS);
-        all_ok &= ok;
-        let mut row = vec![name.to_string(), format!("EXR, {} spp", spec.spp)];
-        row.extend(e.cells());
-        row.push(format!("{t:.2}"));
-        row.push(if ok { "met" } else { "**missed**" }.into());
-        rows.push(row);
-        let sheet = side_by_side(&rt.truth, &maps);
-        let file = format!("fit_{}.png", name.replace(' ', "_"));
-        xylem::picture::png::write_png_rgb8(
-            &plots.join(&file),
-            sheet.width,
-            sheet.height,
-            &sheet.data,
-        )
-        .map_err(|e| e.to_string())?;
-        let png = w.join("camera");
-        to_camera_frames(&rt.sweep_dir, &png, Some(FULL_WELL), 17, Exposure::Wood)?;
-        let (e, _, t) = fit_and_compare(&png, None, true, &rt)?;
-        let ok = e.meets(&GOALS);
-        all_ok &= ok;
-        let mut row = vec![
-            name.to_string(),
-            format!("8-bit sRGB PNG, shot noise {FULL_WELL} e⁻"),
-        ];
-        row.extend(e.cells());
-        row.push(format!("{t:.2}"));
-        row.push(if ok { "met" } else { "**missed**" }.into());
-        rows.push(row);
-        // Curves: fewer frames per arc, fewer arcs, more noise.
-        let mut fc = Vec::new();
-        for stride in [1usize, 2, 4, 8] {
-            let keep = frame_selection(per_arc, arcs, stride);
-            let (e, _, _) = fit_and_compare(&rt.sweep_dir, Some(&keep), true, &rt)?;
-            fc.push((keep.len() as f64, e));
-        }
-        frames_curve.push((name, fc));
-        let mut ac = Vec::new();
-        for use_arcs in 1..=arcs {
-            let keep = frame_selection(per_arc, use_arcs, 1);
-            let (e, _, _) = fit_and_compare(&rt.sweep_dir, Some(&keep), false, &rt)?;
-            ac.push((use_arcs as f64, e));
-        }
-        arcs_curve.push((name, ac));
-        let mut nc = Vec::new();
-        for fw in [16000.0f32, 4000.0, 1000.0, 250.0] {
-            let d = w.join(format!("noise{fw}"));
-            to_camera_frames(&rt.sweep_dir, &d, Some(fw), 23, Exposure::Wood)?;
-            let (e, _, _) = fit_and_compare(&d, None, true, &rt)?;
-            nc.push((fw as f64, e));
-        }
-        noise_curve.push((name, nc));
-    }
-    progress("re-render");
-    readme_figure(base, work, spec, &plots.join(README_FIGURE))?;
-    let mut md = format!(
-        "# Fit validation: per-texel fibre-BSDF parameters measured back from light sweeps\n\n\
-         Written by `cargo run --release -- validate fit` (crates/xylem-lab/src/fit.rs; derivations in \
-         notes/fit.md). Each board — {n}×{n} texels of 0.25 mm, the centre crop of Marschner et \
-         al. 2005's measured maple and padauk (data/) and the procedural african_mahogany and \
-         curly_maple presets sampled at the texel centres on a quartersawn face — is rendered \
-         through the `measured` material as a sweep of {arcs} arcs (azimuths {az:?}°) × {per_arc} \
-         frames over ±{arc}° ({total} frames), {spp} spp, a sphere light of radius {r} mm at \
-         500 mm (its solid angle is the renderer's noise), orthographic camera straight down, \
-         {px}×{px} pixels per texel. `xylem sweep`'s job writes the frames and the manifest; \
-         `xylem fit`'s code fits them; every error is against the maps the renderer read. The \
-         camera capture is the same sweep as 8-bit sRGB PNGs exposed so the brightest pixel of \
-         the wood is at 90 % of full scale (the finish's mirror glint of the light left to clip), with Poisson shot noise of {fw} electrons at full scale.\n\n\
-         Goals (issue 13): fibre-axis angle median ≤ 2°, p90 ≤ 5°; diffuse relative error \
-         median ≤ 3 %; fibre colour ≤ 10 %; β ≤ 15 %.\n\n",
-        n = spec.texels,
-        az = spec.azimuths_deg,
-        arc = spec.arc_deg,
-        total = per_arc * arcs,
-        spp = spec.spp,
-        r = spec.light_radius_mm,
-        px = spec.px_per_texel,
-        fw = FULL_WELL,
-    );
-    md += &markdown_table(&header, &rows);
-    md += &format!(
-        "\n**All goals {}.**\n\n",
-        if all_ok { "met" } else { "NOT met" }
-    );
-    let curve_table = |title: &str, xname: &str, c: &[(&str, Vec<(f64, FitErrors)>)]| {
-        let mut s = format!("### {title}\n\n");
-        let mut rows = Vec::new();
-        for (name, pts) in c {
-            for (x, e) in pts {
-                let mut r = vec![name.to_string(), format!("{x}")];
-                r.extend(e.cells());
-                rows.push(r);
-            }
-        }
-        s += &markdown_table(
-            &[
-                "board",
-                xname,
-                "axis median",
-                "axis p90",
-                "diffuse median",
-                "fibre colour median",
-                "β median",
-            ],
-            &rows,
-        );
-        s
-    };
-    let plot = |file: &str, c: &[(&str, Vec<(f64, FitErrors)>)], log_x: bool| {
-        let series: Vec<Series> = c
-            .iter()
-            .enumerate()
-            .map(|(i, (name, pts))| Series {
-                points: pts.iter().map(|(x, e)| (*x, e.axis_p90_deg)).collect(),
-                color: PALETTE[i % PALETTE.len()],
-                markers: true,
-                label: name.to_string(),
-            })
-            .collect();
-        plot_png(&plots, file, &series, log_x)
-    };
-    plot("fit_frames.png", &frames_curve, true)?;
-    plot("fit_arcs.png", &arcs_curve, false)?;
-    plot("fit_noise.png", &noise_curve, true)?;
-    md += "## How the errors grow\n\nPlots: fibre-axis p90 (degrees) against the abscissa, one line per board in the table's order \
-           (colours: the plot palette's first four).\n\n";
-    md += &curve_table(
-        "Fewer frames (every arc, every 1st/2nd/4th/8th frame; EXR)",
-        "frames",
-        &frames_curve,
-    );
-    md += "\n![axis p90 against frames](plots/fit_frames.png)\n\n";
-    md += &curve_table(
-        "Fewer arcs (the first N arcs of 0°, 60°, 120°, every frame; EXR). `xylem fit` refuses fewer than 3 (notes/fit.md §3); fitted here without that check to show why",
-        "arcs",
-        &arcs_curve,
-    );
-    md += "\n![axis p90 against arcs](plots/fit_arcs.png)\n\n";
-    md += &curve_table(
-        "More noise (8-bit sRGB PNG, full well in electrons at full scale; fewer = noisier)",
-        "full well (e⁻)",
-        &noise_curve,
-    );
-    md += "\n![axis p90 against full well](plots/fit_noise.png)\n\n## Maps: truth (top) and fit (bottom)\n\n\
-           Diffuse, fibre colour (×3) and fibre axis ((u + 1)/2 as RGB), EXR capture.\n\n";
-    for (name, _) in sources() {
-        md += &format!(
-            "{name}:\n\n![{name}](plots/fit_{}.png)\n\n",
-            name.replace(' ', "_")
-        );
-    }
-    md += &format!(
-        "## The README's figure\n\nThe measured maple crop rendered (light 20° from the zenith along the grain), its fitted maps (diffuse, fibre colour, axis) and the fit re-rendered under the same light.\n\n![measured maple, fitted maps, re-rendered fit](plots/{README_FIGURE})\n"
-    );
-    Ok((md, all_ok))
-}
-
-/// The README's figure of the fit, written beside the report's plots (`plots/fit_maple.png`).
-pub const README_FIGURE: &str = "fit_maple.png";
-
-/// The README's figure, written to `path`: the measured maple crop rendered (light 20° from the
-/// zenith along the grain), its fitted maps (diffuse, fibre colour ×3, fibre axis), and the
-/// fitted maps re-rendered through the `measured` material under the same light.
-pub fn readme_figure(
-    base: &Path,
-    work: &Path,
-    spec: &SweepSpec,
-    path: &Path,
-) -> Result<(), String> {
-    use xylem::picture::contact::{contact_sheet_rows, Rgb8};
-    let w = work.join("readme");
-    let source = Source::Measured {
-        dir: "data/marschner2005/maple".into(),
-    };
-    let rt = render_round_trip(&source, spec, base, &w)?;
-    let (_, maps, _) = fit_and_compare(&rt.sweep_dir, None, true, &rt)?;
-    let fit_dir = w.join("fitted");
-    xylem::fit::write_maps(&fit_dir, &maps, &serde_json::json!({})).map_err(|e| e.to_string())?;
-    // One arc of 5 frames over ±40°: frame 3 is the light at +20°.
-    let one = SweepSpec {
-        frames_per_arc: 5,
-        azimuths_deg: vec![0.0],
-        arc_deg: 40.0,
-        ..spec.clone()
-    };
-    let frame = |maps_dir: &Path, out: &Path| -> Result<Rgb8, String> {
-        let text = scene_text(maps_dir, &one);
-        let loaded = scene::from_str(&text, "<fit figure>", base, "fit_figure")
-            .map_err(|e| e.to_string())?;
-        let job = SweepJob {
-            out: out.to_path_buf(),
-            ..SweepJob::default()
-        };
-        run_job(&loaded, &job).map_err(|e| e.to_string())?;
-        let (fw, fh, px) = read_exr_rgb(&out.join("frame_0003.exr")).map_err(|e| e.to_string())?;
-        Ok(Rgb8 {
-            width: fw as u32,
-            height: fh as u32,
-            data: xylem::picture::srgb::to_srgb8(&px, 0.0),
-        })
-    };
-    let measured = frame(&w.join("truth"), &w.join("render_truth"))?;
-    let refit = frame(&fit_dir, &w.join("render_fit"))?;
-    let k = spec.px_per_texel as u32;
-    let enc = Srgb8::new();
-    let big = |v: &[Vec3], f: &dyn Fn(Vec3) -> Vec3| {
-        let n = maps.width as u32;
-        let mut data = Vec::with_capacity((n * k * n * k * 3) as usize);
-        for y in 0..n * k {
-            for x in 0..n * k {
-                let c = f(v[((y / k) * n + x / k) as usize]);
-                data.extend(c.to_array().map(|x| enc.encode(x)));
-            }
-        }
-        Rgb8 {
-            width: n * k,
-            height: n * k,
-            data,
-        }
-    };
-    let thumbs = vec![
-        measured,
-        big(&maps.diffuse, &|c| c),
-        big(&maps.fiber_color, &|c| c),
-        big(&maps.fiber_axis, &|u| 0.5 * (u + Vec3::ONE)),
-        refit,
-    ];
-    let labels: Vec<String> = [
-        "MEASURED",
-        "FIT DIFFUSE",
-        "FIT FIBRE",
-        "FIT AXIS",
-        "RE-RENDERED",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .collect();
-    let sheet = contact_sheet_rows(&thumbs, &labels, 5, 4);
-    xylem::picture::png::write_png_rgb8(path, sheet.width, sheet.height, &sheet.data)
-        .map_err(|e| format!("{}: {e}", path.display()))
-}
