@@ -10,6 +10,7 @@
 //! Each part draws from its own random stream, derived only from (seed, pixel, sample) by
 //! [`sample_rngs`], so a frame rendered with others equals the frame rendered alone bit for bit.
 
+use super::camera::CameraRays;
 use super::film::Aov;
 use super::frames::LightFrames;
 use super::geometry::{segment_misses_box, slab_misses, Accel, Hit, Ray};
@@ -92,11 +93,17 @@ pub(crate) struct RayCount(pub u64);
 /// the camera (filter and lens), the second for lighting. PCG32 streams keyed by a SplitMix64
 /// hash (Steele et al. 2014) of (seed, sample, part) with the pixel index as stream selector.
 pub fn sample_rngs(seed: u64, pixel_index: u64, sample: u32) -> (Pcg32, Pcg32) {
-    let key = |part: u64| splitmix64(seed ^ splitmix64(((sample as u64) << 2) | part));
     (
-        Pcg32::new(key(0), pixel_index),
-        Pcg32::new(key(1), pixel_index),
+        sample_rng(seed, pixel_index, sample, 0),
+        sample_rng(seed, pixel_index, sample, 1),
     )
+}
+
+/// Stream `part` (0 camera, 1 lighting) of [`sample_rngs`], made alone.
+#[inline]
+fn sample_rng(seed: u64, pixel_index: u64, sample: u32, part: u64) -> Pcg32 {
+    let key = splitmix64(seed ^ splitmix64(((sample as u64) << 2) | part));
+    Pcg32::new(key, pixel_index)
 }
 
 /// SplitMix64 finaliser (Steele, Lea, Flood 2014): a bijective 64-bit mix.
@@ -108,13 +115,13 @@ fn splitmix64(x: u64) -> u64 {
 }
 
 /// Builds the shading point of a hit seen along `ray`. `aov` is given at the camera's first hit,
-/// whose pixel footprint (times `footprint_scale`, [`footprint_scale`]) band-limits the textures.
+/// with the pixel footprint at the hit (times `footprint_scale`, [`footprint_scale`]), which
+/// band-limits the textures.
 pub(crate) fn shading_point(
     scene: &Scene,
     ray: &Ray,
     hit: &Hit,
-    aov: Option<&mut Aov>,
-    footprint_scale: f32,
+    aov: Option<(&mut Aov, f32)>,
 ) -> ShadingPoint {
     let s = scene.accel.surface(ray, hit);
     let inst = &scene.accel.instances[s.instance as usize];
@@ -131,11 +138,8 @@ pub(crate) fn shading_point(
         placement: inst.placement,
         // Only the camera's first hit (the one that records AOVs) has a pixel footprint; the
         // ellipse it makes on the surface, stretched by 1/cos, is taken at its geometric mean.
-        footprint: match aov {
-            Some(_) => {
-                footprint_scale * scene.camera.pixel_footprint(ray, hit.t)
-                    / s.ng.dot(ray.d).abs().max(0.05).sqrt()
-            }
+        footprint: match &aov {
+            Some((_, pixel)) => *pixel / s.ng.dot(ray.d).abs().max(0.05).sqrt(),
             None => 0.0,
         },
     };
@@ -152,7 +156,7 @@ pub(crate) fn shading_point(
             n: -frame.n,
         };
     }
-    if let Some(a) = aov {
+    if let Some((a, _)) = aov {
         *a = Aov {
             albedo: shading.aov.albedo,
             normal: frame.n,
@@ -194,25 +198,42 @@ pub fn primary_sample(
     seed: u64,
     footprint_scale: f32,
 ) -> PrimarySample {
-    let cam = &scene.camera;
-    let index = pixel.y as u64 * cam.width as u64 + pixel.x as u64;
-    let (mut rng, _) = sample_rngs(seed, index, sample);
+    primary_sample_with(
+        scene,
+        &scene.camera.rays(),
+        pixel,
+        sample,
+        seed,
+        footprint_scale,
+    )
+}
+
+/// [`primary_sample`] with the camera's per-ray constants worked out by the caller
+/// (`camera` = `scene.camera.rays()`, once per tile); the same bits.
+#[inline]
+pub(crate) fn primary_sample_with(
+    scene: &Scene,
+    camera: &CameraRays,
+    pixel: UVec2,
+    sample: u32,
+    seed: u64,
+    footprint_scale: f32,
+) -> PrimarySample {
+    let index = pixel.y as u64 * scene.camera.width as u64 + pixel.x as u64;
+    let mut rng = sample_rng(seed, index, sample, 0);
     let film = pixel.as_vec2() + Vec2::splat(0.5) + scene.filter.sample(&mut rng);
-    let ray = cam.ray(film, rng.next_vec2());
+    let ray = camera.ray(film, rng.next_vec2());
     let mut aov = Aov::default();
     match scene.accel.intersect(&ray, f32::INFINITY) {
-        Some(hit) => PrimarySample {
-            ray,
-            t_hit: hit.t,
-            point: Some(shading_point(
-                scene,
-                &ray,
-                &hit,
-                Some(&mut aov),
-                footprint_scale,
-            )),
-            aov,
-        },
+        Some(hit) => {
+            let pixel = footprint_scale * camera.pixel_footprint(&ray, hit.t);
+            PrimarySample {
+                ray,
+                t_hit: hit.t,
+                point: Some(shading_point(scene, &ray, &hit, Some((&mut aov, pixel)))),
+                aov,
+            }
+        }
         None => PrimarySample {
             ray,
             t_hit: f32::INFINITY,
@@ -225,7 +246,7 @@ pub fn primary_sample(
 /// The lighting random stream of a sample (the second of [`sample_rngs`]).
 pub(crate) fn light_rng(scene: &Scene, pixel: UVec2, sample: u32, seed: u64) -> Pcg32 {
     let index = pixel.y as u64 * scene.camera.width as u64 + pixel.x as u64;
-    sample_rngs(seed, index, sample).1
+    sample_rng(seed, index, sample, 1)
 }
 
 /// Origin of a ray leaving `sp` along `dir`: the hit point moved `eps` along the geometric
@@ -731,7 +752,7 @@ pub(crate) fn radiance_frames(
             (ray, t_hit, *rng) = (c.ray, c.t_hit, c.rng.clone());
             at_first = false;
             bounce = match c.hit {
-                Some(h) if !last => Some(shading_point(scene, &ray, &h, None, 0.0)),
+                Some(h) if !last => Some(shading_point(scene, &ray, &h, None)),
                 _ => None,
             };
             continue;
@@ -792,7 +813,7 @@ pub(crate) fn radiance_frames(
             Some(h) if last => (t_hit, bounce) = (h.t, None),
             Some(h) => {
                 t_hit = h.t;
-                bounce = Some(shading_point(scene, &ray, &h, None, 0.0));
+                bounce = Some(shading_point(scene, &ray, &h, None));
             }
             None => (t_hit, bounce) = (f32::INFINITY, None),
         }

@@ -16,7 +16,7 @@ pub mod lod;
 pub mod resources;
 pub mod wide_bvh;
 
-pub use camera::{Camera, Projection};
+pub use camera::{Camera, CameraRays, Projection};
 pub(crate) use film::RadianceSum;
 pub use film::{Aov, Filter, Image, PixelSum};
 pub use frames::LightFrames;
@@ -31,7 +31,10 @@ use crate::material::Material;
 use crate::progress::{NoProgress, Progress};
 use crate::simd::{simd_level, Simd};
 use glam::{UVec2, Vec3};
-use integrator::{radiance_frames, FirstBounce, FramesScratch, KeptSample, RayCount, ShadowTest};
+use integrator::{
+    primary_sample_with, radiance_frames, FirstBounce, FramesScratch, KeptSample, RayCount,
+    ShadowTest,
+};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
@@ -514,6 +517,7 @@ fn render_tile_in(
     let mut scratch = FramesScratch::default();
     let mut rays = RayCount::default();
     let fp_scale = integrator::footprint_scale(settings.spp);
+    let camera = scene.camera.rays();
     let spp = settings.spp as usize;
     let mut kept = Vec::new();
     if let Primary::Keep = primary {
@@ -535,7 +539,8 @@ fn render_tile_in(
                 }
                 Primary::Compute | Primary::Keep => {
                     rays.0 += 1;
-                    computed = primary_sample(scene, pixel, s, settings.seed, fp_scale);
+                    computed =
+                        primary_sample_with(scene, &camera, pixel, s, settings.seed, fp_scale);
                     (&computed, None)
                 }
             };
