@@ -116,13 +116,18 @@ fn splitmix64(x: u64) -> u64 {
 
 /// Builds the shading point of a hit seen along `ray`. `aov` is given at the camera's first hit,
 /// with the pixel footprint at the hit (times `footprint_scale`, [`footprint_scale`]), which
-/// band-limits the textures.
+/// band-limits the textures. Written into `out`, where the caller keeps it: a shading point holds
+/// a whole BSDF (484 bytes), and returning it by value cost a copy of all of them per vertex
+/// (`memcpy`, 3–5 % of a Cornell-box render in `perf`); the BSDF itself is copied by its variant
+/// ([`SurfaceBsdf::copied`]).
+#[inline(never)]
 pub(crate) fn shading_point(
     scene: &Scene,
     ray: &Ray,
     hit: &Hit,
     aov: Option<(&mut Aov, f32)>,
-) -> ShadingPoint {
+    out: &mut Option<ShadingPoint>,
+) {
     let s = scene.accel.surface(ray, hit);
     let inst = &scene.accel.instances[s.instance as usize];
     let material = &scene.materials[inst.material as usize];
@@ -167,14 +172,14 @@ pub(crate) fn shading_point(
             coverage: 1.0,
         };
     }
-    ShadingPoint {
+    *out = Some(ShadingPoint {
         p: s.p,
         ng,
         frame,
         wo: frame.to_local(wo_world),
-        bsdf: shading.bsdf,
+        bsdf: shading.bsdf.copied(),
         eps: 2e-5 * scene.accel.scale(),
-    }
+    });
 }
 
 /// The share of the pixel footprint each of `spp` camera samples band-limits its first hit by:
@@ -198,48 +203,69 @@ pub fn primary_sample(
     seed: u64,
     footprint_scale: f32,
 ) -> PrimarySample {
-    primary_sample_with(
+    let mut out = PrimarySample::empty();
+    primary_sample_into(
         scene,
         &scene.camera.rays(),
         pixel,
         sample,
         seed,
         footprint_scale,
-    )
+        &mut out,
+    );
+    out
 }
 
-/// [`primary_sample`] with the camera's per-ray constants worked out by the caller
-/// (`camera` = `scene.camera.rays()`, once per tile); the same bits.
-#[inline]
-pub(crate) fn primary_sample_with(
+impl PrimarySample {
+    /// A placeholder to write samples into ([`primary_sample_into`]): no ray, no hit.
+    pub(crate) fn empty() -> PrimarySample {
+        PrimarySample {
+            ray: Ray {
+                o: Vec3::ZERO,
+                d: Vec3::ZERO,
+            },
+            t_hit: f32::INFINITY,
+            point: None,
+            aov: Aov::default(),
+        }
+    }
+}
+
+/// [`primary_sample`] into `out`, with the camera's per-ray constants worked out by the caller
+/// (`camera` = `scene.camera.rays()`, once per tile); the same bits. Written in place, since a
+/// sample holds a whole BSDF ([`shading_point`]).
+#[inline(always)]
+pub(crate) fn primary_sample_into(
     scene: &Scene,
     camera: &CameraRays,
     pixel: UVec2,
     sample: u32,
     seed: u64,
     footprint_scale: f32,
-) -> PrimarySample {
+    out: &mut PrimarySample,
+) {
     let index = pixel.y as u64 * scene.camera.width as u64 + pixel.x as u64;
     let mut rng = sample_rng(seed, index, sample, 0);
     let film = pixel.as_vec2() + Vec2::splat(0.5) + scene.filter.sample(&mut rng);
     let ray = camera.ray(film, rng.next_vec2());
-    let mut aov = Aov::default();
+    out.ray = ray;
+    out.aov = Aov::default();
     match scene.accel.intersect(&ray, f32::INFINITY) {
         Some(hit) => {
             let pixel = footprint_scale * camera.pixel_footprint(&ray, hit.t);
-            PrimarySample {
-                ray,
-                t_hit: hit.t,
-                point: Some(shading_point(scene, &ray, &hit, Some((&mut aov, pixel)))),
-                aov,
-            }
+            out.t_hit = hit.t;
+            shading_point(
+                scene,
+                &ray,
+                &hit,
+                Some((&mut out.aov, pixel)),
+                &mut out.point,
+            );
         }
-        None => PrimarySample {
-            ray,
-            t_hit: f32::INFINITY,
-            point: None,
-            aov,
-        },
+        None => {
+            out.t_hit = f32::INFINITY;
+            out.point = None;
+        }
     }
 }
 
@@ -751,10 +777,10 @@ pub(crate) fn radiance_frames(
                 (c.beta, c.eta_scale, c.prev_pdf, c.specular, 1);
             (ray, t_hit, *rng) = (c.ray, c.t_hit, c.rng.clone());
             at_first = false;
-            bounce = match c.hit {
-                Some(h) if !last => Some(shading_point(scene, &ray, &h, None)),
-                _ => None,
-            };
+            match c.hit {
+                Some(h) if !last => shading_point(scene, &ray, &h, None, &mut bounce),
+                _ => bounce = None,
+            }
             continue;
         }
         let uc = rng.next_f32();
@@ -813,7 +839,7 @@ pub(crate) fn radiance_frames(
             Some(h) if last => (t_hit, bounce) = (h.t, None),
             Some(h) => {
                 t_hit = h.t;
-                bounce = Some(shading_point(scene, &ray, &h, None));
+                shading_point(scene, &ray, &h, None, &mut bounce);
             }
             None => (t_hit, bounce) = (f32::INFINITY, None),
         }

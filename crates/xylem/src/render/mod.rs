@@ -32,8 +32,8 @@ use crate::progress::{NoProgress, Progress};
 use crate::simd::{simd_level, Simd};
 use glam::{UVec2, Vec3};
 use integrator::{
-    primary_sample_with, radiance_frames, FirstBounce, FramesScratch, KeptSample, RayCount,
-    ShadowTest,
+    primary_sample_into, radiance_frames, FirstBounce, FramesScratch, KeptSample, PrimarySample,
+    RayCount, ShadowTest,
 };
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -518,6 +518,8 @@ fn render_tile_in(
     let mut rays = RayCount::default();
     let fp_scale = integrator::footprint_scale(settings.spp);
     let camera = scene.camera.rays();
+    // The primary sample of the pixel sample at hand, written in place ([`primary_sample_into`]).
+    let mut computed = PrimarySample::empty();
     let spp = settings.spp as usize;
     let mut kept = Vec::new();
     if let Primary::Keep = primary {
@@ -531,7 +533,6 @@ fn render_tile_in(
         .enumerate()
     {
         for s in 0..settings.spp {
-            let computed;
             let (ps, reused) = match primary {
                 Primary::Reuse(p) => {
                     let k = &p[i * spp + s as usize];
@@ -539,8 +540,15 @@ fn render_tile_in(
                 }
                 Primary::Compute | Primary::Keep => {
                     rays.0 += 1;
-                    computed =
-                        primary_sample_with(scene, &camera, pixel, s, settings.seed, fp_scale);
+                    primary_sample_into(
+                        scene,
+                        &camera,
+                        pixel,
+                        s,
+                        settings.seed,
+                        fp_scale,
+                        &mut computed,
+                    );
                     (&computed, None)
                 }
             };
