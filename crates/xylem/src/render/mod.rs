@@ -16,7 +16,7 @@ pub mod lod;
 pub mod resources;
 pub mod wide_bvh;
 
-pub use camera::{Camera, Projection};
+pub use camera::{Camera, CameraRays, Projection};
 pub(crate) use film::RadianceSum;
 pub use film::{Aov, Filter, Image, PixelSum};
 pub use frames::LightFrames;
@@ -31,7 +31,10 @@ use crate::material::Material;
 use crate::progress::{NoProgress, Progress};
 use crate::simd::{simd_wide, Simd};
 use glam::{UVec2, Vec3};
-use integrator::{radiance_frames, FirstBounce, FramesScratch, KeptSample, RayCount, ShadowTest};
+use integrator::{
+    primary_sample_into, radiance_frames, FirstBounce, FramesScratch, KeptSample, PrimarySample,
+    RayCount, ShadowTest,
+};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
@@ -518,6 +521,9 @@ fn render_tile_in(
     let mut scratch = FramesScratch::default();
     let mut rays = RayCount::default();
     let fp_scale = integrator::footprint_scale(settings.spp);
+    let camera = scene.camera.rays();
+    // The primary sample of the pixel sample at hand, written in place ([`primary_sample_into`]).
+    let mut computed = PrimarySample::empty();
     let spp = settings.spp as usize;
     let mut kept = Vec::new();
     if let Primary::Keep = primary {
@@ -531,7 +537,6 @@ fn render_tile_in(
         .enumerate()
     {
         for s in 0..settings.spp {
-            let computed;
             let (ps, reused) = match primary {
                 Primary::Reuse(p) => {
                     let k = &p[i * spp + s as usize];
@@ -539,7 +544,15 @@ fn render_tile_in(
                 }
                 Primary::Compute | Primary::Keep => {
                     rays.0 += 1;
-                    computed = primary_sample(scene, pixel, s, settings.seed, fp_scale);
+                    primary_sample_into(
+                        scene,
+                        &camera,
+                        pixel,
+                        s,
+                        settings.seed,
+                        fp_scale,
+                        &mut computed,
+                    );
                     (&computed, None)
                 }
             };

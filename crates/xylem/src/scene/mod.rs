@@ -590,13 +590,13 @@ impl Builder<'_> {
                     if u.cross(v).length_squared() < 1e-12 {
                         return Err(self.invalid(f("edge_v"), "edges must span a non-zero area"));
                     }
-                    Light::Rect(RectLight {
-                        corner: self.finite3(&f("corner"), *corner)?,
-                        edge_u: u,
-                        edge_v: v,
-                        radiance: self.color(&f("color"), *color, 1e3)?
+                    Light::Rect(RectLight::new(
+                        self.finite3(&f("corner"), *corner)?,
+                        u,
+                        v,
+                        self.color(&f("color"), *color, 1e3)?
                             * self.range(&f("radiance"), *radiance, 0.0, 1e12)?,
-                    })
+                    ))
                 }
                 LightTable::Sphere {
                     center,

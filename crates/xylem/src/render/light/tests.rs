@@ -23,12 +23,12 @@ use crate::math::Pcg32;
 #[test]
 fn sampled_pdf_matches_hit_pdf() {
     let lights = [
-        Light::Rect(RectLight {
-            corner: Vec3::new(-1.0, -1.0, 5.0),
-            edge_u: Vec3::new(0.0, 2.0, 0.0),
-            edge_v: Vec3::new(3.0, 0.0, 0.0),
-            radiance: Vec3::ONE,
-        }),
+        Light::Rect(RectLight::new(
+            Vec3::new(-1.0, -1.0, 5.0),
+            Vec3::new(0.0, 2.0, 0.0),
+            Vec3::new(3.0, 0.0, 0.0),
+            Vec3::ONE,
+        )),
         Light::Sphere(SphereLight {
             center: Vec3::new(0.5, 0.0, 4.0),
             radius: 1.0,
