@@ -145,6 +145,21 @@ impl CameraRays<'_> {
         }
     }
 
+    /// The footprint a pixel of this camera would leave at depth d along the view axis, as
+    /// (per unit depth, constant): 2 tan(fov/2)/height and 0 for a pinhole, 0 and film width /
+    /// pixels for orthographic. pbrt-v4's `Camera::Approximate_dp_dxy` (Pharr, Jakob, Humphreys,
+    /// "Physically Based Rendering" 4th ed., §10.1.1) takes this at points reached after a
+    /// bounce: a lower bound on the true footprint there, since a path's length is at least the
+    /// point's depth (flat mirrors; a diffuse bounce spreads it far wider).
+    #[inline]
+    pub fn depth_footprint(&self) -> (f32, f32) {
+        let cam = self.camera;
+        match cam.projection {
+            Projection::Perspective { .. } => (2.0 * self.tan_half_fov / cam.height as f32, 0.0),
+            Projection::Orthographic { width } => (0.0, width / cam.width as f32),
+        }
+    }
+
     /// [`Camera::pixel_footprint`].
     #[inline]
     pub fn pixel_footprint(&self, ray: &Ray, t: f32) -> f32 {

@@ -83,6 +83,9 @@ pub struct PrimarySample {
     pub point: Option<ShadingPoint>,
     /// The first-hit AOVs of this sample (coverage 0 on a miss).
     pub aov: Aov,
+    /// Footprint of the hits after a bounce, (per unit depth along the view axis, constant) mm:
+    /// the camera's ([`CameraRays::depth_footprint`]) times this sample's `footprint_scale`.
+    pub bounce_footprint: (f32, f32),
 }
 
 /// Counts of rays traced, for the rays/s report.
@@ -125,7 +128,7 @@ pub(crate) fn shading_point(
     scene: &Scene,
     ray: &Ray,
     hit: &Hit,
-    aov: Option<(&mut Aov, f32)>,
+    footprint: Footprint,
     out: &mut Option<ShadingPoint>,
 ) {
     let s = scene.accel.surface(ray, hit);
@@ -141,11 +144,15 @@ pub(crate) fn shading_point(
         object_to_world: Mat3::from(inst.transform.to_world.matrix3),
         normal_to_world: inst.transform.normal_to_world,
         placement: inst.placement,
-        // Only the camera's first hit (the one that records AOVs) has a pixel footprint; the
-        // ellipse it makes on the surface, stretched by 1/cos, is taken at its geometric mean.
-        footprint: match &aov {
-            Some((_, pixel)) => *pixel / s.ng.dot(ray.d).abs().max(0.05).sqrt(),
-            None => 0.0,
+        // The camera's first hit has its pixel's footprint, the ellipse it makes on the surface,
+        // stretched by 1/cos, taken at its geometric mean; a hit after a bounce the camera's at
+        // its depth (a lower bound, `depth_footprint`).
+        footprint: match &footprint {
+            Footprint::Pixel(_, pixel) => *pixel / s.ng.dot(ray.d).abs().max(0.05).sqrt(),
+            Footprint::AtDepth((per_depth, constant)) => {
+                let cam = &scene.camera;
+                constant + per_depth * (s.p - cam.eye).dot(cam.frame.n).abs()
+            }
         },
     };
     let shading = material.shade(&mh);
@@ -161,7 +168,7 @@ pub(crate) fn shading_point(
             n: -frame.n,
         };
     }
-    if let Some((a, _)) = aov {
+    if let Footprint::Pixel(a, _) = footprint {
         *a = Aov {
             albedo: shading.aov.albedo,
             normal: frame.n,
@@ -192,6 +199,15 @@ pub(crate) fn shading_point(
 /// pixel, 3.60·10⁻³ unfiltered; notes/sweep.md "Footprint").
 pub fn footprint_scale(spp: u32) -> f32 {
     (1.0 / (spp.max(1) as f32).sqrt()).max(0.125)
+}
+
+/// The footprint band-limiting a hit's textures ([`shading_point`]).
+pub(crate) enum Footprint<'a> {
+    /// The camera's first hit: its AOVs are written here, and its pixel's footprint (mm, times
+    /// the sample's `footprint_scale`) along the ray.
+    Pixel(&'a mut Aov, f32),
+    /// A hit after a bounce: [`PrimarySample::bounce_footprint`] at the hit's depth.
+    AtDepth((f32, f32)),
 }
 
 /// The light-independent part of sample `sample` of pixel `pixel`; first hits are band-limited
@@ -227,6 +243,7 @@ impl PrimarySample {
             t_hit: f32::INFINITY,
             point: None,
             aov: Aov::default(),
+            bounce_footprint: (0.0, 0.0),
         }
     }
 }
@@ -250,6 +267,8 @@ pub(crate) fn primary_sample_into(
     let ray = camera.ray(film, rng.next_vec2());
     out.ray = ray;
     out.aov = Aov::default();
+    let (per_depth, constant) = camera.depth_footprint();
+    out.bounce_footprint = (footprint_scale * per_depth, footprint_scale * constant);
     match scene.accel.intersect(&ray, f32::INFINITY) {
         Some(hit) => {
             let pixel = footprint_scale * camera.pixel_footprint(&ray, hit.t);
@@ -258,7 +277,7 @@ pub(crate) fn primary_sample_into(
                 scene,
                 &ray,
                 &hit,
-                Some((&mut out.aov, pixel)),
+                Footprint::Pixel(&mut out.aov, pixel),
                 &mut out.point,
             );
         }
@@ -778,7 +797,13 @@ pub(crate) fn radiance_frames(
             (ray, t_hit, *rng) = (c.ray, c.t_hit, c.rng.clone());
             at_first = false;
             match c.hit {
-                Some(h) if !last => shading_point(scene, &ray, &h, None, &mut bounce),
+                Some(h) if !last => shading_point(
+                    scene,
+                    &ray,
+                    &h,
+                    Footprint::AtDepth(ps.bounce_footprint),
+                    &mut bounce,
+                ),
                 _ => bounce = None,
             }
             continue;
@@ -839,7 +864,13 @@ pub(crate) fn radiance_frames(
             Some(h) if last => (t_hit, bounce) = (h.t, None),
             Some(h) => {
                 t_hit = h.t;
-                shading_point(scene, &ray, &h, None, &mut bounce);
+                shading_point(
+                    scene,
+                    &ray,
+                    &h,
+                    Footprint::AtDepth(ps.bounce_footprint),
+                    &mut bounce,
+                );
             }
             None => (t_hit, bounce) = (f32::INFINITY, None),
         }
