@@ -565,38 +565,53 @@ impl WoodVolume {
             texel.fiber_color = fiber;
         }
         if needs.fibers {
-            let mut fiber = frame.n;
-            // The fibres' dip out of the face that the footprint averages (rad²).
-            let mut unresolved_dip = 0.0;
-            if let Some(w) = &self.wander {
-                (fiber, unresolved_dip) = w.band_limited(q, &frame, footprint, fp.normal);
-                if let Some(pores) = self.pores.as_ref().filter(|_| w.pore_deflection > 0.0) {
-                    let fade = footprint_weight(pores.diameter, footprint);
-                    if fade > 0.0 {
-                        let (_, grad) = pores.mask::<true>(q, &frame, g_point);
-                        fiber = w.around_pore(fiber, frame.n, fade * grad, 0.5 * pores.diameter);
-                    }
-                }
-            }
-            if let (Some(k), Some(knots)) = (&c.knot, &self.knots) {
-                fiber = knots.deflect_fiber(fiber, k);
-            }
-            // §5.2 eq. 17: directions looked up at f(p) are transported by J⁻¹.
-            let inv = c.dist.inverse_jacobian();
-            texel.fiber_dir = normalize_or(inv * fiber, Vec3::Z);
-            texel.ray_dir = normalize_or(inv * frame.s, Vec3::X);
-            // The highlight width is the ring wave between two levels: the same filtered mean,
-            // widened by the dip the footprint leaves unresolved: a tilt a moves ψi + ψr by ≈ 2a
-            // (both interior directions near the normal), so g(β, ψi + ψr) averaged over
-            // a ~ N(0, σ²) is g(√(β² + 4σ²), ·) (notes/wood.md §9e).
-            let beta = self.highlight.level(g);
-            texel.highlight_width = if unresolved_dip > 0.0 {
-                (beta * beta + 4.0 * unresolved_dip).sqrt()
-            } else {
-                beta
-            };
+            self.fibers_into(&mut texel, &c, &frame, fp, g, g_point);
         }
         texel
+    }
+
+    /// The fibre and ray directions and the highlight width of `texel` at the core `c` (fibre
+    /// frame `frame`, ring value g filtered and `g_point` at the point), band-limited by `fp`.
+    fn fibers_into(
+        &self,
+        texel: &mut WoodTexel,
+        c: &Core,
+        frame: &Frame,
+        fp: Footprint,
+        g: f32,
+        g_point: f32,
+    ) {
+        let (q, footprint) = (c.dist.point, fp.width);
+        let mut fiber = frame.n;
+        // The fibres' dip out of the face that the footprint averages (rad²).
+        let mut unresolved_dip = 0.0;
+        if let Some(w) = &self.wander {
+            (fiber, unresolved_dip) = w.band_limited(q, frame, footprint, fp.normal);
+            if let Some(pores) = self.pores.as_ref().filter(|_| w.pore_deflection > 0.0) {
+                let fade = footprint_weight(pores.diameter, footprint);
+                if fade > 0.0 {
+                    let (_, grad) = pores.mask::<true>(q, frame, g_point);
+                    fiber = w.around_pore(fiber, frame.n, fade * grad, 0.5 * pores.diameter);
+                }
+            }
+        }
+        if let (Some(k), Some(knots)) = (&c.knot, &self.knots) {
+            fiber = knots.deflect_fiber(fiber, k);
+        }
+        // §5.2 eq. 17: directions looked up at f(p) are transported by J⁻¹.
+        let inv = c.dist.inverse_jacobian();
+        texel.fiber_dir = normalize_or(inv * fiber, Vec3::Z);
+        texel.ray_dir = normalize_or(inv * frame.s, Vec3::X);
+        // The highlight width is the ring wave between two levels: the same filtered mean,
+        // widened by the dip the footprint leaves unresolved: a tilt a moves ψi + ψr by ≈ 2a
+        // (both interior directions near the normal), so g(β, ψi + ψr) averaged over
+        // a ~ N(0, σ²) is g(√(β² + 4σ²), ·) (notes/wood.md §9e).
+        let beta = self.highlight.level(g);
+        texel.highlight_width = if unresolved_dip > 0.0 {
+            (beta * beta + 4.0 * unresolved_dip).sqrt()
+        } else {
+            beta
+        };
     }
 
     /// The sizes (tree mm) of the features [`WoodVolume::eval_footprint`] fades to their means:
