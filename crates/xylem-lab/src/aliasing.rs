@@ -265,7 +265,13 @@ mod tests {
         assert!(independent > 1.2 * removed, "{independent} vs {removed}");
         // Moiré-like stripes two pixels wide survive at their power: ±0.3 keeps ±0.2 after the
         // 3 × 3 mean, 0.04 a pixel.
-        let stripes = |i: usize| if (i % w) / 2 % 2 == 0 { 0.3 } else { -0.3 };
+        let stripes = |i: usize| {
+            if ((i % w) / 2).is_multiple_of(2) {
+                0.3
+            } else {
+                -0.3
+            }
+        };
         let (y1, y2) = (
             field(&mut rng, 0.04, &stripes),
             field(&mut rng, 0.04, &stripes),
