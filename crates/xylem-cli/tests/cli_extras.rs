@@ -308,3 +308,45 @@ fn unwritable_output_folders_are_named_not_measured() {
     );
     assert!(tmp.path().join("new/dir/sweep_board.png").exists());
 }
+
+/// `bench render --scene` other than the Cornell box is refused while Mitsuba is timed (its side
+/// renders only the Cornell box, so the two figures would be of different images), and runs with
+/// `--no-mitsuba` (issue 29's bug).
+#[test]
+fn bench_render_compares_only_like_scenes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = xylem(
+        &[
+            "bench",
+            "render",
+            "--scene",
+            "grazing_oak",
+            "--spp",
+            "1",
+            "--repeats",
+            "1",
+        ],
+        tmp.path(),
+    );
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{e}");
+    assert!(
+        e.contains("--scene grazing_oak") && e.contains("--no-mitsuba"),
+        "{e}"
+    );
+    let o = xylem(
+        &[
+            "bench",
+            "render",
+            "--scene",
+            "grazing_oak",
+            "--spp",
+            "1",
+            "--repeats",
+            "1",
+            "--no-mitsuba",
+        ],
+        tmp.path(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}

@@ -134,6 +134,15 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         bail!("--threads {}: allowed 1 to 256", args.threads);
     }
     let mut loaded = xylem::scene::load(&args.scene).map_err(|e| anyhow::anyhow!("{e}"))?;
+    if !args.no_mitsuba && loaded.name != "cornell_box" {
+        // The Mitsuba side (validation/crosscheck --timing) builds the Cornell box only: timing
+        // it against another scene would compare different images.
+        bail!(
+            "--scene {}: the Mitsuba 3 side of this benchmark renders only the Cornell box \
+             (validation/crosscheck --timing); pass --no-mitsuba to time xylem alone",
+            args.scene.display()
+        );
+    }
     loaded.settings.spp = args.spp;
     let (w, h) = (loaded.scene.camera.width, loaded.scene.camera.height);
     let opts = RunOptions {
