@@ -315,8 +315,8 @@ fn unwritable_output_folders_are_named_not_measured() {
 #[test]
 fn bench_render_compares_only_like_scenes() {
     let tmp = tempfile::tempdir().unwrap();
-    let o = xylem(
-        &[
+    let bench = |extra: &[&str]| {
+        let args = [
             "bench",
             "render",
             "--scene",
@@ -325,28 +325,16 @@ fn bench_render_compares_only_like_scenes() {
             "1",
             "--repeats",
             "1",
-        ],
-        tmp.path(),
-    );
+        ];
+        xylem(&[&args[..], extra].concat(), tmp.path())
+    };
+    let o = bench(&[]);
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success(), "{e}");
     assert!(
         e.contains("--scene grazing_oak") && e.contains("--no-mitsuba"),
         "{e}"
     );
-    let o = xylem(
-        &[
-            "bench",
-            "render",
-            "--scene",
-            "grazing_oak",
-            "--spp",
-            "1",
-            "--repeats",
-            "1",
-            "--no-mitsuba",
-        ],
-        tmp.path(),
-    );
+    let o = bench(&["--no-mitsuba"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
