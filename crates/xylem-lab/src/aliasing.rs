@@ -6,10 +6,10 @@
 //! wood with the Monte Carlo noise taken out ([`aliasing_power`]), and the **error at equal CPU
 //! time**.
 
-use crate::tradeoff::{process_cpu_seconds, reference_from_halves, relative_mse_net, Knobs};
+use crate::tradeoff::{reference_from_halves, relative_mse_net, render_with, Knobs, Rendered};
 use glam::Vec3;
 use xylem::math::luminance;
-use xylem::render::{render, Image, RunOptions};
+use xylem::render::RunOptions;
 use xylem::scene::LoadedScene;
 
 /// High-frequency power of `d` (per-pixel luminance, `width` × `height`) over the pixels of
@@ -94,30 +94,28 @@ impl Row {
     }
 }
 
-/// Renders `scene` with `knobs` (seed `seed`), timing its CPU.
-fn render_knobs(
+/// [`render_with`] at seed `seed`.
+fn render_seeded(
     base: &dyn Fn() -> Result<LoadedScene, String>,
     knobs: &Knobs,
     seed: u64,
     run: &RunOptions,
-) -> Result<(Image, f64), String> {
-    let mut loaded = base()?;
-    crate::tradeoff::apply(&mut loaded, knobs).map_err(|e| e.to_string())?;
-    loaded.settings.seed = seed;
-    let cpu0 = process_cpu_seconds();
-    let out = render(&loaded.scene, &loaded.settings, run).map_err(|e| e.to_string())?;
-    let cpu = match (cpu0, process_cpu_seconds()) {
-        (Some(a), Some(b)) => b - a,
-        _ => out.elapsed.as_secs_f64(),
+) -> Result<Rendered, String> {
+    let seeded = || {
+        base().map(|mut l| {
+            l.settings.seed = seed;
+            l
+        })
     };
-    Ok((out.image, cpu))
+    render_with(&seeded, knobs, run)
 }
 
-/// Measures one scene: `base` loads it (at the size to judge), `spp` the compared renders',
-/// `reference_spp` the reference's (rendered as two halves with other seeds).
+/// Measures one scene: `base` loads it at `size` (width, height: the size judged), `spp` the
+/// compared renders', `reference_spp` the reference's (two halves of other seeds).
 pub fn measure(
     name: &str,
     base: &dyn Fn() -> Result<LoadedScene, String>,
+    size: (u32, u32),
     spp: u32,
     reference_spp: u32,
     run: &RunOptions,
@@ -126,13 +124,13 @@ pub fn measure(
         footprint_filter: false,
         ..Knobs::full((reference_spp / 2).max(1))
     };
-    let (a, _) = render_knobs(base, &half, 1001, run)?;
-    let (b, _) = render_knobs(base, &half, 2002, run)?;
-    let (reference, reference_noise) = reference_from_halves(&a.beauty, &b.beauty);
-    let (w, h) = (a.width as usize, a.height as usize);
+    let a = render_seeded(base, &half, 1001, run)?;
+    let b = render_seeded(base, &half, 2002, run)?;
+    let (reference, reference_noise) = reference_from_halves(&a.image, &b.image);
+    let (w, h) = (size.0 as usize, size.1 as usize);
     let lum = |c: &[Vec3]| -> Vec<f64> { c.iter().map(|&v| luminance(v) as f64).collect() };
-    let (la, lb) = (lum(&a.beauty), lum(&b.beauty));
-    let mask: Vec<bool> = a.aov.iter().map(|v| v.fiber != Vec3::ZERO).collect();
+    let (la, lb) = (lum(&a.image), lum(&b.image));
+    let mask = a.wood;
     let power: f64 = (la.iter().zip(&lb).zip(&mask))
         .filter(|(_, &m)| m)
         .map(|((x, y), _)| (0.5 * (x + y)).powi(2))
@@ -140,7 +138,7 @@ pub fn measure(
         .max(1e-30);
     let mut row = Row {
         scene: name.to_string(),
-        size: (a.width, a.height),
+        size,
         spp,
         reference_spp,
         pixels: 0,
@@ -153,14 +151,14 @@ pub fn measure(
             footprint_filter: filter,
             ..Knobs::full(spp)
         };
-        let (x1, cpu) = render_knobs(base, &knobs, 7, run)?;
-        let (x2, _) = render_knobs(base, &knobs, 8, run)?;
-        let (l1, l2) = (lum(&x1.beauty), lum(&x2.beauty));
+        let x1 = render_seeded(base, &knobs, 7, run)?;
+        let x2 = render_seeded(base, &knobs, 8, run)?;
+        let (l1, l2) = (lum(&x1.image), lum(&x2.image));
         let (energy, _, n) = aliasing_power([&l1, &l2], [&la, &lb], &mask, w, h);
         row.pixels = n;
         row.aliasing[k] = energy / power;
-        row.mse[k] = relative_mse_net(&x1.beauty, &reference, reference_noise);
-        row.cpu[k] = cpu;
+        row.mse[k] = relative_mse_net(&x1.image, &reference, reference_noise);
+        row.cpu[k] = x1.cpu_seconds;
     }
     Ok(row)
 }

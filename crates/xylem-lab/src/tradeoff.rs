@@ -249,6 +249,8 @@ pub fn weak_reference(reference_spp: u32, max_spp: u32) -> Option<String> {
 pub struct Rendered {
     /// The beauty image.
     pub image: Vec<glam::Vec3>,
+    /// The pixels whose first hits are wood (their fibre AOV is not zero).
+    pub wood: Vec<bool>,
     /// Render time, wall clock.
     pub seconds: f64,
     /// Render time in CPU seconds of the process ([`process_cpu_seconds`]; the wall clock where
@@ -276,6 +278,9 @@ pub fn render_with(
         _ => seconds,
     };
     Ok(Rendered {
+        wood: (out.image.aov.iter())
+            .map(|a| a.fiber != glam::Vec3::ZERO)
+            .collect(),
         image: out.image.beauty,
         seconds,
         cpu_seconds,

@@ -68,15 +68,14 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         );
         let (w, h) = (probe.scene.camera.width, probe.scene.camera.height);
         drop(probe);
+        let size = ((w / div).max(8), (h / div).max(8));
         let base = || -> Result<xylem::scene::LoadedScene, String> {
             let mut l = xylem::scene::load(&path).map_err(|e| e.to_string())?;
-            l.scene.camera = l
-                .scene
-                .camera
-                .with_resolution((w / div).max(8), (h / div).max(8));
+            l.scene.camera = l.scene.camera.with_resolution(size.0, size.1);
             Ok(l)
         };
-        rows.push(measure(name, &base, spp, reference_spp, &run).map_err(anyhow::Error::msg)?);
+        let row = measure(name, &base, size, spp, reference_spp, &run);
+        rows.push(row.map_err(anyhow::Error::msg)?);
     }
     bar.finish();
     let command = std::env::args().collect::<Vec<_>>().join(" ");

@@ -394,18 +394,29 @@ impl FibreWander {
         let cyl = crate::field::cylinder_frame(q);
         let (mut angle, mut lost) = ([0.0f32; 2], [0.0f32; 2]);
         for (noises, spread) in self.angles.iter().zip(&self.scales) {
+            // C across the grain is the same for both angles, and C along it too unless their
+            // lengths differ: each erf once.
+            let (across, along) = if footprint > 0.0 {
+                let along = centre_correlation(footprint / spread.along[0]);
+                let along_t = if spread.along[1] == spread.along[0] {
+                    along
+                } else {
+                    centre_correlation(footprint / spread.along[1])
+                };
+                (
+                    centre_correlation(footprint / spread.across),
+                    [along, along_t],
+                )
+            } else {
+                (1.0, [1.0; 2])
+            };
             for k in 0..2 {
                 let Some(n) = &noises[k] else { continue };
-                let share = if footprint > 0.0 {
-                    centre_correlation(footprint / spread.across)
-                        * centre_correlation(footprint / spread.along[k])
-                } else {
-                    1.0
-                };
-                if share * share >= Self::NEGLIGIBLE_SHARE {
+                let c = across * along[k];
+                if c * c >= Self::NEGLIGIBLE_SHARE {
                     let a = n.eval_oriented_with::<false>(q, &cyl, 1, 1.0).0;
-                    angle[k] += if share < 1.0 { share * a } else { a };
-                    lost[k] += (1.0 - share * share) * spread.var[k];
+                    angle[k] += if c < 1.0 { c * a } else { a };
+                    lost[k] += (1.0 - c * c) * spread.var[k];
                 } else {
                     lost[k] += spread.var[k];
                 }
