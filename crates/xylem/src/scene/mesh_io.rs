@@ -329,7 +329,8 @@ pub fn load_ply(path: &Path) -> Result<TriMesh, MeshError> {
     parse_ply(BufReader::new(file)).map_err(|m| bad(path, m))
 }
 
-fn parse_ply<R: BufRead>(mut r: R) -> Result<TriMesh, String> {
+/// The header of a PLY file: its body format and its elements with their properties.
+fn read_ply_header<R: BufRead>(r: &mut R) -> Result<(Format, Vec<Element>), String> {
     let mut line = String::new();
     let read_line = |r: &mut R, line: &mut String| -> Result<(), String> {
         line.clear();
@@ -338,14 +339,14 @@ fn parse_ply<R: BufRead>(mut r: R) -> Result<TriMesh, String> {
         }
         Ok(())
     };
-    read_line(&mut r, &mut line)?;
+    read_line(r, &mut line)?;
     if line.trim() != "ply" {
         return Err("not a PLY file (first line is not `ply`)".into());
     }
     let mut format = None;
     let mut elements: Vec<Element> = Vec::new();
     loop {
-        read_line(&mut r, &mut line)?;
+        read_line(r, &mut line)?;
         let words: Vec<&str> = line.split_whitespace().collect();
         match words.as_slice() {
             ["end_header"] => break,
@@ -384,7 +385,11 @@ fn parse_ply<R: BufRead>(mut r: R) -> Result<TriMesh, String> {
             _ => return Err(format!("unexpected header line `{}`", line.trim())),
         }
     }
-    let format = format.ok_or("no format line")?;
+    Ok((format.ok_or("no format line")?, elements))
+}
+
+fn parse_ply<R: BufRead>(mut r: R) -> Result<TriMesh, String> {
+    let (format, elements) = read_ply_header(&mut r)?;
     let mut body = Body {
         r,
         format,

@@ -519,6 +519,94 @@ impl Checker<'_> {
         self.range(&format!("{name}.size_factor"), n.size_factor, 0.02, 0.9)?;
         self.range(&format!("{name}.dropoff"), n.dropoff, 0.0, 4.0)
     }
+
+    /// The growth wave, its phase warp and its noise: time stays monotone.
+    fn growth(&self, g: &GrowthParams) -> Result<(), WoodError> {
+        for (i, l) in g.wave.iter().enumerate() {
+            self.range(&format!("growth.wave[{i}]"), *l, 0.0, 1000.0)?;
+        }
+        let [_, top, _, bottom] = g.wave;
+        self.range("growth.wave[1] (top)", top, 0.01, 1000.0)?;
+        self.range("growth.wave[3] (bottom)", bottom, 0.01, 1000.0)?;
+        self.range("growth.amplitude", g.amplitude, 0.0, 1000.0)?;
+        // Monotone time (notes/wood.md): the wave's steepest descent must stay below 1.
+        let descent = SmoothTriangleWave::new(g.wave, g.amplitude).max_descent();
+        if descent >= 0.95 {
+            return Err(self.err(
+                "growth.amplitude",
+                g.amplitude,
+                format!(
+                    "small enough that the wave's steepest descent is < 0.95 (it is {descent:.3}; time would run backwards)"
+                ),
+            ));
+        }
+        // Phase warp: dt_pre/du = 1 + w′(v)(1 + a m′) ≥ 1 − s_down (1 + a · 2.5462/h) > 0.
+        self.positive("growth.phase_scale", g.phase_scale, 1000.0)?;
+        let max_phase = if descent > 0.0 {
+            (0.95 * g.phase_scale * (1.0 / descent - 1.0) / GROWTH_NOISE_SLOPE_BOUND).min(1000.0)
+        } else {
+            1000.0
+        };
+        self.range("growth.phase_amplitude", g.phase_amplitude, 0.0, max_phase)?;
+        self.positive("growth.noise_scale", g.noise_scale, 1000.0)?;
+        let max_noise = 0.95 * g.noise_scale / GROWTH_NOISE_SLOPE_BOUND;
+        self.range("growth.noise_amplitude", g.noise_amplitude, 0.0, max_noise)?;
+        Ok(())
+    }
+
+    /// The vessels' sizes, density and depth.
+    fn pores(&self, p: &PoreParams) -> Result<(), WoodError> {
+        self.range("pores.radius", p.radius, 0.005, 5.0)?;
+        self.range("pores.length", p.length, 0.005, 100.0)?;
+        self.positive("pores.density", p.density, 16.0)?;
+        self.range("pores.sharpness", p.sharpness, 0.05, 100.0)?;
+        self.range("pores.ring_porosity", p.ring_porosity, 0.0, 1.0)?;
+        self.range("pores.depth", p.depth, 0.0, 4.0)?;
+        Ok(())
+    }
+
+    /// The rays' sizes, density, strength and wander.
+    fn rays(&self, r: &RayParams) -> Result<(), WoodError> {
+        self.range("rays.width", r.width, 0.005, 10.0)?;
+        self.range("rays.height", r.height, 0.005, 100.0)?;
+        self.range("rays.length", r.length, 0.005, 1000.0)?;
+        self.positive("rays.density", r.density, 16.0)?;
+        self.range("rays.sharpness", r.sharpness, 0.0, 100.0)?;
+        self.range("rays.strength", r.strength, 0.0, 1.0)?;
+        self.range("rays.wander", r.wander, 0.0, 10.0)?;
+        self.range("rays.wander_length", r.wander_length, 0.05, 1000.0)?;
+        Ok(())
+    }
+
+    /// The knots' whorls, cones and bark.
+    fn knots(&self, k: &KnotParams) -> Result<(), WoodError> {
+        self.range("knots.whorl_spacing", k.whorl_spacing, 10.0, 100_000.0)?;
+        if !(1..=12).contains(&k.per_whorl) {
+            return Err(self.err("knots.per_whorl", k.per_whorl, "1..=12".into()));
+        }
+        self.range("knots.rise", k.rise, 0.0, 80.0)?;
+        self.range("knots.cone", k.cone, 0.5, 30.0)?;
+        if let Some(d) = k.death_year {
+            self.range("knots.death_year", d, 0.0, 1000.0)?;
+        }
+        self.range("knots.darkening", k.darkening, 0.0, 10.0)?;
+        self.range("knots.swell", k.swell, 0.0, 50.0)?;
+        self.range("knots.swell_width", k.swell_width, 0.5, 500.0)?;
+        self.range("knots.bark_width", k.bark_width, 0.0, 20.0)?;
+        Ok(())
+    }
+
+    /// The birdseye traces.
+    fn eyes(&self, e: &EyeParams) -> Result<(), WoodError> {
+        self.range("eyes.density", e.density, 0.0, 10.0)?;
+        self.range("eyes.diameter[0]", e.diameter[0], 0.1, 50.0)?;
+        self.range("eyes.diameter[1]", e.diameter[1], e.diameter[0], 50.0)?;
+        self.range("eyes.depth", e.depth, 0.0, 20.0)?;
+        self.range("eyes.length", e.length, 1.0, 1000.0)?;
+        self.range("eyes.core", e.core, 0.01, 10.0)?;
+        self.range("eyes.darkening", e.darkening, 0.0, 10.0)?;
+        Ok(())
+    }
 }
 
 impl WoodParams {
@@ -567,37 +655,7 @@ impl WoodParams {
         c.range("rings.proportions[1] (transition)", rise, 0.01, 1.0)?;
         c.range("rings.proportions[3] (fall)", fall, 0.01, 1.0)?;
         if let Some(g) = &self.growth {
-            for (i, l) in g.wave.iter().enumerate() {
-                c.range(&format!("growth.wave[{i}]"), *l, 0.0, 1000.0)?;
-            }
-            let [rise, top, fall, bottom] = g.wave;
-            c.range("growth.wave[1] (top)", top, 0.01, 1000.0)?;
-            c.range("growth.wave[3] (bottom)", bottom, 0.01, 1000.0)?;
-            let _ = (rise, fall);
-            c.range("growth.amplitude", g.amplitude, 0.0, 1000.0)?;
-            // Monotone time (notes/wood.md): the wave's steepest descent must stay below 1.
-            let descent = SmoothTriangleWave::new(g.wave, g.amplitude).max_descent();
-            if descent >= 0.95 {
-                return Err(c.err(
-                    "growth.amplitude",
-                    g.amplitude,
-                    format!(
-                        "small enough that the wave's steepest descent is < 0.95 (it is {descent:.3}; time would run backwards)"
-                    ),
-                ));
-            }
-            // Phase warp: dt_pre/du = 1 + w′(v)(1 + a m′) ≥ 1 − s_down (1 + a · 2.5462/h) > 0.
-            c.positive("growth.phase_scale", g.phase_scale, 1000.0)?;
-            let max_phase = if descent > 0.0 {
-                (0.95 * g.phase_scale * (1.0 / descent - 1.0) / GROWTH_NOISE_SLOPE_BOUND)
-                    .min(1000.0)
-            } else {
-                1000.0
-            };
-            c.range("growth.phase_amplitude", g.phase_amplitude, 0.0, max_phase)?;
-            c.positive("growth.noise_scale", g.noise_scale, 1000.0)?;
-            let max_noise = 0.95 * g.noise_scale / GROWTH_NOISE_SLOPE_BOUND;
-            c.range("growth.noise_amplitude", g.noise_amplitude, 0.0, max_noise)?;
+            c.growth(g)?;
         }
         if let Some(i) = &self.interlock {
             c.range("interlock.angle", i.angle, 0.0, 45.0)?;
@@ -613,22 +671,10 @@ impl WoodParams {
             }
         }
         if let Some(p) = &self.pores {
-            c.range("pores.radius", p.radius, 0.005, 5.0)?;
-            c.range("pores.length", p.length, 0.005, 100.0)?;
-            c.positive("pores.density", p.density, 16.0)?;
-            c.range("pores.sharpness", p.sharpness, 0.05, 100.0)?;
-            c.range("pores.ring_porosity", p.ring_porosity, 0.0, 1.0)?;
-            c.range("pores.depth", p.depth, 0.0, 4.0)?;
+            c.pores(p)?;
         }
         if let Some(r) = &self.rays {
-            c.range("rays.width", r.width, 0.005, 10.0)?;
-            c.range("rays.height", r.height, 0.005, 100.0)?;
-            c.range("rays.length", r.length, 0.005, 1000.0)?;
-            c.positive("rays.density", r.density, 16.0)?;
-            c.range("rays.sharpness", r.sharpness, 0.0, 100.0)?;
-            c.range("rays.strength", r.strength, 0.0, 1.0)?;
-            c.range("rays.wander", r.wander, 0.0, 10.0)?;
-            c.range("rays.wander_length", r.wander_length, 0.05, 1000.0)?;
+            c.rays(r)?;
         }
         for (name, col) in [
             ("color.earlywood", self.color.earlywood),
@@ -662,28 +708,10 @@ impl WoodParams {
             }
         }
         if let Some(k) = &self.knots {
-            c.range("knots.whorl_spacing", k.whorl_spacing, 10.0, 100_000.0)?;
-            if !(1..=12).contains(&k.per_whorl) {
-                return Err(c.err("knots.per_whorl", k.per_whorl, "1..=12".into()));
-            }
-            c.range("knots.rise", k.rise, 0.0, 80.0)?;
-            c.range("knots.cone", k.cone, 0.5, 30.0)?;
-            if let Some(d) = k.death_year {
-                c.range("knots.death_year", d, 0.0, 1000.0)?;
-            }
-            c.range("knots.darkening", k.darkening, 0.0, 10.0)?;
-            c.range("knots.swell", k.swell, 0.0, 50.0)?;
-            c.range("knots.swell_width", k.swell_width, 0.5, 500.0)?;
-            c.range("knots.bark_width", k.bark_width, 0.0, 20.0)?;
+            c.knots(k)?;
         }
         if let Some(e) = &self.eyes {
-            c.range("eyes.density", e.density, 0.0, 10.0)?;
-            c.range("eyes.diameter[0]", e.diameter[0], 0.1, 50.0)?;
-            c.range("eyes.diameter[1]", e.diameter[1], e.diameter[0], 50.0)?;
-            c.range("eyes.depth", e.depth, 0.0, 20.0)?;
-            c.range("eyes.length", e.length, 1.0, 1000.0)?;
-            c.range("eyes.core", e.core, 0.01, 10.0)?;
-            c.range("eyes.darkening", e.darkening, 0.0, 10.0)?;
+            c.eyes(e)?;
         }
         Ok(())
     }
