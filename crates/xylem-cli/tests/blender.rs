@@ -85,19 +85,9 @@ fn linked(case: &Value, input: &str) -> bool {
     case["material"]["inputs"][input]["linked"] == Value::Bool(true)
 }
 
-#[test]
-fn blender_imports_the_anisotropy_and_renders_it_across_the_fibre() {
-    let venv = match blender_venv() {
-        Ok(v) => v,
-        Err(why) if std::env::var_os("CI").is_none() => {
-            eprintln!(
-                "\n!!!!!!!! SKIPPED blender.rs: Blender (PyPI bpy) is not installable here !!!!!!!!\n\
-                 {why}\n(on CI, with CI set, this fails instead)\n"
-            );
-            return;
-        }
-        Err(why) => panic!("Blender (PyPI bpy) is needed on CI: {why}"),
-    };
+/// Bakes the board, renders xylem's grazing view of it, and runs python/blender/check_gltf.py
+/// in Blender on both; returns its report.json.
+fn bake_render_and_check_in_blender(venv: &std::path::Path) -> Value {
     let dir = tempfile::tempdir().unwrap();
     let bake = dir.path().join("bake");
     let out = root().join("target/blender-test");
@@ -157,8 +147,23 @@ fn blender_imports_the_anisotropy_and_renders_it_across_the_fibre() {
         "blender.rs: bake, xylem render and Blender took {:.1} s",
         started.elapsed().as_secs_f64()
     );
-    let report: Value =
-        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn blender_imports_the_anisotropy_and_renders_it_across_the_fibre() {
+    let venv = match blender_venv() {
+        Ok(v) => v,
+        Err(why) if std::env::var_os("CI").is_none() => {
+            eprintln!(
+                "\n!!!!!!!! SKIPPED blender.rs: Blender (PyPI bpy) is not installable here !!!!!!!!\n\
+                 {why}\n(on CI, with CI set, this fails instead)\n"
+            );
+            return;
+        }
+        Err(why) => panic!("Blender (PyPI bpy) is needed on CI: {why}"),
+    };
+    let report = bake_render_and_check_in_blender(&venv);
     let cases = &report["cases"];
     let check = |name: &str| -> (f64, f64) {
         let c = &cases[name];
