@@ -14,6 +14,7 @@ use xylem::render::{render, RunOptions};
 use xylem::scene::quality::Quality;
 use xylem::scene::Overrides;
 use xylem::sweep::{render_sweep, SweepPath};
+use xylem_lab::scenes::Expectations;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -136,6 +137,8 @@ fn scenes(out: &Path, only: &[String], o: &Overrides) -> anyhow::Result<bool> {
             .map(|o| o.name)
             .collect();
         let mut s = xylem::scene::load(&path)?;
+        let expect = Expectations::of(s.expect.as_ref(), &path.display().to_string())
+            .map_err(anyhow::Error::msg)?;
         o.apply(&mut s)?;
         let (w, h) = (s.scene.camera.width, s.scene.camera.height);
         eprintln!("{name}: {w}x{h}, {} spp", s.settings.spp);
@@ -154,7 +157,7 @@ fn scenes(out: &Path, only: &[String], o: &Overrides) -> anyhow::Result<bool> {
             progress: &bar,
         };
         let (measures, companion) = xylem_lab::scenes::measure_rendered(
-            name,
+            &expect,
             &s.scene,
             &s.settings,
             &run,
@@ -162,10 +165,10 @@ fn scenes(out: &Path, only: &[String], o: &Overrides) -> anyhow::Result<bool> {
             &r.image,
             s.exposure,
         )?;
-        if let Some(c) = companion {
+        if let (Some(c), Some(kind)) = (companion, expect.companion) {
             // The check's second render (turned_bowl: the key light mirrored along the fibre;
             // cornell_bunny: without its background).
-            let label = xylem_lab::scenes::companion_label(name);
+            let label = kind.label();
             let png = out.join(format!("{name}_{label}.png"));
             write_png_rgb8(&png, w, h, &to_srgb8(&c.beauty, s.exposure))?;
         }

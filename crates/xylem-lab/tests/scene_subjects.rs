@@ -5,7 +5,7 @@
 
 use std::path::Path;
 use xylem::render::{render, RunOptions};
-use xylem_lab::scenes::{measure, measure_rendered, Measure};
+use xylem_lab::scenes::{measure, measure_rendered, Expectations, Measure};
 
 /// (scene, divisor of the default width and height, spp or None for the scene's own, the
 /// measures checked at that size: those whose name contains one of these, all when empty).
@@ -41,6 +41,11 @@ const CASES: [(&str, u32, Option<u32>, &[&str]); 16] = [
     ("grazing_oak", 2, Some(4), &[]),
 ];
 
+/// The scene's own `[expect]` checks.
+fn expect(s: &xylem::scene::LoadedScene) -> Expectations {
+    Expectations::of(s.expect.as_ref(), &s.name).unwrap_or_else(|e| panic!("{e}"))
+}
+
 fn object_names(text: &str) -> Vec<Option<String>> {
     xylem::scene::parse(text, "scene")
         .unwrap()
@@ -69,8 +74,16 @@ fn measured(
     }
     let run = RunOptions::default();
     let img = render(&s.scene, &s.settings, &run).unwrap().image;
-    let (m, _) =
-        measure_rendered(name, &s.scene, &s.settings, &run, &names, &img, s.exposure).unwrap();
+    let (m, _) = measure_rendered(
+        &expect(&s),
+        &s.scene,
+        &s.settings,
+        &run,
+        &names,
+        &img,
+        s.exposure,
+    )
+    .unwrap();
     for m in &m {
         println!(
             "{name} ({}x{}, {} spp): {m}",
@@ -117,7 +130,7 @@ fn subject_checks_fail_on_a_broken_scene() {
     let img = render(&s.scene, &s.settings, &RunOptions::default())
         .unwrap()
         .image;
-    let m = measure("cornell_wood_marble", &s.scene, &names, &img, None, 0.0);
+    let m = measure(&expect(&s), &s.scene, &names, &img, None, 0.0);
     let firefly = m.iter().find(|m| m.what.starts_with("firefly")).unwrap();
     assert!(!firefly.pass(), "{firefly}");
 }
@@ -161,7 +174,7 @@ fn cornell_box_bleed_check_fails_without_the_red_wall() {
     let img = render(&s.scene, &s.settings, &RunOptions::default())
         .unwrap()
         .image;
-    let m = measure("cornell_box", &s.scene, &names, &img, None, s.exposure);
+    let m = measure(&expect(&s), &s.scene, &names, &img, None, s.exposure);
     let bleed = m
         .iter()
         .find(|m| m.what.starts_with("red bleeding"))

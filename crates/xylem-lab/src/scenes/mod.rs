@@ -27,7 +27,9 @@ use xylem::render::{
     RenderError, RenderSettings, RunOptions, Scene, SphereLight, SpotLight,
 };
 
+mod expect;
 mod subject;
+pub use expect::*;
 pub use subject::*;
 
 /// What the ray through a pixel's centre meets first.
@@ -469,37 +471,13 @@ pub fn mirrored_x(lights: &[Light]) -> Vec<Light> {
         .collect()
 }
 
-/// The lights of the second render a scene's check needs, or None when one render is enough:
-/// for `turned_bowl` (the curl's chatoyance) the key light on the other side along the fibre; for
-/// `grazing_oak` (the pore bump) the raking light on the other side across it; for
-/// `cornell_bunny` (the blue-background variant) the same lights without the background, so the
-/// check compares the light on the wood with and without it.
-pub fn companion_lights(name: &str, scene: &Scene) -> Option<Vec<Light>> {
-    match name {
-        "turned_bowl" | "grazing_oak" => Some(mirrored_x(&scene.lights)),
-        "cornell_bunny" => Some(
-            (scene.lights.iter())
-                .filter(|l| !matches!(l, Light::Environment(_)))
-                .cloned()
-                .collect(),
-        ),
-        _ => None,
-    }
-}
-
-/// What the companion render of [`companion_lights`] is, as a file-name suffix (the gallery
-/// writes it beside the scene's image as `NAME_SUFFIX.png`).
-pub fn companion_label(name: &str) -> &'static str {
-    match name {
-        "cornell_bunny" => "no_background",
-        _ => "light_mirrored",
-    }
-}
-
-/// [`measure`] with the companion render it needs (if any) made here at `settings`; returns the
-/// measures and the companion image.
+/// [`measure`] with the companion render `expect` asks for (if any) made here at `settings`:
+/// `turned_bowl` (the curl's chatoyance) has its key light mirrored along the fibre,
+/// `grazing_oak` (the pore bump) its raking light mirrored across it, `cornell_bunny` (the
+/// blue-background variant) the same lights without the background. Returns the measures and
+/// the companion image.
 pub fn measure_rendered(
-    name: &str,
+    expect: &Expectations,
     scene: &Scene,
     settings: &RenderSettings,
     run: &RunOptions,
@@ -507,13 +485,14 @@ pub fn measure_rendered(
     img: &Image,
     exposure: f32,
 ) -> Result<(Vec<Measure>, Option<Image>), RenderError> {
-    let companion = match companion_lights(name, scene) {
-        Some(lights) => {
+    let companion = match expect.companion {
+        Some(c) => {
+            let lights = c.lights(scene);
             Some(render_frames(scene, &LightFrames::fixed(&lights), settings, run)?.image(0))
         }
         None => None,
     };
-    let m = measure(name, scene, names, img, companion.as_ref(), exposure);
+    let m = measure(expect, scene, names, img, companion.as_ref(), exposure);
     Ok((m, companion))
 }
 

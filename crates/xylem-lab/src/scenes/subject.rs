@@ -255,11 +255,11 @@ fn light_colour(
     }
 }
 
-/// The numbers that say whether scene `name` (a file stem of scenes/) shows its subject in
-/// `img`, rendered from `scene`; `names` are its objects' names in file order. Empty for a
-/// scene without a check.
+/// The numbers that say whether a scene shows its subject in `img`, rendered from `scene`: the
+/// measures of its `[expect]` checks, in order (none without checks). `names` are its objects'
+/// names in file order; `companion` is the render `expect.companion` asks for.
 pub fn measure(
-    name: &str,
+    expect: &Expectations,
     scene: &Scene,
     names: &[Option<String>],
     img: &Image,
@@ -274,39 +274,12 @@ pub fn measure(
         companion,
         exposure,
     };
-    match name {
-        "cornell_box" => s.cornell_box(),
-        n if n.starts_with("cornell") => s.cornell_variant(n),
-        "turned_bowl" => s.turned_bowl(),
-        "parquet_floor" => s.step("strips against seams", &["floor"], &["seams"], None),
-        "box_joint" => [
-            s.step(
-                "fingers on the front face",
-                &["a_"],
-                &["b_finger"],
-                Some(-Vec3::Y),
-            ),
-            s.step(
-                "fingers on the side face",
-                &["b_"],
-                &["a_finger"],
-                Some(-Vec3::X),
-            ),
-        ]
-        .concat(),
-        "dovetail" => s.step("tails against pins", &["tails"], &["pins"], Some(-Vec3::Y)),
-        "cube_carved_vs_veneer" => s.carved_vs_veneer(),
-        "carved_bunny" => vec![s.lit("bunny", &["bunny"]), s.fig("bunny rings", &["bunny"])],
-        // Walnut is dark by nature (median sRGB ≈ 0.16 here): only its grain is checked.
-        "teapot" => vec![s.fig("teapot grain", &["teapot"])],
-        "sweep_board" => vec![s.fig("board stripes", &["board"])],
-        "grazing_oak" => vec![Measure {
-            what: "pore relief under the raking light, either side".into(),
-            value: companion.map_or(0.0, |c| pore_relief(img, c, &s.on(&["board"]))),
-            limit: Limit::AtLeast(MIN_PORE_RELIEF),
-        }],
-        _ => Vec::new(),
-    }
+    expect.checks.iter().flat_map(|c| s.check(c)).collect()
+}
+
+/// Name prefixes as the helpers take them.
+fn prefixes(v: &[String]) -> Vec<&str> {
+    v.iter().map(String::as_str).collect()
 }
 
 /// A rendered scene with each pixel's first hit: what [`measure`]'s checks look at.
@@ -360,9 +333,43 @@ impl Subject<'_> {
         step(self.img, &self.hits, self.names, what, a, b, face)
     }
 
-    /// The classic box: its light seen directly, and colour bleeding from both walls.
-    fn cornell_box(&self) -> Vec<Measure> {
-        let white = self.on(&["floor", "ceiling", "back", "short_box", "tall_box"]);
+    /// The measures of one check.
+    fn check(&self, c: &Check) -> Vec<Measure> {
+        match c {
+            Check::Lit { what, objects } => vec![self.lit(what, &prefixes(objects))],
+            Check::Figure { what, objects } => vec![self.fig(what, &prefixes(objects))],
+            Check::Rings { objects } => self.rings(&prefixes(objects)),
+            Check::Step { what, a, b, face } => {
+                let face = face.map(Vec3::from_array);
+                self.step(what, &prefixes(a), &prefixes(b), face)
+            }
+            Check::LightSeenDirectly {} => vec![self.light_seen_directly()],
+            Check::Bleeding { objects } => self.bleeding(&prefixes(objects)),
+            Check::Fireflies {} => vec![self.fireflies()],
+            Check::LightColour {
+                objects,
+                black_background,
+            } => vec![light_colour(
+                self.scene,
+                self.img,
+                &self.on(&prefixes(objects)),
+                *black_background,
+                self.companion,
+            )],
+            Check::CurlFlip { objects } => self.curl_flip(&prefixes(objects)),
+            Check::SeamRatio { carved, veneered } => vec![self.seam_ratio(carved, veneered)],
+            Check::PoreRelief { what, objects } => vec![Measure {
+                what: what.clone(),
+                value: (self.companion).map_or(0.0, |c| {
+                    pore_relief(self.img, c, &self.on(&prefixes(objects)))
+                }),
+                limit: Limit::AtLeast(MIN_PORE_RELIEF),
+            }],
+        }
+    }
+
+    /// The first rect light seen directly: the largest relative error of its pixels' means.
+    fn light_seen_directly(&self) -> Measure {
         let expected = self.scene.lights.iter().find_map(|l| match l {
             Light::Rect(r) => Some(r.radiance),
             Light::Point(_)
@@ -372,12 +379,17 @@ impl Subject<'_> {
             | Light::Environment(_) => None,
         });
         let light_error = |e| light_error(self.scene, self.img, &self.hits, e);
+        Measure {
+            what: "light seen directly, largest |mean / (radiance × color) − 1|".into(),
+            value: expected.map_or(f64::INFINITY, light_error),
+            limit: Limit::AtMost(MAX_LIGHT_ERROR),
+        }
+    }
+
+    /// Colour bleeding onto the white surfaces `objs` from the red left and green right walls.
+    fn bleeding(&self, objs: &[&str]) -> Vec<Measure> {
+        let white = self.on(objs);
         vec![
-            Measure {
-                what: "light seen directly, largest |mean / (radiance × color) − 1|".into(),
-                value: expected.map_or(f64::INFINITY, light_error),
-                limit: Limit::AtMost(MAX_LIGHT_ERROR),
-            },
             Measure {
                 what: "red bleeding: R/G of white surfaces, left third over middle".into(),
                 value: bleed_ratio(self.img, &white, 0, 0, 1),
@@ -391,36 +403,22 @@ impl Subject<'_> {
         ]
     }
 
-    /// The wooden boxes (`cornell_*` but the classic one): no fireflies, visible rings, and
-    /// the lighting variant's colour on the wood.
-    fn cornell_variant(&self, name: &str) -> Vec<Measure> {
+    /// The largest firefly ratio over diffuse and glossy surfaces (mirrors and glass excluded).
+    fn fireflies(&self) -> Measure {
         let keep: Vec<bool> = (self.hits.iter())
             .map(|h| matches!(h, PixelHit::Surface { delta: false, .. }))
             .collect();
-        let mut m = vec![Measure {
+        Measure {
             what: "firefly ratio (pixel / 3×3 median)".into(),
             value: firefly_ratio(self.img, &keep).0,
             limit: Limit::AtMost(MAX_FIREFLY_RATIO),
-        }];
-        if name == "cornell_wood_marble" {
-            m.extend(self.rings(&["floor", "left", "right"]));
-        } else {
-            m.extend(self.rings(&["floor", "back"]));
-            m.push(light_colour(
-                self.scene,
-                self.img,
-                &self.on(&["floor", "back"]),
-                name.ends_with("_black"),
-                self.companion,
-            ));
         }
-        m
     }
 
-    /// The bowl: lit, and its curl bands flipping with the light (the companion render has
-    /// the light mirrored).
-    fn turned_bowl(&self) -> Vec<Measure> {
-        let bowl = objects(self.names, &["bowl"]);
+    /// Curl bands on `objs` flipping with the light (the companion render has the light
+    /// mirrored along the fibre).
+    fn curl_flip(&self, objs: &[&str]) -> Vec<Measure> {
+        let bowl = objects(self.names, objs);
         let flip = match (self.companion, self.curl_band_mm(&bowl)) {
             (Some(b), Some(mm)) => {
                 let scene = self.scene;
@@ -450,7 +448,6 @@ impl Subject<'_> {
             },
         };
         vec![
-            self.lit("bowl", &["bowl"]),
             Measure {
                 what: "curl bands on the floor flipping with the light, Weber contrast".into(),
                 value: flip.weber,
@@ -476,20 +473,15 @@ impl Subject<'_> {
         Some(w.volume.params().distortion.tangential.as_ref()?.size[2])
     }
 
-    /// The carved and the veneered cube: both lit, and the veneer's edge jump against the
-    /// carved cube's.
-    fn carved_vs_veneer(&self) -> Vec<Measure> {
+    /// How much more the veneered object's wood jumps across its edges than the carved one's.
+    fn seam_ratio(&self, carved: &str, veneered: &str) -> Measure {
         let id = |n: &str| (objects(self.names, &[n]).first().copied()).unwrap_or(u32::MAX);
-        let carved = edge_jump(self.img, &self.hits, id("carved"));
-        let veneered = edge_jump(self.img, &self.hits, id("veneered"));
-        vec![
-            self.lit("carved cube", &["carved"]),
-            self.lit("veneered cube", &["veneered"]),
-            Measure {
-                what: "edge jump of the veneer over the carved cube's".into(),
-                value: veneered / carved,
-                limit: Limit::AtLeast(MIN_SEAM_RATIO),
-            },
-        ]
+        let carved = edge_jump(self.img, &self.hits, id(carved));
+        let veneered = edge_jump(self.img, &self.hits, id(veneered));
+        Measure {
+            what: "edge jump of the veneer over the carved cube's".into(),
+            value: veneered / carved,
+            limit: Limit::AtLeast(MIN_SEAM_RATIO),
+        }
     }
 }

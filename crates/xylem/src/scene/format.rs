@@ -50,6 +50,10 @@ pub struct SceneFile {
     pub sweep: Option<SweepTable>,
     /// `[quality]`: the speed/accuracy preset and wood-model knobs (none: the full model).
     pub quality: Option<QualityTable>,
+    /// `[expect]`: what the scene's render must show, as checks a validation lab runs on it
+    /// (`xylem gallery`; the vocabulary is `xylem_lab::scenes::Expectations`). The renderer
+    /// carries the table through unread.
+    pub expect: Option<toml::Table>,
 }
 
 /// `[quality]`: what the scene trades for speed, as `--quality` does on the command line

@@ -109,6 +109,8 @@ pub struct LoadedScene {
     pub sweep: Option<SweepTable>,
     /// Non-fatal problems (e.g. degenerate triangles dropped), for the CLI to print.
     pub warnings: Vec<String>,
+    /// The `[expect]` table, unread (see [`SceneFile::expect`]).
+    pub expect: Option<toml::Table>,
 }
 
 /// Reads and builds a scene file, refusing geometry whose BVH build would not fit in memory.
@@ -415,6 +417,7 @@ impl Builder<'_> {
             light_names,
             sweep: file.sweep,
             warnings: self.warnings,
+            expect: file.expect,
         };
         if let Some(k) = knobs {
             quality::apply(&mut loaded, &k).map_err(|e| SceneError::Invalid {
