@@ -31,6 +31,7 @@ pub use xylem::bsdf::layered_reference;
 pub mod pattern;
 pub mod report;
 pub mod rough_finish;
+pub mod scene_template;
 pub mod scenes;
 pub mod sweep;
 pub mod tradeoff;

@@ -18,6 +18,7 @@
 
 use crate::highlight::{inclined_fibre, peak_in_arc_deg};
 use crate::report::markdown_table;
+use crate::scene_template::{pair, vec3, SceneTemplate};
 use serde::Serialize;
 use std::path::Path;
 use xylem::bsdf::{Bsdf, WoodBsdf, WoodBsdfParams};
@@ -70,8 +71,8 @@ const ETA: f32 = 1.5;
 /// normal, on the arc's +x side); every inclination then has one peak inside the arc.
 const VIEW_DEG: f32 = 40.0;
 
-/// The flat board with constant fibres along x dipping `incl_deg`, lit by a distant light named
-/// `sun` sweeping about +y.
+/// The flat board with constant fibres along x dipping `incl_deg` (validation/scenes/
+/// fibre_board.toml), `res`² pixels, lobe width `beta_deg`, `frames` frames over `arc`.
 fn fiber_board_toml(
     incl_deg: f32,
     beta_deg: f32,
@@ -79,111 +80,33 @@ fn fiber_board_toml(
     arc: (f32, f32),
     res: u32,
 ) -> String {
-    let u = inclined_fibre(Vec3::X, incl_deg);
     let (s, c) = VIEW_DEG.to_radians().sin_cos();
-    format!(
-        r#"
-[render]
-width = {res}
-height = {res}
-spp = 1
-seed = 5
-filter = "box"
-filter_radius = 0.5
-
-[camera]
-projection = "orthographic"
-eye = [{ex}, 0.0, {ez}]
-target = [0.0, 0.0, 0.0]
-up = [0.0, 1.0, 0.0]
-width = 40.0
-
-[[lights]]
-type = "distant"
-name = "sun"
-direction = [0.0, 0.0, 1.0]
-irradiance = 1.0
-
-[materials.fibres]
-type = "fiber"
-diffuse = [0.25, 0.2, 0.15]
-fiber_color = [0.6, 0.5, 0.4]
-fiber_dir = [{ux}, {uy}, {uz}]
-highlight_width_deg = {beta_deg}
-eta = {ETA}
-
-[[objects]]
-shape = "quad"
-size = [200.0, 200.0]
-material = "fibres"
-
-[sweep]
-frames = {frames}
-arc_deg = [{a0}, {a1}]
-light = "sun"
-radius = 1000.0
-axis = [0.0, 1.0, 0.0]
-"#,
-        ex = 500.0 * s,
-        ez = 500.0 * c,
-        ux = u.x,
-        uy = u.y,
-        uz = u.z,
-        a0 = arc.0,
-        a1 = arc.1,
-    )
+    SceneTemplate::named("fibre_board")
+        .set("render.width", res as i64)
+        .set("render.height", res as i64)
+        .set("camera.eye", vec3(Vec3::new(500.0 * s, 0.0, 500.0 * c)))
+        .set(
+            "materials.fibres.fiber_dir",
+            vec3(inclined_fibre(Vec3::X, incl_deg)),
+        )
+        .set("materials.fibres.highlight_width_deg", beta_deg as f64)
+        .set("materials.fibres.eta", ETA as f64)
+        .set("sweep.frames", frames as i64)
+        .set("sweep.arc_deg", pair(arc.0, arc.1))
+        .text()
 }
 
-/// A quartersawn board (radial face up, grain along x) of a wood preset under a smooth finish,
-/// seen from straight above by an orthographic camera, lit by a distant light sweeping about +y.
+/// The quartersawn board of `preset` (validation/scenes/preset_board.toml), `res` pixels,
+/// `frames` frames over `arc`.
 fn preset_board_toml(preset: &str, frames: usize, arc: (f32, f32), res: (u32, u32)) -> String {
-    format!(
-        r#"
-[render]
-width = {w}
-height = {h}
-spp = 2
-seed = 9
-filter = "box"
-filter_radius = 0.5
-
-[camera]
-projection = "orthographic"
-eye = [0.0, 0.0, 500.0]
-target = [0.0, 0.0, 0.0]
-up = [0.0, 1.0, 0.0]
-width = 120.0
-
-[[lights]]
-type = "distant"
-name = "sun"
-direction = [0.0, 0.0, 1.0]
-irradiance = 1.0
-
-[materials.board]
-type = "wood"
-preset = "{preset}"
-seed = 3
-eta = {ETA}
-
-[[objects]]
-shape = "quad"
-size = [200.0, 200.0]
-material = "board"
-tree = {{ origin = [0.0, 120.0, 0.0], axis = [1.0, 0.0, 0.0], rotation_deg = 0.0 }}
-
-[sweep]
-frames = {frames}
-arc_deg = [{a0}, {a1}]
-light = "sun"
-radius = 1000.0
-axis = [0.0, 1.0, 0.0]
-"#,
-        w = res.0,
-        h = res.1,
-        a0 = arc.0,
-        a1 = arc.1,
-    )
+    SceneTemplate::named("preset_board")
+        .set("render.width", res.0 as i64)
+        .set("render.height", res.1 as i64)
+        .set("materials.board.preset", preset)
+        .set("materials.board.eta", ETA as f64)
+        .set("sweep.frames", frames as i64)
+        .set("sweep.arc_deg", pair(arc.0, arc.1))
+        .text()
 }
 
 fn load(name: &str, text: &str) -> Result<LoadedScene, SweepCheckError> {

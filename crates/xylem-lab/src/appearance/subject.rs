@@ -2,6 +2,7 @@
 //! under a moving light ([`SweepLuminance`]).
 
 use super::*;
+use crate::scene_template::{pair, vec3, SceneTemplate};
 
 /// A board to compare: a preset (with its tree placement) or a measured board's maps.
 #[derive(Clone, Debug)]
@@ -110,53 +111,31 @@ impl Subject {
         }
     }
 
-    /// A top-down orthographic sweep of the board: a distant light moving along the grain over
-    /// `arc` degrees from the zenith in `frames` steps, `res`² pixels over the board.
+    /// A top-down orthographic sweep of the board (validation/scenes/appearance_sweep.toml): a
+    /// distant light moving along the grain over `arc` degrees from the zenith in `frames`
+    /// steps, `res`² pixels over the board.
     pub fn sweep_scene(&self, frames: usize, arc: f32, res: u32, spp: u32) -> String {
         let (material, tree) = self.material_toml();
+        let table = |text: &str| -> toml::Table { toml::from_str(text).expect("a TOML table") };
         let axis = if self.grain_along_x() {
-            "[0.0, 1.0, 0.0]"
+            Vec3::Y
         } else {
-            "[1.0, 0.0, 0.0]"
+            Vec3::X
         };
-        format!(
-            r#"
-[render]
-width = {res}
-height = {res}
-spp = {spp}
-seed = 5
-filter = "box"
-filter_radius = 0.5
-[camera]
-projection = "orthographic"
-eye = [0.0, 0.0, 500.0]
-target = [0.0, 0.0, 18.0]
-up = [0.0, 1.0, 0.0]
-width = {BOARD_MM}
-[[lights]]
-type = "distant"
-name = "sun"
-direction = [0.0, 0.0, 1.0]
-irradiance = 1.0
-[materials.board]
-{material}
-[[objects]]
-name = "board"
-shape = "box"
-size = [{BOARD_MM}, {BOARD_MM}, 18.0]
-translate = [0.0, 0.0, 9.0]
-material = "board"
-{tree}
-[sweep]
-frames = {frames}
-arc_deg = [{lo}, {arc}]
-light = "sun"
-radius = 1000.0
-axis = {axis}
-"#,
-            lo = -arc,
-        )
+        let mut t = SceneTemplate::named("appearance_sweep")
+            .set("render.width", res as i64)
+            .set("render.height", res as i64)
+            .set("render.spp", spp as i64)
+            .set("camera.width", BOARD_MM as f64)
+            .set("materials.board", toml::Value::Table(table(&material)))
+            .set("objects.0.size", vec3(Vec3::new(BOARD_MM, BOARD_MM, 18.0)))
+            .set("sweep.frames", frames as i64)
+            .set("sweep.arc_deg", pair(-arc, arc))
+            .set("sweep.axis", vec3(axis));
+        if let Some(tree) = table(&tree).get("tree") {
+            t = t.set("objects.0.tree", tree.clone());
+        }
+        t.text()
     }
 
     /// Renders [`Subject::sweep_scene`]: per-pixel luminance of every frame.

@@ -2,46 +2,17 @@
 //! brightness must follow its diffuse albedo.
 
 use super::*;
+use crate::scene_template::{inline_table, SceneTemplate};
 
-/// A board of `preset` seen straight down through an orthographic camera (1 mm pixels over
-/// 200 × 100 mm of its showcase face, as the gallery cuts it: `SawnCut::showcase_board`) under a
-/// uniform white environment, smooth finish η 1.5.
+/// A board of `preset` under a uniform white environment (validation/scenes/
+/// white_light_board.toml), cut as the gallery cuts it (`SawnCut::showcase_board`), at `spp`.
 fn white_light_board_scene(preset: &str, spp: u32) -> String {
     let tree = SawnCut::showcase_board(xylem::wood::showcase_ring_angle_deg(preset)).tree_toml();
-    format!(
-        r#"
-[render]
-width = 200
-height = 100
-spp = {spp}
-integrator = "direct"
-seed = 3
-filter = "box"
-[camera]
-projection = "orthographic"
-eye = [0.0, 0.0, 400.0]
-target = [0.0, 0.0, 18.0]
-up = [0.0, 1.0, 0.0]
-width = 200.0
-[[lights]]
-type = "environment"
-radiance = 1.0
-[materials.board]
-type = "wood"
-preset = "{preset}"
-seed = 7
-eta = 1.5
-roughness = 0.0
-bump = 0.0
-[[objects]]
-name = "board"
-shape = "box"
-size = [260.0, 110.0, 18.0]
-translate = [0.0, 0.0, 9.0]
-material = "board"
-tree = {tree}
-"#
-    )
+    SceneTemplate::named("white_light_board")
+        .set("render.spp", spp as i64)
+        .set("materials.board.preset", preset)
+        .set("objects.0.tree", inline_table(&tree))
+        .text()
 }
 
 /// How a preset's board renders under uniform white light, against its diffuse albedo.

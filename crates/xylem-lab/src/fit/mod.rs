@@ -10,6 +10,7 @@
 //! gives: 8-bit sRGB PNG frames with Poisson shot noise (notes/fit.md §5).
 
 use crate::appearance::BoardMaps;
+use crate::scene_template::{pair, vec3, SceneTemplate};
 use glam::Vec3;
 use std::path::{Path, PathBuf};
 use xylem::bsdf::{WoodBsdf, WoodBsdfParams};
@@ -128,81 +129,46 @@ fn truth_board(source: &Source, n: usize, base: &Path) -> Result<MeasuredBoard, 
     }
 }
 
-/// The scene of a round trip: the board's maps on a box face through the `measured` material,
-/// an orthographic camera straight down with `px_per_texel`² pixels per texel, and a small
-/// sphere light 500 mm from the board centre on `azimuths_deg` arcs.
+/// The scene of a round trip (validation/scenes/fit_round_trip.toml): the board's maps on a box
+/// face through the `measured` material, an orthographic camera straight down with
+/// `px_per_texel`² pixels per texel, and a small sphere light 500 mm from the board centre on
+/// `azimuths_deg` arcs.
 fn scene_text(maps: &Path, spec: &SweepSpec) -> String {
     let size = spec.texels as f32 * PITCH_MM;
-    let res = spec.texels * spec.px_per_texel;
+    let res = (spec.texels * spec.px_per_texel) as i64;
     let r = spec.light_radius_mm;
     // Radiance giving intensity 250 000 (π r² L): pixel values of order 0.1–1.
     let radiance = 250_000.0 / (std::f32::consts::PI * r * r);
     let d = |f: &str| maps.join(f).display().to_string();
+    let mut t = SceneTemplate::named("fit_round_trip")
+        .set("render.width", res)
+        .set("render.height", res)
+        .set("render.spp", spec.spp as i64)
+        .set("camera.width", size as f64)
+        .set("lights.0.radius", r as f64)
+        .set("lights.0.radiance", radiance as f64)
+        .set("materials.board.diffuse", d("diffuse.png"))
+        .set("materials.board.fiber_color", d("fiber_color.png"))
+        .set("materials.board.fiber_axis", d("fiber_axis.png"))
+        .set("materials.board.size_mm", pair(size, size))
+        .set("objects.0.size", vec3(Vec3::new(size, size, 18.0)))
+        .set("sweep.frames", spec.frames_per_arc as i64)
+        .set("sweep.arc_deg", pair(-spec.arc_deg, spec.arc_deg))
+        .set(
+            "sweep.azimuths_deg",
+            toml::Value::Array(
+                spec.azimuths_deg
+                    .iter()
+                    .map(|&a| (a as f64).into())
+                    .collect(),
+            ),
+        )
+        .set("sweep.board.size_mm", pair(size, size));
     // A fitted folder has a β map; the truth boards use the material's default β.
-    let beta_map = if maps.join("highlight_width.png").exists() {
-        format!("highlight_width = {:?}", d("highlight_width.png"))
-    } else {
-        String::new()
-    };
-    format!(
-        r#"
-[render]
-width = {res}
-height = {res}
-spp = {spp}
-integrator = "direct"
-seed = 11
-filter = "box"
-filter_radius = 0.5
-[camera]
-projection = "orthographic"
-eye = [0.0, 0.0, 500.0]
-target = [0.0, 0.0, 18.0]
-up = [0.0, 1.0, 0.0]
-width = {size}
-[[lights]]
-name = "key"
-type = "sphere"
-center = [0.0, 0.0, 518.0]
-radius = {r}
-radiance = {radiance}
-[materials.board]
-type = "measured"
-diffuse = {diffuse:?}
-fiber_color = {fiber:?}
-fiber_axis = {axis:?}
-{beta_map}
-size_mm = [{size}, {size}]
-eta = 1.5
-roughness = 0.0
-[[objects]]
-name = "board"
-shape = "box"
-size = [{size}, {size}, 18.0]
-translate = [0.0, 0.0, 9.0]
-material = "board"
-[sweep]
-frames = {frames}
-arc_deg = [{lo}, {hi}]
-light = "key"
-pivot = [0.0, 0.0, 18.0]
-radius = 500.0
-axis = [0.0, 1.0, 0.0]
-azimuths_deg = {az:?}
-[sweep.board]
-origin = [0.0, 0.0, 18.0]
-size_mm = [{size}, {size}]
-eta = 1.5
-"#,
-        spp = spec.spp,
-        diffuse = d("diffuse.png"),
-        fiber = d("fiber_color.png"),
-        axis = d("fiber_axis.png"),
-        frames = spec.frames_per_arc,
-        lo = -spec.arc_deg,
-        hi = spec.arc_deg,
-        az = spec.azimuths_deg,
-    )
+    if maps.join("highlight_width.png").exists() {
+        t = t.set("materials.board.highlight_width", d("highlight_width.png"));
+    }
+    t.text()
 }
 
 /// Per-texel errors of a fit against the truth.
