@@ -151,13 +151,18 @@ def test_render_releases_the_gil(root):
             ticks.append(time.perf_counter())
             time.sleep(0.005)
 
-    t = threading.Thread(target=tick)
+    # A daemon stopped in `finally`: a render that raises must not leave pytest waiting on it.
+    t = threading.Thread(target=tick, daemon=True)
     t.start()
-    start = time.perf_counter()
-    out = xylem.render(str(root / "scenes" / "sweep_board.toml"), spp=16, res=(96, 72), threads=1)
-    end = time.perf_counter()
-    done.set()
-    t.join()
+    try:
+        start = time.perf_counter()
+        out = xylem.render(
+            str(root / "scenes" / "sweep_board.toml"), spp=16, res=(96, 72), threads=1
+        )
+        end = time.perf_counter()
+    finally:
+        done.set()
+        t.join()
     assert out["seconds"] > 0.05, "render too short to tell"
     during = [x for x in ticks if start < x < end]
     assert len(during) >= 5, f"only {len(during)} ticks during a {end - start:.2f} s render"

@@ -170,7 +170,7 @@ impl Staged {
     /// Renames the temporary file to the final name only where no file has that name yet
     /// (atomically: of two runs committing at once exactly one succeeds); otherwise an
     /// [`io::ErrorKind::AlreadyExists`] error, and the temporary is removed.
-    pub fn commit_new(self) -> io::Result<()> {
+    pub(crate) fn commit_new(self) -> io::Result<()> {
         self.tmp
             .persist_noclobber(&self.path)
             .map_err(|e| e.error)?;
@@ -249,7 +249,7 @@ fn alive(pid: i32) -> bool {
 /// Removes from `dir` the temporaries of dead processes of this host (runs killed before they
 /// could delete them), once per folder and process; live runs' temporaries and other hosts'
 /// (a farm sharing the folder) stay. Failures are ignored: this is tidying, not output.
-pub fn remove_stale_temporaries(dir: &Path) {
+pub(crate) fn remove_stale_temporaries(dir: &Path) {
     static DONE: Mutex<BTreeSet<PathBuf>> = Mutex::new(BTreeSet::new());
     let key = std::path::absolute(dir).unwrap_or_else(|_| dir.to_path_buf());
     if !DONE.lock().map(|mut d| d.insert(key)).unwrap_or(false) {
@@ -475,7 +475,7 @@ pub fn verify_set(dir: &Path, record: &str) -> Result<(), String> {
 /// record lists it with its size and CRC-32, `Ok(false)` where the record does not list it,
 /// and an error naming both where the record is unreadable or lists another file (another
 /// run's, or one changed since).
-pub fn check_member(dir: &Path, record: &str, name: &str) -> Result<bool, String> {
+pub(crate) fn check_member(dir: &Path, record: &str, name: &str) -> Result<bool, String> {
     let path = dir.join(record);
     let files = record_files(&path)?;
     let Some(entry) = files

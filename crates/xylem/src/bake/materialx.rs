@@ -26,24 +26,24 @@ use std::path::Path;
 pub const COAT_IOR: f32 = FINISH_IOR;
 
 /// The coat's roughness: the bake's finish is smooth (the scenes' default `roughness = 0`).
-pub const COAT_ROUGHNESS: f32 = 0.0;
+pub(crate) const COAT_ROUGHNESS: f32 = 0.0;
 
 /// OpenPBR's `specular_ior`. Under a coat OpenPBR reflects at the base with the ratio
 /// η_s / η_c (\[OpenPBR\] § Coat), so η_s = η_c would remove the fibre highlight entirely. The
 /// fibre lobe is no Fresnel interface; it is given the ratio 1.5 (F0 = 0.04 under the coat),
 /// the strength the `.glb` gives it in air, so both exports show the same lobe.
-pub const SPECULAR_IOR: f32 = COAT_IOR * 1.5;
+pub(crate) const SPECULAR_IOR: f32 = COAT_IOR * 1.5;
 
 /// File names of the maps the document reads, relative to the document's folder.
-pub const BASE_COLOR_PNG: &str = "base_color.png";
+pub(crate) const BASE_COLOR_PNG: &str = "base_color.png";
 /// The tangent-space normal map (0.5 + 0.5 n, linear).
-pub const NORMAL_PNG: &str = "normal.png";
+pub(crate) const NORMAL_PNG: &str = "normal.png";
 /// The KHR_materials_anisotropy map: red, green = the direction across the fibre.
-pub const ANISOTROPY_PNG: &str = "anisotropy.png";
+pub(crate) const ANISOTROPY_PNG: &str = "anisotropy.png";
 /// OpenPBR `specular_roughness` per texel (grey, linear), made by [`stage_materialx`].
-pub const ROUGHNESS_PNG: &str = "openpbr_specular_roughness.png";
+pub(crate) const ROUGHNESS_PNG: &str = "openpbr_specular_roughness.png";
 /// OpenPBR `specular_roughness_anisotropy` per texel (grey, linear), made by [`stage_materialx`].
-pub const ROUGHNESS_ANISOTROPY_PNG: &str = "openpbr_specular_anisotropy.png";
+pub(crate) const ROUGHNESS_ANISOTROPY_PNG: &str = "openpbr_specular_anisotropy.png";
 
 /// OpenPBR's (`specular_roughness`, `specular_roughness_anisotropy`) for the fibre lobe of width
 /// `beta` (radians) whose fibre lies in the face with `strength` (the anisotropy texel's blue).
@@ -90,7 +90,7 @@ pub enum MaterialXError {
 
 /// A valid MaterialX element name made from `name` (\[MTLX\] "Element names": letters, digits and
 /// underscores, not starting with a digit): every other character becomes `_`.
-pub fn element_name(name: &str) -> String {
+pub(crate) fn element_name(name: &str) -> String {
     let mut s: String = name
         .chars()
         .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
@@ -103,7 +103,7 @@ pub fn element_name(name: &str) -> String {
 
 /// The name of the `surfacematerial` in the document for preset `name` (`M_<name>`), which the
 /// USD stage references.
-pub fn material_name(name: &str) -> String {
+pub(crate) fn material_name(name: &str) -> String {
     format!("M_{}", element_name(name))
 }
 
@@ -122,7 +122,7 @@ fn num(v: f32) -> String {
 
 /// The `.mtlx` text for preset `name`, reading the maps by the file names above (relative to the
 /// document). Deterministic: the same name gives the same bytes.
-pub fn materialx_document(name: &str) -> Result<String, MaterialXError> {
+pub(crate) fn materialx_document(name: &str) -> Result<String, MaterialXError> {
     if name.is_empty() {
         return Err(MaterialXError::EmptyName);
     }

@@ -100,7 +100,8 @@ impl BoardCut {
     }
 
     /// Texture size for `res` texels along the length (at least 1 × 1).
-    pub fn texture_size(&self, res: u32) -> (u32, u32) {
+    #[cfg(test)]
+    pub(crate) fn texture_size(&self, res: u32) -> (u32, u32) {
         self.rect().texture_size(res)
     }
 
@@ -108,7 +109,7 @@ impl BoardCut {
     /// along z, centred) → tree space: x → the top face's right, y → its normal, z → its down,
     /// ×1000, about the board's centre. A rotation (right · (normal × down) = 1) and a scale, so
     /// the top face's texel (u, v) lands where [`BoardCut::rect`] puts it.
-    pub fn gltf_to_tree(&self) -> Affine3A {
+    pub(crate) fn gltf_to_tree(&self) -> Affine3A {
         let (_, right, down, normal) = self.face();
         Affine3A::from_mat3_translation(
             Mat3::from_cols(1000.0 * right, 1000.0 * normal, 1000.0 * down),

@@ -98,7 +98,7 @@ impl UvMesh {
 
     /// A mesh and one texture coordinate per vertex; smooth area-weighted normals where the mesh
     /// has none. Degenerate triangles are dropped; an error when none is left.
-    pub fn from_trimesh(mut m: TriMesh, uvs: Vec<Vec2>) -> Result<UvMesh, String> {
+    pub(crate) fn from_trimesh(mut m: TriMesh, uvs: Vec<Vec2>) -> Result<UvMesh, String> {
         if uvs.len() != m.positions.len() {
             return Err(format!(
                 "{} texture coordinates for {} vertices",
@@ -133,7 +133,7 @@ impl UvMesh {
     }
 
     /// Per-triangle (∂p/∂u, ∂p/∂v), zero where the triangle's UVs are degenerate.
-    pub fn triangle_derivatives(&self, t: [u32; 3]) -> (Vec3, Vec3) {
+    pub(crate) fn triangle_derivatives(&self, t: [u32; 3]) -> (Vec3, Vec3) {
         let [p0, p1, p2] = t.map(|i| self.positions[i as usize]);
         let [t0, t1, t2] = t.map(|i| self.uvs[i as usize]);
         let (e1, e2, d1, d2) = (p1 - p0, p2 - p0, t1 - t0, t2 - t0);

@@ -42,7 +42,7 @@ pub fn cylinder_frame(p: Vec3) -> Frame {
 
 /// (cos θ, sin θ) of the point (x, y, ·): r̂'s components, (1, 0) on the pith.
 #[inline(always)]
-pub fn cylinder_cos_sin(x: f32, y: f32) -> (f32, f32) {
+pub(crate) fn cylinder_cos_sin(x: f32, y: f32) -> (f32, f32) {
     let r2 = x * x + y * y;
     let inv = 1.0 / r2.sqrt();
     if r2 > PITH_EPSILON * PITH_EPSILON {
@@ -54,7 +54,7 @@ pub fn cylinder_cos_sin(x: f32, y: f32) -> (f32, f32) {
 
 /// The frame (r̂, θ̂, ẑ) from r̂ = (c, s, 0).
 #[inline(always)]
-pub fn cylinder_frame_from(c: f32, s: f32) -> Frame {
+pub(crate) fn cylinder_frame_from(c: f32, s: f32) -> Frame {
     Frame {
         s: Vec3::new(c, s, 0.0),
         t: Vec3::new(-s, c, 0.0),

@@ -50,20 +50,6 @@ impl Distortion {
         }
     }
 
-    /// Distortion of `p` by magnitude fields along r̂, θ̂, ẑ of `frame` (the cylindrical frame at p);
-    /// `None` switches a direction off (and skips its noise).
-    #[inline]
-    pub fn from_fields<M: Magnitude>(p: Vec3, frame: &Frame, fields: [Option<&M>; 3]) -> Self {
-        let mut d = Distortion::identity(p);
-        for (field, dir) in fields.into_iter().zip([frame.s, frame.t, frame.n]) {
-            if let Some(field) = field {
-                let (m, grad_m) = field.eval(p);
-                d.add(Displacement { dir, m, grad_m });
-            }
-        }
-        d
-    }
-
     /// Add one displacement term: f += m a (eq. 15) and J += a ⊗ ∇m / (1 + ‖∇m‖) (eq. 22). The
     /// compression keeps J = I + a ⊗ g with ‖g‖ < 1, so det J = 1 + a·g > 0 for one term: no
     /// singularity however steep the noise.

@@ -14,7 +14,7 @@ pub fn rotate_about_radial(frame: &Frame, angle: f32) -> Frame {
 
 /// [`rotate_about_radial`] by the angle whose sine and cosine are `s` and `c`.
 #[inline(always)]
-pub fn rotate_by(frame: &Frame, s: f32, c: f32) -> Frame {
+pub(crate) fn rotate_by(frame: &Frame, s: f32, c: f32) -> Frame {
     Frame {
         s: frame.s,
         t: frame.t * c - frame.n * s,

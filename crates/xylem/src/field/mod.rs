@@ -6,8 +6,9 @@ mod cylindrical;
 mod distortion;
 mod interlock;
 
-pub use cylindrical::{
-    cylinder_cos_sin, cylinder_frame, cylinder_frame_from, Cylindrical, PITH_EPSILON,
-};
+pub(crate) use cylindrical::cylinder_cos_sin;
+pub(crate) use cylindrical::cylinder_frame_from;
+pub use cylindrical::{cylinder_frame, Cylindrical, PITH_EPSILON};
 pub use distortion::{exact_jacobian, Displacement, Distortion, JacobianModel, Magnitude};
-pub use interlock::{rotate_about_radial, rotate_by};
+pub use interlock::rotate_about_radial;
+pub(crate) use interlock::rotate_by;

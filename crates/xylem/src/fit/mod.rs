@@ -14,7 +14,8 @@ pub mod model;
 
 pub use capture::{Capture, CaptureError};
 pub use maps::{write_maps, FittedMaps};
-pub use model::{fit_texel, Scratch, TexelData, TexelFit};
+pub(crate) use model::fit_texel;
+pub use model::{Scratch, TexelData, TexelFit};
 
 use crate::progress::{NoProgress, Progress};
 use glam::Vec3;
@@ -165,7 +166,7 @@ impl Rejections {
     }
 
     /// The counts by cause, as `fit.json` reports them.
-    pub fn to_json(&self) -> serde_json::Value {
+    pub(crate) fn to_json(&self) -> serde_json::Value {
         serde_json::json!({
             "used": self.used,
             "clipped_or_not_finite": self.clipped,

@@ -328,7 +328,7 @@ fn highlight_axis(prob: &Problem) -> Option<Vec3> {
 /// Fits one texel (notes/fit.md §2): highlight-first axis, a scan over β, Levenberg–Marquardt
 /// on (φ, δ, ln β), outlier frames (residual > 5 robust σ, at most a fifth of the frames)
 /// rejected and the fit refined once more. `None` when fewer than 8 frames are usable.
-pub fn fit_texel(d: &mut TexelData, eta: f32, s: &mut Scratch) -> Option<TexelFit> {
+pub(crate) fn fit_texel(d: &mut TexelData, eta: f32, s: &mut Scratch) -> Option<TexelFit> {
     let usable = d.w.iter().filter(|w| **w > 0.0).count();
     if usable < 8 {
         return None;

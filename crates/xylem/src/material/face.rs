@@ -43,7 +43,7 @@ impl FaceRect {
     }
 
     /// Texture size for `res` texels along `right` (at least 1 × 1), square texels.
-    pub fn texture_size(&self, res: u32) -> (u32, u32) {
+    pub(crate) fn texture_size(&self, res: u32) -> (u32, u32) {
         let res = res.max(1);
         (
             res,
@@ -59,7 +59,7 @@ impl FaceRect {
 
 /// The four texels and weights of a bilinear lookup at `uv` in a `width` × `height` row-major map
 /// (texel centres at (i + ½)/W, clamped to the edge texels outside [0, 1]²).
-pub fn bilinear_taps(uv: Vec2, width: u32, height: u32) -> [(usize, f32); 4] {
+pub(crate) fn bilinear_taps(uv: Vec2, width: u32, height: u32) -> [(usize, f32); 4] {
     let (w, h) = (width as usize, height as usize);
     let x = (uv.x * w as f32 - 0.5).clamp(0.0, (w - 1) as f32);
     let y = (uv.y * h as f32 - 0.5).clamp(0.0, (h - 1) as f32);

@@ -13,7 +13,7 @@ mod placement;
 pub use baked::{
     across_fiber, fiber_from_anisotropy, BakedFibers, BakedMaps, BakedTexel, BakedWoodMaterial,
 };
-pub use face::{bilinear_taps, FaceRect};
+pub use face::FaceRect;
 pub use measured::{
     energy_bounded_fiber_color, BoardFace, ColorSpace, MeasuredBoard, MeasuredError, MeasuredFiles,
     MeasuredMaterial, DEFAULT_FIBER_COLOR_SCALE, DEFAULT_HIGHLIGHT_WIDTH_DEG,

@@ -15,7 +15,7 @@ pub use sampling::*;
 /// π.
 pub const PI: f32 = std::f32::consts::PI;
 /// 1/π.
-pub const INV_PI: f32 = std::f32::consts::FRAC_1_PI;
+pub(crate) const INV_PI: f32 = std::f32::consts::FRAC_1_PI;
 
 /// `sqrt(max(x, 0))`: rounding can push a mathematically non-negative argument below 0.
 #[inline]
@@ -31,7 +31,7 @@ pub fn safe_asin(x: f32) -> f32 {
 
 /// `acos` with its argument clamped to [-1, 1], so rounding never yields NaN.
 #[inline]
-pub fn safe_acos(x: f32) -> f32 {
+pub(crate) fn safe_acos(x: f32) -> f32 {
     x.clamp(-1.0, 1.0).acos()
 }
 

@@ -4,7 +4,7 @@ use super::{INV_PI, PI};
 use glam::{Vec2, Vec3};
 
 /// Concentric map of the square onto the unit disk (Shirley & Chiu 1997), area-preserving.
-pub fn concentric_disk(u: Vec2) -> Vec2 {
+pub(crate) fn concentric_disk(u: Vec2) -> Vec2 {
     let o = 2.0 * u - Vec2::ONE;
     if o.x == 0.0 && o.y == 0.0 {
         return Vec2::ZERO;
@@ -27,7 +27,7 @@ pub fn cosine_hemisphere(u: Vec2) -> Vec3 {
 /// The density of [`cosine_hemisphere`] at a direction with cosine `cos_theta` (0 below the
 /// horizon).
 #[inline]
-pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
+pub(crate) fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
     cos_theta.max(0.0) * INV_PI
 }
 
@@ -40,33 +40,11 @@ pub fn uniform_sphere(u: Vec2) -> Vec3 {
 }
 
 /// The density of [`uniform_sphere`].
-pub const UNIFORM_SPHERE_PDF: f32 = 1.0 / (4.0 * PI);
-
-/// Uniform direction in the cone of half-angle `acos(cos_max)` about +z; density `1 / (2π(1 − cos_max))`.
-pub fn uniform_cone(u: Vec2, cos_max: f32) -> Vec3 {
-    let cos_t = 1.0 - u.x * (1.0 - cos_max);
-    let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
-    let phi = 2.0 * PI * u.y;
-    Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t)
-}
-
-/// Uniform point on a triangle as barycentrics `(b1, b2)` (Heitz 2019, "A Low-Distortion Map
-/// Between Triangle and Square").
-pub fn uniform_triangle(u: Vec2) -> Vec2 {
-    if u.y > u.x {
-        let b0 = u.x / 2.0;
-        let b1 = u.y - b0;
-        Vec2::new(b0, b1)
-    } else {
-        let b1 = u.y / 2.0;
-        let b0 = u.x - b1;
-        Vec2::new(b0, b1)
-    }
-}
+pub(crate) const UNIFORM_SPHERE_PDF: f32 = 1.0 / (4.0 * PI);
 
 /// Power heuristic with β = 2 (Veach 1997, eq. 9.13) for multiple importance sampling.
 #[inline]
-pub fn power_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
+pub(crate) fn power_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
     let a = pdf_a * pdf_a;
     let b = pdf_b * pdf_b;
     if a + b > 0.0 && (a + b).is_finite() {
@@ -92,10 +70,6 @@ mod tests {
             let c = cosine_hemisphere(u);
             assert!(c.z >= 0.0 && (c.length() - 1.0).abs() < 1e-5);
             assert!((uniform_sphere(u).length() - 1.0).abs() < 1e-5);
-            let k = uniform_cone(u, 0.9);
-            assert!(k.z >= 0.9 - 1e-6);
-            let b = uniform_triangle(u);
-            assert!(b.x >= 0.0 && b.y >= 0.0 && b.x + b.y <= 1.0 + 1e-6);
         }
     }
 

@@ -22,7 +22,7 @@ pub fn fade(t: f32) -> f32 {
 
 /// Derivative of [`fade`]: `30 t² (t − 1)²`.
 #[inline(always)]
-pub fn fade_d(t: f32) -> f32 {
+pub(crate) fn fade_d(t: f32) -> f32 {
     30.0 * t * t * (t * (t - 2.0) + 1.0)
 }
 

@@ -57,12 +57,6 @@ pub(crate) fn cell3_offset(ix: i32, iy: i32, iz: i32, s: &[u32; 3]) -> [u32; 3] 
     ])
 }
 
-/// Hash of a 1D cell and a seed (first lane of [`cell3`] on the line `(i, 0, 0)`).
-#[inline(always)]
-pub fn cell1(i: i32, seed: u32) -> u32 {
-    cell3(i, 0, 0, seed)[0]
-}
-
 /// Three large pseudo-random lattice translations derived from a seed (see [`cell3`]).
 #[inline(always)]
 pub fn seed_offsets(seed: u32) -> [u32; 3] {

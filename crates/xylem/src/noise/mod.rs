@@ -94,12 +94,10 @@ mod warp;
 pub use cellular::{cellular3, feature_point, CellularSample};
 pub use fractal::{Basis, Fractal, FractalKind};
 pub use gradient::{
-    fade, fade_d, gradient1, gradient1_grad, gradient3, gradient3_grad, gradient3_many,
-    gradient3_many_with,
+    fade, gradient1, gradient1_grad, gradient3, gradient3_grad, gradient3_many, gradient3_many_with,
 };
 pub use sparse::{
-    band_cells, Cells, Kernel, NoiseError, SeededSparse, SparseConvolution, SparseConvolution1,
-    Weights, MAX_IMPULSES_PER_CELL,
+    Cells, Kernel, NoiseError, SeededSparse, SparseConvolution, SparseConvolution1, Weights,
 };
 pub use value::{value1, value1_grad, value3, value3_grad};
 pub use warp::{Warp, WarpSample};

@@ -44,7 +44,7 @@ pub fn load_mesh(path: &Path) -> Result<TriMesh, MeshError> {
 /// [`load_mesh`], and the texture coordinates of every vertex where the file gives every face
 /// corner one (an OBJ's `vt`; glTF's orientation: v = 1 − the OBJ's v, so v runs down the
 /// image). `None` for a PLY, or an OBJ with a face corner without `vt`.
-pub fn load_mesh_uv(path: &Path) -> Result<(TriMesh, Option<Vec<glam::Vec2>>), MeshError> {
+pub(crate) fn load_mesh_uv(path: &Path) -> Result<(TriMesh, Option<Vec<glam::Vec2>>), MeshError> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -324,7 +324,8 @@ impl<R: BufRead> Body<R> {
 }
 
 /// Reads a PLY mesh (checked as [`load_obj`]).
-pub fn load_ply(path: &Path) -> Result<TriMesh, MeshError> {
+#[cfg(test)]
+pub(crate) fn load_ply(path: &Path) -> Result<TriMesh, MeshError> {
     let file = open_mesh(path, false)?;
     parse_ply(BufReader::new(file)).map_err(|m| bad(path, m))
 }

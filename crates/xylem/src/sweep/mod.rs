@@ -22,9 +22,7 @@ pub mod sequence;
 pub mod viewer;
 
 pub use crate::scene::MAX_ARCS;
-pub use path::{
-    parse_arc, parse_frames_range, ArcPlane, LightArc, PathError, SetupError, SweepPath,
-};
+pub use path::{parse_arc, ArcPlane, LightArc, PathError, SetupError, SweepPath};
 pub use sequence::{assemble, AssembleOptions, FrameRecord, Region, SequenceError};
 
 use crate::render::{

@@ -102,7 +102,8 @@ impl LightArc {
     }
 
     /// All light angles in degrees, frame by frame.
-    pub fn angles_deg(&self) -> Vec<f32> {
+    #[cfg(test)]
+    pub(crate) fn angles_deg(&self) -> Vec<f32> {
         (0..self.frames).map(|i| self.angle_deg(i)).collect()
     }
 }
@@ -162,7 +163,7 @@ pub fn parse_arc(text: &str) -> Result<(f32, f32), PathError> {
 
 /// Parses `A..B` (frames A to B-1, as Rust ranges) or `A..=B` (frames A to B) against a sweep of
 /// `frames` frames. `A..` runs to the last frame.
-pub fn parse_frames_range(text: &str, frames: usize) -> Result<Range<usize>, PathError> {
+pub(crate) fn parse_frames_range(text: &str, frames: usize) -> Result<Range<usize>, PathError> {
     let syntax = || PathError::RangeSyntax(text.to_string());
     let (a, rest) = text.trim().split_once("..").ok_or_else(syntax)?;
     let (inclusive, b) = match rest.strip_prefix('=') {

@@ -155,7 +155,8 @@ pub fn board_to_tree(
 /// Solid: an object carved from one block. `p` in object space (mm) maps rigidly into the tree:
 /// the block's origin sits at `origin` in tree space and its `grain` axis (object space, unit) runs
 /// along the pith direction ẑ.
-pub fn solid_to_tree(p: Vec3, origin: Vec3, grain: Vec3) -> Vec3 {
+#[cfg(test)]
+pub(crate) fn solid_to_tree(p: Vec3, origin: Vec3, grain: Vec3) -> Vec3 {
     let rot = glam::Quat::from_rotation_arc(grain.normalize_or(Vec3::Z), Vec3::Z);
     origin + rot * p
 }

@@ -436,7 +436,7 @@ impl FibreWander {
 
     /// The narrowest footprint (mm) under which every angle of the wander falls below
     /// [`FibreWander::NEGLIGIBLE_SHARE`] and is no longer evaluated, for the scale `p`.
-    pub fn skipped_from(p: &WanderScale) -> f32 {
+    pub(crate) fn skipped_from(p: &WanderScale) -> f32 {
         let s = Self::variances(p);
         let share = |w: f32| {
             (centre_correlation(w / s.across) * centre_correlation(w / s.along[0].min(s.along[1])))

@@ -248,7 +248,7 @@ fn taper(x: f32) -> f32 {
 /// Polynomial smooth minimum of width `k` (Quílez 2013, "smooth minimum"): C¹, equals min(a, b)
 /// when |a − b| ≥ k.
 #[inline]
-pub fn smooth_min(a: f32, b: f32, k: f32) -> f32 {
+pub(crate) fn smooth_min(a: f32, b: f32, k: f32) -> f32 {
     let h = (0.5 + 0.5 * (b - a) / k).clamp(0.0, 1.0);
     b + (a - b) * h - k * h * (1.0 - h)
 }

@@ -17,7 +17,7 @@ pub use color::BeerColor;
 pub use error::WoodError;
 pub use eyes::{EyeSample, Eyes};
 pub use growth::{RingExpTable, SmoothRectangleWave, SmoothTriangleWave};
-pub use knots::{smooth_min, KnotSample, Knots};
+pub use knots::{KnotSample, Knots};
 pub use params::*;
 pub use preview::preview_color;
 pub use volume::{Footprint, WoodVolume};

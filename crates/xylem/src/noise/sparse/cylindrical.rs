@@ -123,6 +123,6 @@ fn wrap_arc(a: i32, n: i32) -> i32 {
 /// Cells in cylindrical band `j` (Liu 2016 §4.2): proportional to the band's midpoint radius so
 /// that every cell is ≈ `arc` long and all cells have ≈ equal volume.
 #[inline]
-pub fn band_cells(j: i32, radial: f32, arc: f32) -> i32 {
+pub(super) fn band_cells(j: i32, radial: f32, arc: f32) -> i32 {
     ((2.0 * PI * (j as f32 + 0.5) * radial / arc).round() as i32).max(1)
 }

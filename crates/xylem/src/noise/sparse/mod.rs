@@ -22,7 +22,6 @@ mod one_dimensional;
 #[cfg(test)]
 mod tests;
 
-pub use cylindrical::band_cells;
 use impulses::{impulse, impulse_numbers, impulse_stream, poisson, PoissonTable, TABLE};
 pub use one_dimensional::SparseConvolution1;
 
@@ -163,7 +162,7 @@ fn check(field: &'static str, value: f32, ok: bool, range: &'static str) -> Resu
 }
 
 /// Upper bound on the mean impulse count per cell (keeps the Poisson walk short and exact in f64).
-pub const MAX_IMPULSES_PER_CELL: f32 = 64.0;
+pub(crate) const MAX_IMPULSES_PER_CELL: f32 = 64.0;
 /// Hard cap on the impulses drawn in one cell (never reached in practice: P < 1e-40 at the mean bound).
 const MAX_DRAW: u32 = 256;
 
@@ -237,18 +236,6 @@ impl SparseConvolution {
     #[inline]
     pub fn eval_oriented_grad(&self, p: Vec3, frame: &Frame, seed: u32) -> (f32, Vec3) {
         self.sum::<true>(p, Some(frame), seed)
-    }
-
-    /// The bounding-box shrink factor s_b (eq. 9–11) of a kernel with semi-axes `env` rotated to
-    /// the columns of `frame`, against cell half-extents `cell` (both in the same axes):
-    /// `min(1, min_i cell_i / ext_i)` with `ext_i` the 2-norm of row i of R·Sₑ (eq. 9). We clamp at
-    /// 1 so kernels are only ever shrunk, never grown.
-    pub fn fit_scale(env: Vec3, frame: &Frame, cell: Vec3) -> f32 {
-        let ext = bbox_half_extent(env, frame);
-        (cell.x / ext.x)
-            .min(cell.y / ext.y)
-            .min(cell.z / ext.z)
-            .min(1.0)
     }
 
     fn sum<const GRAD: bool>(&self, p: Vec3, frame: Option<&Frame>, seed: u32) -> (f32, Vec3) {

@@ -1,3 +1,4 @@
+use super::cylindrical::band_cells;
 use super::impulses::poisson_with;
 use super::*;
 use crate::math::{uniform_sphere, Pcg32};
