@@ -7,14 +7,16 @@
 //!   hit, its shading frame, `wo` and the evaluated material (a small `Copy` [`ShadingPoint`]);
 //! - `radiance_frames`: the path from there, its light-dependent terms per frame.
 //!
-//! Each part draws from its own random stream, derived only from (seed, pixel, sample) by
-//! [`sample_rngs`], so a frame rendered with others equals the frame rendered alone bit for bit.
+//! Each part draws its numbers from (seed, pixel, sample) alone — the camera from a scrambled
+//! Sobol point (`sampler::pixel_sample`), the lighting from its own random stream (`sampler::sample_rng`) — so a
+//! frame rendered with others equals the frame rendered alone bit for bit.
 
 use super::camera::CameraRays;
 use super::film::Aov;
 use super::frames::LightFrames;
 use super::geometry::{segment_misses_box, slab_misses, Accel, Hit, Ray};
 use super::light::{LightSample, LightSamples, LightU};
+use super::sampler::{pixel_sample, sample_rng};
 use super::Scene;
 use crate::bsdf::{Bsdf, WoodAtWo};
 use crate::material::{MaterialHit, SurfaceBsdf};
@@ -91,31 +93,6 @@ pub struct PrimarySample {
 /// Counts of rays traced, for the rays/s report.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct RayCount(pub u64);
-
-/// The two independent random streams of sample `sample` of pixel `pixel_index`: the first for
-/// the camera (filter and lens), the second for lighting. PCG32 streams keyed by a SplitMix64
-/// hash (Steele et al. 2014) of (seed, sample, part) with the pixel index as stream selector.
-pub fn sample_rngs(seed: u64, pixel_index: u64, sample: u32) -> (Pcg32, Pcg32) {
-    (
-        sample_rng(seed, pixel_index, sample, 0),
-        sample_rng(seed, pixel_index, sample, 1),
-    )
-}
-
-/// Stream `part` (0 camera, 1 lighting) of [`sample_rngs`], made alone.
-#[inline]
-fn sample_rng(seed: u64, pixel_index: u64, sample: u32, part: u64) -> Pcg32 {
-    let key = splitmix64(seed ^ splitmix64(((sample as u64) << 2) | part));
-    Pcg32::new(key, pixel_index)
-}
-
-/// SplitMix64 finaliser (Steele, Lea, Flood 2014): a bijective 64-bit mix.
-fn splitmix64(x: u64) -> u64 {
-    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
 
 /// Builds the shading point of a hit seen along `ray`. `aov` is given at the camera's first hit,
 /// with the pixel footprint at the hit (times `footprint_scale`, [`footprint_scale`]), which
@@ -262,9 +239,9 @@ pub(crate) fn primary_sample_into(
     out: &mut PrimarySample,
 ) {
     let index = pixel.y as u64 * scene.camera.width as u64 + pixel.x as u64;
-    let mut rng = sample_rng(seed, index, sample, 0);
-    let film = pixel.as_vec2() + Vec2::splat(0.5) + scene.filter.sample(&mut rng);
-    let ray = camera.ray(film, rng.next_vec2());
+    let u = pixel_sample(seed, index, sample);
+    let film = pixel.as_vec2() + Vec2::splat(0.5) + scene.filter.sample(Vec2::new(u[0], u[1]));
+    let ray = camera.ray(film, Vec2::new(u[2], u[3]));
     out.ray = ray;
     out.aov = Aov::default();
     let (per_depth, constant) = camera.depth_footprint();
@@ -288,10 +265,10 @@ pub(crate) fn primary_sample_into(
     }
 }
 
-/// The lighting random stream of a sample (the second of [`sample_rngs`]).
+/// The lighting random stream of a sample ([`sample_rng`](super::sampler::sample_rng)).
 pub(crate) fn light_rng(scene: &Scene, pixel: UVec2, sample: u32, seed: u64) -> Pcg32 {
     let index = pixel.y as u64 * scene.camera.width as u64 + pixel.x as u64;
-    sample_rng(seed, index, sample, 1)
+    sample_rng(seed, index, sample)
 }
 
 /// Origin of a ray leaving `sp` along `dir`: the hit point moved `eps` along the geometric

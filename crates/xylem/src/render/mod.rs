@@ -14,6 +14,7 @@ pub mod integrator;
 pub mod light;
 pub mod lod;
 pub mod resources;
+mod sampler;
 pub mod wide_bvh;
 
 pub use camera::{Camera, CameraRays, Projection};
@@ -22,7 +23,7 @@ pub use film::{Aov, Filter, Image, PixelSum};
 pub use frames::LightFrames;
 pub use geometry::{Accel, Instance, Ray, Transform, TriMesh};
 pub(crate) use integrator::light_rng;
-pub use integrator::{primary_sample, sample_rngs, Integrator, ShadingPoint};
+pub use integrator::{primary_sample, Integrator, ShadingPoint};
 pub use light::{
     DistantLight, EnvMap, Environment, Light, PointLight, RectLight, SphereLight, SpotLight,
 };
