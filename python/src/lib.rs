@@ -1476,6 +1476,15 @@ fn fit(
     Ok(report.to_string())
 }
 
+/// `max_lobe_albedo(beta, dip)`: the bound on the energy-bounded fibre lobe's directional
+/// albedo at any view for highlight width `beta` and fibre dip `dip` = asin|u·n| (radians), as
+/// `WoodBsdf` bounds its diffuse with it (bilinear in xylem's table, plus its margin). The baked
+/// Mitsuba plugin tabulates it into a Dr.Jit texture.
+#[pyfunction]
+fn max_lobe_albedo(beta: f32, dip: f32) -> f32 {
+    xylem::bsdf::fiber_albedo::max_lobe_albedo(beta, dip)
+}
+
 #[pymodule]
 fn _xylem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyWoodBsdf>()?;
@@ -1489,6 +1498,7 @@ fn _xylem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(render, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(fit, m)?)?;
+    m.add_function(wrap_pyfunction!(max_lobe_albedo, m)?)?;
     m.add("PRESETS", xylem::wood::PRESET_NAMES.to_vec())?;
     Ok(())
 }
