@@ -252,7 +252,8 @@ def bsdf_class(mi, dr):
                     f"xylem_wood_baked: `roughness` = {roughness}: only the smooth finish (0) is "
                     "implemented; use xylem_wood for a rough finish")
             linear = dict(filter_mode=dr.FilterMode.Linear, wrap_mode=dr.WrapMode.Clamp)
-            self._textures = [mi.Texture2f(mi.TensorXf(m), **linear) for m in _maps(self.maps)]
+            self._tensors = [mi.TensorXf(m) for m in _maps(self.maps)]
+            self._textures = [mi.Texture2f(t, **linear) for t in self._tensors]
             self._albedo = mi.Texture2f(mi.TensorXf(_albedo_table()[..., None]), **linear)
             eta = self.eta
             # F_ext = 2 int_0^1 F(mu) mu dmu (fresnel.rs fresnel_diffuse_reflectance), 0 at eta 1.
@@ -365,12 +366,12 @@ def bsdf_class(mi, dr):
             return bs, dr.select(ok, weight, 0.0)
 
         def traverse(self, callback):
-            for name, tex in zip(("colour", "fibre_colour", "fibre"), self._textures):
-                callback.put(name, tex.tensor(), mi.ParamFlags.Differentiable)
+            for name, tensor in zip(("colour", "fibre_colour", "fibre"), self._tensors):
+                callback.put(name, tensor, mi.ParamFlags.Differentiable)
 
         def parameters_changed(self, keys=None):
-            for tex in self._textures:
-                tex.set_tensor(tex.tensor())
+            for tex, tensor in zip(self._textures, self._tensors):
+                tex.set_tensor(tensor)
 
         def to_string(self):
             return f"XylemWoodBaked[maps={self.maps}, eta={self.eta}]"
