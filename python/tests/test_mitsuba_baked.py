@@ -150,10 +150,12 @@ CHI2_CASES = [("normal", [0.0, 0.0, 1.0], [0.3, 0.4], 1.5),
 
 
 @pytest.mark.parametrize("name,wi,uv,eta", CHI2_CASES, ids=[c[0] for c in CHI2_CASES])
-def test_baked_chi2(maps, name, wi, uv, eta):
+def test_baked_chi2(maps, name, wi, uv, eta, tmp_path, monkeypatch):
     """sample() against pdf() with the smooth finish's mirror (a delta, component 1) masked
-    out by the context; the control, the pdf tilted by 1 + 0.1 (2 cos - 1), is rejected."""
+    out by the context; the control, the pdf tilted by 1 + 0.1 (2 cos - 1), is rejected (in a
+    temporary folder: a rejecting ChiSquareTest writes chi2_data.py into the current one)."""
     use("llvm_ad_rgb")
+    monkeypatch.chdir(tmp_path)
     from mitsuba.chi2 import BSDFAdapter
 
     ctx = mi.BSDFContext()
