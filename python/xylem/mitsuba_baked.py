@@ -258,7 +258,7 @@ def bsdf_class(mi, dr):
             eta = self.eta
             # F_ext = 2 int_0^1 F(mu) mu dmu (fresnel.rs fresnel_diffuse_reflectance), 0 at eta 1.
             mu = (_GL_X + 1.0) / 2.0
-            fresnel = np.array(_fresnel(mi, dr, mi.Float(mu.astype(np.float32)), eta), np.float64)
+            fresnel = np.array([np.ravel(_fresnel(mi, dr, mi.Float(float(x)), eta))[0] for x in mu])
             f_ext = 0.0 if eta <= 1.0 else float(np.sum(_GL_W / 2.0 * 2.0 * mu * fresnel))
             self._escape = (1.0 - f_ext) / (eta * eta)   # 1 - R_int (wood.rs `escape`)
             self._f_int = 1.0 - self._escape
@@ -339,9 +339,11 @@ def bsdf_class(mi, dr):
             t = Texel(self, si, active)
             wo = si.wi
             probs = self._probs(t, wo, ctx)
+            # (Comparisons, not `~`: the scalar variant's masks are Python bools.)
+            c1, c2 = probs[0] + probs[1], probs[0] + probs[1] + probs[2]
             spec = sample1 < probs[0]
-            diff = ~spec & (sample1 < probs[0] + probs[1])
-            fib = ~spec & ~diff & (sample1 < probs[0] + probs[1] + probs[2])
+            diff = (sample1 >= probs[0]) & (sample1 < c1)
+            fib = (sample1 >= c1) & (sample1 < c2)
             axis = dr.select(fib, t.u, t.r)
             wo_in = _refract_in(mi, dr, wo, self.eta)
             wi_in, lobe_ok = _lobe_sample(mi, dr, axis, _psi(dr, wo_in, axis), sample2, t.beta,
