@@ -137,16 +137,21 @@ def _gaussian(dr, beta, x):
     return dr.exp(-0.5 * dr.square(x / beta)) / (beta * math.sqrt(2.0 * math.pi))
 
 
-def _psi(dr, w, u):
-    """Longitudinal angle psi = asin(w . u) (Marschner et al. 2005 eq. 2)."""
-    return dr.asin(dr.clip(dr.dot(w, u), -1.0, 1.0))
+class _Angles:
+    """A direction's longitudinal angle about a fibre u: sin psi = w . u (clamped), psi (Marschner
+    et al. 2005 eq. 2) and cos psi = sqrt(1 - sin^2 psi)."""
+
+    def __init__(self, dr, w, u):
+        self.sin = dr.clip(dr.dot(w, u), -1.0, 1.0)
+        self.psi = dr.asin(self.sin)
+        self.cos = dr.safe_sqrt(1.0 - self.sin * self.sin)
 
 
-def _lobe(dr, u, psi_o, psi_i, beta):
+def _lobe(dr, o, i, beta):
     """The energy-bounded fibre lobe g(beta, psi_i + psi_o) / (2 pi max(cos psi_i, cos psi_o))
-    (fiber.rs lobe_value; notes/bsdf.md §2), without its colour."""
-    c = dr.maximum(dr.maximum(dr.cos(psi_i), dr.cos(psi_o)), MIN_COS_PSI)
-    return _gaussian(dr, beta, psi_i + psi_o) / (2.0 * math.pi * c)
+    (fiber.rs lobe_value; notes/bsdf.md §2), without its colour; o, i: `_Angles`."""
+    c = dr.maximum(dr.maximum(i.cos, o.cos), MIN_COS_PSI)
+    return _gaussian(dr, beta, i.psi + o.psi) / (2.0 * math.pi * c)
 
 
 def _arc(dr, u, sin_psi, cos_psi, z_min):
@@ -158,15 +163,14 @@ def _arc(dr, u, sin_psi, cos_psi, z_min):
     return dr.select(t <= -1.0, math.pi, dr.select(t >= 1.0, 0.0, dr.acos(dr.clip(t, -1.0, 1.0))))
 
 
-def _lobe_pdf(dr, u, psi_o, wi_in, beta, z_min):
-    """Density of `_lobe_sample` per interior solid angle: g(beta, psi_i + psi_o) /
-    (2 max(Delta, MIN_ARC) cos psi_i) (fiber.rs pdf_about; notes/bsdf.md §3)."""
-    s = dr.clip(dr.dot(wi_in, u), -1.0, 1.0)
-    c = dr.safe_sqrt(1.0 - s * s)
-    delta = _arc(dr, u, s, c, z_min)
-    ok = (wi_in.z > z_min) & (c >= MIN_COS_PSI) & (delta > 0)
-    g = _gaussian(dr, beta, dr.asin(s) + psi_o)
-    return dr.select(ok, g / (2.0 * dr.maximum(delta, MIN_ARC) * dr.maximum(c, MIN_COS_PSI)), 0.0)
+def _lobe_pdf(dr, u, o, i, wi_z, beta, z_min):
+    """Density of `_lobe_sample` per interior solid angle at the interior direction with angles
+    i and z = wi_z: g(beta, psi_i + psi_o) / (2 max(Delta, MIN_ARC) cos psi_i) (fiber.rs
+    pdf_about; notes/bsdf.md §3)."""
+    delta = _arc(dr, u, i.sin, i.cos, z_min)
+    ok = (wi_z > z_min) & (i.cos >= MIN_COS_PSI) & (delta > 0)
+    g = _gaussian(dr, beta, i.psi + o.psi)
+    return dr.select(ok, g / (2.0 * dr.maximum(delta, MIN_ARC) * dr.maximum(i.cos, MIN_COS_PSI)), 0.0)
 
 
 def _lobe_sample(mi, dr, u, psi_o, u2, beta, z_min):
@@ -307,9 +311,9 @@ def bsdf_class(mi, dr):
             wo_in, wi_in = _refract_in(mi, dr, wo, eta), _refract_in(mi, dr, wi, eta)
             lobes, dens = [], []
             for ax in (t.u, t.r):
-                psi_o = _psi(dr, wo_in, ax)
-                lobes.append(_lobe(dr, ax, psi_o, _psi(dr, wi_in, ax), t.beta))
-                dens.append(_lobe_pdf(dr, ax, psi_o, wi_in, t.beta, self._z_crit))
+                o, i = _Angles(dr, wo_in, ax), _Angles(dr, wi_in, ax)
+                lobes.append(_lobe(dr, o, i, t.beta))
+                dens.append(_lobe_pdf(dr, ax, o, i, wi_in.z, t.beta, self._z_crit))
             substrate = t.diffuse_eff / math.pi + t.fiber_color * (
                 (1.0 - t.m) * lobes[0] + t.m * lobes[1])
             f = substrate * (self._transmittance(wo.z) * self._transmittance(wi.z) / (eta * eta))
@@ -346,8 +350,8 @@ def bsdf_class(mi, dr):
             fib = (sample1 >= c1) & (sample1 < c2)
             axis = dr.select(fib, t.u, t.r)
             wo_in = _refract_in(mi, dr, wo, self.eta)
-            wi_in, lobe_ok = _lobe_sample(mi, dr, axis, _psi(dr, wo_in, axis), sample2, t.beta,
-                                          self._z_crit)
+            wi_in, lobe_ok = _lobe_sample(mi, dr, axis, _Angles(dr, wo_in, axis).psi, sample2,
+                                          t.beta, self._z_crit)
             wi_lobe, leaves = _refract_out(mi, dr, wi_in, self.eta)
             wi = dr.select(spec, mi.Vector3f(-wo.x, -wo.y, wo.z),
                            dr.select(diff, mi.warp.square_to_cosine_hemisphere(sample2), wi_lobe))
