@@ -325,7 +325,7 @@ def test_baked_gradients_match_finite_differences(maps):
     assert abs(ctrl - results["light"]["fd"]) > 0.3 * abs(results["light"]["fd"]), results
     # A map value: the red base colour of the texels around the lookup (all four taps).
     params = mi.traverse(bsdf)
-    colour = params["colour"]
+    colour = params["maps"]                 # channel 0: the base colour's red
     si.wi = theta_direction(mi.Float(theta_o), phi_o)
     wo = theta_direction(mi.Float(0.55), phi_i)
     dr.enable_grad(colour)
@@ -340,7 +340,7 @@ def test_baked_gradients_match_finite_differences(maps):
     def red_at(delta):
         moved = base.copy()
         moved[k[0], k[1], 0] += delta
-        params["colour"] = mi.TensorXf(moved)
+        params["maps"] = mi.TensorXf(moved)
         params.update()
         return float(np.array(bsdf.eval(ctx, si, wo).x)[0])
 

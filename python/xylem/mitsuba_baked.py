@@ -11,8 +11,8 @@ megakernel and is differentiable.
 ``maps`` is the folder of a ``xylem bake PRESET --out DIR`` (a board face or ``--mesh``): the
 plugin reads ``base_color.exr``, ``fiber_color.exr``, ``fiber_direction.exr`` (the signed
 tangent-space fibre axis), ``highlight_width.exr`` (beta, radians) and ``ray_mask.exr`` into
-three ``mi.Texture2f`` (bilinear, clamped at the edges, texel centres at (i + 1/2)/W as xylem's
-own ``BakedMaps::lookup``) and looks them up at ``si.uv`` (texel (0, 0) is the image's top-left,
+one 12-channel ``mi.Texture2f`` (bilinear, clamped at the edges, texel centres at (i + 1/2)/W as
+xylem's own ``BakedMaps::lookup``; one texture, so a lookup computes its taps once) and looks them up at ``si.uv`` (texel (0, 0) is the image's top-left,
 v runs down the rows, as glTF and the bake write them). ``eta`` is the finish's index (1-4,
 default 1.5); only the smooth finish is implemented (``roughness`` must be 0).
 
@@ -31,9 +31,9 @@ defines it; where ``dp/du`` is unset (a zero-initialised interaction, as
 ``mitsuba.chi2.BSDFAdapter`` makes) x is the shading frame's s.
 
 Unlike ``xylem_wood`` it needs no ``evaluated()`` mode, leaves other scenes renderable, and
-is differentiable by Dr.Jit's AD (directions, uv and the map tensors, which ``mi.traverse``
-lists as ``colour`` (base colour + beta), ``fibre_colour`` (fibre colour + ray mask) and
-``fibre`` (direction)).
+is differentiable by Dr.Jit's AD (directions, uv and the maps, which ``mi.traverse`` lists as
+``maps``: an (H, W, 12) tensor of base colour, beta, fibre colour, ray mask, fibre direction
+and a zero channel).
 
 What it approximates compared with the solid wood of ``xylem_wood``: the wood is sampled at the
 texel centres and interpolated bilinearly (at ``--res 1024`` on a 300 mm board, 0.29 mm
@@ -65,8 +65,8 @@ _GL_X, _GL_W = np.polynomial.legendre.leggauss(12)
 
 
 def _maps(folder):
-    """The bake's maps (float32 EXRs) as three (H, W, 4) arrays: base colour + beta, fibre
-    colour + ray mask, fibre direction + 0."""
+    """The bake's maps (float32 EXRs) as one (H, W, 12) array: base colour, beta, fibre colour,
+    ray mask, fibre direction, 0."""
     import mitsuba as mi
 
     folder = pathlib.Path(folder)
@@ -83,14 +83,12 @@ def _maps(folder):
             raise ValueError(f"xylem_wood_baked: {path} has {a.shape[2]} channels, not {channels}")
         return a
 
-    colour, fibre_colour, fibre = (read(n, 3) for n in ("base_color", "fiber_color", "fiber_direction"))
-    beta, ray = read("highlight_width", 1), read("ray_mask", 1)
-    shapes = {m.shape[:2] for m in (colour, fibre_colour, fibre, beta, ray)}
+    layers = [read("base_color", 3), read("highlight_width", 1), read("fiber_color", 3),
+              read("ray_mask", 1), read("fiber_direction", 3)]
+    shapes = {m.shape[:2] for m in layers}
     if len(shapes) != 1:
         raise ValueError(f"xylem_wood_baked: the maps in {folder} differ in size: {sorted(shapes)}")
-    zero = np.zeros_like(beta)
-    return (np.concatenate([colour, beta], 2), np.concatenate([fibre_colour, ray], 2),
-            np.concatenate([fibre, zero], 2))
+    return np.concatenate(layers + [np.zeros_like(layers[1])], 2)
 
 
 def _albedo_table():
@@ -208,7 +206,8 @@ def bsdf_class(mi, dr):
 
         def __init__(self, bsdf, si, active):
             uv = si.uv
-            a, b, f = (t.eval(uv, active) for t in bsdf._textures)
+            v = bsdf._texture.eval(uv, active)
+            a, b, f = v[0:4], v[4:8], v[8:12]
             # Clamped as material/baked.rs `BakedWoodMaterial::shade` clamps the lookup.
             self.diffuse = dr.clip(mi.Color3f(a[0], a[1], a[2]), 0.0, 1.0)
             self.fiber_color = dr.clip(mi.Color3f(b[0], b[1], b[2]), 0.0, 1.0)
@@ -256,8 +255,9 @@ def bsdf_class(mi, dr):
                     f"xylem_wood_baked: `roughness` = {roughness}: only the smooth finish (0) is "
                     "implemented; use xylem_wood for a rough finish")
             linear = dict(filter_mode=dr.FilterMode.Linear, wrap_mode=dr.WrapMode.Clamp)
-            self._tensors = [mi.TensorXf(m) for m in _maps(self.maps)]
-            self._textures = [mi.Texture2f(t, **linear) for t in self._tensors]
+            # One 12-channel texture: a lookup computes its taps and weights once.
+            self._tensor = mi.TensorXf(_maps(self.maps))
+            self._texture = mi.Texture2f(self._tensor, **linear)
             self._albedo = mi.Texture2f(mi.TensorXf(_albedo_table()[..., None]), **linear)
             eta = self.eta
             # F_ext = 2 int_0^1 F(mu) mu dmu (fresnel.rs fresnel_diffuse_reflectance), 0 at eta 1.
@@ -372,12 +372,10 @@ def bsdf_class(mi, dr):
             return bs, dr.select(ok, weight, 0.0)
 
         def traverse(self, callback):
-            for name, tensor in zip(("colour", "fibre_colour", "fibre"), self._tensors):
-                callback.put(name, tensor, mi.ParamFlags.Differentiable)
+            callback.put("maps", self._tensor, mi.ParamFlags.Differentiable)
 
         def parameters_changed(self, keys=None):
-            for tex, tensor in zip(self._textures, self._tensors):
-                tex.set_tensor(tensor)
+            self._texture.set_tensor(self._tensor)
 
         def to_string(self):
             return f"XylemWoodBaked[maps={self.maps}, eta={self.eta}]"
