@@ -8,12 +8,14 @@ megakernel and is differentiable.
     xylem.mitsuba.register()           # registers xylem_wood and xylem_wood_baked
     bsdf = mi.load_dict({"type": "xylem_wood_baked", "maps": "out/walnut", "eta": 1.5})
 
-``maps`` is the folder of a ``xylem bake PRESET --out DIR`` (a board face or ``--mesh``): the
-plugin reads ``base_color.exr``, ``fiber_color.exr``, ``fiber_direction.exr`` (the signed
-tangent-space fibre axis), ``highlight_width.exr`` (beta, radians) and ``ray_mask.exr`` into
-one 12-channel ``mi.Texture2f`` (bilinear, clamped at the edges, texel centres at (i + 1/2)/W as
-xylem's own ``BakedMaps::lookup``; one texture, so a lookup computes its taps once) and looks them up at ``si.uv`` (texel (0, 0) is the image's top-left,
-v runs down the rows, as glTF and the bake write them). ``eta`` is the finish's index (1-4,
+``maps`` is the folder of a ``xylem bake PRESET --out DIR`` (checked on a board face; a
+``--mesh`` bake has the same maps, but its uv convention through Mitsuba's mesh loaders is not
+checked): the plugin reads ``base_color.exr``, ``fiber_color.exr``, ``fiber_direction.exr``
+(the signed tangent-space fibre axis), ``highlight_width.exr`` (beta, radians) and
+``ray_mask.exr`` into one 12-channel ``mi.Texture2f`` (bilinear, clamped at the edges, texel
+centres at (i + 1/2)/W as xylem's own ``BakedMaps::lookup``; one texture, so a lookup computes
+its taps once) and looks them up at ``si.uv`` (texel (0, 0) is the image's top-left, v runs
+down the rows, as glTF and the bake write them). ``eta`` is the finish's index (1-4,
 default 1.5); only the smooth finish is implemented (``roughness`` must be 0).
 
 The BSDF at a texel is xylem's ``WoodBsdf`` (crates/xylem/src/bsdf/wood.rs) for the parameters
@@ -168,7 +170,8 @@ def _lobe_pdf(dr, u, o, i, wi_z, beta, z_min):
     delta = _arc(dr, u, i.sin, i.cos, z_min)
     ok = (wi_z > z_min) & (i.cos >= MIN_COS_PSI) & (delta > 0)
     g = _gaussian(dr, beta, i.psi + o.psi)
-    return dr.select(ok, g / (2.0 * dr.maximum(delta, MIN_ARC) * dr.maximum(i.cos, MIN_COS_PSI)), 0.0)
+    width = 2.0 * dr.maximum(delta, MIN_ARC) * dr.maximum(i.cos, MIN_COS_PSI)
+    return dr.select(ok, g / width, 0.0)
 
 
 def _lobe_sample(mi, dr, u, psi_o, u2, beta, z_min):
@@ -244,7 +247,8 @@ def bsdf_class(mi, dr):
         def __init__(self, props):
             mi.BSDF.__init__(self, props)
             if not _has(props, "maps"):
-                raise ValueError("xylem_wood_baked: `maps` (a `xylem bake` output folder) is required")
+                raise ValueError(
+                    "xylem_wood_baked: `maps` (a `xylem bake` output folder) is required")
             self.maps = str(props.get("maps"))
             self.eta = float(props.get("eta", 1.5))
             roughness = float(props.get("roughness", 0.0))
@@ -291,7 +295,7 @@ def bsdf_class(mi, dr):
             mirror, rest = self._enabled(ctx)
             zero = mi.Float(0.0)
             spec = _fresnel(mi, dr, wo.z, self.eta) if mirror else zero
-            tr = (1.0 - _fresnel(mi, dr, wo.z, self.eta)) if rest else zero
+            tr = self._transmittance(wo.z) if rest else zero
             diff = tr * luminance(t.diffuse_eff) * self._escape
             kf = tr * luminance(t.fiber_color) / math.pi
             fib, ray = kf * (1.0 - t.m), kf * t.m
