@@ -9,8 +9,8 @@ megakernel and is differentiable.
     bsdf = mi.load_dict({"type": "xylem_wood_baked", "maps": "out/walnut", "eta": 1.5})
 
 ``maps`` is the folder of a ``xylem bake PRESET --out DIR`` (checked on a board face; a
-``--mesh`` bake has the same maps, but its uv convention through Mitsuba's mesh loaders is not
-checked): the plugin reads ``base_color.exr``, ``fiber_color.exr``, ``fiber_direction.exr``
+``--mesh`` bake has the same maps, and Mitsuba's OBJ loader flips v as xylem's reader does, so
+si.uv is the bake's uv, but no mesh bake has been rendered through this plugin): the plugin reads ``base_color.exr``, ``fiber_color.exr``, ``fiber_direction.exr``
 (the signed tangent-space fibre axis), ``highlight_width.exr`` (beta, radians) and
 ``ray_mask.exr`` into one 12-channel ``mi.Texture2f`` (bilinear, clamped at the edges, texel
 centres at (i + 1/2)/W as xylem's own ``BakedMaps::lookup``; one texture, so a lookup computes
