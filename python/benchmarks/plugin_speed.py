@@ -16,7 +16,11 @@ Three renders per repeat, in turn:
 - ``roughplastic_evaluated``: the same inside ``xylem.mitsuba.evaluated()`` (wavefront mode,
   what the plugin needs), which separates the plugin's own cost from the mode's;
 - ``xylem_wood``: the board with the plugin (mahogany, eta 1.5, roughness 0.25) inside
-  ``evaluated()``.
+  ``evaluated()``;
+- ``xylem_wood_baked``: the board with the Dr.Jit-native plugin on maps of the same preset
+  baked by ``xylem bake`` (a 300 x 300 mm board at ``--bake-res`` texels, smooth finish, eta
+  1.5), in Dr.Jit's default symbolic modes like ``roughplastic``. ``--maps DIR`` gives a bake
+  folder; otherwise the script bakes one with ``$XYLEM_BIN`` or target/release/xylem.
 
 Each case runs in its own Python process (a ``xylem_wood`` BSDF alive in a process makes every
 symbolic render there fail: Dr.Jit traces a symbolic call for every registered BSDF instance,
@@ -38,6 +42,7 @@ import pstats
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 
 import drjit as dr
@@ -63,7 +68,14 @@ BSDFS = {
 }
 
 
-def scene(bsdf, res, spp):
+def bake(exe, res, out):
+    """Bakes the board's maps (the preset of BSDFS["xylem_wood"]) into `out`."""
+    subprocess.run([exe, "bake", "african_mahogany", "--board", "300x300x20", "--res", str(res),
+                    "--out", out], check=True, capture_output=True)
+    return out
+
+
+def scene(bsdf, res, spp, maps=None):
     T = mi.ScalarTransform4f
     return mi.load_dict({
         "type": "scene",
@@ -79,7 +91,8 @@ def scene(bsdf, res, spp):
                 "irradiance": {"type": "rgb", "value": [3.0, 3.0, 3.0]}},
         "sky": {"type": "constant", "radiance": {"type": "rgb", "value": [0.2, 0.2, 0.25]}},
         "board": {"type": "rectangle", "to_world": T().scale([0.15, 0.15, 1.0]),
-                  "bsdf": dict(BSDFS[bsdf])},
+                  "bsdf": ({"type": "xylem_wood_baked", "maps": maps, "eta": 1.5}
+                           if bsdf == "xylem_wood_baked" else dict(BSDFS[bsdf]))},
     })
 
 
@@ -107,18 +120,23 @@ def main():
     ap.add_argument("--before", help="a folder holding an older `xylem` package (its plugin "
                     "runs as the extra case xylem_wood_before, with this folder first on "
                     "PYTHONPATH)")
+    ap.add_argument("--maps", help="a `xylem bake` folder for xylem_wood_baked (default: bake "
+                    "one into a temporary folder)")
+    ap.add_argument("--bake-res", type=int, default=1024, help="texels along the board when "
+                    "baking (default 1024)")
     ap.add_argument("--one", help=argparse.SUPPRESS)         # child process: this case only
     ap.add_argument("--seed", type=int, default=1, help=argparse.SUPPRESS)
     args = ap.parse_args()
 
     cases = [("roughplastic", "roughplastic", False),
              ("roughplastic_evaluated", "roughplastic", True),
-             ("xylem_wood", "xylem_wood", True)]
+             ("xylem_wood", "xylem_wood", True),
+             ("xylem_wood_baked", "xylem_wood_baked", False)]
     if args.before or args.one == "xylem_wood_before":
         cases.append(("xylem_wood_before", "xylem_wood", True))
     if args.one:                                 # child: one warm-up, one timed render
         name, b, ev = next(c for c in cases if c[0] == args.one)
-        sc = scene(b, args.res, args.spp)
+        sc = scene(b, args.res, args.spp, args.maps)
         render(sc, 0, ev)
         if args.profile:
             prof = cProfile.Profile()
@@ -135,7 +153,8 @@ def main():
 
     def child(name, seed, profile=False):
         cmd = [sys.executable, __file__, "--one", name, "--seed", str(seed), "--res",
-               *map(str, args.res), "--spp", str(args.spp)] + (["--profile"] if profile else [])
+               *map(str, args.res), "--spp", str(args.spp), "--maps", args.maps] + (
+                   ["--profile"] if profile else [])
         env = dict(os.environ)
         if name == "xylem_wood_before":
             env["PYTHONPATH"] = os.pathsep.join([args.before, env.get("PYTHONPATH", "")])
@@ -145,6 +164,10 @@ def main():
         res = json.loads(out.stdout.strip().splitlines()[-1])
         return res["seconds"], res["cpu_seconds"]
 
+    if not args.maps:
+        root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+        exe = os.environ.get("XYLEM_BIN") or os.path.join(root, "target/release/xylem")
+        args.maps = bake(exe, args.bake_res, os.path.join(tempfile.mkdtemp(), "maps"))
     times = {name: [] for name, _, _ in cases}
     cpu_times = {name: [] for name, _, _ in cases}
     print(f"{mi.variant()}, {args.res[0]}x{args.res[1]}, {args.spp} spp, {args.repeats} repeats, "
@@ -160,6 +183,7 @@ def main():
                 "times_s": ts}
 
     out = {"variant": mi.variant(), "res": list(args.res), "spp": args.spp,
+           "bake_res": args.bake_res,
            "repeats": args.repeats, "machine": platform.processor() or platform.machine(),
            "cpus": os.cpu_count(), "load_avg": os.getloadavg(),
            "cases": {k: summary(v) for k, v in times.items()},
@@ -188,6 +212,11 @@ def main():
     out["cpu_ratio_vs_roughplastic"] = cpu_med["xylem_wood"] / cpu_med["roughplastic"]
     out["cpu_ratio_vs_roughplastic_evaluated"] = (cpu_med["xylem_wood"]
                                                   / cpu_med["roughplastic_evaluated"])
+    baked = [w / b for w, b in zip(cpu_times["xylem_wood_baked"], cpu_times["roughplastic"])]
+    out["cpu_ratio_baked_vs_roughplastic"] = cpu_med["xylem_wood_baked"] / cpu_med["roughplastic"]
+    out["cpu_ratio_baked_vs_roughplastic_range"] = [min(baked), max(baked)]
+    print(f"CPU: xylem_wood_baked / roughplastic {out['cpu_ratio_baked_vs_roughplastic']:.2f}x "
+          f"(per repeat {min(baked):.2f}-{max(baked):.2f})")
     print(f"CPU: xylem_wood / roughplastic {out['cpu_ratio_vs_roughplastic']:.2f}x, "
           f"/ roughplastic evaluated {out['cpu_ratio_vs_roughplastic_evaluated']:.2f}x"
           + (f", / before {cpu_med['xylem_wood'] / cpu_med['xylem_wood_before']:.2f}x"

@@ -320,3 +320,12 @@ pub(crate) fn params_dict<'py>(
     d.set_item("roughness", out(py, one(|p| p.roughness), shape)?)?;
     Ok(d)
 }
+
+/// `max_lobe_albedo(beta, dip)`: the bound on the energy-bounded fibre lobe's directional
+/// albedo at any view for highlight width `beta` and fibre dip `dip` = asin|u·n| (radians), as
+/// `WoodBsdf` bounds its diffuse with it (bilinear in xylem's table, plus its margin). The baked
+/// Mitsuba plugin tabulates it into a Dr.Jit texture.
+#[pyfunction]
+pub(crate) fn max_lobe_albedo(beta: f32, dip: f32) -> f32 {
+    xylem::bsdf::fiber_albedo::max_lobe_albedo(beta, dip)
+}

@@ -22,7 +22,9 @@ Array arguments broadcast over their leading dimensions as numpy does (an ``(H, 
 directions gives ``(H, W, 3)`` values; an empty batch gives empty results), and every input must
 be finite (NaN or infinity raises ``ValueError`` naming the argument and the element).
 
-``xylem.mitsuba.register()`` registers the ``xylem_wood`` BSDF with Mitsuba 3.
+``xylem.mitsuba.register()`` registers the ``xylem_wood`` BSDF (the solid wood, per interaction)
+and ``xylem_wood_baked`` (``xylem.mitsuba_baked``: the BSDF in Dr.Jit over baked maps) with
+Mitsuba 3.
 
 Distributed on PyPI as ``xylem-wood`` (the name ``xylem`` there is an unrelated project); the
 import name is ``xylem``.

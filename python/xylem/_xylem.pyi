@@ -19,6 +19,7 @@ __all__ = [
     "render",
     "sweep",
     "fit",
+    "max_lobe_albedo",
     "PRESETS",
 ]
 
@@ -124,3 +125,4 @@ def sweep(
 def fit(
     capture: _PathLike, out: _PathLike, texels: tuple[int, int] | None = None, threads: int = 0
 ) -> str: ...
+def max_lobe_albedo(beta: float, dip: float) -> float: ...

@@ -123,8 +123,9 @@ def evaluated():
 
 
 def register():
-    """Registers the ``xylem_wood`` BSDF with Mitsuba 3 (a variant must be set first). Changes
-    no Dr.Jit flag: render JIT variants inside ``evaluated()``."""
+    """Registers the ``xylem_wood`` BSDF (render JIT variants inside ``evaluated()``) and the
+    Dr.Jit-native ``xylem_wood_baked`` (``xylem.mitsuba_baked``: baked maps, symbolic modes,
+    differentiable) with Mitsuba 3 (a variant must be set first). Changes no Dr.Jit flag."""
     global _REGISTERED
     import drjit as dr
     import mitsuba as mi
@@ -132,6 +133,9 @@ def register():
     if mi.variant() is None:
         raise RuntimeError("xylem.mitsuba.register(): call mitsuba.set_variant(...) first")
     mi.register_bsdf("xylem_wood", lambda props: _make(mi, dr, props))
+    from . import mitsuba_baked
+
+    mi.register_bsdf("xylem_wood_baked", lambda props: mitsuba_baked.bsdf_class(mi, dr)(props))
     _REGISTERED = True
 
 

@@ -1,0 +1,388 @@
+"""A Mitsuba 3 BSDF plugin, ``xylem_wood_baked``: xylem's finished-wood BSDF written in Dr.Jit,
+shading the maps that ``xylem bake`` writes, so that it runs inside Mitsuba's symbolic
+megakernel and is differentiable.
+
+    import mitsuba as mi
+    mi.set_variant("llvm_ad_rgb")
+    import xylem.mitsuba
+    xylem.mitsuba.register()           # registers xylem_wood and xylem_wood_baked
+    bsdf = mi.load_dict({"type": "xylem_wood_baked", "maps": "out/walnut", "eta": 1.5})
+
+``maps`` is the folder of a ``xylem bake PRESET --out DIR`` (checked on a board face; a
+``--mesh`` bake has the same maps, and Mitsuba's OBJ loader flips v as xylem's reader does, so
+si.uv is the bake's uv, but no mesh bake has been rendered through this plugin): the plugin reads ``base_color.exr``, ``fiber_color.exr``, ``fiber_direction.exr``
+(the signed tangent-space fibre axis), ``highlight_width.exr`` (beta, radians) and
+``ray_mask.exr`` into one 12-channel ``mi.Texture2f`` (bilinear, clamped at the edges, texel
+centres at (i + 1/2)/W as xylem's own ``BakedMaps::lookup``; one texture, so a lookup computes
+its taps once) and looks them up at ``si.uv`` (texel (0, 0) is the image's top-left, v runs
+down the rows, as glTF and the bake write them). ``eta`` is the finish's index (1-4,
+default 1.5); only the smooth finish is implemented (``roughness`` must be 0).
+
+The BSDF at a texel is xylem's ``WoodBsdf`` (crates/xylem/src/bsdf/wood.rs) for the parameters
+xylem's own baked-map material builds there (``material/face.rs`` ``face_shading``): the
+Lambertian substrate with its internal reflections under the finish, scaled so the fibre lobes
+fit (notes/bsdf.md §1.3, §2.3), plus the energy-bounded Marschner et al. 2005 fibre lobe of the
+fibre axis and of the ray axis (in the face, across the fibre), blended by the ray mask, all
+seen through a smooth Fresnel finish; the mirror of the finish is a delta component
+(component 1). Sampling is xylem's: a lobe by its estimated albedo, the fibre lobes by their
+Gaussian in psi and a uniform azimuth on the cone's arc above the critical angle
+(notes/bsdf.md §3); pdf is the mixture's density.
+
+Tangent space: x along dp/du, y along -dp/dv (up the image), z the shading normal, as the bake
+defines it; where ``dp/du`` is unset (a zero-initialised interaction, as
+``mitsuba.chi2.BSDFAdapter`` makes) x is the shading frame's s.
+
+Unlike ``xylem_wood`` it needs no ``evaluated()`` mode, leaves other scenes renderable, and
+is differentiable by Dr.Jit's AD (directions, uv and the maps, which ``mi.traverse`` lists as
+``maps``: an (H, W, 12) tensor of base colour, beta, fibre colour, ray mask, fibre direction
+and a zero channel).
+
+What it approximates compared with the solid wood of ``xylem_wood``: the wood is sampled at the
+texel centres and interpolated bilinearly (at ``--res 1024`` on a 300 mm board, 0.29 mm
+texels; pores and ray flecks narrower than that blur); the ray axis is taken in the face
+across the fibre (the volume knows the radial direction); no pore bump (the normal map is not
+read); no rough finish. ``BSDFContext`` masks are honoured per component (0: the diffuse and
+fibre lobes, 1: the mirror), with the lobe probabilities renormalised over what is enabled.
+"""
+
+import math
+import pathlib
+
+import numpy as np
+
+from . import _xylem
+from .mitsuba import _has
+
+# Below this cos psi a direction lies on the fibre axis (fiber.rs MIN_COS_PSI).
+MIN_COS_PSI = 1e-5
+# Smallest half-width of the sampled azimuth arc (fiber.rs MIN_ARC).
+MIN_ARC = math.pi / 8
+# Nodes per axis of the tabulated lobe-albedo bound: a refinement (120 = 4 x 30) of xylem's
+# 31-node bilinear table (fiber_albedo_table.rs), so bilinear lookup here reproduces it exactly.
+ALBEDO_NODES = 121
+# Rec. 709 luminance (crates/xylem/src/math/mod.rs `luminance`).
+LUMINANCE = (0.2126, 0.7152, 0.0722)
+# 12-point Gauss-Legendre on [0, 1] (fresnel.rs GL_X / GL_W; Abramowitz & Stegun 25.4.29).
+_GL_X, _GL_W = np.polynomial.legendre.leggauss(12)
+
+
+def _maps(folder):
+    """The bake's maps (float32 EXRs) as one (H, W, 12) array: base colour, beta, fibre colour,
+    ray mask, fibre direction, 0."""
+    import mitsuba as mi
+
+    folder = pathlib.Path(folder)
+
+    def read(name, channels):
+        path = folder / f"{name}.exr"
+        if not path.exists():
+            raise FileNotFoundError(
+                f"xylem_wood_baked: {path} is missing (`maps` must be a `xylem bake` folder)"
+            )
+        a = np.array(mi.Bitmap(str(path)), dtype=np.float32)
+        a = a.reshape(a.shape[0], a.shape[1], -1)
+        if a.shape[2] != channels:
+            raise ValueError(f"xylem_wood_baked: {path} has {a.shape[2]} channels, not {channels}")
+        return a
+
+    layers = [read("base_color", 3), read("highlight_width", 1), read("fiber_color", 3),
+              read("ray_mask", 1), read("fiber_direction", 3)]
+    shapes = {m.shape[:2] for m in layers}
+    if len(shapes) != 1:
+        raise ValueError(f"xylem_wood_baked: the maps in {folder} differ in size: {sorted(shapes)}")
+    return np.concatenate(layers + [np.zeros_like(layers[1])], 2)
+
+
+def _albedo_table():
+    """xylem's bound on the fibre lobe's albedo (``max_lobe_albedo``, with its margin) at
+    ALBEDO_NODES x ALBEDO_NODES nodes, rows the dip, columns beta, both over [0, pi/2]."""
+    nodes = np.linspace(0.0, 0.5 * math.pi, ALBEDO_NODES)
+    return np.array([[_xylem.max_lobe_albedo(b, d) for b in nodes] for d in nodes],
+                    dtype=np.float32)
+
+
+def _frame_axes(mi, dr, si):
+    """Tangent-space x ("right") and y ("up") in the shading frame's coordinates: x = dp/du
+    projected into the surface (the shading frame's s where dp/du is unset), y = n x right,
+    turned to the side of -dp/dv (the bake's up, bake/mod.rs `TexelFrame`)."""
+    du, dv = si.sh_frame.to_local(si.dp_du), si.sh_frame.to_local(si.dp_dv)
+    right = mi.Vector3f(du.x, du.y, 0.0)
+    unset = dr.squared_norm(right) < 1e-12
+    right = dr.select(unset, mi.Vector3f(1, 0, 0), dr.normalize(right))
+    up = mi.Vector3f(-right.y, right.x, 0.0)
+    up = dr.select(dr.dot(up, dv) > 0, -up, up)
+    return right, up
+
+
+def _refract_in(mi, dr, w, eta):
+    """The interior direction that refracts into exterior w (Snell; fresnel.rs refract_in)."""
+    e2 = eta * eta
+    return mi.Vector3f(w.x / eta, w.y / eta, dr.safe_sqrt((e2 - 1.0 + w.z * w.z) / e2))
+
+
+def _refract_out(mi, dr, w, eta):
+    """Exterior direction of interior w and whether it leaves (fresnel.rs refract_out)."""
+    e2 = eta * eta
+    z2 = (1.0 - e2) + e2 * w.z * w.z
+    return mi.Vector3f(w.x * eta, w.y * eta, dr.safe_sqrt(z2)), (z2 > 0) & (w.z > 0)
+
+
+def _fresnel(mi, dr, cos, eta):
+    """Unpolarised Fresnel reflectance from outside (Born & Wolf §1.5.2; Mitsuba's mi.fresnel)."""
+    return mi.fresnel(dr.clip(cos, 0.0, 1.0), eta)[0]
+
+
+def _gaussian(dr, beta, x):
+    """g(beta, x) = exp(-x^2 / 2 beta^2) / (beta sqrt(2 pi)) (Marschner et al. 2005 §4.2)."""
+    return dr.exp(-0.5 * dr.square(x / beta)) / (beta * math.sqrt(2.0 * math.pi))
+
+
+class _Angles:
+    """A direction's longitudinal angle about a fibre u: sin psi = w . u (clamped), psi (Marschner
+    et al. 2005 eq. 2) and cos psi = sqrt(1 - sin^2 psi)."""
+
+    def __init__(self, dr, w, u):
+        self.sin = dr.clip(dr.dot(w, u), -1.0, 1.0)
+        self.psi = dr.asin(self.sin)
+        self.cos = dr.safe_sqrt(1.0 - self.sin * self.sin)
+
+
+def _lobe(dr, o, i, beta):
+    """The energy-bounded fibre lobe g(beta, psi_i + psi_o) / (2 pi max(cos psi_i, cos psi_o))
+    (fiber.rs lobe_value; notes/bsdf.md §2), without its colour; o, i: `_Angles`."""
+    c = dr.maximum(dr.maximum(i.cos, o.cos), MIN_COS_PSI)
+    return _gaussian(dr, beta, i.psi + o.psi) / (2.0 * math.pi * c)
+
+
+def _arc(dr, u, sin_psi, cos_psi, z_min):
+    """Half-width Delta of the azimuth arc of the cone at psi above z_min: z(phi) = sin psi u_z
+    + cos psi h cos(phi - phi0), h = sqrt(1 - u_z^2) (fiber.rs half_width_argument and
+    arc_from_argument)."""
+    a, b = sin_psi * u.z, cos_psi * dr.safe_sqrt(1.0 - u.z * u.z)
+    t = dr.select(b < 1e-7, dr.select(a > z_min, -1.0, 1.0), (z_min - a) / dr.maximum(b, 1e-7))
+    return dr.select(t <= -1.0, math.pi, dr.select(t >= 1.0, 0.0, dr.acos(dr.clip(t, -1.0, 1.0))))
+
+
+def _lobe_pdf(dr, u, o, i, wi_z, beta, z_min):
+    """Density of `_lobe_sample` per interior solid angle at the interior direction with angles
+    i and z = wi_z: g(beta, psi_i + psi_o) / (2 max(Delta, MIN_ARC) cos psi_i) (fiber.rs
+    pdf_about; notes/bsdf.md §3)."""
+    delta = _arc(dr, u, i.sin, i.cos, z_min)
+    ok = (wi_z > z_min) & (i.cos >= MIN_COS_PSI) & (delta > 0)
+    g = _gaussian(dr, beta, i.psi + o.psi)
+    width = 2.0 * dr.maximum(delta, MIN_ARC) * dr.maximum(i.cos, MIN_COS_PSI)
+    return dr.select(ok, g / width, 0.0)
+
+
+def _lobe_sample(mi, dr, u, psi_o, u2, beta, z_min):
+    """An interior direction about the fibre u: psi_i from the Gaussian about -psi_o (inverse
+    CDF), phi uniform on the arc above z_min widened to MIN_ARC, off-arc samples rejected
+    (fiber.rs sample_about); and whether it is valid."""
+    x = dr.clip(2.0 * u2.x - 1.0, -0.9999999, 0.9999999)
+    psi_i = -psi_o + beta * math.sqrt(2.0) * dr.erfinv(x)
+    s, c = dr.sincos(psi_i)
+    v, w = mi.coordinate_system(u)
+    delta = _arc(dr, u, s, c, z_min)
+    offset = dr.maximum(delta, MIN_ARC) * (2.0 * u2.y - 1.0)
+    sp, cp = dr.sincos(dr.atan2(w.z, v.z) + offset)
+    wi_in = s * u + c * (cp * v + sp * w)
+    ok = ((dr.abs(psi_i) < 0.5 * math.pi) & (c >= MIN_COS_PSI) & (delta > 0)
+          & (dr.abs(offset) < delta) & (wi_in.z > z_min))
+    return wi_in, ok
+
+
+_CLASSES = {}
+
+
+def bsdf_class(mi, dr):
+    """The ``xylem_wood_baked`` class for the current variant."""
+    key = mi.variant()
+    if key in _CLASSES:
+        return _CLASSES[key]
+
+    def luminance(c):
+        return LUMINANCE[0] * c.x + LUMINANCE[1] * c.y + LUMINANCE[2] * c.z
+
+    class Texel:
+        """The BSDF's parameters at the interaction (wood.rs `WoodBsdf::new` for the texel
+        `face_shading` builds), in the shading frame's coordinates."""
+
+        def __init__(self, bsdf, si, active):
+            uv = si.uv
+            v = bsdf._texture.eval(uv, active)
+            a, b, f = v[0:4], v[4:8], v[8:12]
+            # Clamped as material/baked.rs `BakedWoodMaterial::shade` clamps the lookup.
+            self.diffuse = dr.clip(mi.Color3f(a[0], a[1], a[2]), 0.0, 1.0)
+            self.fiber_color = dr.clip(mi.Color3f(b[0], b[1], b[2]), 0.0, 1.0)
+            self.beta = dr.clip(a[3], 1e-3, 0.5 * math.pi)
+            self.m = dr.clip(b[3], 0.0, 1.0)
+            right, up = _frame_axes(mi, dr, si)
+            u = right * f[0] + up * f[1] + mi.Vector3f(0, 0, 1) * f[2]
+            fallback = dr.squared_norm(u) < 1e-12
+            self.u = dr.select(fallback, right, dr.normalize(u))
+            # The ray axis: in the face, across the fibre (face.rs: xylem's frame.t = n x s).
+            s = mi.Vector3f(self.u.x, self.u.y, 0.0)
+            s = dr.select(dr.squared_norm(s) > 1e-12, dr.normalize(s), mi.Vector3f(1, 0, 0))
+            self.r = mi.Vector3f(-s.y, s.x, 0.0)
+            self.diffuse_eff = self._diffuse(bsdf)
+
+        def _diffuse(self, bsdf):
+            """rho'' = rho' / (1 - rho' F_int), rho' = s rho, s = min(1, min_c room_c / rho_c),
+            room = 1 - k_f A with A the ray-mask blend of the lobes' albedo bounds (wood.rs
+            `bounded_diffuse`; notes/bsdf.md §1.3, §2.3)."""
+            def bound(axis_z):
+                dip = dr.asin(dr.minimum(dr.abs(axis_z), 1.0))
+                scale = 2.0 / math.pi * (ALBEDO_NODES - 1) / ALBEDO_NODES
+                pos = mi.Point2f(self.beta * scale + 0.5 / ALBEDO_NODES,
+                                 dip * scale + 0.5 / ALBEDO_NODES)
+                return bsdf._albedo.eval(pos)[0]
+
+            albedo = (1.0 - self.m) * bound(self.u.z) + self.m * bound(self.r.z)
+            room, rho = 1.0 - self.fiber_color * albedo, self.diffuse
+            ratio = dr.select(rho > room, room / dr.maximum(rho, 1e-30), 1.0)
+            rho = rho * dr.minimum(dr.minimum(ratio.x, ratio.y), dr.minimum(ratio.z, 1.0))
+            return rho / (1.0 - rho * bsdf._f_int)
+
+    class XylemWoodBaked(mi.BSDF):
+        def __init__(self, props):
+            mi.BSDF.__init__(self, props)
+            if not _has(props, "maps"):
+                raise ValueError(
+                    "xylem_wood_baked: `maps` (a `xylem bake` output folder) is required")
+            self.maps = str(props.get("maps"))
+            self.eta = float(props.get("eta", 1.5))
+            roughness = float(props.get("roughness", 0.0))
+            if not 1.0 <= self.eta <= 4.0:
+                raise ValueError(f"xylem_wood_baked: `eta` = {self.eta}: expected 1 to 4")
+            if roughness >= 1e-3:
+                raise ValueError(
+                    f"xylem_wood_baked: `roughness` = {roughness}: only the smooth finish (0) is "
+                    "implemented; use xylem_wood for a rough finish")
+            linear = dict(filter_mode=dr.FilterMode.Linear, wrap_mode=dr.WrapMode.Clamp)
+            # One 12-channel texture: a lookup computes its taps and weights once.
+            self._tensor = mi.TensorXf(_maps(self.maps))
+            self._texture = mi.Texture2f(self._tensor, **linear)
+            self._albedo = mi.Texture2f(mi.TensorXf(_albedo_table()[..., None]), **linear)
+            eta = self.eta
+            # F_ext = 2 int_0^1 F(mu) mu dmu (fresnel.rs fresnel_diffuse_reflectance), 0 at eta 1.
+            mu = (_GL_X + 1.0) / 2.0
+            fresnel = np.array([np.ravel(_fresnel(mi, dr, mi.Float(float(x)), eta))[0] for x in mu])
+            f_ext = 0.0 if eta <= 1.0 else float(np.sum(_GL_W / 2.0 * 2.0 * mu * fresnel))
+            self._escape = (1.0 - f_ext) / (eta * eta)   # 1 - R_int (wood.rs `escape`)
+            self._f_int = 1.0 - self._escape
+            self._z_crit = math.sqrt(max(0.0, 1.0 - 1.0 / (eta * eta)))
+            self._delta = eta > 1.0
+            lobes = (mi.BSDFFlags.DiffuseReflection | mi.BSDFFlags.GlossyReflection
+                     | mi.BSDFFlags.FrontSide | mi.BSDFFlags.SpatiallyVarying
+                     | mi.BSDFFlags.Anisotropic)
+            delta = mi.BSDFFlags.DeltaReflection | mi.BSDFFlags.FrontSide
+            # Component 0: everything but the finish's mirror; component 1: the mirror.
+            self.m_components = [lobes, delta] if self._delta else [lobes]
+            self.m_flags = (lobes | delta) if self._delta else lobes
+
+        def _transmittance(self, cos):
+            return 1.0 - _fresnel(mi, dr, cos, self.eta)
+
+        def _enabled(self, ctx):
+            """(the mirror, the other lobes) as `ctx` asks for them (component 1 / 0)."""
+            return (self._delta and ctx.is_enabled(mi.BSDFFlags.DeltaReflection, 1),
+                    ctx.is_enabled(mi.BSDFFlags.GlossyReflection, 0))
+
+        def _probs(self, t, wo, ctx):
+            """Lobe probabilities for wo, proportional to each lobe's estimated albedo
+            (wood.rs `lobe_probs`): specular F, diffuse T lum(rho'') (1 - R_int), fibre and ray
+            T lum(k_f) / pi (1 - m) and m; a lobe `ctx` leaves out gets 0."""
+            mirror, rest = self._enabled(ctx)
+            zero = mi.Float(0.0)
+            spec = _fresnel(mi, dr, wo.z, self.eta) if mirror else zero
+            tr = self._transmittance(wo.z) if rest else zero
+            diff = tr * luminance(t.diffuse_eff) * self._escape
+            kf = tr * luminance(t.fiber_color) / math.pi
+            fib, ray = kf * (1.0 - t.m), kf * t.m
+            total = spec + diff + fib + ray
+            inv = dr.select(total > 0, 1.0 / total, 0.0)
+            return spec * inv, diff * inv, fib * inv, ray * inv
+
+        def _eval_pdf(self, t, probs, wo, wi):
+            """xylem's f (no cosine) and the sampling density, sharing the refracted directions
+            and the longitudinal angles. f = T(wo) T(wi) / eta^2 (rho''/pi + k_f ((1 - m)
+            f_fib + m f_ray)(wo', wi')), ' refracted into the finish (notes/bsdf.md eq. 1.4);
+            the density of the non-delta lobes' mixture (wood.rs `density`): diffuse cos/pi,
+            the fibre lobes' interior densities times d w_int / d w_ext = cos theta_i / (eta^2
+            cos theta_i') (notes/bsdf.md §1.1). Zero where either cosine is <= 0 or where not
+            finite."""
+            eta = self.eta
+            wo_in, wi_in = _refract_in(mi, dr, wo, eta), _refract_in(mi, dr, wi, eta)
+            lobes, dens = [], []
+            for ax in (t.u, t.r):
+                o, i = _Angles(dr, wo_in, ax), _Angles(dr, wi_in, ax)
+                lobes.append(_lobe(dr, o, i, t.beta))
+                dens.append(_lobe_pdf(dr, ax, o, i, wi_in.z, t.beta, self._z_crit))
+            substrate = t.diffuse_eff / math.pi + t.fiber_color * (
+                (1.0 - t.m) * lobes[0] + t.m * lobes[1])
+            f = substrate * (self._transmittance(wo.z) * self._transmittance(wi.z) / (eta * eta))
+            jac = wi.z / (eta * eta) / dr.maximum(wi_in.z, 1e-7)
+            pdf = probs[1] * wi.z / math.pi + (probs[2] * dens[0] + probs[3] * dens[1]) * jac
+            ok = (wo.z > 0) & (wi.z > 0)
+            f = dr.select(ok & dr.isfinite(f.x + f.y + f.z), dr.maximum(f, 0.0), 0.0)
+            return f, dr.select(ok & dr.isfinite(pdf), pdf, 0.0)
+
+        # Mitsuba's si.wi (towards the viewer) is xylem's wo; its `wo` (towards the light) is
+        # xylem's wi. Mitsuba's eval carries the cosine of its wo.
+        def eval(self, ctx, si, wo, active=True):
+            return self.eval_pdf(ctx, si, wo, active)[0]
+
+        def pdf(self, ctx, si, wo, active=True):
+            return self.eval_pdf(ctx, si, wo, active)[1]
+
+        def eval_pdf(self, ctx, si, wo, active=True):
+            t = Texel(self, si, active)
+            f, pdf = self._eval_pdf(t, self._probs(t, si.wi, ctx), si.wi, wo)
+            active = active & self._enabled(ctx)[1]
+            return dr.select(active, f * wo.z, 0.0), dr.select(active, pdf, 0.0)
+
+        def sample(self, ctx, si, sample1, sample2, active=True):
+            """A lobe by `sample1` over the cumulative probabilities (specular, diffuse, fibre,
+            ray; wood.rs `pick`), a direction from it by `sample2` (wood.rs `sample`)."""
+            t = Texel(self, si, active)
+            wo = si.wi
+            probs = self._probs(t, wo, ctx)
+            # (Comparisons, not `~`: the scalar variant's masks are Python bools.)
+            c1, c2 = probs[0] + probs[1], probs[0] + probs[1] + probs[2]
+            spec = sample1 < probs[0]
+            diff = (sample1 >= probs[0]) & (sample1 < c1)
+            fib = (sample1 >= c1) & (sample1 < c2)
+            axis = dr.select(fib, t.u, t.r)
+            wo_in = _refract_in(mi, dr, wo, self.eta)
+            wi_in, lobe_ok = _lobe_sample(mi, dr, axis, _Angles(dr, wo_in, axis).psi, sample2,
+                                          t.beta, self._z_crit)
+            wi_lobe, leaves = _refract_out(mi, dr, wi_in, self.eta)
+            wi = dr.select(spec, mi.Vector3f(-wo.x, -wo.y, wo.z),
+                           dr.select(diff, mi.warp.square_to_cosine_hemisphere(sample2), wi_lobe))
+            f, pdf = self._eval_pdf(t, probs, wo, wi)
+            ok = active & (wo.z > 0) & (wi.z > 0) & (spec | diff | (lobe_ok & leaves))
+            ok &= spec | (pdf > 0)
+            bs = dr.zeros(mi.BSDFSample3f, dr.width(sample1))
+            bs.wo = wi
+            bs.eta = 1.0
+            bs.pdf = dr.select(ok, dr.select(spec, probs[0], pdf), 0.0)
+            bs.sampled_type = dr.select(spec, mi.UInt32(+mi.BSDFFlags.DeltaReflection),
+                                        mi.UInt32(+mi.BSDFFlags.GlossyReflection))
+            bs.sampled_component = dr.select(spec, mi.UInt32(1), mi.UInt32(0))
+            # The mirror's weight F / P(specular) (f = F / cos); the rest f cos / pdf.
+            mirror = _fresnel(mi, dr, wo.z, self.eta) / dr.maximum(probs[0], 1e-30)
+            weight = f * wi.z / dr.select(pdf > 0, pdf, 1.0)
+            weight = dr.select(spec, mi.Color3f(mirror), weight)
+            return bs, dr.select(ok, weight, 0.0)
+
+        def traverse(self, callback):
+            callback.put("maps", self._tensor, mi.ParamFlags.Differentiable)
+
+        def parameters_changed(self, keys=None):
+            self._texture.set_tensor(self._tensor)
+
+        def to_string(self):
+            return f"XylemWoodBaked[maps={self.maps}, eta={self.eta}]"
+
+    _CLASSES[key] = XylemWoodBaked
+    return XylemWoodBaked
