@@ -107,8 +107,9 @@ pub enum Check {
     /// No firefly on diffuse or glossy surfaces: every pixel ≤ [`MAX_FIREFLY_RATIO`] × its 3×3
     /// median.
     Fireflies {},
-    /// The light's colour on `objects` ([`light_colour`]): with `black_background`, no cooler
-    /// than the ceiling light; without, cooler than the companion render without the background.
+    /// The light's colour on `objects` (blue over red, [`light_blue_over_red`]): with
+    /// `black_background`, no cooler than the ceiling light; without, cooler than the companion
+    /// render without the background.
     LightColour {
         /// Object name prefixes.
         objects: Vec<String>,

@@ -166,7 +166,7 @@ impl Rejections {
     }
 
     /// The counts by cause, as `fit.json` reports them.
-    pub(crate) fn to_json(&self) -> serde_json::Value {
+    pub(crate) fn to_json(self) -> serde_json::Value {
         serde_json::json!({
             "used": self.used,
             "clipped_or_not_finite": self.clipped,
