@@ -177,7 +177,10 @@ pub fn report_md(rows: &[Row], command: &str) -> (String, bool) {
          noise's share subtracted (measured from a second render of other seeds and from the \
          reference's two halves, so noise correlated between pixels comes off too). **Error at equal time**: net relative MSE × CPU seconds, filtered \
          over point-sampled (exact when the error is all noise). Goals: aliasing ≤ 0.3×, error at \
-         equal time ≤ 0.7×.\n\n",
+         equal time ≤ 0.7×. All three take their pixel samples from the per-pixel scrambled \
+         Sobol sequence (since 2026-12-04; before, independent samples): the filter is compared \
+         with point sampling under the same stratification, and the gain of the stratification \
+         itself is in notes/render.md (\"Stratified pixel samples\").\n\n",
     );
     md += &format!("Command: `{command}`\n\n");
     md += "| scene | size, spp (reference) | wood px | aliasing filtered | point | ratio | rel. MSE filtered | point | CPU s filtered | point | equal-time ratio |\n";
