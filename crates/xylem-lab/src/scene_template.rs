@@ -53,14 +53,6 @@ impl SceneTemplate {
         self
     }
 
-    /// Removes the value at top-level table `table`, key `key`, if there.
-    pub fn remove(mut self, table: &str, key: &str) -> SceneTemplate {
-        if let Some(toml::Value::Table(t)) = self.table.get_mut(table) {
-            t.remove(key);
-        }
-        self
-    }
-
     /// The scene as TOML text, for `xylem::scene::from_str`.
     pub fn text(&self) -> String {
         toml::to_string(&self.table).expect("a TOML table serialises")
