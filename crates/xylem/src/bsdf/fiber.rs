@@ -285,16 +285,17 @@ impl FiberAxis {
         (f, pdf_value(g, wi.z, z_min, cos_psi, arc_from_argument(t)))
     }
 
-    /// [`FiberAxis::eval_pdf_at`] of `wi[k]` into `f[k]` and, when `with_pdf`, `pdf[k]` (else
-    /// left as they are), for `k < wi.len() ≤ BATCH`. Stage by stage over all directions:
-    /// the arithmetic stages are loops LLVM vectorises, the libm calls (asin, exp, cos, acos)
-    /// loops of independent calls, instead of one dependent chain per direction.
+    /// [`FiberAxis::eval_pdf_at`] of the directions whose components are `wi[0][k]`,
+    /// `wi[1][k]`, `wi[2][k]` (columns, structure of arrays) into `f[k]` and, when `with_pdf`,
+    /// `pdf[k]` (else left as they are), for `k < wi[0].len() ≤ BATCH`. Stage by stage over all
+    /// directions: each stage is a loop LLVM vectorises (the transcendental functions are
+    /// `math::elementary`'s polynomials), instead of one dependent chain per direction.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub fn eval_pdf_many_at(
         &self,
         at: &FiberAtWo,
-        wi: &[Vec3],
+        wi: [&[f32]; 3],
         beta: f32,
         norm: FiberNormalization,
         z_min: f32,
@@ -302,12 +303,14 @@ impl FiberAxis {
         f: &mut [f32],
         pdf: &mut [f32],
     ) {
-        let n = wi.len();
+        let n = wi[0].len();
+        let [wx, wy, wz] = wi;
+        let (wx, wy, wz) = (&wx[..n], &wy[..n], &wz[..n]);
         assert!(n <= BATCH && f.len() >= n && pdf.len() >= n);
         let (mut sin_psi, mut psi, mut g, mut c) =
             ([0.0; BATCH], [0.0; BATCH], [0.0; BATCH], [0.0; BATCH]);
         for k in 0..n {
-            sin_psi[k] = wi[k].dot(self.frame.n);
+            sin_psi[k] = Vec3::new(wx[k], wy[k], wz[k]).dot(self.frame.n);
         }
         for k in 0..n {
             psi[k] = asin(sin_psi[k]);
@@ -333,12 +336,12 @@ impl FiberAxis {
             (cos_psi[k], t[k]) = self.arc_argument(sin_psi[k], z_min);
         }
         for k in 0..n {
-            if arc_needed(wi[k].z, z_min, cos_psi[k]) {
+            if arc_needed(wz[k], z_min, cos_psi[k]) {
                 t[k] = arc_from_argument(t[k]);
             }
         }
         for k in 0..n {
-            pdf[k] = pdf_value(g[k], wi[k].z, z_min, cos_psi[k], t[k]);
+            pdf[k] = pdf_value(g[k], wz[k], z_min, cos_psi[k], t[k]);
         }
     }
 

@@ -8,22 +8,20 @@ use glam::Vec3;
 /// Unpolarised Fresnel reflectance of a dielectric interface for light arriving with
 /// `cos_i` ≥ 0 on the side of index 1, the other side having relative index `eta` = η_t/η_i
 /// (Born & Wolf, *Principles of Optics*, §1.5.2, eqs. 21; pbrt-v4 eq. 9.5). Returns 1 under
-/// total internal reflection.
-#[inline]
+/// total internal reflection. Branch-free (the reflectance is worked out in every case and the
+/// total-reflection one selected), so a loop of it runs in SIMD lanes.
+#[inline(always)]
 pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
     let cos_i = cos_i.clamp(0.0, 1.0);
     let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
-    if sin2_t >= 1.0 {
-        return 1.0;
-    }
     let cos_t = safe_sqrt(1.0 - sin2_t);
     let r_par = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
     let r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
     let f = 0.5 * (r_par * r_par + r_perp * r_perp);
-    if f.is_finite() {
-        f.clamp(0.0, 1.0)
-    } else {
+    if (sin2_t >= 1.0) | !f.is_finite() {
         1.0
+    } else {
+        f.clamp(0.0, 1.0)
     }
 }
 

@@ -12,6 +12,7 @@ pub struct Lambertian {
 }
 
 impl Bsdf for Lambertian {
+    #[inline]
     fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         if wo.z > 0.0 && wi.z > 0.0 {
             self.albedo * INV_PI
@@ -20,6 +21,7 @@ impl Bsdf for Lambertian {
         }
     }
 
+    #[inline]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         if wo.z > 0.0 && wi.z > 0.0 {
             cosine_hemisphere_pdf(wi.z)

@@ -314,8 +314,16 @@ impl WoodBsdf {
     fn transmittance(&self, cos: f32) -> f32 {
         match &self.rough {
             Some(r) => 1.0 - r.reflectance(cos),
-            None => 1.0 - fresnel_dielectric(cos, self.params.eta),
+            None => self.smooth_transmittance(cos),
         }
+    }
+
+    /// [`WoodBsdf::transmittance`] of the smooth finish, 1 − F (Fresnel,
+    /// [`fresnel_dielectric`]): branch-free, so a loop of it over many directions runs in SIMD
+    /// lanes (`WoodAtWo::eval_pdf_lanes`).
+    #[inline(always)]
+    fn smooth_transmittance(&self, cos: f32) -> f32 {
+        1.0 - fresnel_dielectric(cos, self.params.eta)
     }
 
     /// The substrate BSDF for interior directions (no cosine): diffuse with its internal
@@ -513,10 +521,33 @@ impl WoodBsdf {
         p_fib: f32,
         p_ray: f32,
     ) -> f32 {
-        let mut pdf = probs.diffuse * wi.z * INV_PI;
+        let mut pdf = self.substrate_density(probs, wi.z, wi_in.z, p_fib, p_ray);
+        if let Some(r) = &self.rough {
+            if probs.specular > 0.0 {
+                let h = (wo + wi).normalize_or_zero();
+                pdf += probs.specular * r.ggx.reflection_pdf(wo, h);
+            }
+        }
+        finite_or_zero(pdf)
+    }
+
+    /// The part of [`WoodBsdf::density`] that passes through the finish, for cos θi = `wi_z`
+    /// and its refraction's cos θi' = `wi_in_z`: the diffuse's cos θi/π plus the fibre and ray
+    /// lobes' interior densities mapped to exterior solid angle (not yet checked for being
+    /// finite). Branch-free but for the lobe probabilities, which are the same for every ωi.
+    #[inline(always)]
+    fn substrate_density(
+        &self,
+        probs: &LobeProbs,
+        wi_z: f32,
+        wi_in_z: f32,
+        p_fib: f32,
+        p_ray: f32,
+    ) -> f32 {
+        let mut pdf = probs.diffuse * wi_z * INV_PI;
         if probs.fiber > 0.0 || probs.ray > 0.0 {
             // dω_int/dω_ext = cos θi / (η² cos θi') (notes/bsdf.md §1.1).
-            let jac = wi.z * self.inv_eta2 / wi_in.z.max(1e-7);
+            let jac = wi_z * self.inv_eta2 / wi_in_z.max(1e-7);
             let mut p_int = 0.0;
             if probs.fiber > 0.0 {
                 p_int += probs.fiber * p_fib;
@@ -526,17 +557,7 @@ impl WoodBsdf {
             }
             pdf += p_int * jac;
         }
-        if let Some(r) = &self.rough {
-            if probs.specular > 0.0 {
-                let h = (wo + wi).normalize_or_zero();
-                pdf += probs.specular * r.ggx.reflection_pdf(wo, h);
-            }
-        }
-        if pdf.is_finite() {
-            pdf
-        } else {
-            0.0
-        }
+        pdf
     }
 
     /// f from the substrate's value (no cosine, interior directions) and the finish's
@@ -548,11 +569,29 @@ impl WoodBsdf {
         if let Some(r) = &self.rough {
             f += Vec3::splat(r.reflection(wo, wi));
         }
-        if f.is_finite() {
-            f.max(Vec3::ZERO)
-        } else {
-            Vec3::ZERO
-        }
+        finite_nonnegative(f)
+    }
+}
+
+/// `f` clamped to ≥ 0, or 0 where any channel is not finite (the last step of
+/// [`WoodBsdf::value`]); branch-free.
+#[inline(always)]
+fn finite_nonnegative(f: Vec3) -> Vec3 {
+    let finite = f.x.is_finite() & f.y.is_finite() & f.z.is_finite();
+    if finite {
+        f.max(Vec3::ZERO)
+    } else {
+        Vec3::ZERO
+    }
+}
+
+/// `x`, or 0 where it is not finite (the last step of [`WoodBsdf::density`]).
+#[inline(always)]
+fn finite_or_zero(x: f32) -> f32 {
+    if x.is_finite() {
+        x
+    } else {
+        0.0
     }
 }
 

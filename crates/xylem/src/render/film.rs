@@ -136,13 +136,23 @@ impl RadianceSum {
     #[inline(always)]
     pub fn add(&mut self, radiance: Vec3) {
         self.count += 1;
-        if radiance.is_finite() {
-            self.sum += radiance;
-            let y = crate::math::luminance(radiance) as f64;
-            self.sum_sq += y * y;
+        self.accumulate(radiance);
+    }
+
+    /// [`RadianceSum::add`] without the count: the sum, Σ (luminance)² and the non-finite
+    /// count, branch-free (selects), so that a loop of it over frames runs in SIMD lanes
+    /// ([`FrameSums::add`]).
+    #[inline(always)]
+    fn accumulate(&mut self, radiance: Vec3) {
+        let finite = radiance.x.is_finite() & radiance.y.is_finite() & radiance.z.is_finite();
+        let y = crate::math::luminance(radiance) as f64;
+        let (sum, sum_sq) = (self.sum + radiance, self.sum_sq + y * y);
+        (self.sum, self.sum_sq) = if finite {
+            (sum, sum_sq)
         } else {
-            self.nonfinite += 1;
-        }
+            (self.sum, self.sum_sq)
+        };
+        self.nonfinite += (!finite) as u32;
     }
 
     /// The mean radiance and the standard error of its luminance (the sample variance with
@@ -153,6 +163,79 @@ impl RadianceSum {
         let m = crate::math::luminance(mean) as f64;
         let var = ((self.sum_sq / n - m * m) * n / (n - 1.0).max(1.0)).max(0.0);
         (mean, (var / n).sqrt() as f32)
+    }
+}
+
+/// The [`RadianceSum`]s of a tile's pixels in every frame of a run (pixel-major: pixel i,
+/// frame k at i·frames + k), as columns (structure of arrays), so that adding one sample's
+/// radiance in every frame is a loop in SIMD lanes. Each entry sums as a [`RadianceSum`] does,
+/// bit for bit; the count, the same in every frame, is kept once per pixel.
+#[derive(Clone, Debug)]
+pub(crate) struct FrameSums {
+    frames: usize,
+    /// Samples taken per pixel (finite or not).
+    count: Vec<u32>,
+    /// Σ radiance by channel.
+    sum: [Vec<f32>; 3],
+    /// Σ (luminance)².
+    sum_sq: Vec<f64>,
+    /// Samples whose radiance was NaN or infinite (dropped).
+    nonfinite: Vec<u32>,
+}
+
+impl FrameSums {
+    /// Empty sums of `pixels` pixels in `frames` frames.
+    pub fn new(pixels: usize, frames: usize) -> Self {
+        let n = pixels * frames;
+        FrameSums {
+            frames,
+            count: vec![0; pixels],
+            sum: std::array::from_fn(|_| vec![0.0; n]),
+            sum_sq: vec![0.0; n],
+            nonfinite: vec![0; n],
+        }
+    }
+
+    /// Adds one sample of pixel `i` in every frame, its radiance in frame k being
+    /// (`radiance[0][k]`, `radiance[1][k]`, `radiance[2][k]`) ([`RadianceSum::add`]).
+    #[inline(always)]
+    pub fn add(&mut self, i: usize, radiance: &[Vec<f32>; 3]) {
+        let n = self.frames;
+        self.count[i] += 1;
+        let lanes = i * n..(i + 1) * n;
+        let [sr, sg, sb] = &mut self.sum;
+        let (sr, sg, sb) = (
+            &mut sr[lanes.clone()],
+            &mut sg[lanes.clone()],
+            &mut sb[lanes.clone()],
+        );
+        let (sum_sq, nonfinite) = (&mut self.sum_sq[lanes.clone()], &mut self.nonfinite[lanes]);
+        let [r, g, b] = radiance;
+        let (r, g, b) = (&r[..n], &g[..n], &b[..n]);
+        for k in 0..n {
+            let mut s = RadianceSum {
+                sum: Vec3::new(sr[k], sg[k], sb[k]),
+                count: 0,
+                sum_sq: sum_sq[k],
+                nonfinite: nonfinite[k],
+            };
+            s.accumulate(Vec3::new(r[k], g[k], b[k]));
+            [sr[k], sg[k], sb[k]] = s.sum.to_array();
+            (sum_sq[k], nonfinite[k]) = (s.sum_sq, s.nonfinite);
+        }
+    }
+
+    /// Frame `k`'s sums, pixel by pixel.
+    pub fn frame(&self, k: usize) -> impl ExactSizeIterator<Item = RadianceSum> + '_ {
+        (0..self.count.len()).map(move |i| {
+            let j = i * self.frames + k;
+            RadianceSum {
+                sum: Vec3::new(self.sum[0][j], self.sum[1][j], self.sum[2][j]),
+                count: self.count[i],
+                sum_sq: self.sum_sq[j],
+                nonfinite: self.nonfinite[j],
+            }
+        })
     }
 }
 
@@ -191,7 +274,7 @@ pub struct Image {
 impl Image {
     /// Averages pixel sums into an image.
     pub(crate) fn from_sums(width: u32, height: u32, sums: &[PixelSum]) -> Self {
-        let mut img = Self::from_radiance(width, height, sums.iter().map(|s| &s.radiance));
+        let mut img = Self::from_radiance(width, height, sums.iter().map(|s| s.radiance));
         img.aov = (sums.iter())
             .map(|s| {
                 let mut a = s.aov;
@@ -203,10 +286,10 @@ impl Image {
     }
 
     /// Averages radiance sums into an image without AOVs (`aov` empty).
-    pub(crate) fn from_radiance<'a>(
+    pub(crate) fn from_radiance(
         width: u32,
         height: u32,
-        sums: impl ExactSizeIterator<Item = &'a RadianceSum>,
+        sums: impl ExactSizeIterator<Item = RadianceSum>,
     ) -> Self {
         let mut beauty = Vec::with_capacity(sums.len());
         let mut std_error = Vec::with_capacity(sums.len());

@@ -309,12 +309,19 @@ impl<'a> BsdfAtWo<'a> {
         }
     }
 
-    /// [`BsdfAtWo::eval_pdf`] of every `wi[k]` into `f[k]`, `pdf[k]` (the wood BSDF a batch at
-    /// a time, [`WoodAtWo::eval_pdf_many`]; others one by one).
+    /// [`BsdfAtWo::eval_pdf`] of the directions in the columns `wi` (x, y, z; one lane per
+    /// direction) into the colour columns `f` and `pdf` (the wood BSDF in SIMD lanes,
+    /// [`WoodAtWo::eval_pdf_lanes`]; others one by one).
     #[inline(always)]
-    pub fn eval_pdf_many(&self, wi: &[Vec3], with_pdf: bool, f: &mut [Vec3], pdf: &mut [f32]) {
+    pub fn eval_pdf_lanes(
+        &self,
+        wi: [&[f32]; 3],
+        with_pdf: bool,
+        f: [&mut [f32]; 3],
+        pdf: &mut [f32],
+    ) {
         match self {
-            BsdfAtWo::Wood(w) => w.eval_pdf_many(wi, with_pdf, f, pdf),
+            BsdfAtWo::Wood(w) => w.eval_pdf_lanes(wi, with_pdf, f, pdf),
             // The material's kind chosen once, not per direction.
             BsdfAtWo::Other(SurfaceBsdf::Lambertian(b), wo) => {
                 eval_then_pdf_each(b, *wo, wi, with_pdf, f, pdf)
@@ -324,31 +331,32 @@ impl<'a> BsdfAtWo<'a> {
     }
 }
 
-/// `(eval(wo, wi), pdf(wo, wi))`, the density only when `with_pdf` and f ≠ 0 (else 0).
+/// `(eval(wo, wi), pdf(wo, wi))`, the density only when `with_pdf` and f ≠ 0 (else 0). The
+/// density is worked out in every case and selected (the BSDFs that come here have cheap
+/// ones), so a loop of this over many directions has no branches and runs in SIMD lanes.
 #[inline(always)]
 fn eval_then_pdf(b: &impl Bsdf, wo: Vec3, wi: Vec3, with_pdf: bool) -> (Vec3, f32) {
-    let f = b.eval(wo, wi);
-    (
-        f,
-        if with_pdf && f != Vec3::ZERO {
-            b.pdf(wo, wi)
-        } else {
-            0.0
-        },
-    )
+    let (f, pdf) = (b.eval(wo, wi), b.pdf(wo, wi));
+    (f, if with_pdf & !is_zero(f) { pdf } else { 0.0 })
 }
 
-/// [`eval_then_pdf`] of every `wi[k]` into `f[k]`, `pdf[k]`.
+/// [`eval_then_pdf`] of every direction of the columns `wi` into the columns `f`, `pdf`.
+#[inline(always)]
 fn eval_then_pdf_each(
     b: &impl Bsdf,
     wo: Vec3,
-    wi: &[Vec3],
+    wi: [&[f32]; 3],
     with_pdf: bool,
-    f: &mut [Vec3],
+    f: [&mut [f32]; 3],
     pdf: &mut [f32],
 ) {
-    for ((wi, f), pdf) in wi.iter().zip(f.iter_mut()).zip(pdf.iter_mut()) {
-        (*f, *pdf) = eval_then_pdf(b, wo, *wi, with_pdf);
+    let n = pdf.len();
+    let ([wx, wy, wz], [fr, fg, fb]) = (wi, f);
+    let (wx, wy, wz) = (&wx[..n], &wy[..n], &wz[..n]);
+    let (fr, fg, fb) = (&mut fr[..n], &mut fg[..n], &mut fb[..n]);
+    for k in 0..n {
+        let (v, p) = eval_then_pdf(b, wo, Vec3::new(wx[k], wy[k], wz[k]), with_pdf);
+        [fr[k], fg[k], fb[k], pdf[k]] = [v.x, v.y, v.z, p];
     }
 }
 
@@ -539,24 +547,43 @@ fn mis_scale(wi_z: f32, pdf: f32, bsdf_pdf: f32, is_delta: bool) -> f32 {
     wi_z.abs() * w / pdf
 }
 
+/// Per-frame `Vec3`s as three columns (x, y, z or r, g, b: structure of arrays, one lane per
+/// frame), so that a loop over the frames runs in SIMD lanes.
+pub(crate) type Columns = [Vec<f32>; 3];
+
+/// Each column of `c` resized to `n` (new lanes 0).
+fn resize_columns(c: &mut Columns, n: usize) {
+    for c in c {
+        c.resize(n, 0.0);
+    }
+}
+
+/// Whether every component of `v` is 0 (`v == Vec3::ZERO`), without branches.
+#[inline(always)]
+fn is_zero(v: Vec3) -> bool {
+    (v.x == 0.0) & (v.y == 0.0) & (v.z == 0.0)
+}
+
 /// Scratch columns of [`light_terms`], reused from call to call.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct TermScratch {
     /// The samples' directions in the local shading frame.
-    wi: Vec<Vec3>,
-    f: Vec<Vec3>,
+    wi: Columns,
+    /// The BSDF's values (by channel) and densities at them.
+    f: Columns,
     bsdf_pdf: Vec<f32>,
     /// Whether each shadow segment surely misses every object (no BVH query needed).
     culled: Vec<bool>,
     segments: Segments,
-    /// [`mis_scale`] of each sample.
-    scale: Vec<f32>,
+    /// Whether each sample's term is nonzero unless its light is occluded (a shadow ray).
+    shadowed: Vec<bool>,
 }
 
 /// [`light_term`] of every sample of `ls` (one light at many places: a light sweep's frames)
-/// where `active[k]`, into `out[k]` (others left as they are), stage by stage over all samples —
-/// local directions, BSDF values and densities, culled shadow segments, MIS weights — so each
-/// stage is a loop without dependencies from one sample to the next. The same functions as
+/// where `active[k]`, into the columns `out` at k (others left as they are), stage by stage over
+/// all samples in structure-of-arrays columns — local directions, BSDF values and densities,
+/// culled shadow segments, then the MIS-weighted terms in one loop — so each stage is a loop in
+/// SIMD lanes without dependencies from one sample to the next. The same functions as
 /// [`light_term`] on the same values, so the same bits (tested by the sweep's equality test).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
@@ -567,7 +594,7 @@ pub(crate) fn light_terms(
     ls: &LightSamples,
     active: &[bool],
     scratch: &mut TermScratch,
-    out: &mut [Vec3],
+    out: &mut Columns,
     rays: &mut RayCount,
 ) {
     let n = ls.len();
@@ -577,55 +604,72 @@ pub(crate) fn light_terms(
         bsdf_pdf,
         culled,
         segments,
-        scale,
+        shadowed,
     } = scratch;
+    resize_columns(wi, n);
+    resize_columns(f, n);
+    bsdf_pdf.resize(n, 0.0);
+    shadowed.resize(n, false);
     let [wx, wy, wz] = &ls.wi;
     let (wx, wy, wz) = (&wx[..n], &wy[..n], &wz[..n]);
-    wi.clear();
-    wi.extend((0..n).map(|k| sp.frame.to_local(Vec3::new(wx[k], wy[k], wz[k]))));
-    f.resize(n, Vec3::ZERO);
-    bsdf_pdf.resize(n, 0.0);
-    let (f, bsdf_pdf, wi) = (&mut f[..n], &mut bsdf_pdf[..n], &wi[..n]);
-    let (active, pdf, li, dist) = (&active[..n], &ls.pdf[..n], &ls.li[..n], &ls.dist[..n]);
-    let out = &mut out[..n];
-    bsdf.eval_pdf_many(wi, !ls.is_delta, f, bsdf_pdf);
+    let [lx, ly, lz] = wi;
+    let (lx, ly, lz) = (&mut lx[..n], &mut ly[..n], &mut lz[..n]);
     for k in 0..n {
-        let keep = active[k] & (pdf[k] > 0.0) & (li[k] != Vec3::ZERO);
-        f[k] = if keep { f[k] } else { Vec3::ZERO };
+        let l = sp.frame.to_local(Vec3::new(wx[k], wy[k], wz[k]));
+        [lx[k], ly[k], lz[k]] = l.to_array();
     }
+    let [fr, fg, fb] = f;
+    let (fr, fg, fb) = (&mut fr[..n], &mut fg[..n], &mut fb[..n]);
+    let bsdf_pdf = &mut bsdf_pdf[..n];
+    bsdf.eval_pdf_lanes([lx, ly, lz], !ls.is_delta, [fr, fg, fb], bsdf_pdf);
     shadow.culled_many(sp, ls, segments, culled);
-    scale.resize(n, 0.0);
-    let scale = &mut scale[..n];
-    for k in 0..n {
-        scale[k] = mis_scale(wi[k].z, pdf[k], bsdf_pdf[k], ls.is_delta);
-    }
+    let (active, pdf, dist, shadowed) = (
+        &active[..n],
+        &ls.pdf[..n],
+        &ls.dist[..n],
+        &mut shadowed[..n],
+    );
+    let [lr, lg, lb] = &ls.li;
+    let (lr, lg, lb) = (&lr[..n], &lg[..n], &lb[..n]);
+    let [or, og, ob] = out;
+    let (or, og, ob) = (&mut or[..n], &mut og[..n], &mut ob[..n]);
     // The unoccluded terms of all samples (a loop in lanes), then the few shadow segments the
     // boxes did not cull traced one by one; inactive samples keep what `out` held.
     for k in 0..n {
-        // A zero f stays zero whatever the scale (which may be infinite where pdf = 0).
-        let term = if f[k] == Vec3::ZERO {
-            Vec3::ZERO
+        let li = Vec3::new(lr[k], lg[k], lb[k]);
+        let keep = active[k] & (pdf[k] > 0.0) & !is_zero(li);
+        let f = if keep {
+            Vec3::new(fr[k], fg[k], fb[k])
         } else {
-            f[k] * li[k] * scale[k]
+            Vec3::ZERO
         };
-        out[k] = if active[k] { term } else { out[k] };
+        let scale = mis_scale(lz[k], pdf[k], bsdf_pdf[k], ls.is_delta);
+        // A zero f stays zero whatever the scale (which may be infinite where pdf = 0).
+        let lit = !is_zero(f);
+        let term = if lit { f * li * scale } else { Vec3::ZERO };
+        shadowed[k] = lit;
+        let term = if active[k] {
+            term
+        } else {
+            Vec3::new(or[k], og[k], ob[k])
+        };
+        [or[k], og[k], ob[k]] = term.to_array();
     }
+    rays.0 += shadowed.iter().map(|&s| s as u64).sum::<u64>();
+    let culled = &culled[..n];
     for k in 0..n {
-        if !active[k] || f[k] == Vec3::ZERO {
+        if !shadowed[k] | culled[k] {
             continue;
         }
-        rays.0 += 1;
         let d = Vec3::new(wx[k], wy[k], wz[k]);
-        if !culled[k]
-            && !shadow.accel.unoccluded(
-                &Ray {
-                    o: offset_origin(sp, d),
-                    d,
-                },
-                shadow_t_max(dist[k]),
-            )
-        {
-            out[k] = Vec3::ZERO;
+        if !shadow.accel.unoccluded(
+            &Ray {
+                o: offset_origin(sp, d),
+                d,
+            },
+            shadow_t_max(dist[k]),
+        ) {
+            [or[k], og[k], ob[k]] = [0.0; 3];
         }
     }
 }
@@ -678,12 +722,12 @@ pub(crate) struct FramesScratch {
     /// Whether each frame's path still runs (it stops where a ray meets a light).
     alive: Vec<bool>,
     /// Each frame's next-event estimate at the current vertex.
-    nee: Vec<Vec3>,
+    nee: Columns,
     /// Each light's next-event term; those of the lights that do not move hold for every frame.
     terms: Vec<Vec3>,
     /// The moving light's samples and terms in every frame, and their scratch columns.
     samples: LightSamples,
-    moving_terms: Vec<Vec3>,
+    moving_terms: Columns,
     term_scratch: TermScratch,
 }
 
@@ -714,12 +758,15 @@ pub(crate) fn radiance_frames(
     rng: &mut Pcg32,
     max_depth: u32,
     scratch: &mut FramesScratch,
-    out: &mut [Vec3],
+    out: &mut Columns,
     rays: &mut RayCount,
     mut first: FirstBounce,
 ) {
     let n = lights.len();
-    out[..n].fill(Vec3::ZERO);
+    resize_columns(out, n);
+    for c in out.iter_mut() {
+        c.fill(0.0);
+    }
     scratch.alive.clear();
     scratch.alive.resize(n, true);
     let mut beta = Vec3::ONE;
@@ -746,7 +793,10 @@ pub(crate) fn radiance_frames(
                 } else {
                     power_heuristic(prev_pdf, hit.pdf)
                 };
-                out[k] += beta * hit.radiance * w;
+                let add = beta * hit.radiance * w;
+                for (c, a) in out.iter_mut().zip(add.to_array()) {
+                    c[k] += a;
+                }
                 alive[k] = false;
             }
         });
@@ -758,8 +808,14 @@ pub(crate) fn radiance_frames(
         }
         if !sp.bsdf.is_delta() {
             next_event_frames(lights, shadow, sp, rng, scratch, rays);
-            for k in (0..n).filter(|&k| scratch.alive[k]) {
-                out[k] += beta * scratch.nee[k];
+            // out += β · nee in the live frames, a channel at a time in lanes.
+            let alive = &scratch.alive[..n];
+            for ((o, e), b) in out.iter_mut().zip(&scratch.nee).zip(beta.to_array()) {
+                let (o, e) = (&mut o[..n], &e[..n]);
+                for k in 0..n {
+                    let sum = o[k] + b * e[k];
+                    o[k] = if alive[k] { sum } else { o[k] };
+                }
             }
         }
         let last = depth + 1 >= max_depth;
@@ -854,7 +910,8 @@ pub(crate) fn radiance_frames(
     }
 }
 
-/// Next-event estimation at `sp` in every live frame into `scratch.nee`: one sample of every
+/// Next-event estimation at `sp` in every live frame into `scratch.nee` (by channel; what it
+/// holds for frames no longer alive is not read): one sample of every
 /// light (two numbers per light from `rng`, whatever its place), each weighted against BSDF
 /// sampling by the power heuristic (delta lights take weight 1), summed in the lights' order.
 #[inline(always)]
@@ -888,17 +945,19 @@ fn next_event_frames(
             light_term(shadow, sp, &bsdf, light.sample(sp.p, u), rays)
         });
     }
-    nee.clear();
-    nee.resize(n, Vec3::ZERO);
+    resize_columns(nee, n);
     let (Some(m), Some(u)) = (moving, moving_u) else {
-        nee.fill(terms.iter().fold(Vec3::ZERO, |l, t| l + *t));
+        let sum = terms.iter().fold(Vec3::ZERO, |l, t| l + *t);
+        for (c, v) in nee.iter_mut().zip(sum.to_array()) {
+            c.fill(v);
+        }
         return;
     };
     match lights.sphere() {
         Some(s) => samples.sample_sphere(sp.p, &s.centers, s.radius, s.radiance, &u),
         None => samples.sample_each(sp.p, lights.moving_places(m), &u),
     }
-    moving_terms.resize(n, Vec3::ZERO);
+    resize_columns(moving_terms, n);
     light_terms(
         shadow,
         sp,
@@ -912,11 +971,19 @@ fn next_event_frames(
     // Σ_j terms[j] in the lights' order with the moving light's term at j = m: the sum of the
     // terms before it is the same in every frame, so it is formed once; the same additions in
     // the same order as summing each frame from scratch, hence the same bits.
+    // Each channel is summed on its own (as `Vec3` addition does), one light at a time over
+    // the frames in lanes. Frames no longer alive get a sum too, which nothing reads.
     let before = terms[..m].iter().fold(Vec3::ZERO, |l, t| l + *t);
     let after = &terms[m + 1..];
-    let (nee, alive, moving_terms) = (&mut nee[..n], &alive[..n], &moving_terms[..n]);
-    for k in 0..n {
-        let l = after.iter().fold(before + moving_terms[k], |l, t| l + *t);
-        nee[k] = if alive[k] { l } else { nee[k] };
+    for (c, (e, t)) in nee.iter_mut().zip(moving_terms.iter()).enumerate() {
+        let (e, t) = (&mut e[..n], &t[..n]);
+        for k in 0..n {
+            e[k] = before[c] + t[k];
+        }
+        for a in after {
+            for e in e.iter_mut() {
+                *e += a[c];
+            }
+        }
     }
 }

@@ -461,8 +461,9 @@ pub struct LightSamples {
     pub dist: Vec<f32>,
     /// Solid-angle density (1 for delta lights); 0 where there is no sample.
     pub pdf: Vec<f32>,
-    /// Incident radiance of each sample (irradiance at normal incidence for delta lights).
-    pub li: Vec<Vec3>,
+    /// Incident radiance of each sample (irradiance at normal incidence for delta lights), by
+    /// channel.
+    pub li: [Vec<f32>; 3],
     /// Whether the light is a delta light (the same in every place).
     pub is_delta: bool,
 }
@@ -479,10 +480,11 @@ impl LightSamples {
     }
 
     fn resize(&mut self, n: usize) {
-        for c in self.wi.iter_mut().chain([&mut self.dist, &mut self.pdf]) {
+        for c in self.wi.iter_mut().chain(&mut self.li) {
             c.resize(n, 0.0);
         }
-        self.li.resize(n, Vec3::ZERO);
+        self.dist.resize(n, 0.0);
+        self.pdf.resize(n, 0.0);
     }
 
     /// Samples the sphere of radius `radius` and radiance `radiance` centred at `centers[k]` (by
@@ -499,7 +501,9 @@ impl LightSamples {
         let n = centers[0].len();
         self.resize(n);
         self.is_delta = false;
-        self.li.fill(radiance);
+        for (c, v) in self.li.iter_mut().zip(radiance.to_array()) {
+            c.fill(v);
+        }
         let [cx, cy, cz] = centers;
         let (cx, cy, cz) = (&cx[..n], &cy[..n], &cz[..n]);
         let [wx, wy, wz] = &mut self.wi;
@@ -538,7 +542,10 @@ impl LightSamples {
             for (c, v) in self.wi.iter_mut().zip(s.wi.to_array()) {
                 c[k] = v;
             }
-            (self.dist[k], self.pdf[k], self.li[k]) = (s.dist, s.pdf, s.li);
+            for (c, v) in self.li.iter_mut().zip(s.li.to_array()) {
+                c[k] = v;
+            }
+            (self.dist[k], self.pdf[k]) = (s.dist, s.pdf);
         }
     }
 
@@ -548,7 +555,7 @@ impl LightSamples {
         (self.pdf[k] != 0.0).then(|| LightSample {
             wi: Vec3::new(self.wi[0][k], self.wi[1][k], self.wi[2][k]),
             dist: self.dist[k],
-            li: self.li[k],
+            li: Vec3::new(self.li[0][k], self.li[1][k], self.li[2][k]),
             pdf: self.pdf[k],
             is_delta: self.is_delta,
         })

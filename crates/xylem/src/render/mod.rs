@@ -18,7 +18,7 @@ mod sampler;
 pub mod wide_bvh;
 
 pub use camera::{Camera, CameraRays, Projection};
-pub(crate) use film::RadianceSum;
+pub(crate) use film::FrameSums;
 pub use film::{Aov, Filter, Image, PixelSum};
 pub use frames::LightFrames;
 pub use geometry::{Accel, Instance, Ray, Transform, TriMesh};
@@ -516,9 +516,10 @@ fn render_tile_in(
     let max_depth = settings.integrator.max_depth();
     // Pixel-major (pixel i, frame k at i·frames + k): a pixel's samples update one contiguous
     // run of sums instead of one cache line in each of `frames` arrays.
-    let mut sums = vec![RadianceSum::default(); n * frames];
+    let mut sums = FrameSums::new(n, frames);
     let mut aov_sums = vec![PixelSum::default(); n];
-    let mut radiance = vec![Vec3::ZERO; frames];
+    // Each frame's radiance of the sample at hand, by channel ([`integrator::Columns`]).
+    let mut radiance = integrator::Columns::default();
     let mut scratch = FramesScratch::default();
     let mut rays = RayCount::default();
     let fp_scale = integrator::footprint_scale(settings.spp);
@@ -579,15 +580,13 @@ fn render_tile_in(
             if let Primary::Keep = primary {
                 kept.push(KeptSample { primary: *ps, next });
             }
-            for (sum, l) in sums[i * frames..(i + 1) * frames].iter_mut().zip(&radiance) {
-                sum.add(*l);
-            }
+            sums.add(i, &radiance);
             aov_sums[i].add(Vec3::ZERO, &ps.aov);
         }
     }
     let aov = Image::from_sums(tw, th, &aov_sums).aov;
     let frames = (0..frames)
-        .map(|k| Image::from_radiance(tw, th, sums.iter().skip(k).step_by(frames)))
+        .map(|k| Image::from_radiance(tw, th, sums.frame(k)))
         .collect();
     TileFrames {
         aov,

@@ -4,7 +4,7 @@
 
 use super::super::fiber::{FiberAtWo, FiberAxis, BATCH};
 use super::super::fresnel::refract_in;
-use super::{About, LobeProbs, RoughView, WoodBsdf};
+use super::{finite_nonnegative, finite_or_zero, About, LobeProbs, RoughView, WoodBsdf};
 use glam::Vec3;
 
 /// [`WoodBsdf`]'s `eval` and `pdf` for one fixed `wo`, with what depends on `wo` alone — its
@@ -74,32 +74,70 @@ impl WoodAtWo<'_> {
     }
 
     /// [`WoodAtWo::eval_pdf`] of every `wi[k]` into `f[k]`, `pdf[k]` (`f`, `pdf` as long as
-    /// `wi`): the same stages, each run over `BATCH` directions at a time ([`FiberAxis::
-    /// eval_pdf_many_at`] for the fibre lobes), so that the same values come out (tested) with
-    /// the arithmetic in SIMD lanes.
-    #[inline(always)]
+    /// `wi`): [`WoodAtWo::eval_pdf_lanes`] on columns copied [`BATCH`] directions at a time.
     pub fn eval_pdf_many(&self, wi: &[Vec3], with_pdf: bool, f: &mut [Vec3], pdf: &mut [f32]) {
         assert!(f.len() == wi.len() && pdf.len() == wi.len());
-        if self.rough.is_some() {
-            // Under a rough finish every direction has its own spreads: one at a time.
-            for k in 0..wi.len() {
-                (f[k], pdf[k]) = self.eval_pdf(wi[k], with_pdf);
-            }
-            return;
-        }
-        let (b, probs) = (self.bsdf, &self.probs);
-        let p = &b.params;
         for ((wi, f), pdf) in wi
             .chunks(BATCH)
             .zip(f.chunks_mut(BATCH))
             .zip(pdf.chunks_mut(BATCH))
         {
             let n = wi.len();
-            let mut wi_in = [Vec3::ZERO; BATCH];
-            for k in 0..n {
-                wi_in[k] = refract_in(wi[k], p.eta);
+            let (mut w, mut v) = ([[0.0; BATCH]; 3], [[0.0; BATCH]; 3]);
+            for (k, d) in wi.iter().enumerate() {
+                [w[0][k], w[1][k], w[2][k]] = d.to_array();
             }
-            let wi_in = &wi_in[..n];
+            let [vx, vy, vz] = &mut v;
+            self.eval_pdf_lanes(
+                [&w[0][..n], &w[1][..n], &w[2][..n]],
+                with_pdf,
+                [&mut vx[..n], &mut vy[..n], &mut vz[..n]],
+                pdf,
+            );
+            for (k, f) in f.iter_mut().enumerate() {
+                *f = Vec3::new(v[0][k], v[1][k], v[2][k]);
+            }
+        }
+    }
+
+    /// [`WoodAtWo::eval_pdf`] of the directions whose components are `wi[0][k]`, `wi[1][k]`,
+    /// `wi[2][k]` (columns: structure of arrays, one lane per direction) into the colour columns
+    /// `f[c][k]` and `pdf[k]` (all as long as `pdf`): the same stages, each a loop over
+    /// [`BATCH`] directions at a time ([`FiberAxis::eval_pdf_many_at`] for the fibre lobes), so
+    /// that the same values come out (tested) with the arithmetic in SIMD lanes. Under a rough
+    /// finish every direction has its own spreads, and they are taken one at a time.
+    #[inline(always)]
+    pub fn eval_pdf_lanes(
+        &self,
+        wi: [&[f32]; 3],
+        with_pdf: bool,
+        f: [&mut [f32]; 3],
+        pdf: &mut [f32],
+    ) {
+        let n = pdf.len();
+        let [wx, wy, wz] = wi;
+        let [fr, fg, fb] = f;
+        let (wx, wy, wz) = (&wx[..n], &wy[..n], &wz[..n]);
+        let (fr, fg, fb) = (&mut fr[..n], &mut fg[..n], &mut fb[..n]);
+        if self.rough.is_some() {
+            for k in 0..n {
+                let (v, p) = self.eval_pdf(Vec3::new(wx[k], wy[k], wz[k]), with_pdf);
+                [fr[k], fg[k], fb[k], pdf[k]] = [v.x, v.y, v.z, p];
+            }
+            return;
+        }
+        let (b, probs) = (self.bsdf, &self.probs);
+        let p = &b.params;
+        for start in (0..n).step_by(BATCH) {
+            let m = BATCH.min(n - start);
+            let lanes = start..start + m;
+            let (x, y, z) = (&wx[lanes.clone()], &wy[lanes.clone()], &wz[lanes.clone()]);
+            let mut wi_in = [[0.0; BATCH]; 3];
+            for k in 0..m {
+                let w = refract_in(Vec3::new(x[k], y[k], z[k]), p.eta);
+                [wi_in[0][k], wi_in[1][k], wi_in[2][k]] = w.to_array();
+            }
+            let wi_in = [&wi_in[0][..m], &wi_in[1][..m], &wi_in[2][..m]];
             let (f_fib, p_fib) = self.lobe_many(
                 &b.fiber,
                 &self.fiber,
@@ -116,27 +154,26 @@ impl WoodAtWo<'_> {
                 p.ray_mask > 0.0,
                 probs.ray > 0.0,
             );
-            let mut t = [0.0; BATCH];
-            for k in 0..n {
-                t[k] = self.transmission(wi[k].z);
-            }
-            for k in 0..n {
-                let above = self.wo.z > 0.0 && wi[k].z > 0.0;
-                f[k] = self.value(wi[k], t[k], f_fib[k], f_ray[k]);
-                pdf[k] = if with_pdf {
-                    self.density(wi[k], wi_in[k], p_fib[k], p_ray[k])
-                } else {
-                    0.0
-                };
-                if !above {
-                    (f[k], pdf[k]) = (Vec3::ZERO, 0.0);
-                }
+            let (fr, fg, fb, pdf) = (
+                &mut fr[lanes.clone()],
+                &mut fg[lanes.clone()],
+                &mut fb[lanes.clone()],
+                &mut pdf[lanes],
+            );
+            for k in 0..m {
+                let above = (self.wo.z > 0.0) & (z[k] > 0.0);
+                let t = self.transmission_from(b.smooth_transmittance(z[k]));
+                let v = finite_nonnegative(b.blend(f_fib[k], f_ray[k]) * t);
+                let d = b.substrate_density(probs, z[k], wi_in[2][k], p_fib[k], p_ray[k]);
+                let d = if with_pdf { finite_or_zero(d) } else { 0.0 };
+                let (v, d) = if above { (v, d) } else { (Vec3::ZERO, 0.0) };
+                [fr[k], fg[k], fb[k], pdf[k]] = [v.x, v.y, v.z, d];
             }
         }
     }
 
-    /// One fibre lobe (`axis`, seen from `at`) at up to [`BATCH`] interior directions, its
-    /// values and densities, or zeros where neither is needed (`in_f`: the lobe is in f;
+    /// One fibre lobe (`axis`, seen from `at`) at up to [`BATCH`] interior directions (columns),
+    /// its values and densities, or zeros where neither is needed (`in_f`: the lobe is in f;
     /// `in_pdf`: it is sampled). A method rather than a closure so that it inlines into the
     /// caller's SIMD level.
     #[allow(clippy::too_many_arguments)]
@@ -145,7 +182,7 @@ impl WoodAtWo<'_> {
         &self,
         axis: &FiberAxis,
         at: &FiberAtWo,
-        wi_in: &[Vec3],
+        wi_in: [&[f32]; 3],
         with_pdf: bool,
         in_f: bool,
         in_pdf: bool,
@@ -162,8 +199,13 @@ impl WoodAtWo<'_> {
     /// T(θo) T(θi) / η², the finish's share of f (notes/bsdf.md eq. 1.4) for cos θi = `wi_z`.
     #[inline(always)]
     fn transmission(&self, wi_z: f32) -> f32 {
-        let b = self.bsdf;
-        self.t_o * b.transmittance(wi_z) * b.inv_eta2
+        self.transmission_from(self.bsdf.transmittance(wi_z))
+    }
+
+    /// [`WoodAtWo::transmission`] from T(θi) = `t_i`.
+    #[inline(always)]
+    fn transmission_from(&self, t_i: f32) -> f32 {
+        self.t_o * t_i * self.bsdf.inv_eta2
     }
 
     /// f from the finish's [`WoodAtWo::transmission`] `t` and the fibre and ray lobes' values at
