@@ -74,7 +74,7 @@ impl WoodAtWo<'_> {
     }
 
     /// [`WoodAtWo::eval_pdf`] of every `wi[k]` into `f[k]`, `pdf[k]` (`f`, `pdf` as long as
-    /// `wi`): [`WoodAtWo::eval_pdf_lanes`] on columns copied [`BATCH`] directions at a time.
+    /// `wi`): [`WoodAtWo::eval_pdf_lanes`] on columns copied `BATCH` directions at a time.
     pub fn eval_pdf_many(&self, wi: &[Vec3], with_pdf: bool, f: &mut [Vec3], pdf: &mut [f32]) {
         assert!(f.len() == wi.len() && pdf.len() == wi.len());
         for ((wi, f), pdf) in wi
@@ -103,7 +103,7 @@ impl WoodAtWo<'_> {
     /// [`WoodAtWo::eval_pdf`] of the directions whose components are `wi[0][k]`, `wi[1][k]`,
     /// `wi[2][k]` (columns: structure of arrays, one lane per direction) into the colour columns
     /// `f[c][k]` and `pdf[k]` (all as long as `pdf`): the same stages, each a loop over
-    /// [`BATCH`] directions at a time ([`FiberAxis::eval_pdf_many_at`] for the fibre lobes), so
+    /// `BATCH` directions at a time ([`FiberAxis::eval_pdf_many_at`] for the fibre lobes), so
     /// that the same values come out (tested) with the arithmetic in SIMD lanes. Under a rough
     /// finish every direction has its own spreads, and they are taken one at a time.
     #[inline(always)]
@@ -172,7 +172,7 @@ impl WoodAtWo<'_> {
         }
     }
 
-    /// One fibre lobe (`axis`, seen from `at`) at up to [`BATCH`] interior directions (columns),
+    /// One fibre lobe (`axis`, seen from `at`) at up to `BATCH` interior directions (columns),
     /// its values and densities, or zeros where neither is needed (`in_f`: the lobe is in f;
     /// `in_pdf`: it is sampled). A method rather than a closure so that it inlines into the
     /// caller's SIMD level.
