@@ -8,19 +8,19 @@
 //! - `radiance_frames`: the path from there, its light-dependent terms per frame.
 //!
 //! Each part draws its numbers from (seed, pixel, sample) alone — the camera from a scrambled
-//! Sobol point (`sampler::pixel_sample`), the lighting from its own random stream (`sampler::sample_rng`) — so a
-//! frame rendered with others equals the frame rendered alone bit for bit.
+//! Sobol point (`sampler::pixel_sample`), the path from one per role (`sampler::PathNumbers`) —
+//! so a frame rendered with others equals the frame rendered alone bit for bit.
 
 use super::camera::CameraRays;
 use super::film::Aov;
 use super::frames::LightFrames;
 use super::geometry::{segment_misses_box, slab_misses, Accel, Hit, Ray};
 use super::light::{LightSample, LightSamples, LightU};
-use super::sampler::{pixel_sample, sample_rng};
+use super::sampler::{pixel_sample, PathNumbers};
 use super::Scene;
 use crate::bsdf::{Bsdf, WoodAtWo};
 use crate::material::{MaterialHit, SurfaceBsdf};
-use crate::math::{power_heuristic, Frame, Pcg32};
+use crate::math::{power_heuristic, Frame};
 use glam::{Mat3, UVec2, Vec2, Vec3, Vec3A};
 
 /// Which light transport to simulate.
@@ -265,10 +265,10 @@ pub(crate) fn primary_sample_into(
     }
 }
 
-/// The lighting random stream of a sample ([`sample_rng`](super::sampler::sample_rng)).
-pub(crate) fn light_rng(scene: &Scene, pixel: UVec2, sample: u32, seed: u64) -> Pcg32 {
+/// The path numbers of a sample ([`PathNumbers`]).
+pub(crate) fn path_numbers(scene: &Scene, pixel: UVec2, sample: u32, seed: u64) -> PathNumbers {
     let index = pixel.y as u64 * scene.camera.width as u64 + pixel.x as u64;
-    sample_rng(seed, index, sample)
+    PathNumbers::new(seed, index, sample)
 }
 
 /// Origin of a ray leaving `sp` along `dir`: the hit point moved `eps` along the geometric
@@ -697,7 +697,6 @@ pub(crate) struct Continuation {
     ray: Ray,
     t_hit: f32,
     hit: Option<Hit>,
-    rng: Pcg32,
 }
 
 /// One pixel sample kept for later passes: its primary sample and its first bounce's
@@ -738,7 +737,7 @@ pub(crate) struct FramesScratch {
 /// lighting is the path of one bounce.
 ///
 /// The frames share everything but the lights, so the path — its rays, hits, BSDF samples and
-/// roulette, all drawn from `rng` the same way whatever the lights — is traced once; per frame
+/// roulette, all drawn from `numbers` by role whatever the lights — is traced once; per frame
 /// only the emission a ray meets (which also ends that frame's path) and the next-event terms
 /// are worked out: the fixed lights' terms once, the moving light's for all frames at once,
 /// frames in SIMD lanes ([`light_terms`]). Each frame sums its terms in the lights' order, so
@@ -755,7 +754,7 @@ pub(crate) fn radiance_frames(
     lights: &LightFrames,
     shadow: &ShadowTest,
     ps: &PrimarySample,
-    rng: &mut Pcg32,
+    numbers: &PathNumbers,
     max_depth: u32,
     scratch: &mut FramesScratch,
     out: &mut Columns,
@@ -807,7 +806,7 @@ pub(crate) fn radiance_frames(
             break;
         }
         if !sp.bsdf.is_delta() {
-            next_event_frames(lights, shadow, sp, rng, scratch, rays);
+            next_event_frames(lights, shadow, sp, numbers, depth, scratch, rays);
             // out += β · nee in the live frames, a channel at a time in lanes.
             let alive = &scratch.alive[..n];
             for ((o, e), b) in out.iter_mut().zip(&scratch.nee).zip(beta.to_array()) {
@@ -827,7 +826,7 @@ pub(crate) fn radiance_frames(
             let Some(c) = kept else { break };
             (beta, eta_scale, prev_pdf, specular, depth) =
                 (c.beta, c.eta_scale, c.prev_pdf, c.specular, 1);
-            (ray, t_hit, *rng) = (c.ray, c.t_hit, c.rng.clone());
+            (ray, t_hit) = (c.ray, c.t_hit);
             at_first = false;
             match c.hit {
                 Some(h) if !last => shading_point(
@@ -841,8 +840,8 @@ pub(crate) fn radiance_frames(
             }
             continue;
         }
-        let uc = rng.next_f32();
-        let u = rng.next_vec2();
+        let [u0, u1, uc, u_roulette] = numbers.bounce(depth);
+        let u = Vec2::new(u0, u1);
         if last && !lights.hittable() && !keeping {
             // The continuation could only collect emission, and no ray meets a delta light.
             break;
@@ -860,7 +859,7 @@ pub(crate) fn radiance_frames(
         depth += 1;
         if depth >= 3 {
             let q = survival(beta, eta_scale);
-            if rng.next_f32() >= q {
+            if u_roulette >= q {
                 break;
             }
             beta /= q;
@@ -886,7 +885,6 @@ pub(crate) fn radiance_frames(
                 ray,
                 t_hit: hit.map_or(f32::INFINITY, |h| h.t),
                 hit,
-                rng: rng.clone(),
             });
             if last && !lights.hittable() {
                 break;
@@ -912,14 +910,15 @@ pub(crate) fn radiance_frames(
 
 /// Next-event estimation at `sp` in every live frame into `scratch.nee` (by channel; what it
 /// holds for frames no longer alive is not read): one sample of every
-/// light (two numbers per light from `rng`, whatever its place), each weighted against BSDF
+/// light (its two numbers from `numbers`, whatever the light's place), each weighted against BSDF
 /// sampling by the power heuristic (delta lights take weight 1), summed in the lights' order.
 #[inline(always)]
 fn next_event_frames(
     lights: &LightFrames,
     shadow: &ShadowTest,
     sp: &ShadingPoint,
-    rng: &mut Pcg32,
+    numbers: &PathNumbers,
+    depth: u32,
     scratch: &mut FramesScratch,
     rays: &mut RayCount,
 ) {
@@ -937,7 +936,7 @@ fn next_event_frames(
     let mut moving_u = None;
     terms.clear();
     for (j, light) in lights.first().iter().enumerate() {
-        let u = rng.next_vec2();
+        let u = Vec2::from(numbers.light(depth, j));
         terms.push(if Some(j) == moving {
             moving_u = Some(LightU::new(u));
             Vec3::ZERO

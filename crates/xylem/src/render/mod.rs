@@ -22,7 +22,7 @@ pub(crate) use film::FrameSums;
 pub use film::{Aov, Filter, Image, PixelSum};
 pub use frames::LightFrames;
 pub use geometry::{Accel, Instance, Ray, Transform, TriMesh};
-pub(crate) use integrator::light_rng;
+pub(crate) use integrator::path_numbers;
 pub use integrator::{primary_sample, Integrator, ShadingPoint};
 pub use light::{
     DistantLight, EnvMap, Environment, Light, PointLight, RectLight, SphereLight, SpotLight,
@@ -564,13 +564,13 @@ fn render_tile_in(
                 (Primary::Keep, _) => FirstBounce::Keep(&mut next),
                 _ => FirstBounce::Trace,
             };
-            let mut rng = light_rng(scene, pixel, s, settings.seed);
+            let numbers = path_numbers(scene, pixel, s, settings.seed);
             radiance_frames(
                 scene,
                 lights,
                 shadow,
                 ps,
-                &mut rng,
+                &numbers,
                 max_depth,
                 &mut scratch,
                 &mut radiance,
