@@ -267,8 +267,10 @@ def mitsuba_bsdf(m):
     raise ValueError(f"no Mitsuba equivalent for material type {m['type']!r}")
 
 
-def mitsuba_dict(mi, case, meshes, max_depth, spp, seed, res=None, rr_depth=5):
-    """The case as a Mitsuba 3 scene dictionary; `max_depth` in xylem's counting (+1 here)."""
+def mitsuba_dict(mi, case, meshes, max_depth, spp, seed, res=None, rr_depth=5,
+                 sampler="independent"):
+    """The case as a Mitsuba 3 scene dictionary; `max_depth` in xylem's counting (+1 here),
+    `sampler` the name of Mitsuba's sampler plugin."""
     w, h = res or case["res"]
     cam = case["camera"]
     scene = {
@@ -280,7 +282,7 @@ def mitsuba_dict(mi, case, meshes, max_depth, spp, seed, res=None, rr_depth=5):
                                                        up=cam["up"]),
             "film": {"type": "hdrfilm", "width": w, "height": h, "pixel_format": "rgb",
                      "component_format": "float32", "rfilter": {"type": "box"}},
-            "sampler": {"type": "independent", "sample_count": spp, "seed": seed},
+            "sampler": {"type": sampler, "sample_count": spp, "seed": seed},
         },
     }
     for i, light in enumerate(case["lights"]):

@@ -45,6 +45,9 @@ def add_arguments(ap):
     g.add_argument("--xylem-seconds", type=float, default=None,
                    help="its render time (s), for samples/s and RMSE at equal time")
     g.add_argument("--xylem-spp", type=int, default=None, help="its spp (default --spp)")
+    g.add_argument("--sampler", default="independent",
+                   choices=["independent", "multijitter", "orthogonal", "ldsampler", "stratified"],
+                   help="Mitsuba's sampler of the timed render (its default: independent)")
     g.add_argument("--serve", action="store_true",
                    help="time one render per `render` line on stdin, then score (see above)")
 
@@ -95,7 +98,8 @@ def run(mi, args):
     ref, ref_path = reference(mi, args.work, meshes, args.reference_spp)
     t0 = time.perf_counter()
     scene = mi.load_dict(scenes.mitsuba_dict(mi, scenes.cornell_lambertian(), meshes, DEPTH,
-                                             args.spp, 1, RES, rr_depth=RR_DEPTH))
+                                             args.spp, 1, RES, rr_depth=RR_DEPTH,
+                                             sampler=args.sampler))
     load_s = time.perf_counter() - t0
     def timed():
         t0 = time.perf_counter()
@@ -128,7 +132,8 @@ def run(mi, args):
     img = np.array(img, dtype=np.float64)[..., :3]
     samples = RES[0] * RES[1] * args.spp
     sec = float(np.median(times))
-    m = {"renderer": f"Mitsuba {mi.__version__} {mi.variant()}", "threads": args.threads,
+    m = {"renderer": f"Mitsuba {mi.__version__} {mi.variant()}", "sampler": args.sampler,
+         "threads": args.threads,
          "spp": args.spp, "seconds": sec, "seconds_range": [min(times), max(times)],
          "repeats": len(times), "first_render_s": first, "load_s": load_s,
          "samples_per_s": samples / sec, "rmse": rmse(img, ref),
@@ -163,7 +168,8 @@ def run(mi, args):
 def table(out):
     lines = [f"Cornell box {out['res'][0]}x{out['res'][1]}, xylem depth {out['xylem_depth']} "
              f"(Mitsuba {out['mitsuba_depth']}, rr_depth {out['mitsuba_rr_depth']} = xylem's "
-             f"roulette start), reference {out['reference']} "
+             f"roulette start), Mitsuba sampler {out['mitsuba'].get('sampler', 'independent')}, "
+             f"reference {out['reference']} "
              f"({out['reference_spp']} spp Mitsuba)",
              f"{'renderer':<28} {'spp':>5} {'seconds (min-max)':>20} {'Msamples/s':>11} {'RMSE':>9} "
              f"{'RMSE@equal time':>16} {'RMSE surfaces':>14} {'@equal time':>12}"]

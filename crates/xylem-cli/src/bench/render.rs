@@ -39,6 +39,11 @@ pub struct Args {
     /// Timed renders of each renderer, 1 to 100, interleaved.
     #[arg(long, default_value_t = 5)]
     repeats: u32,
+    /// Mitsuba's sampler for the timed renders: `independent` (its default) or one of its
+    /// stratified ones (`multijitter`, `orthogonal`, `ldsampler`, `stratified`), to compare
+    /// with xylem's Owen-scrambled Sobol samples like with like.
+    #[arg(long, default_value = "independent", value_parser = ["independent", "multijitter", "orthogonal", "ldsampler", "stratified"])]
+    mitsuba_sampler: String,
 }
 
 /// Mitsuba's timing process (`python -m validation.crosscheck --timing --serve`): one timed
@@ -230,6 +235,7 @@ fn mitsuba_process(args: &Args) -> anyhow::Result<Option<Mitsuba>> {
         .args(["--threads", &args.threads.to_string()])
         .args(["--spp", &args.spp.to_string()])
         .args(["--reference-spp", &args.reference_spp.to_string()])
+        .args(["--sampler", &args.mitsuba_sampler])
         .current_dir(&repo);
     if std::env::var_os("DRJIT_LIBLLVM_PATH").is_none() {
         if let Some(p) = libllvm_19() {
