@@ -177,10 +177,11 @@ pub fn report_md(rows: &[Row], command: &str) -> (String, bool) {
          noise's share subtracted (measured from a second render of other seeds and from the \
          reference's two halves, so noise correlated between pixels comes off too). **Error at equal time**: net relative MSE × CPU seconds, filtered \
          over point-sampled (exact when the error is all noise). Goals: aliasing ≤ 0.3×, error at \
-         equal time ≤ 0.7×. All three take their pixel samples from the per-pixel scrambled \
-         Sobol sequence (since 2026-12-04; before, independent samples): the filter is compared \
-         with point sampling under the same stratification, and the gain of the stratification \
-         itself is in notes/render.md (\"Stratified pixel samples\").\n\n",
+         equal time ≤ 0.7×. All three take their film and path numbers from per-pixel scrambled \
+         Sobol points (since 2026-12-04; before, independent samples): the filter is compared \
+         with point sampling under the same stratification; the gain of the stratification \
+         itself, and these goals against the default the issue was filed against, are in \
+         notes/render.md (\"Stratified pixel samples\", \"Issue 28's goals measured\").\n\n",
     );
     md += &format!("Command: `{command}`\n\n");
     md += "| scene | size, spp (reference) | wood px | aliasing filtered | point | ratio | rel. MSE filtered | point | CPU s filtered | point | equal-time ratio |\n";
@@ -188,8 +189,13 @@ pub fn report_md(rows: &[Row], command: &str) -> (String, bool) {
     let mut ok = true;
     for r in rows {
         let (a, e) = (r.aliasing_ratio(), r.equal_time_ratio());
-        let meets = a <= 0.3 && e <= 0.7;
-        ok &= meets;
+        let missed = match (a <= 0.3, e <= 0.7) {
+            (true, true) => "",
+            (false, true) => " (aliasing goal missed)",
+            (true, false) => " (time goal missed)",
+            (false, false) => " (both goals missed)",
+        };
+        ok &= missed.is_empty();
         md += &format!(
             "| `{}` | {}×{}, {} ({}) | {} | {:.2e} | {:.2e} | {:.2} | {:.2e} | {:.2e} | {:.2} | {:.2} | {:.2}{} |\n",
             r.scene,
@@ -206,7 +212,7 @@ pub fn report_md(rows: &[Row], command: &str) -> (String, bool) {
             r.cpu[0],
             r.cpu[1],
             e,
-            if meets { "" } else { " (missed)" }
+            missed
         );
     }
     md +=
