@@ -8,11 +8,12 @@ megakernel and is differentiable.
     xylem.mitsuba.register()           # registers xylem_wood and xylem_wood_baked
     bsdf = mi.load_dict({"type": "xylem_wood_baked", "maps": "out/walnut", "eta": 1.5})
 
-``maps`` is the folder of a ``xylem bake PRESET --out DIR`` (checked on a board face; a
-``--mesh`` bake has the same maps, and Mitsuba's OBJ loader flips v as xylem's reader does, so
-si.uv is the bake's uv, but no mesh bake has been rendered through this plugin): the plugin reads ``base_color.exr``, ``fiber_color.exr``, ``fiber_direction.exr``
-(the signed tangent-space fibre axis), ``highlight_width.exr`` (beta, radians) and
-``ray_mask.exr`` into one 12-channel ``mi.Texture2f`` (bilinear, clamped at the edges, texel
+``maps`` is the folder of a ``xylem bake PRESET --out DIR``, of a board or of a ``--mesh``
+(an OBJ with ``vt`` whose same file Mitsuba loads: its OBJ loader flips v as xylem's reader
+does, so si.uv is the bake's uv): the plugin reads ``base_color.exr``, ``fiber_color.exr``,
+``fiber_direction.exr`` and ``ray_direction.exr`` (the signed tangent-space fibre and ray
+axes), ``highlight_width.exr`` (beta, radians) and ``ray_mask.exr`` into one 14-channel
+``mi.Texture2f`` (bilinear, clamped at the edges, texel
 centres at (i + 1/2)/W as xylem's own ``BakedMaps::lookup``; one texture, so a lookup computes
 its taps once) and looks them up at ``si.uv`` (texel (0, 0) is the image's top-left, v runs
 down the rows, as glTF and the bake write them). ``eta`` is the finish's index (1-4,
@@ -40,14 +41,15 @@ defines it; where ``dp/du`` is unset (a zero-initialised interaction, as
 
 Unlike ``xylem_wood`` it needs no ``evaluated()`` mode, leaves other scenes renderable, and
 is differentiable by Dr.Jit's AD (directions, uv and the maps, which ``mi.traverse`` lists as
-``maps``: an (H, W, 12) tensor of base colour, beta, fibre colour, ray mask, fibre direction
-and a zero channel).
+``maps``: an (H, W, 14) tensor of base colour, beta, fibre colour, ray mask, fibre direction
+and ray direction).
 
 What it approximates compared with the solid wood of ``xylem_wood``: the wood is sampled at the
 texel centres and interpolated bilinearly (at ``--res 1024`` on a 300 mm board, 0.29 mm
-texels; pores and ray flecks narrower than that blur); the ray axis is taken in the face
-across the fibre (the volume knows the radial direction); no pore bump (the normal map is not
-read). ``BSDFContext`` masks are honoured per component (0: the diffuse and fibre lobes and
+texels; pores and ray flecks narrower than that blur); the tangent frame is Mitsuba's per
+triangle (dp/du, dp/dv) where the bake interpolated vertex tangents; a bake without
+``ray_direction.exr`` gets the ray axis in the face across the fibre; no pore bump (the normal
+map is not read). ``BSDFContext`` masks are honoured per component (0: the diffuse and fibre lobes and
 a rough finish's reflection, 1: a smooth finish's mirror), with the lobe probabilities
 renormalised over what is enabled.
 """
@@ -74,14 +76,17 @@ _GL_X, _GL_W = np.polynomial.legendre.leggauss(12)
 
 
 def _maps(folder):
-    """The bake's maps (float32 EXRs) as one (H, W, 12) array: base colour, beta, fibre colour,
-    ray mask, fibre direction, 0."""
+    """The bake's maps (float32 EXRs) as one (H, W, 14) array: base colour, beta, fibre colour,
+    ray mask, fibre direction, ray direction (zeros where the bake has no ``ray_direction.exr``,
+    as bakes before it had none: the in-face axis is used then)."""
     import mitsuba as mi
 
     folder = pathlib.Path(folder)
 
-    def read(name, channels):
+    def read(name, channels, optional=False):
         path = folder / f"{name}.exr"
+        if optional and not path.exists():
+            return None
         if not path.exists():
             raise FileNotFoundError(
                 f"xylem_wood_baked: {path} is missing (`maps` must be a `xylem bake` folder)"
@@ -94,10 +99,12 @@ def _maps(folder):
 
     layers = [read("base_color", 3), read("highlight_width", 1), read("fiber_color", 3),
               read("ray_mask", 1), read("fiber_direction", 3)]
+    ray = read("ray_direction", 3, optional=True)
+    layers.append(np.zeros_like(layers[0]) if ray is None else ray)
     shapes = {m.shape[:2] for m in layers}
     if len(shapes) != 1:
         raise ValueError(f"xylem_wood_baked: the maps in {folder} differ in size: {sorted(shapes)}")
-    return np.concatenate(layers + [np.zeros_like(layers[1])], 2)
+    return np.concatenate(layers, 2)
 
 
 def _albedo_table():
@@ -275,20 +282,27 @@ def bsdf_class(mi, dr):
         def __init__(self, bsdf, si, active):
             uv = si.uv
             v = bsdf._texture.eval(uv, active)
-            a, b, f = v[0:4], v[4:8], v[8:12]
+            a, b, f, g = v[0:4], v[4:8], v[8:11], v[11:14]
             # Clamped as material/baked.rs `BakedWoodMaterial::shade` clamps the lookup.
             self.diffuse = dr.clip(mi.Color3f(a[0], a[1], a[2]), 0.0, 1.0)
             self.fiber_color = dr.clip(mi.Color3f(b[0], b[1], b[2]), 0.0, 1.0)
             self.beta = dr.clip(a[3], 1e-3, 0.5 * math.pi)
             self.m = dr.clip(b[3], 0.0, 1.0)
             right, up = _frame_axes(mi, dr, si)
-            u = right * f[0] + up * f[1] + mi.Vector3f(0, 0, 1) * f[2]
-            fallback = dr.squared_norm(u) < 1e-12
-            self.u = dr.select(fallback, right, dr.normalize(u))
-            # The ray axis: in the face, across the fibre (face.rs: xylem's frame.t = n x s).
+
+            def axis(t):
+                return right * t[0] + up * t[1] + mi.Vector3f(0, 0, 1) * t[2]
+
+            u = axis(f)
+            self.u = dr.select(dr.squared_norm(u) < 1e-12, right, dr.normalize(u))
+            # The ray axis: the baked one (the volume's, as the solid wood's material.rs
+            # `WoodMaterial` gives it), else in the face across the fibre (face.rs: xylem's
+            # frame.t = n x s).
             s = mi.Vector3f(self.u.x, self.u.y, 0.0)
             s = dr.select(dr.squared_norm(s) > 1e-12, dr.normalize(s), mi.Vector3f(1, 0, 0))
-            self.r = mi.Vector3f(-s.y, s.x, 0.0)
+            r = axis(g)
+            self.r = dr.select(dr.squared_norm(r) < 1e-12, mi.Vector3f(-s.y, s.x, 0.0),
+                               dr.normalize(r))
             self.diffuse_eff = self._diffuse(bsdf)
 
         def _diffuse(self, bsdf):
@@ -343,7 +357,7 @@ def bsdf_class(mi, dr):
                 raise ValueError(
                     f"xylem_wood_baked: `roughness` = {self.roughness}: expected 0 (smooth) to 1")
             linear = dict(filter_mode=dr.FilterMode.Linear, wrap_mode=dr.WrapMode.Clamp)
-            # One 12-channel texture: a lookup computes its taps and weights once.
+            # One 14-channel texture: a lookup computes its taps and weights once.
             self._tensor = mi.TensorXf(_maps(self.maps))
             self._texture = mi.Texture2f(self._tensor, **linear)
             self._albedo = mi.Texture2f(mi.TensorXf(_albedo_table()[..., None]), **linear)
