@@ -368,9 +368,9 @@ def bsdf_class(mi, dr):
                 nodes = _xylem.rough_finish_nodes(self.roughness, eta)
                 table = np.concatenate([nodes["reflectance"][:, None], nodes["multiple"][:, None],
                                         nodes["transmission"]], 1).astype(np.float32)
-                # One row of texels, the mu nodes at their centres: linear filtering is the
+                # A 1D texture, the mu nodes at its texel centres: linear filtering is the
                 # tables' interpolation in sqrt(mu).
-                self._rough = mi.Texture2f(mi.TensorXf(table[None]), **linear)
+                self._rough = mi.Texture1f(mi.TensorXf(table), **linear)
                 self._ggx = mi.MicrofacetDistribution(mi.MicrofacetType.GGX, self.roughness,
                                                       True)
                 self._mu_nodes = table.shape[0]
@@ -409,7 +409,7 @@ def bsdf_class(mi, dr):
             sqrt(mu) between the tables' nodes (rough_finish.rs `locate`)."""
             n = self._mu_nodes
             x = dr.sqrt(dr.clip(mu, 0.0, 1.0)) * (n - 1)
-            v = self._rough.eval(mi.Point2f((x + 0.5) / n, 0.5))
+            v = self._rough.eval(mi.Point1f((x + 0.5) / n))
             mu = dr.clip(mu, 0.0, 1.0)
             refr = _refract_in(mi, dr, mi.Vector3f(dr.safe_sqrt(1.0 - mu * mu), 0.0, mu),
                                self.eta)
