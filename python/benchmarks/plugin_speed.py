@@ -24,6 +24,9 @@ Three renders per repeat, in turn:
 - ``xylem_wood_baked_rough``: the same with a rough finish (roughness 0.25, as
   ``roughplastic``'s alpha): xylem's energy-compensated GGX finish.
 
+Both baked cases use the plugin's pore bump at ``--bump`` (default 1, the plugin's default;
+0: the normal map is not read).
+
 Each case runs in its own Python process (a ``xylem_wood`` BSDF alive in a process makes every
 symbolic render there fail: Dr.Jit traces a symbolic call for every registered BSDF instance,
 so the plugin's symbolic-scope error fires even for a scene that does not use it), one process
@@ -77,7 +80,7 @@ def bake(exe, res, out):
     return out
 
 
-def scene(bsdf, res, spp, maps=None):
+def scene(bsdf, res, spp, maps=None, bump=1.0):
     T = mi.ScalarTransform4f
     return mi.load_dict({
         "type": "scene",
@@ -94,7 +97,8 @@ def scene(bsdf, res, spp, maps=None):
         "sky": {"type": "constant", "radiance": {"type": "rgb", "value": [0.2, 0.2, 0.25]}},
         "board": {"type": "rectangle", "to_world": T().scale([0.15, 0.15, 1.0]),
                   "bsdf": ({"type": "xylem_wood_baked", "maps": maps, "eta": 1.5,
-                            "roughness": 0.25 if bsdf.endswith("_rough") else 0.0}
+                            "roughness": 0.25 if bsdf.endswith("_rough") else 0.0,
+                            "bump": bump}
                            if bsdf.startswith("xylem_wood_baked") else dict(BSDFS[bsdf]))},
     })
 
@@ -127,6 +131,8 @@ def main():
                     "one into a temporary folder)")
     ap.add_argument("--bake-res", type=int, default=1024, help="texels along the board when "
                     "baking (default 1024)")
+    ap.add_argument("--bump", type=float, default=1.0, help="the baked cases' pore bump "
+                    "(default 1; 0 leaves the normal map unread)")
     ap.add_argument("--one", help=argparse.SUPPRESS)         # child process: this case only
     ap.add_argument("--seed", type=int, default=1, help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -140,7 +146,7 @@ def main():
         cases.append(("xylem_wood_before", "xylem_wood", True))
     if args.one:                                 # child: one warm-up, one timed render
         name, b, ev = next(c for c in cases if c[0] == args.one)
-        sc = scene(b, args.res, args.spp, args.maps)
+        sc = scene(b, args.res, args.spp, args.maps, args.bump)
         render(sc, 0, ev)
         if args.profile:
             prof = cProfile.Profile()
@@ -157,7 +163,8 @@ def main():
 
     def child(name, seed, profile=False):
         cmd = [sys.executable, __file__, "--one", name, "--seed", str(seed), "--res",
-               *map(str, args.res), "--spp", str(args.spp), "--maps", args.maps] + (
+               *map(str, args.res), "--spp", str(args.spp), "--maps", args.maps,
+               "--bump", str(args.bump)] + (
                    ["--profile"] if profile else [])
         env = dict(os.environ)
         if name == "xylem_wood_before":

@@ -18,7 +18,9 @@ centres at (i + 1/2)/W as xylem's own ``BakedMaps::lookup``; one texture, so a l
 its taps once) and looks them up at ``si.uv`` (texel (0, 0) is the image's top-left, v runs
 down the rows, as glTF and the bake write them). ``eta`` is the finish's index (1-4,
 default 1.5) and ``roughness`` its GGX roughness (0-1, default 0; below 1e-3 the finish is
-smooth, as in ``WoodBsdf``).
+smooth, as in ``WoodBsdf``). ``bump`` (0-100, default 1) scales the slope of the baked normal
+map (``normal.exr``, the pore bump at the strength xylem's ``bump = 1``; 0 leaves it unread):
+the BSDF is evaluated in a frame about the tilted normal, as xylem's solid wood is.
 
 The BSDF at a texel is xylem's ``WoodBsdf`` (crates/xylem/src/bsdf/wood.rs) for the parameters
 xylem's own baked-map material builds there (``material/face.rs`` ``face_shading``): the
@@ -48,8 +50,9 @@ What it approximates compared with the solid wood of ``xylem_wood``: the wood is
 texel centres and interpolated bilinearly (at ``--res 1024`` on a 300 mm board, 0.29 mm
 texels; pores and ray flecks narrower than that blur); the tangent frame is Mitsuba's per
 triangle (dp/du, dp/dv) where the bake interpolated vertex tangents; a bake without
-``ray_direction.exr`` gets the ray axis in the face across the fibre; no pore bump (the normal
-map is not read). ``BSDFContext`` masks are honoured per component (0: the diffuse and fibre lobes and
+``ray_direction.exr`` gets the ray axis in the face across the fibre; the pore bump is the
+baked normal map's, bilinear between texel centres (pores are about a texel wide at
+``--res 1024``), no mip maps. ``BSDFContext`` masks are honoured per component (0: the diffuse and fibre lobes and
 a rough finish's reflection, 1: a smooth finish's mirror), with the lobe probabilities
 renormalised over what is enabled.
 """
@@ -75,10 +78,11 @@ LUMINANCE = (0.2126, 0.7152, 0.0722)
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(12)
 
 
-def _maps(folder):
+def _maps(folder, normal):
     """The bake's maps (float32 EXRs) as one (H, W, 14) array: base colour, beta, fibre colour,
     ray mask, fibre direction, ray direction (zeros where the bake has no ``ray_direction.exr``,
-    as bakes before it had none: the in-face axis is used then)."""
+    as bakes before it had none: the in-face axis is used then); with `normal`, 17 channels, the
+    tangent-space normal last."""
     import mitsuba as mi
 
     folder = pathlib.Path(folder)
@@ -101,6 +105,8 @@ def _maps(folder):
               read("ray_mask", 1), read("fiber_direction", 3)]
     ray = read("ray_direction", 3, optional=True)
     layers.append(np.zeros_like(layers[0]) if ray is None else ray)
+    if normal:
+        layers.append(read("normal", 3))
     shapes = {m.shape[:2] for m in layers}
     if len(shapes) != 1:
         raise ValueError(f"xylem_wood_baked: the maps in {folder} differ in size: {sorted(shapes)}")
@@ -303,7 +309,25 @@ def bsdf_class(mi, dr):
             r = axis(g)
             self.r = dr.select(dr.squared_norm(r) < 1e-12, mi.Vector3f(-s.y, s.x, 0.0),
                                dr.normalize(r))
+            self.frame = None
+            if bsdf.bump > 0:
+                # The pore bump (Blinn 1978), as material.rs `WoodMaterial` tilts the normal:
+                # the baked tangent-space normal (-dh/dx, -dh/dy, 1) normalised, its slope scaled
+                # by `bump`; the BSDF is evaluated in a frame about it, the fibre and ray axes
+                # expressed there unprojected, as xylem's Frame::from_normal_tangent does.
+                n = v[14:17]
+                nb = axis((bsdf.bump * n[0], bsdf.bump * n[1], n[2]))
+                nb = dr.select(dr.squared_norm(nb) < 1e-12, mi.Vector3f(0, 0, 1), dr.normalize(nb))
+                self.frame = mi.Frame3f(nb)
+                self.u, self.r = self.frame.to_local(self.u), self.frame.to_local(self.r)
             self.diffuse_eff = self._diffuse(bsdf)
+
+        def local(self, w):
+            """A shading-frame direction in the BSDF's frame (the bumped one, if any)."""
+            return w if self.frame is None else self.frame.to_local(w)
+
+        def world(self, w):
+            return w if self.frame is None else self.frame.to_world(w)
 
         def _diffuse(self, bsdf):
             """rho'' = rho' / (1 - rho' F_int), rho' = s rho, s = min(1, min_c room_c / rho_c),
@@ -351,6 +375,10 @@ def bsdf_class(mi, dr):
             self.maps = str(props.get("maps"))
             self.eta = float(props.get("eta", 1.5))
             self.roughness = float(props.get("roughness", 0.0))
+            self.bump = float(props.get("bump", 1.0))
+            if not 0.0 <= self.bump <= 100.0:
+                raise ValueError(f"xylem_wood_baked: `bump` = {self.bump}: expected 0 (off) to "
+                                 "100 (1: the baked normal map as it is)")
             if not 1.0 <= self.eta <= 4.0:
                 raise ValueError(f"xylem_wood_baked: `eta` = {self.eta}: expected 1 to 4")
             if not 0.0 <= self.roughness <= 1.0:
@@ -358,7 +386,7 @@ def bsdf_class(mi, dr):
                     f"xylem_wood_baked: `roughness` = {self.roughness}: expected 0 (smooth) to 1")
             linear = dict(filter_mode=dr.FilterMode.Linear, wrap_mode=dr.WrapMode.Clamp)
             # One 14-channel texture: a lookup computes its taps and weights once.
-            self._tensor = mi.TensorXf(_maps(self.maps))
+            self._tensor = mi.TensorXf(_maps(self.maps, normal=self.bump > 0))
             self._texture = mi.Texture2f(self._tensor, **linear)
             self._albedo = mi.Texture2f(mi.TensorXf(_albedo_table()[..., None]), **linear)
             eta = self.eta
@@ -512,10 +540,11 @@ def bsdf_class(mi, dr):
 
         def eval_pdf(self, ctx, si, wo, active=True):
             t = Texel(self, si, active)
-            view = View(self, t, si.wi)
-            f, pdf = self._eval_pdf(t, view, self._probs(t, view, ctx), wo)
+            view = View(self, t, t.local(si.wi))
+            wi = t.local(wo)
+            f, pdf = self._eval_pdf(t, view, self._probs(t, view, ctx), wi)
             active = active & self._enabled(ctx)[1]
-            return dr.select(active, f * wo.z, 0.0), dr.select(active, pdf, 0.0)
+            return dr.select(active, f * wi.z, 0.0), dr.select(active, pdf, 0.0)
 
         def sample(self, ctx, si, sample1, sample2, active=True):
             """A lobe by `sample1` over the cumulative probabilities (finish, diffuse, fibre,
@@ -524,7 +553,7 @@ def bsdf_class(mi, dr):
             density `_reflection_pdf` states), cosine-weighted, or about the fibre or ray
             axis."""
             t = Texel(self, si, active)
-            wo = si.wi
+            wo = t.local(si.wi)
             view = View(self, t, wo)
             probs = self._probs(t, view, ctx)
             # (Comparisons, not `~`: the scalar variant's masks are Python bools.)
@@ -546,7 +575,7 @@ def bsdf_class(mi, dr):
             f, pdf = self._eval_pdf(t, view, probs, wi)
             ok = active & (wo.z > 0) & (wi.z > 0) & (spec | diff | (lobe_ok & leaves))
             bs = dr.zeros(mi.BSDFSample3f, dr.width(sample1))
-            bs.wo = wi
+            bs.wo = t.world(wi)
             bs.eta = 1.0
             if self._rough is None:
                 ok &= spec | (pdf > 0)
@@ -575,7 +604,7 @@ def bsdf_class(mi, dr):
 
         def to_string(self):
             return (f"XylemWoodBaked[maps={self.maps}, eta={self.eta}, "
-                    f"roughness={self.roughness}]")
+                    f"roughness={self.roughness}, bump={self.bump}]")
 
     _CLASSES[key] = XylemWoodBaked
     return XylemWoodBaked
