@@ -44,7 +44,7 @@ defines it; where ``dp/du`` is unset (a zero-initialised interaction, as
 Unlike ``xylem_wood`` it needs no ``evaluated()`` mode, leaves other scenes renderable, and
 is differentiable by Dr.Jit's AD (directions, uv and the maps, which ``mi.traverse`` lists as
 ``maps``: an (H, W, 14) tensor of base colour, beta, fibre colour, ray mask, fibre direction
-and ray direction).
+and ray direction, and the tangent-space normal when ``bump`` > 0: (H, W, 17)).
 
 What it approximates compared with the solid wood of ``xylem_wood``: the wood is sampled at the
 texel centres and interpolated bilinearly (at ``--res 1024`` on a 300 mm board, 0.29 mm
