@@ -282,8 +282,9 @@ def bsdf_class(mi, dr):
         return LUMINANCE[0] * c.x + LUMINANCE[1] * c.y + LUMINANCE[2] * c.z
 
     class Texel:
-        """The BSDF's parameters at the interaction (wood.rs `WoodBsdf::new` for the texel
-        `face_shading` builds), in the shading frame's coordinates."""
+        """The BSDF's parameters at the interaction (wood.rs `WoodBsdf::new` for the texel's
+        values), in the coordinates of the BSDF's frame: the shading frame, or the frame about
+        the bumped normal (`local` / `world` map directions between the two)."""
 
         def __init__(self, bsdf, si, active):
             uv = si.uv
@@ -385,7 +386,8 @@ def bsdf_class(mi, dr):
                 raise ValueError(
                     f"xylem_wood_baked: `roughness` = {self.roughness}: expected 0 (smooth) to 1")
             linear = dict(filter_mode=dr.FilterMode.Linear, wrap_mode=dr.WrapMode.Clamp)
-            # One 14-channel texture: a lookup computes its taps and weights once.
+            # One texture (14 channels, 17 with the normal): a lookup computes its taps and
+            # weights once.
             self._tensor = mi.TensorXf(_maps(self.maps, normal=self.bump > 0))
             self._texture = mi.Texture2f(self._tensor, **linear)
             self._albedo = mi.Texture2f(mi.TensorXf(_albedo_table()[..., None]), **linear)
