@@ -387,22 +387,39 @@ def write_sphere(path, mirrored):
     return path
 
 
+# The built-in teapot as `xylem bake --mesh teapot` places it (scenes/teapot.toml: 30 mm per
+# unit, 10 steps per patch, tree (0, 110, 0), fibres along z), seen as that scene sees it.
+TEAPOT_TREE = {"origin": [0.0, 110.0, 0.0], "axis": [0.0, 0.0, 1.0]}
+TEAPOT_VIEW = {"eye": [0.0, -330.0, 190.0], "target": [10.0, 0.0, 45.0], "up": [0.0, 0.0, 1.0],
+               "fov_deg": 30.0, "width": 64, "height": 48,
+               "light": list(np.array([0.5, -0.4, 0.75]) / np.linalg.norm([0.5, -0.4, 0.75]))}
+
+
 @pytest.fixture(scope="session")
-def sphere_bakes(tmp_path_factory, root):
-    """{mirrored: (the OBJ, its `xylem bake --mesh` folder)} for both UV layouts."""
+def mesh_bakes(tmp_path_factory, root):
+    """{subject: (its OBJ, its `xylem bake --mesh` folder, the xylem object table, the view)}:
+    the sphere in both UV layouts (the OBJ the test writes) and the built-in teapot (the OBJ
+    the bake writes beside its maps; xylem renders its own `teapot` shape)."""
     out = {}
     for mirrored in (False, True):
         d = tmp_path_factory.mktemp("sphere")
         obj = write_sphere(d / "sphere.obj", mirrored)
         tree = [",".join(f"{x:g}" for x in SPHERE_TREE[k]) for k in ("origin", "axis")]
-        out[mirrored] = (obj, xylem_bake(root, d / "maps", "--mesh", str(obj), "--origin",
-                                         tree[0], "--axis", tree[1]))
+        maps = xylem_bake(root, d / "maps", "--mesh", str(obj), "--origin", tree[0], "--axis",
+                          tree[1])
+        out["sphere_mirrored" if mirrored else "sphere"] = (
+            obj, maps, {"shape": "mesh", "file": str(obj), "tree": SPHERE_TREE}, SPHERE_VIEW)
+    maps = xylem_bake(root, tmp_path_factory.mktemp("teapot") / "maps", "--mesh", "teapot")
+    out["teapot"] = (maps / f"{PRESET}.obj", maps, {"shape": "teapot", "size": [30.0],
+                                                    "resolution": 10, "tree": TEAPOT_TREE},
+                     TEAPOT_VIEW)
     return out
 
 
-def sphere_mitsuba(obj, maps, roughness, bump, spp):
-    """The sphere scene in Mitsuba (mm), the OBJ with xylem_wood_baked over `maps`."""
-    v = SPHERE_VIEW
+def mesh_mitsuba(view, obj, bsdf, spp):
+    """A mesh scene in Mitsuba (mm): the OBJ with `bsdf`, `view`'s camera and distant light,
+    direct lighting by emitter sampling, box filter."""
+    v = view
     return mi.load_dict({
         "type": "scene",
         "integrator": {"type": "direct", "emitter_samples": 1, "bsdf_samples": 0},
@@ -414,16 +431,14 @@ def sphere_mitsuba(obj, maps, roughness, bump, spp):
                    "sampler": {"type": "independent", "sample_count": spp}},
         "light": {"type": "directional", "direction": [-x for x in v["light"]],
                   "irradiance": {"type": "rgb", "value": [3.0, 3.0, 3.0]}},
-        "sphere": {"type": "obj", "filename": str(obj),
-                   "bsdf": baked(maps, roughness=roughness, bump=bump)},
+        "mesh": {"type": "obj", "filename": str(obj), "bsdf": bsdf},
     })
 
 
-def sphere_xylem(obj, roughness, bump, spp):
+def mesh_xylem(view, obj_table, roughness, bump, spp):
     """The same scene for xylem's renderer: its solid wood (the volume the bake sampled, with
-    the pore bump `bump`, point-sampled as the plugin is: no footprint filter), the same
-    OBJ."""
-    v = SPHERE_VIEW
+    the pore bump `bump`, point-sampled as the plugin is: no footprint filter)."""
+    v = view
     return xylem.load_dict({
         "render": {"width": v["width"], "height": v["height"], "spp": spp,
                    "integrator": "direct", "filter": "box", "footprint_filter": False},
@@ -431,32 +446,42 @@ def sphere_xylem(obj, roughness, bump, spp):
         "lights": [{"type": "distant", "direction": v["light"], "irradiance": 3.0}],
         "materials": {"wood": {"type": "wood", "preset": PRESET, "seed": 1, "eta": 1.5,
                                "roughness": roughness, "bump": bump}},
-        "objects": [{"shape": "mesh", "file": obj.name, "material": "wood",
-                     "tree": SPHERE_TREE}],
-    }, base=str(obj.parent))
+        "objects": [dict(obj_table, material="wood")],
+    })
 
 
-MESH_CASES = [("smooth", 0.0, False, 0.0), ("rough_bump_mirrored_uv", 0.2, True, 1.0)]
+# (name, subject, roughness, bump, the control's maps). The teapot's patches are not all
+# oriented alike (some vertex normals point inwards), and Mitsuba's BSDFs are one-sided:
+# Mitsuba's `twosided` wraps the plugin there, as xylem's renderer shades both sides.
+MESH_CASES = [("sphere_smooth", "sphere", 0.0, 0.0, "sphere_mirrored"),
+              ("sphere_rough_bump_mirrored_uv", "sphere_mirrored", 0.2, 1.0, "sphere"),
+              ("teapot_rough_bump", "teapot", 0.2, 1.0, "sphere")]
 
 
-@pytest.mark.parametrize("name,roughness,mirrored,bump", MESH_CASES,
+@pytest.mark.parametrize("name,subject,roughness,bump,wrong", MESH_CASES,
                          ids=[c[0] for c in MESH_CASES])
-def test_baked_mesh_renders_as_xylem(sphere_bakes, name, roughness, mirrored, bump):
-    """A `xylem bake --mesh` of an OBJ rendered end to end: Mitsuba with the same OBJ and
-    xylem_wood_baked against xylem's own render of the solid wood, per sphere pixel z of the
-    luminance difference (standard errors from 16 renders x 16 spp of each): smooth without
-    the pore bump, and rough with it (the baked normal map against xylem's bump of the
-    volume) on the mirrored UV layout. Asserted as for the board: |mean z| < 0.5, rms z < 1.5,
-    mean luminances within 1 %. The control, the other UV layout's maps (mirrored along u) on
-    this mesh, fails."""
+def test_baked_mesh_renders_as_xylem(mesh_bakes, name, subject, roughness, bump, wrong):
+    """A `xylem bake --mesh` rendered end to end: Mitsuba with the OBJ and xylem_wood_baked
+    against xylem's own render of the solid wood, per mesh pixel z of the luminance difference
+    (standard errors from 16 renders x 16 spp of each): the sphere smooth without the pore
+    bump, and rough with it (the baked normal map against xylem's bump of the volume) on the
+    mirrored UV layout; the built-in teapot (the bake's OBJ against xylem's own teapot shape),
+    rough with the bump. Asserted as for the board: |mean z| < 0.5, rms z < 1.5, mean
+    luminances within 1 %. The control, another bake's maps on this mesh (the sphere's other
+    UV layout; on the teapot, the sphere's), fails."""
     use("llvm_ad_rgb")
     gc.collect()
     spp, seeds = 16, range(1, 17)
-    obj, maps = sphere_bakes[mirrored]
-    wrong = sphere_bakes[not mirrored][1]
-    plugin = mean_and_error(sphere_mitsuba(obj, maps, roughness, bump, spp), seeds, False)
-    control = mean_and_error(sphere_mitsuba(obj, wrong, roughness, bump, spp), seeds, False)
-    scene = sphere_xylem(obj, roughness, bump, spp)
+    obj, maps, table, view = mesh_bakes[subject]
+
+    def bsdf(m):
+        b = baked(m, roughness=roughness, bump=bump)
+        return {"type": "twosided", "bsdf": b} if subject == "teapot" else b
+
+    plugin = mean_and_error(mesh_mitsuba(view, obj, bsdf(maps), spp), seeds, False)
+    control = mean_and_error(mesh_mitsuba(view, obj, bsdf(mesh_bakes[wrong][1]), spp), seeds,
+                             False)
+    scene = mesh_xylem(view, table, roughness, bump, spp)
     imgs = np.array([luminance(xylem.render(scene, seed=s + 100)["beauty"].astype(np.float64))
                      for s in seeds])
     own = imgs.mean(0), imgs.std(0, ddof=1) / math.sqrt(len(seeds))
@@ -465,8 +490,8 @@ def test_baked_mesh_renders_as_xylem(sphere_bakes, name, roughness, mirrored, bu
     record(f"baked/mesh_render_match/{name}", {
         "pixels": z.size, "spp": spp, "renders": len(seeds), **z_stats(z),
         "relative_difference_of_means": float(plugin[0].mean() / own[0].mean() - 1),
-        "control_other_layout": z_stats(zc)})
-    assert own[0].mean() > 1e-3 and z.size > 0.2 * own[0].size, "the sphere is lit and in view"
+        "control_other_maps": z_stats(zc)})
+    assert own[0].mean() > 1e-3 and z.size > 0.2 * own[0].size, "the mesh is lit and in view"
     assert within_bake_noise(z, plugin[0], own[0]), z_stats(z)
     assert not within_bake_noise(zc, control[0], own[0]), z_stats(zc)
 
