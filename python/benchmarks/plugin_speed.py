@@ -20,7 +20,12 @@ Three renders per repeat, in turn:
 - ``xylem_wood_baked``: the board with the Dr.Jit-native plugin on maps of the same preset
   baked by ``xylem bake`` (a 300 x 300 mm board at ``--bake-res`` texels, smooth finish, eta
   1.5), in Dr.Jit's default symbolic modes like ``roughplastic``. ``--maps DIR`` gives a bake
-  folder; otherwise the script bakes one with ``$XYLEM_BIN`` or target/release/xylem.
+  folder; otherwise the script bakes one with ``$XYLEM_BIN`` or target/release/xylem;
+- ``xylem_wood_baked_rough``: the same with a rough finish (roughness 0.25, as
+  ``roughplastic``'s alpha): xylem's energy-compensated GGX finish.
+
+Both baked cases use the plugin's pore bump at ``--bump`` (default 1, the plugin's default;
+0: the normal map is not read).
 
 Each case runs in its own Python process (a ``xylem_wood`` BSDF alive in a process makes every
 symbolic render there fail: Dr.Jit traces a symbolic call for every registered BSDF instance,
@@ -75,7 +80,7 @@ def bake(exe, res, out):
     return out
 
 
-def scene(bsdf, res, spp, maps=None):
+def scene(bsdf, res, spp, maps=None, bump=1.0):
     T = mi.ScalarTransform4f
     return mi.load_dict({
         "type": "scene",
@@ -91,8 +96,10 @@ def scene(bsdf, res, spp, maps=None):
                 "irradiance": {"type": "rgb", "value": [3.0, 3.0, 3.0]}},
         "sky": {"type": "constant", "radiance": {"type": "rgb", "value": [0.2, 0.2, 0.25]}},
         "board": {"type": "rectangle", "to_world": T().scale([0.15, 0.15, 1.0]),
-                  "bsdf": ({"type": "xylem_wood_baked", "maps": maps, "eta": 1.5}
-                           if bsdf == "xylem_wood_baked" else dict(BSDFS[bsdf]))},
+                  "bsdf": ({"type": "xylem_wood_baked", "maps": maps, "eta": 1.5,
+                            "roughness": 0.25 if bsdf.endswith("_rough") else 0.0,
+                            "bump": bump}
+                           if bsdf.startswith("xylem_wood_baked") else dict(BSDFS[bsdf]))},
     })
 
 
@@ -124,6 +131,8 @@ def main():
                     "one into a temporary folder)")
     ap.add_argument("--bake-res", type=int, default=1024, help="texels along the board when "
                     "baking (default 1024)")
+    ap.add_argument("--bump", type=float, default=1.0, help="the baked cases' pore bump "
+                    "(default 1; 0 leaves the normal map unread)")
     ap.add_argument("--one", help=argparse.SUPPRESS)         # child process: this case only
     ap.add_argument("--seed", type=int, default=1, help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -131,12 +140,13 @@ def main():
     cases = [("roughplastic", "roughplastic", False),
              ("roughplastic_evaluated", "roughplastic", True),
              ("xylem_wood", "xylem_wood", True),
-             ("xylem_wood_baked", "xylem_wood_baked", False)]
+             ("xylem_wood_baked", "xylem_wood_baked", False),
+             ("xylem_wood_baked_rough", "xylem_wood_baked_rough", False)]
     if args.before or args.one == "xylem_wood_before":
         cases.append(("xylem_wood_before", "xylem_wood", True))
     if args.one:                                 # child: one warm-up, one timed render
         name, b, ev = next(c for c in cases if c[0] == args.one)
-        sc = scene(b, args.res, args.spp, args.maps)
+        sc = scene(b, args.res, args.spp, args.maps, args.bump)
         render(sc, 0, ev)
         if args.profile:
             prof = cProfile.Profile()
@@ -153,7 +163,8 @@ def main():
 
     def child(name, seed, profile=False):
         cmd = [sys.executable, __file__, "--one", name, "--seed", str(seed), "--res",
-               *map(str, args.res), "--spp", str(args.spp), "--maps", args.maps] + (
+               *map(str, args.res), "--spp", str(args.spp), "--maps", args.maps,
+               "--bump", str(args.bump)] + (
                    ["--profile"] if profile else [])
         env = dict(os.environ)
         if name == "xylem_wood_before":
@@ -212,11 +223,12 @@ def main():
     out["cpu_ratio_vs_roughplastic"] = cpu_med["xylem_wood"] / cpu_med["roughplastic"]
     out["cpu_ratio_vs_roughplastic_evaluated"] = (cpu_med["xylem_wood"]
                                                   / cpu_med["roughplastic_evaluated"])
-    baked = [w / b for w, b in zip(cpu_times["xylem_wood_baked"], cpu_times["roughplastic"])]
-    out["cpu_ratio_baked_vs_roughplastic"] = cpu_med["xylem_wood_baked"] / cpu_med["roughplastic"]
-    out["cpu_ratio_baked_vs_roughplastic_range"] = [min(baked), max(baked)]
-    print(f"CPU: xylem_wood_baked / roughplastic {out['cpu_ratio_baked_vs_roughplastic']:.2f}x "
-          f"(per repeat {min(baked):.2f}-{max(baked):.2f})")
+    for case, key in (("xylem_wood_baked", "baked"), ("xylem_wood_baked_rough", "baked_rough")):
+        per = [w / b for w, b in zip(cpu_times[case], cpu_times["roughplastic"])]
+        out[f"cpu_ratio_{key}_vs_roughplastic"] = cpu_med[case] / cpu_med["roughplastic"]
+        out[f"cpu_ratio_{key}_vs_roughplastic_range"] = [min(per), max(per)]
+        print(f"CPU: {case} / roughplastic {cpu_med[case] / cpu_med['roughplastic']:.2f}x "
+              f"(per repeat {min(per):.2f}-{max(per):.2f})")
     print(f"CPU: xylem_wood / roughplastic {out['cpu_ratio_vs_roughplastic']:.2f}x, "
           f"/ roughplastic evaluated {out['cpu_ratio_vs_roughplastic_evaluated']:.2f}x"
           + (f", / before {cpu_med['xylem_wood'] / cpu_med['xylem_wood_before']:.2f}x"

@@ -329,3 +329,39 @@ pub(crate) fn params_dict<'py>(
 pub(crate) fn max_lobe_albedo(beta: f32, dip: f32) -> f32 {
     xylem::bsdf::fiber_albedo::max_lobe_albedo(beta, dip)
 }
+
+/// `rough_finish_nodes(alpha, eta)`: xylem's rough-finish tables for one finish (GGX roughness
+/// `alpha` in [0.001, 1], index `eta` in [1, 4]) on the μ nodes μᵢ = (i/(N−1))², to be
+/// interpolated linearly in √μ (`xylem::bsdf::rough_finish::finish_nodes`): a dict of
+/// `reflectance` R(μᵢ) and `multiple` R_ms(μᵢ) (N,), `transmission` (N, 11) (the share of
+/// single scattering, then mean x, mean z as offsets from the smooth refraction, cov xx, yy, xz
+/// of the single- and of the multiple-scattering part), `ms_norm` 1/(π R̄_ms) and
+/// `avg_reflectance` R̄. The baked Mitsuba plugin reads them into a Dr.Jit texture.
+#[pyfunction]
+pub(crate) fn rough_finish_nodes(
+    py: Python<'_>,
+    alpha: f32,
+    eta: f32,
+) -> PyResult<Bound<'_, PyDict>> {
+    if !(alpha.is_finite() && (1e-3..=1.0).contains(&alpha)) {
+        return Err(PyValueError::new_err(format!(
+            "rough_finish_nodes: alpha = {alpha}: expected a roughness in [0.001, 1]"
+        )));
+    }
+    if !(eta.is_finite() && (1.0..=4.0).contains(&eta)) {
+        return Err(PyValueError::new_err(format!(
+            "rough_finish_nodes: eta = {eta}: expected an index in [1, 4]"
+        )));
+    }
+    let n = xylem::bsdf::rough_finish::finish_nodes(alpha, eta);
+    let d = PyDict::new(py);
+    let rows = n.transmission.len();
+    let flat: Vec<f32> = n.transmission.iter().flatten().copied().collect();
+    d.set_item("reflectance", out(py, n.reflectance, &[rows])?)?;
+    d.set_item("multiple", out(py, n.multiple, &[rows])?)?;
+    let cols = xylem::bsdf::rough_transmission::PER_NODE;
+    d.set_item("transmission", out(py, flat, &[rows, cols])?)?;
+    d.set_item("ms_norm", n.ms_norm)?;
+    d.set_item("avg_reflectance", n.avg_reflectance)?;
+    Ok(d)
+}

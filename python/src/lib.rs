@@ -102,6 +102,7 @@ fn _xylem(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(fit, m)?)?;
     m.add_function(wrap_pyfunction!(max_lobe_albedo, m)?)?;
+    m.add_function(wrap_pyfunction!(rough_finish_nodes, m)?)?;
     m.add("PRESETS", xylem::wood::PRESET_NAMES.to_vec())?;
     Ok(())
 }

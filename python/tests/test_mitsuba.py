@@ -110,14 +110,15 @@ CHI2_CASES = [
 ]
 
 
-def chi2_run(sample_func, pdf_func):
+def chi2_run(sample_func, pdf_func, ires=4):
     """Mitsuba's chi-square goodness-of-fit test (mitsuba.chi2) of `sample_func` against
-    `pdf_func` on the sphere (400 000 samples, 64 x 32 bins, ires 4, seed 11) at the 1 %
-    significance level (Mitsuba's own default): (passed, the test with its p_value)."""
+    `pdf_func` on the sphere (400 000 samples, 64 x 32 bins, `ires`^2 pdf points per bin, seed
+    11) at the 1 % significance level (Mitsuba's own default): (passed, the test with its
+    p_value)."""
     from mitsuba.chi2 import ChiSquareTest, SphericalDomain
 
     test = ChiSquareTest(domain=SphericalDomain(), sample_func=sample_func, pdf_func=pdf_func,
-                         sample_dim=3, sample_count=400_000, res=64, ires=4, seed=11)
+                         sample_dim=3, sample_count=400_000, res=64, ires=ires, seed=11)
     return test.run(significance_level=0.01), test
 
 

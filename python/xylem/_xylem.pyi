@@ -20,6 +20,7 @@ __all__ = [
     "sweep",
     "fit",
     "max_lobe_albedo",
+    "rough_finish_nodes",
     "PRESETS",
 ]
 
@@ -126,3 +127,4 @@ def fit(
     capture: _PathLike, out: _PathLike, texels: tuple[int, int] | None = None, threads: int = 0
 ) -> str: ...
 def max_lobe_albedo(beta: float, dip: float) -> float: ...
+def rough_finish_nodes(alpha: float, eta: float) -> dict[str, Any]: ...

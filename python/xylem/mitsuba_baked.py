@@ -8,25 +8,34 @@ megakernel and is differentiable.
     xylem.mitsuba.register()           # registers xylem_wood and xylem_wood_baked
     bsdf = mi.load_dict({"type": "xylem_wood_baked", "maps": "out/walnut", "eta": 1.5})
 
-``maps`` is the folder of a ``xylem bake PRESET --out DIR`` (checked on a board face; a
-``--mesh`` bake has the same maps, and Mitsuba's OBJ loader flips v as xylem's reader does, so
-si.uv is the bake's uv, but no mesh bake has been rendered through this plugin): the plugin reads ``base_color.exr``, ``fiber_color.exr``, ``fiber_direction.exr``
-(the signed tangent-space fibre axis), ``highlight_width.exr`` (beta, radians) and
-``ray_mask.exr`` into one 12-channel ``mi.Texture2f`` (bilinear, clamped at the edges, texel
+``maps`` is the folder of a ``xylem bake PRESET --out DIR``, of a board or of a ``--mesh``
+(an OBJ with ``vt`` whose same file Mitsuba loads: its OBJ loader flips v as xylem's reader
+does, so si.uv is the bake's uv): the plugin reads ``base_color.exr``, ``fiber_color.exr``,
+``fiber_direction.exr`` and ``ray_direction.exr`` (the signed tangent-space fibre and ray
+axes), ``highlight_width.exr`` (beta, radians) and ``ray_mask.exr`` into one 14-channel
+``mi.Texture2f`` (bilinear, clamped at the edges, texel
 centres at (i + 1/2)/W as xylem's own ``BakedMaps::lookup``; one texture, so a lookup computes
 its taps once) and looks them up at ``si.uv`` (texel (0, 0) is the image's top-left, v runs
 down the rows, as glTF and the bake write them). ``eta`` is the finish's index (1-4,
-default 1.5); only the smooth finish is implemented (``roughness`` must be 0).
+default 1.5) and ``roughness`` its GGX roughness (0-1, default 0; below 1e-3 the finish is
+smooth, as in ``WoodBsdf``). ``bump`` (0-100, default 1) scales the slope of the baked normal
+map (``normal.exr``, the pore bump at the strength xylem's ``bump = 1``; 0 leaves it unread):
+the BSDF is evaluated in a frame about the tilted normal, as xylem's solid wood is.
 
 The BSDF at a texel is xylem's ``WoodBsdf`` (crates/xylem/src/bsdf/wood.rs) for the parameters
 xylem's own baked-map material builds there (``material/face.rs`` ``face_shading``): the
 Lambertian substrate with its internal reflections under the finish, scaled so the fibre lobes
 fit (notes/bsdf.md §1.3, §2.3), plus the energy-bounded Marschner et al. 2005 fibre lobe of the
 fibre axis and of the ray axis (in the face, across the fibre), blended by the ray mask, all
-seen through a smooth Fresnel finish; the mirror of the finish is a delta component
-(component 1). Sampling is xylem's: a lobe by its estimated albedo, the fibre lobes by their
-Gaussian in psi and a uniform azimuth on the cone's arc above the critical angle
-(notes/bsdf.md §3); pdf is the mixture's density.
+seen through the finish. A smooth finish is Fresnel's, its mirror a delta component
+(component 1). A rough finish is xylem's energy-compensated GGX interface (notes/bsdf.md §4):
+its single- and multiple-scattering reflection, the substrate seen through 1 - R(mu), and the
+fibre lobes convolved with the spreads of the light it transmits, with xylem's own tables
+(``xylem._xylem.rough_finish_nodes``: R, R_ms and the spreads on the sqrt(mu) nodes for this
+roughness and index) in a Dr.Jit texture. Sampling is xylem's: a lobe by its estimated albedo,
+the fibre lobes by their Gaussian in psi and a uniform azimuth on the cone's arc above the
+critical angle (notes/bsdf.md §3), a rough finish's reflection by its visible normals; pdf is
+the mixture's density.
 
 Tangent space: x along dp/du, y along -dp/dv (up the image), z the shading normal, as the bake
 defines it; where ``dp/du`` is unset (a zero-initialised interaction, as
@@ -34,15 +43,18 @@ defines it; where ``dp/du`` is unset (a zero-initialised interaction, as
 
 Unlike ``xylem_wood`` it needs no ``evaluated()`` mode, leaves other scenes renderable, and
 is differentiable by Dr.Jit's AD (directions, uv and the maps, which ``mi.traverse`` lists as
-``maps``: an (H, W, 12) tensor of base colour, beta, fibre colour, ray mask, fibre direction
-and a zero channel).
+``maps``: an (H, W, 14) tensor of base colour, beta, fibre colour, ray mask, fibre direction
+and ray direction, and the tangent-space normal when ``bump`` > 0: (H, W, 17)).
 
 What it approximates compared with the solid wood of ``xylem_wood``: the wood is sampled at the
 texel centres and interpolated bilinearly (at ``--res 1024`` on a 300 mm board, 0.29 mm
-texels; pores and ray flecks narrower than that blur); the ray axis is taken in the face
-across the fibre (the volume knows the radial direction); no pore bump (the normal map is not
-read); no rough finish. ``BSDFContext`` masks are honoured per component (0: the diffuse and
-fibre lobes, 1: the mirror), with the lobe probabilities renormalised over what is enabled.
+texels; pores and ray flecks narrower than that blur); the tangent frame is Mitsuba's per
+triangle (dp/du, dp/dv) where the bake interpolated vertex tangents; a bake without
+``ray_direction.exr`` gets the ray axis in the face across the fibre; the pore bump is the
+baked normal map's, bilinear between texel centres (pores are about a texel wide at
+``--res 1024``), no mip maps. ``BSDFContext`` masks are honoured per component (0: the diffuse and fibre lobes and
+a rough finish's reflection, 1: a smooth finish's mirror), with the lobe probabilities
+renormalised over what is enabled.
 """
 
 import math
@@ -66,15 +78,19 @@ LUMINANCE = (0.2126, 0.7152, 0.0722)
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(12)
 
 
-def _maps(folder):
-    """The bake's maps (float32 EXRs) as one (H, W, 12) array: base colour, beta, fibre colour,
-    ray mask, fibre direction, 0."""
+def _maps(folder, normal):
+    """The bake's maps (float32 EXRs) as one (H, W, 14) array: base colour, beta, fibre colour,
+    ray mask, fibre direction, ray direction (zeros where the bake has no ``ray_direction.exr``,
+    as bakes before it had none: the in-face axis is used then); with `normal`, 17 channels, the
+    tangent-space normal last."""
     import mitsuba as mi
 
     folder = pathlib.Path(folder)
 
-    def read(name, channels):
+    def read(name, channels, optional=False):
         path = folder / f"{name}.exr"
+        if optional and not path.exists():
+            return None
         if not path.exists():
             raise FileNotFoundError(
                 f"xylem_wood_baked: {path} is missing (`maps` must be a `xylem bake` folder)"
@@ -87,10 +103,14 @@ def _maps(folder):
 
     layers = [read("base_color", 3), read("highlight_width", 1), read("fiber_color", 3),
               read("ray_mask", 1), read("fiber_direction", 3)]
+    ray = read("ray_direction", 3, optional=True)
+    layers.append(np.zeros_like(layers[0]) if ray is None else ray)
+    if normal:
+        layers.append(read("normal", 3))
     shapes = {m.shape[:2] for m in layers}
     if len(shapes) != 1:
         raise ValueError(f"xylem_wood_baked: the maps in {folder} differ in size: {sorted(shapes)}")
-    return np.concatenate(layers + [np.zeros_like(layers[1])], 2)
+    return np.concatenate(layers, 2)
 
 
 def _albedo_table():
@@ -163,13 +183,13 @@ def _arc(dr, u, sin_psi, cos_psi, z_min):
     return dr.select(t <= -1.0, math.pi, dr.select(t >= 1.0, 0.0, dr.acos(dr.clip(t, -1.0, 1.0))))
 
 
-def _lobe_pdf(dr, u, o, i, wi_z, beta, z_min):
-    """Density of `_lobe_sample` per interior solid angle at the interior direction with angles
-    i and z = wi_z: g(beta, psi_i + psi_o) / (2 max(Delta, MIN_ARC) cos psi_i) (fiber.rs
-    pdf_about; notes/bsdf.md §3)."""
+def _lobe_pdf(dr, u, psi_o, i, wi_z, beta, z_min):
+    """Density of `_lobe_sample` about psi_o per interior solid angle at the interior direction
+    with angles i and z = wi_z: g(beta, psi_i + psi_o) / (2 max(Delta, MIN_ARC) cos psi_i)
+    (fiber.rs pdf_about; notes/bsdf.md §3)."""
     delta = _arc(dr, u, i.sin, i.cos, z_min)
     ok = (wi_z > z_min) & (i.cos >= MIN_COS_PSI) & (delta > 0)
-    g = _gaussian(dr, beta, i.psi + o.psi)
+    g = _gaussian(dr, beta, i.psi + psi_o)
     width = 2.0 * dr.maximum(delta, MIN_ARC) * dr.maximum(i.cos, MIN_COS_PSI)
     return dr.select(ok, g / width, 0.0)
 
@@ -191,6 +211,64 @@ def _lobe_sample(mi, dr, u, psi_o, u2, beta, z_min):
     return wi_in, ok
 
 
+def _ggx_d(dr, alpha, h):
+    """GGX D(h) = alpha^2 / (pi (cos^2 theta_h (alpha^2 - 1) + 1)^2), 0 for h.z <= 0 (Walter et
+    al. 2007 eq. 33; ggx.rs `Ggx::d`)."""
+    a2 = alpha * alpha
+    t = h.z * h.z * (a2 - 1.0) + 1.0
+    return dr.select(h.z > 0, a2 / (math.pi * t * t), 0.0)
+
+
+def _ggx_lambda(dr, alpha, w):
+    """Smith Lambda(w) = (-1 + sqrt(1 + alpha^2 tan^2 theta)) / 2 (Heitz 2014 eq. 72; ggx.rs
+    `Ggx::lambda`); infinite at or below the horizon."""
+    c2 = w.z * w.z
+    tan2 = dr.maximum(1.0 - c2, 0.0) / dr.maximum(c2, 1e-30)
+    return dr.select(c2 > 0, 0.5 * (-1.0 + dr.sqrt(1.0 + alpha * alpha * tan2)), math.inf)
+
+
+class _Spread:
+    """How a fibre u sees one part of the light a rough finish transmits from exterior w: its
+    share, mean longitudinal angle psi = asin E[t.u], cos psi, and var psi = var(t.u) / (1 -
+    E[t.u]^2) (fiber.rs `FiberAxis::spread`); E and var of t.u from the part's mean and
+    covariance turned to w's azimuth (rough_transmission.rs `TransmittedPart::along`). `part`:
+    (share, mean x, mean z, cov xx, cov yy, cov xz)."""
+
+    def __init__(self, dr, w, part, u):
+        share, mx, mz, cxx, cyy, cxz = part
+        r2 = w.x * w.x + w.y * w.y
+        r = dr.sqrt(dr.maximum(r2, 1e-12))
+        c, s = dr.select(r2 > 1e-12, w.x / r, 1.0), dr.select(r2 > 1e-12, w.y / r, 0.0)
+        ux, uy = c * u.x + s * u.y, c * u.y - s * u.x
+        czz = dr.maximum(1.0 - cxx - cyy - mx * mx - mz * mz, 0.0)
+        mean = dr.clip(mx * ux + mz * u.z, -0.9999, 0.9999)
+        var = dr.maximum(cxx * ux * ux + cyy * uy * uy + czz * u.z * u.z + 2.0 * cxz * ux * u.z,
+                         0.0)
+        cos2 = 1.0 - mean * mean
+        self.share, self.psi, self.cos, self.var = share, dr.asin(mean), dr.sqrt(cos2), var / cos2
+
+
+def _lobe_spread(dr, o, i, beta):
+    """The energy-bounded fibre lobe seen through a rough finish (notes/bsdf.md §4.6; fiber.rs
+    `FiberAxis::eval_spread`): sum over the parts a of wo's and b of wi's `_Spread`s of
+    share_a share_b g(sqrt(beta^2 + var_a + var_b), psi_a + psi_b) / (2 pi max(cos_a, cos_b))."""
+    f = 0.0
+    for a in o:
+        for b in i:
+            g = _gaussian(dr, dr.sqrt(beta * beta + a.var + b.var), a.psi + b.psi)
+            c = dr.maximum(dr.maximum(b.cos, a.cos), MIN_COS_PSI)
+            f += a.share * b.share * g / (2.0 * math.pi * c)
+    return f
+
+
+def _sampling_about(dr, spread, beta):
+    """(psi, width) a fibre lobe's samples are drawn with under a rough finish: the single
+    scattering part's mean angle, beta widened by twice the mean variance (wood.rs
+    `sampling_about`)."""
+    var = spread[0].share * spread[0].var + spread[1].share * spread[1].var
+    return spread[0].psi, dr.minimum(dr.sqrt(beta * beta + 2.0 * var), 0.5 * math.pi)
+
+
 _CLASSES = {}
 
 
@@ -204,27 +282,53 @@ def bsdf_class(mi, dr):
         return LUMINANCE[0] * c.x + LUMINANCE[1] * c.y + LUMINANCE[2] * c.z
 
     class Texel:
-        """The BSDF's parameters at the interaction (wood.rs `WoodBsdf::new` for the texel
-        `face_shading` builds), in the shading frame's coordinates."""
+        """The BSDF's parameters at the interaction (wood.rs `WoodBsdf::new` for the texel's
+        values), in the coordinates of the BSDF's frame: the shading frame, or the frame about
+        the bumped normal (`local` / `world` map directions between the two)."""
 
         def __init__(self, bsdf, si, active):
             uv = si.uv
             v = bsdf._texture.eval(uv, active)
-            a, b, f = v[0:4], v[4:8], v[8:12]
+            a, b, f, g = v[0:4], v[4:8], v[8:11], v[11:14]
             # Clamped as material/baked.rs `BakedWoodMaterial::shade` clamps the lookup.
             self.diffuse = dr.clip(mi.Color3f(a[0], a[1], a[2]), 0.0, 1.0)
             self.fiber_color = dr.clip(mi.Color3f(b[0], b[1], b[2]), 0.0, 1.0)
             self.beta = dr.clip(a[3], 1e-3, 0.5 * math.pi)
             self.m = dr.clip(b[3], 0.0, 1.0)
             right, up = _frame_axes(mi, dr, si)
-            u = right * f[0] + up * f[1] + mi.Vector3f(0, 0, 1) * f[2]
-            fallback = dr.squared_norm(u) < 1e-12
-            self.u = dr.select(fallback, right, dr.normalize(u))
-            # The ray axis: in the face, across the fibre (face.rs: xylem's frame.t = n x s).
+
+            def axis(t):
+                return right * t[0] + up * t[1] + mi.Vector3f(0, 0, 1) * t[2]
+
+            u = axis(f)
+            self.u = dr.select(dr.squared_norm(u) < 1e-12, right, dr.normalize(u))
+            # The ray axis: the baked one (the volume's, as the solid wood's material.rs
+            # `WoodMaterial` gives it), else in the face across the fibre (face.rs: xylem's
+            # frame.t = n x s).
             s = mi.Vector3f(self.u.x, self.u.y, 0.0)
             s = dr.select(dr.squared_norm(s) > 1e-12, dr.normalize(s), mi.Vector3f(1, 0, 0))
-            self.r = mi.Vector3f(-s.y, s.x, 0.0)
+            r = axis(g)
+            self.r = dr.select(dr.squared_norm(r) < 1e-12, mi.Vector3f(-s.y, s.x, 0.0),
+                               dr.normalize(r))
+            self.frame = None
+            if bsdf.bump > 0:
+                # The pore bump (Blinn 1978), as material.rs `WoodMaterial` tilts the normal:
+                # the baked tangent-space normal (-dh/dx, -dh/dy, 1) normalised, its slope scaled
+                # by `bump`; the BSDF is evaluated in a frame about it, the fibre and ray axes
+                # expressed there unprojected, as xylem's Frame::from_normal_tangent does.
+                n = v[14:17]
+                nb = axis((bsdf.bump * n[0], bsdf.bump * n[1], n[2]))
+                nb = dr.select(dr.squared_norm(nb) < 1e-12, mi.Vector3f(0, 0, 1), dr.normalize(nb))
+                self.frame = mi.Frame3f(nb)
+                self.u, self.r = self.frame.to_local(self.u), self.frame.to_local(self.r)
             self.diffuse_eff = self._diffuse(bsdf)
+
+        def local(self, w):
+            """A shading-frame direction in the BSDF's frame (the bumped one, if any)."""
+            return w if self.frame is None else self.frame.to_local(w)
+
+        def world(self, w):
+            return w if self.frame is None else self.frame.to_world(w)
 
         def _diffuse(self, bsdf):
             """rho'' = rho' / (1 - rho' F_int), rho' = s rho, s = min(1, min_c room_c / rho_c),
@@ -243,6 +347,26 @@ def bsdf_class(mi, dr):
             rho = rho * dr.minimum(dr.minimum(ratio.x, ratio.y), dr.minimum(ratio.z, 1.0))
             return rho / (1.0 - rho * bsdf._f_int)
 
+    class View:
+        """What the BSDF needs of the view wo (Mitsuba's si.wi) alone, shared by every wi: the
+        finish's transmittance T(wo); smooth: wo refracted into the finish and its angles about
+        the fibre and ray axes; rough: R(wo), R_ms(wo) and how each axis sees the transmitted
+        light (`_Spread`s) with the (psi, width) its samples are drawn about (wood.rs
+        `RoughView`)."""
+
+        def __init__(self, bsdf, t, wo):
+            self.wo = wo
+            if bsdf._rough is None:
+                self.trans = bsdf._transmittance(wo.z)
+                wo_in = _refract_in(mi, dr, wo, bsdf.eta)
+                self.angles = [_Angles(dr, wo_in, ax) for ax in (t.u, t.r)]
+                self.about = [(a.psi, t.beta) for a in self.angles]
+                return
+            self.reflectance, self.multiple, parts = bsdf._finish_at(wo.z)
+            self.trans = 1.0 - self.reflectance
+            self.spreads = [[_Spread(dr, wo, p, ax) for p in parts] for ax in (t.u, t.r)]
+            self.about = [_sampling_about(dr, sp, t.beta) for sp in self.spreads]
+
     class XylemWoodBaked(mi.BSDF):
         def __init__(self, props):
             mi.BSDF.__init__(self, props)
@@ -251,78 +375,159 @@ def bsdf_class(mi, dr):
                     "xylem_wood_baked: `maps` (a `xylem bake` output folder) is required")
             self.maps = str(props.get("maps"))
             self.eta = float(props.get("eta", 1.5))
-            roughness = float(props.get("roughness", 0.0))
+            self.roughness = float(props.get("roughness", 0.0))
+            self.bump = float(props.get("bump", 1.0))
+            if not 0.0 <= self.bump <= 100.0:
+                raise ValueError(f"xylem_wood_baked: `bump` = {self.bump}: expected 0 (off) to "
+                                 "100 (1: the baked normal map as it is)")
             if not 1.0 <= self.eta <= 4.0:
                 raise ValueError(f"xylem_wood_baked: `eta` = {self.eta}: expected 1 to 4")
-            if roughness >= 1e-3:
+            if not 0.0 <= self.roughness <= 1.0:
                 raise ValueError(
-                    f"xylem_wood_baked: `roughness` = {roughness}: only the smooth finish (0) is "
-                    "implemented; use xylem_wood for a rough finish")
+                    f"xylem_wood_baked: `roughness` = {self.roughness}: expected 0 (smooth) to 1")
             linear = dict(filter_mode=dr.FilterMode.Linear, wrap_mode=dr.WrapMode.Clamp)
-            # One 12-channel texture: a lookup computes its taps and weights once.
-            self._tensor = mi.TensorXf(_maps(self.maps))
+            # One texture (14 channels, 17 with the normal): a lookup computes its taps and
+            # weights once.
+            self._tensor = mi.TensorXf(_maps(self.maps, normal=self.bump > 0))
             self._texture = mi.Texture2f(self._tensor, **linear)
             self._albedo = mi.Texture2f(mi.TensorXf(_albedo_table()[..., None]), **linear)
             eta = self.eta
-            # F_ext = 2 int_0^1 F(mu) mu dmu (fresnel.rs fresnel_diffuse_reflectance), 0 at eta 1.
-            mu = (_GL_X + 1.0) / 2.0
-            fresnel = np.array([np.ravel(_fresnel(mi, dr, mi.Float(float(x)), eta))[0] for x in mu])
-            f_ext = 0.0 if eta <= 1.0 else float(np.sum(_GL_W / 2.0 * 2.0 * mu * fresnel))
-            self._escape = (1.0 - f_ext) / (eta * eta)   # 1 - R_int (wood.rs `escape`)
+            # As WoodBsdf: below roughness 1e-3 the finish is smooth (wood.rs MIN_ROUGHNESS).
+            self._rough = None
+            if self.roughness >= 1e-3:
+                nodes = _xylem.rough_finish_nodes(self.roughness, eta)
+                table = np.concatenate([nodes["reflectance"][:, None], nodes["multiple"][:, None],
+                                        nodes["transmission"]], 1).astype(np.float32)
+                # A 1D texture, the mu nodes at its texel centres: linear filtering is the
+                # tables' interpolation in sqrt(mu).
+                self._rough = mi.Texture1f(mi.TensorXf(table), **linear)
+                self._ggx = mi.MicrofacetDistribution(mi.MicrofacetType.GGX, self.roughness,
+                                                      True)
+                self._mu_nodes = table.shape[0]
+                self._ms_norm = float(nodes["ms_norm"])
+                avg_reflectance = float(nodes["avg_reflectance"])
+            else:
+                # F_ext = 2 int_0^1 F(mu) mu dmu (fresnel.rs fresnel_diffuse_reflectance), 0 at
+                # eta 1.
+                mu = (_GL_X + 1.0) / 2.0
+                fresnel = np.array([np.ravel(_fresnel(mi, dr, mi.Float(float(x)), eta))[0]
+                                    for x in mu])
+                avg_reflectance = (0.0 if eta <= 1.0
+                                   else float(np.sum(_GL_W / 2.0 * 2.0 * mu * fresnel)))
+            # 1 - R_int = (1 - R_avg) / eta^2 (wood.rs `escape`; notes/bsdf.md §1.3, §4.3).
+            self._escape = (1.0 - avg_reflectance) / (eta * eta)
             self._f_int = 1.0 - self._escape
             self._z_crit = math.sqrt(max(0.0, 1.0 - 1.0 / (eta * eta)))
-            self._delta = eta > 1.0
+            self._delta = eta > 1.0 and self._rough is None
             lobes = (mi.BSDFFlags.DiffuseReflection | mi.BSDFFlags.GlossyReflection
                      | mi.BSDFFlags.FrontSide | mi.BSDFFlags.SpatiallyVarying
                      | mi.BSDFFlags.Anisotropic)
             delta = mi.BSDFFlags.DeltaReflection | mi.BSDFFlags.FrontSide
-            # Component 0: everything but the finish's mirror; component 1: the mirror.
+            # Component 0: everything but a smooth finish's mirror (a rough finish's reflection
+            # included); component 1: the mirror.
             self.m_components = [lobes, delta] if self._delta else [lobes]
             self.m_flags = (lobes | delta) if self._delta else lobes
 
         def _transmittance(self, cos):
+            """1 - F of the smooth finish (Fresnel)."""
             return 1.0 - _fresnel(mi, dr, cos, self.eta)
+
+        def _finish_at(self, mu):
+            """The rough finish at exterior cosine mu: R(mu), R_ms(mu) and the transmitted
+            light's two parts (share, mean x, mean z, cov xx, yy, xz), the means the smooth
+            refraction plus the table's offsets (rough_transmission.rs `parts`); all linear in
+            sqrt(mu) between the tables' nodes (rough_finish.rs `locate`)."""
+            n = self._mu_nodes
+            x = dr.sqrt(dr.clip(mu, 0.0, 1.0)) * (n - 1)
+            v = self._rough.eval(mi.Point1f((x + 0.5) / n))
+            mu = dr.clip(mu, 0.0, 1.0)
+            refr = _refract_in(mi, dr, mi.Vector3f(dr.safe_sqrt(1.0 - mu * mu), 0.0, mu),
+                               self.eta)
+            single = dr.clip(v[2], 0.0, 1.0)
+            parts = [(single, refr.x + v[3], refr.z + v[4], v[5], v[6], v[7]),
+                     (1.0 - single, refr.x + v[8], refr.z + v[9], v[10], v[11], v[12])]
+            return v[0], v[1], parts
+
+        def _reflection(self, wo, wi, multiple_o, multiple_i):
+            """The rough finish's reflection (no cosine), F(wo.h) D G2 / (4 mu_o mu_i) (Walter
+            et al. 2007 eq. 20; Heitz 2014 eq. 99) plus the multiple-scattering lobe R_ms(mu_o)
+            R_ms(mu_i) / (pi avg R_ms) (Kulla & Conty 2017; rough_finish.rs `reflection`); and
+            the half vector."""
+            a = self.roughness
+            h = dr.normalize(wo + wi)
+            g2 = 1.0 / (1.0 + _ggx_lambda(dr, a, wo) + _ggx_lambda(dr, a, wi))
+            single = (_fresnel(mi, dr, dr.dot(wo, h), self.eta) * _ggx_d(dr, a, h) * g2
+                      / (4.0 * wo.z * wi.z))
+            f = single + multiple_o * multiple_i * self._ms_norm
+            return dr.select(h.z > 0, f, 0.0), h
+
+        def _reflection_pdf(self, wo, h):
+            """Density of wi = reflect(wo, h) for h drawn from the visible normals: G1(wo) D(h)
+            / (4 wo.z) (Heitz 2018; ggx.rs `reflection_pdf`)."""
+            a = self.roughness
+            p = _ggx_d(dr, a, h) / ((1.0 + _ggx_lambda(dr, a, wo)) * 4.0 * wo.z)
+            return dr.select((wo.z > 0) & (dr.dot(wo, h) > 0), p, 0.0)
 
         def _enabled(self, ctx):
             """(the mirror, the other lobes) as `ctx` asks for them (component 1 / 0)."""
             return (self._delta and ctx.is_enabled(mi.BSDFFlags.DeltaReflection, 1),
                     ctx.is_enabled(mi.BSDFFlags.GlossyReflection, 0))
 
-        def _probs(self, t, wo, ctx):
+        def _probs(self, t, view, ctx):
             """Lobe probabilities for wo, proportional to each lobe's estimated albedo
-            (wood.rs `lobe_probs`): specular F, diffuse T lum(rho'') (1 - R_int), fibre and ray
+            (wood.rs `lobe_probs`): the finish's reflection (smooth: F; rough: R - R_ms),
+            diffuse T lum(rho'') (1 - R_int) (+ R_ms, drawn with the diffuse), fibre and ray
             T lum(k_f) / pi (1 - m) and m; a lobe `ctx` leaves out gets 0."""
             mirror, rest = self._enabled(ctx)
             zero = mi.Float(0.0)
-            spec = _fresnel(mi, dr, wo.z, self.eta) if mirror else zero
-            tr = self._transmittance(wo.z) if rest else zero
-            diff = tr * luminance(t.diffuse_eff) * self._escape
+            ms = zero
+            if self._rough is None:
+                spec = _fresnel(mi, dr, view.wo.z, self.eta) if mirror else zero
+            elif rest:
+                spec = dr.maximum(view.reflectance - view.multiple, 0.0)
+                ms = view.multiple
+            else:
+                spec = zero
+            tr = view.trans if rest else zero
+            diff = tr * luminance(t.diffuse_eff) * self._escape + ms
             kf = tr * luminance(t.fiber_color) / math.pi
             fib, ray = kf * (1.0 - t.m), kf * t.m
             total = spec + diff + fib + ray
             inv = dr.select(total > 0, 1.0 / total, 0.0)
             return spec * inv, diff * inv, fib * inv, ray * inv
 
-        def _eval_pdf(self, t, probs, wo, wi):
+        def _eval_pdf(self, t, view, probs, wi):
             """xylem's f (no cosine) and the sampling density, sharing the refracted directions
             and the longitudinal angles. f = T(wo) T(wi) / eta^2 (rho''/pi + k_f ((1 - m)
-            f_fib + m f_ray)(wo', wi')), ' refracted into the finish (notes/bsdf.md eq. 1.4);
-            the density of the non-delta lobes' mixture (wood.rs `density`): diffuse cos/pi,
-            the fibre lobes' interior densities times d w_int / d w_ext = cos theta_i / (eta^2
-            cos theta_i') (notes/bsdf.md §1.1). Zero where either cosine is <= 0 or where not
+            f_fib + m f_ray)) (notes/bsdf.md eq. 1.4), the fibre lobes of the directions
+            refracted into a smooth finish or seen through a rough one (`_lobe_spread`), plus a
+            rough finish's reflection; the density of the non-delta lobes' mixture (wood.rs
+            `density`): diffuse cos/pi, the fibre lobes' interior densities times d w_int /
+            d w_ext = cos theta_i / (eta^2 cos theta_i') (notes/bsdf.md §1.1), a rough
+            finish's visible-normal density. Zero where either cosine is <= 0 or where not
             finite."""
-            eta = self.eta
-            wo_in, wi_in = _refract_in(mi, dr, wo, eta), _refract_in(mi, dr, wi, eta)
-            lobes, dens = [], []
-            for ax in (t.u, t.r):
-                o, i = _Angles(dr, wo_in, ax), _Angles(dr, wi_in, ax)
-                lobes.append(_lobe(dr, o, i, t.beta))
-                dens.append(_lobe_pdf(dr, ax, o, i, wi_in.z, t.beta, self._z_crit))
+            eta, wo = self.eta, view.wo
+            wi_in = _refract_in(mi, dr, wi, eta)
+            if self._rough is None:
+                trans_i = self._transmittance(wi.z)
+                lobes = [_lobe(dr, o, _Angles(dr, wi_in, ax), t.beta)
+                         for o, ax in zip(view.angles, (t.u, t.r))]
+            else:
+                reflectance_i, multiple_i, parts = self._finish_at(wi.z)
+                trans_i = 1.0 - reflectance_i
+                lobes = [_lobe_spread(dr, sp, [_Spread(dr, wi, p, ax) for p in parts], t.beta)
+                         for sp, ax in zip(view.spreads, (t.u, t.r))]
+            dens = [_lobe_pdf(dr, ax, psi, _Angles(dr, wi_in, ax), wi_in.z, width, self._z_crit)
+                    for ax, (psi, width) in zip((t.u, t.r), view.about)]
             substrate = t.diffuse_eff / math.pi + t.fiber_color * (
                 (1.0 - t.m) * lobes[0] + t.m * lobes[1])
-            f = substrate * (self._transmittance(wo.z) * self._transmittance(wi.z) / (eta * eta))
+            f = substrate * (view.trans * trans_i / (eta * eta))
             jac = wi.z / (eta * eta) / dr.maximum(wi_in.z, 1e-7)
             pdf = probs[1] * wi.z / math.pi + (probs[2] * dens[0] + probs[3] * dens[1]) * jac
+            if self._rough is not None:
+                reflection, h = self._reflection(wo, wi, view.multiple, multiple_i)
+                f += reflection
+                pdf += probs[0] * self._reflection_pdf(wo, h)
             ok = (wo.z > 0) & (wi.z > 0)
             f = dr.select(ok & dr.isfinite(f.x + f.y + f.z), dr.maximum(f, 0.0), 0.0)
             return f, dr.select(ok & dr.isfinite(pdf), pdf, 0.0)
@@ -337,42 +542,60 @@ def bsdf_class(mi, dr):
 
         def eval_pdf(self, ctx, si, wo, active=True):
             t = Texel(self, si, active)
-            f, pdf = self._eval_pdf(t, self._probs(t, si.wi, ctx), si.wi, wo)
+            view = View(self, t, t.local(si.wi))
+            wi = t.local(wo)
+            f, pdf = self._eval_pdf(t, view, self._probs(t, view, ctx), wi)
             active = active & self._enabled(ctx)[1]
-            return dr.select(active, f * wo.z, 0.0), dr.select(active, pdf, 0.0)
+            return dr.select(active, f * wi.z, 0.0), dr.select(active, pdf, 0.0)
 
         def sample(self, ctx, si, sample1, sample2, active=True):
-            """A lobe by `sample1` over the cumulative probabilities (specular, diffuse, fibre,
-            ray; wood.rs `pick`), a direction from it by `sample2` (wood.rs `sample`)."""
+            """A lobe by `sample1` over the cumulative probabilities (finish, diffuse, fibre,
+            ray; wood.rs `pick`), a direction from it by `sample2` (wood.rs `sample`): the
+            smooth finish's mirror, or a visible GGX normal (Mitsuba's sampler of D_vis, the
+            density `_reflection_pdf` states), cosine-weighted, or about the fibre or ray
+            axis."""
             t = Texel(self, si, active)
-            wo = si.wi
-            probs = self._probs(t, wo, ctx)
+            wo = t.local(si.wi)
+            view = View(self, t, wo)
+            probs = self._probs(t, view, ctx)
             # (Comparisons, not `~`: the scalar variant's masks are Python bools.)
             c1, c2 = probs[0] + probs[1], probs[0] + probs[1] + probs[2]
             spec = sample1 < probs[0]
             diff = (sample1 >= probs[0]) & (sample1 < c1)
             fib = (sample1 >= c1) & (sample1 < c2)
             axis = dr.select(fib, t.u, t.r)
-            wo_in = _refract_in(mi, dr, wo, self.eta)
-            wi_in, lobe_ok = _lobe_sample(mi, dr, axis, _Angles(dr, wo_in, axis).psi, sample2,
-                                          t.beta, self._z_crit)
+            psi, width = (dr.select(fib, a, b) for a, b in zip(*view.about))
+            wi_in, lobe_ok = _lobe_sample(mi, dr, axis, psi, sample2, width, self._z_crit)
             wi_lobe, leaves = _refract_out(mi, dr, wi_in, self.eta)
-            wi = dr.select(spec, mi.Vector3f(-wo.x, -wo.y, wo.z),
+            if self._rough is None:
+                wi_spec = mi.Vector3f(-wo.x, -wo.y, wo.z)
+            else:
+                h = self._ggx.sample(wo, sample2)[0]
+                wi_spec = 2.0 * dr.dot(wo, h) * h - wo
+            wi = dr.select(spec, wi_spec,
                            dr.select(diff, mi.warp.square_to_cosine_hemisphere(sample2), wi_lobe))
-            f, pdf = self._eval_pdf(t, probs, wo, wi)
+            f, pdf = self._eval_pdf(t, view, probs, wi)
             ok = active & (wo.z > 0) & (wi.z > 0) & (spec | diff | (lobe_ok & leaves))
-            ok &= spec | (pdf > 0)
             bs = dr.zeros(mi.BSDFSample3f, dr.width(sample1))
-            bs.wo = wi
+            bs.wo = t.world(wi)
             bs.eta = 1.0
-            bs.pdf = dr.select(ok, dr.select(spec, probs[0], pdf), 0.0)
-            bs.sampled_type = dr.select(spec, mi.UInt32(+mi.BSDFFlags.DeltaReflection),
-                                        mi.UInt32(+mi.BSDFFlags.GlossyReflection))
-            bs.sampled_component = dr.select(spec, mi.UInt32(1), mi.UInt32(0))
-            # The mirror's weight F / P(specular) (f = F / cos); the rest f cos / pdf.
-            mirror = _fresnel(mi, dr, wo.z, self.eta) / dr.maximum(probs[0], 1e-30)
-            weight = f * wi.z / dr.select(pdf > 0, pdf, 1.0)
-            weight = dr.select(spec, mi.Color3f(mirror), weight)
+            if self._rough is None:
+                ok &= spec | (pdf > 0)
+                bs.pdf = dr.select(ok, dr.select(spec, probs[0], pdf), 0.0)
+                bs.sampled_type = dr.select(spec, mi.UInt32(+mi.BSDFFlags.DeltaReflection),
+                                            mi.UInt32(+mi.BSDFFlags.GlossyReflection))
+                bs.sampled_component = dr.select(spec, mi.UInt32(1), mi.UInt32(0))
+                # The mirror's weight F / P(specular) (f = F / cos); the rest f cos / pdf.
+                mirror = _fresnel(mi, dr, wo.z, self.eta) / dr.maximum(probs[0], 1e-30)
+                weight = f * wi.z / dr.select(pdf > 0, pdf, 1.0)
+                weight = dr.select(spec, mi.Color3f(mirror), weight)
+            else:
+                ok &= pdf > 0
+                bs.pdf = dr.select(ok, pdf, 0.0)
+                bs.sampled_type = dr.select(diff, mi.UInt32(+mi.BSDFFlags.DiffuseReflection),
+                                            mi.UInt32(+mi.BSDFFlags.GlossyReflection))
+                bs.sampled_component = mi.UInt32(0)
+                weight = f * wi.z / dr.select(pdf > 0, pdf, 1.0)
             return bs, dr.select(ok, weight, 0.0)
 
         def traverse(self, callback):
@@ -382,7 +605,8 @@ def bsdf_class(mi, dr):
             self._texture.set_tensor(self._tensor)
 
         def to_string(self):
-            return f"XylemWoodBaked[maps={self.maps}, eta={self.eta}]"
+            return (f"XylemWoodBaked[maps={self.maps}, eta={self.eta}, "
+                    f"roughness={self.roughness}, bump={self.bump}]")
 
     _CLASSES[key] = XylemWoodBaked
     return XylemWoodBaked

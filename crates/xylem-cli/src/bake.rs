@@ -211,7 +211,7 @@ fn mesh_of(spec: &str) -> anyhow::Result<(UvMesh, [f32; 3], [f32; 3])> {
 }
 
 /// `xylem bake PRESET --mesh …`: the maps over the mesh's UV layout, its coverage mask, the
-/// mesh as a `.glb` and (with --preview) a picture of it.
+/// mesh as a `.glb` and as an `.obj` (for Mitsuba), and (with --preview) a picture of it.
 fn run_mesh(args: &Args, volume: &xylem::wood::WoodVolume) -> anyhow::Result<ExitCode> {
     let spec = args.mesh.as_deref().unwrap_or_default();
     let (mesh, origin, axis) = mesh_of(spec)?;
@@ -260,6 +260,12 @@ fn run_mesh(args: &Args, volume: &xylem::wood::WoodVolume) -> anyhow::Result<Exi
     let name = &args.preset;
     let glb = args.out.join(format!("{name}.glb"));
     staged.push(xylem::bake::gltf::stage_mesh_glb(&glb, &mesh, maps, name)?);
+    // The mesh as baked, for renderers that load OBJ (Mitsuba with xylem_wood_baked).
+    let obj = args.out.join(format!("{name}.obj"));
+    staged.push(
+        xylem::output::stage_bytes(&obj, mesh.to_obj().as_bytes())
+            .with_context(|| format!("writing {}", obj.display()))?,
+    );
     if args.preview {
         let (w, h) = (480, 360);
         let px = xylem::bake::preview::preview(&mesh, maps, w, h);

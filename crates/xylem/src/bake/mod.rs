@@ -277,16 +277,19 @@ pub(crate) fn texel_values(
             .map(|t| t.as_ref().map_or(0.0, |(t, _)| f(t)))
             .collect()
     };
-    let obj_fiber = |t: &WoodTexel| (l_inv * t.fiber_dir).normalize_or_zero();
+    // Directions go back contravariantly: object-space unit vectors, then their components in
+    // the texel's frame.
+    let obj_dir = |d: Vec3| (l_inv * d).normalize_or_zero();
+    let tangent =
+        |d: Vec3, fr: &TexelFrame| Vec3::new(d.dot(fr.right), d.dot(fr.up), d.dot(fr.normal));
+    let obj_fiber = |t: &WoodTexel| obj_dir(t.fiber_dir);
     BakedMaps {
         width: w,
         height: h,
         base_color: each(&|t, _| t.diffuse),
         fiber_color: each(&|t, _| t.fiber_color),
-        fiber: each(&|t, fr| {
-            let f = obj_fiber(t);
-            Vec3::new(f.dot(fr.right), f.dot(fr.up), f.dot(fr.normal))
-        }),
+        fiber: each(&|t, fr| tangent(obj_fiber(t), fr)),
+        ray: each(&|t, fr| tangent(obj_dir(t.ray_dir), fr)),
         anisotropy: each(&|t, fr| anisotropy_texel(obj_fiber(t), fr.right, fr.up)),
         highlight_width: scalar(&|t| t.highlight_width),
         ray_mask: scalar(&|t| t.ray_mask),
@@ -341,7 +344,8 @@ pub(crate) fn textures(m: &BakedMaps) -> DataCodes {
 /// PNG: base and fibre colour in sRGB (tagged so); the data maps (`DataCodes`: anisotropy, normal,
 /// metallic-roughness, highlight width, ray mask, fibre direction) as linear codes with no
 /// colour-space chunk. EXR: the same maps as 32-bit floats, with the anisotropy and normal maps
-/// *decoded* (direction components in [−1, 1], strength; unit normal) and β in radians.
+/// *decoded* (direction components in [−1, 1], strength; unit normal) and β in radians, and the
+/// tangent-space ray direction (`ray_direction.exr`, no PNG: only the Mitsuba plugin reads it).
 pub fn stage_maps(dir: &std::path::Path, m: &BakedMaps) -> Result<Vec<Staged>, ImageError> {
     let (w, h) = (m.width, m.height);
     let mut files = vec![
@@ -377,7 +381,7 @@ pub fn stage_maps(dir: &std::path::Path, m: &BakedMaps) -> Result<Vec<Staged>, I
         .iter()
         .map(|a| Vec3::new(2.0 * a.x - 1.0, 2.0 * a.y - 1.0, a.z))
         .collect();
-    let exrs: [(&str, &[&str], Vec<f32>); 7] = [
+    let exrs: [(&str, &[&str], Vec<f32>); 8] = [
         ("base_color", &["R", "G", "B"], flat(&m.base_color)),
         ("fiber_color", &["R", "G", "B"], flat(&m.fiber_color)),
         ("anisotropy", &["R", "G", "B"], flat(&aniso)),
@@ -385,6 +389,7 @@ pub fn stage_maps(dir: &std::path::Path, m: &BakedMaps) -> Result<Vec<Staged>, I
         ("ray_mask", &["Y"], m.ray_mask.clone()),
         ("normal", &["R", "G", "B"], flat(&m.normal)),
         ("fiber_direction", &["R", "G", "B"], flat(&m.fiber)),
+        ("ray_direction", &["R", "G", "B"], flat(&m.ray)),
     ];
     for (name, channels, data) in exrs {
         let layer = ExrLayer {

@@ -125,6 +125,7 @@ mod tests {
             ray_mask: vec![0.0],
             normal: vec![Vec3::Z],
             fiber: vec![Vec3::X],
+            ray: vec![Vec3::Y],
         };
         let px = preview(&m, &maps, 40, 30);
         let mid = px[15 * 40 + 20];

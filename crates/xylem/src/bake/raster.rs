@@ -200,6 +200,7 @@ fn blend(m: &mut BakedMaps, i: usize, taps: &[(usize, f32)]) {
     m.ray_mask[i] = s(&m.ray_mask);
     m.normal[i] = v3(&m.normal).try_normalize().unwrap_or(Vec3::Z);
     m.fiber[i] = v3(&m.fiber).try_normalize().unwrap_or(Vec3::X);
+    m.ray[i] = v3(&m.ray).try_normalize().unwrap_or(Vec3::Y);
 }
 
 /// Grows the filled texels `pad` rings outward: each pass gives every unfilled texel with a

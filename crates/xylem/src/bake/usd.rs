@@ -282,6 +282,7 @@ mod tests {
             ray_mask: vec![0.0],
             normal: vec![Vec3::Z],
             fiber: vec![Vec3::X],
+            ray: vec![Vec3::Y],
             fiber_color: vec![Vec3::ONE],
         };
         let a = usda_stage(&board, &maps, "walnut", "walnut.mtlx");

@@ -12,6 +12,7 @@ use super::ggx::Ggx;
 use super::rough_finish_table::{
     ALPHA_NODES, ETA_NODES, MULTIPLE_REFLECTANCE, MU_NODES, MU_WEIGHTS, SINGLE_REFLECTANCE,
 };
+use super::rough_transmission::{RoughTransmission, PER_NODE};
 use crate::math::INV_PI;
 use glam::{Vec2, Vec3};
 
@@ -171,6 +172,40 @@ impl RoughFinish {
         let ms =
             Self::lookup(&self.multiple, wo.z) * Self::lookup(&self.multiple, wi.z) * self.ms_norm;
         single + ms
+    }
+}
+
+/// One finish's tables (α, η fixed) on the μ nodes [`mu_node`], to be interpolated linearly in
+/// √μ between them as [`RoughFinish`] and [`RoughTransmission`] do: for code that evaluates the
+/// rough finish outside this crate (the Dr.Jit Mitsuba plugin `xylem_wood_baked`, through the
+/// Python extension), so that it reads xylem's numbers instead of re-deriving them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FinishNodes {
+    /// R(μᵢ) = min(1, R_ss (1 + [`SS_MARGIN`]) + R_ms): all the finish reflects.
+    pub reflectance: Vec<f32>,
+    /// R_ms(μᵢ): the albedo of the multiple-scattering lobe.
+    pub multiple: Vec<f32>,
+    /// 1/(π R̄_ms), the multiple-scattering lobe's normalisation (0 when it scatters nothing).
+    pub ms_norm: f32,
+    /// R̄ = 2∫R(μ)μ dμ, the finish's hemispherical reflectance from outside.
+    pub avg_reflectance: f32,
+    /// [`RoughTransmission::node`]: the transmitted light's spreads at μᵢ (the share of single
+    /// scattering, then mean x and z as offsets from the smooth refraction, cov xx, yy, xz of
+    /// the single- and of the multiple-scattering part).
+    pub transmission: Vec<[f32; PER_NODE]>,
+}
+
+/// [`FinishNodes`] of the rough finish of roughness `alpha` in [10⁻³, 1] and index `eta` in
+/// [1, 4] (clamped into the tables' range as [`RoughFinish::new`] does).
+pub fn finish_nodes(alpha: f32, eta: f32) -> FinishNodes {
+    let f = RoughFinish::new(alpha, eta);
+    let t = RoughTransmission::new(alpha, eta);
+    FinishNodes {
+        reflectance: f.reflectance.to_vec(),
+        multiple: f.multiple.to_vec(),
+        ms_norm: f.ms_norm,
+        avg_reflectance: f.avg_reflectance,
+        transmission: (0..MU_NODES).map(|i| t.node(i)).collect(),
     }
 }
 

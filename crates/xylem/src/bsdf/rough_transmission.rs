@@ -19,7 +19,7 @@ use glam::Vec3;
 /// of the single- and of the multiple-scattering part, the means stored as their offsets from
 /// the smooth refraction of the node's direction (so that interpolation is exact where the
 /// finish is smooth or index-matched, and a narrow lobe is not bent by the table).
-const PER_NODE: usize = 11;
+pub const PER_NODE: usize = 11;
 const NODES: usize = ALPHA_NODES * ETA_NODES * MU_NODES;
 static TABLE: &[u8; NODES * PER_NODE * 4] = include_bytes!("rough_transmission_table.bin");
 
@@ -80,7 +80,7 @@ impl TransmittedPart {
 
 /// The tabulated spreads of one finish (α, η): where the table's nodes around them lie.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct RoughTransmission {
+pub struct RoughTransmission {
     eta: f32,
     j: usize,
     fa: f32,
@@ -104,25 +104,33 @@ impl RoughTransmission {
         RoughTransmission { eta, j, fa, k, fe }
     }
 
-    /// The single- and multiple-scattering parts for an exterior direction of cosine `mu`
-    /// (trilinear in √μ, √α, √((η − 1)/3), the table's node spacing).
-    pub fn parts(&self, mu: f32) -> [TransmittedPart; 2] {
-        let (i, fm) = locate(mu.max(0.0).sqrt(), MU_NODES);
+    /// The table's [`PER_NODE`] values at μ node `i` (0..`MU_NODES`) for this finish: bilinear in
+    /// √α, √((η − 1)/3), the table's node spacing. The means are offsets from the smooth
+    /// refraction; [`RoughTransmission::parts`] interpolates these linearly in √μ.
+    pub fn node(&self, i: usize) -> [f32; PER_NODE] {
         let mut v = [0.0f32; PER_NODE];
         for (dj, wj) in [(0, 1.0 - self.fa), (1, self.fa)] {
             for (dk, wk) in [(0, 1.0 - self.fe), (1, self.fe)] {
-                for (di, wi) in [(0, 1.0 - fm), (1, fm)] {
-                    let w = wj * wk * wi;
-                    if w == 0.0 {
-                        continue;
-                    }
-                    let node = ((self.j + dj) * ETA_NODES + self.k + dk) * MU_NODES + i + di;
-                    for (x, vx) in v.iter_mut().enumerate() {
-                        *vx += w * table(node, x);
-                    }
+                let w = wj * wk;
+                if w == 0.0 {
+                    continue;
+                }
+                let node = ((self.j + dj) * ETA_NODES + self.k + dk) * MU_NODES + i;
+                for (x, vx) in v.iter_mut().enumerate() {
+                    *vx += w * table(node, x);
                 }
             }
         }
+        v
+    }
+
+    /// The single- and multiple-scattering parts for an exterior direction of cosine `mu`
+    /// (trilinear in √μ, √α, √((η − 1)/3), the table's node spacing: [`RoughTransmission::node`]
+    /// linear in √μ).
+    pub fn parts(&self, mu: f32) -> [TransmittedPart; 2] {
+        let (i, fm) = locate(mu.max(0.0).sqrt(), MU_NODES);
+        let (lo, hi) = (self.node(i), self.node(i + 1));
+        let v: [f32; PER_NODE] = std::array::from_fn(|x| lo[x] + fm * (hi[x] - lo[x]));
         let (rx, rz) = refracted(mu, self.eta);
         let part = |share: f32, o: usize| TransmittedPart {
             share,

@@ -41,6 +41,11 @@ pub struct BakedMaps {
     /// Tangent-space fibre direction (unit, x right, y up, z out of the face), stored as
     /// 0.5 + 0.5·f: unlike the anisotropy texel it keeps the sign of the tilt out of the face.
     pub fiber: Vec<Vec3>,
+    /// Tangent-space ray-cell direction (unit, the frame of `fiber`): the volume's radial ray
+    /// axis, which xylem's own baked material replaces by the in-face axis across the fibre;
+    /// written for renderers that shade the ray lobe from it (the Mitsuba plugin
+    /// `xylem_wood_baked`).
+    pub ray: Vec<Vec3>,
 }
 
 /// Which map gives a baked material its fibre direction.
@@ -210,6 +215,7 @@ mod tests {
             ray_mask: vec![0.0, 1.0],
             normal: vec![Vec3::Z; 2],
             fiber: vec![Vec3::X; 2],
+            ray: vec![Vec3::Y; 2],
         }
     }
 
