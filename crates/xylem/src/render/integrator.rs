@@ -14,7 +14,7 @@
 use super::camera::CameraRays;
 use super::film::Aov;
 use super::frames::LightFrames;
-use super::geometry::{segment_misses_box, slab_misses, Accel, Hit, Ray};
+use super::geometry::{slab_misses, Accel, Hit, Ray, Slab};
 use super::light::{LightSample, LightSamples, LightU};
 use super::sampler::{pixel_sample, sample_rng};
 use super::Scene;
@@ -370,8 +370,62 @@ fn eval_then_pdf_each(
 #[derive(Clone)]
 pub struct ShadowTest<'a> {
     accel: &'a Accel,
-    /// Widened world boxes (min, max) of the objects; `None`: always ask the BVH.
-    boxes: Option<Vec<(Vec3A, Vec3A)>>,
+    /// Widened world boxes of the objects, one lane each; `None`: always ask the BVH.
+    boxes: Option<BoxLanes>,
+}
+
+/// Up to [`ShadowTest::MAX_BOXES`] world boxes as structure-of-arrays lanes (lower and upper
+/// corner by axis, one lane per box), so that one segment's slab tests against all of them run
+/// as one loop in SIMD lanes ([`BoxLanes::all_missed`]) instead of one box after the other.
+#[derive(Clone, Debug)]
+struct BoxLanes {
+    lo: [[f32; ShadowTest::MAX_BOXES]; 3],
+    hi: [[f32; ShadowTest::MAX_BOXES]; 3],
+    /// How many lanes hold a box (the rest are not read).
+    n: usize,
+}
+
+impl BoxLanes {
+    /// The boxes (min, max), at most [`ShadowTest::MAX_BOXES`] of them.
+    fn new(boxes: &[(Vec3A, Vec3A)]) -> BoxLanes {
+        assert!(boxes.len() <= ShadowTest::MAX_BOXES);
+        let mut b = BoxLanes {
+            lo: [[0.0; ShadowTest::MAX_BOXES]; 3],
+            hi: [[0.0; ShadowTest::MAX_BOXES]; 3],
+            n: boxes.len(),
+        };
+        for (k, (lo, hi)) in boxes.iter().enumerate() {
+            for a in 0..3 {
+                (b.lo[a][k], b.hi[a][k]) = (lo[a], hi[a]);
+            }
+        }
+        b
+    }
+
+    /// Box `k` as (min, max) arrays.
+    #[inline(always)]
+    fn get(&self, k: usize) -> ([f32; 3], [f32; 3]) {
+        (self.lo.map(|c| c[k]), self.hi.map(|c| c[k]))
+    }
+
+    /// Whether the segment `o + t·d`, t in [0, t_max] (`inv` = 1/d), surely misses every box:
+    /// the slab test ([`slab_misses`]) of every lane at once, axis by axis, the lanes past `n`
+    /// counted as missed.
+    #[inline(always)]
+    fn all_missed(&self, o: [f32; 3], inv: [f32; 3], t_max: f32) -> bool {
+        let mut slab = [Slab::new(t_max); ShadowTest::MAX_BOXES];
+        for a in 0..3 {
+            let (lo, hi) = (&self.lo[a], &self.hi[a]);
+            for (k, s) in slab.iter_mut().enumerate() {
+                s.clip(o[a], inv[a], lo[k], hi[k]);
+            }
+        }
+        let mut all = true;
+        for (k, s) in slab.iter().enumerate() {
+            all &= s.missed() | (k >= self.n);
+        }
+        all
+    }
 }
 
 impl<'a> ShadowTest<'a> {
@@ -410,18 +464,18 @@ impl<'a> ShadowTest<'a> {
             .filter(|b: &Vec<(Vec3A, Vec3A)>| {
                 b.iter().all(|(lo, hi)| lo.is_finite() && hi.is_finite())
             });
-        ShadowTest { accel, boxes }
+        ShadowTest {
+            accel,
+            boxes: boxes.as_deref().map(BoxLanes::new),
+        }
     }
 
     /// True when nothing blocks the segment `o + t·d`, t in (0, t_max) ([`Accel::unoccluded`]).
     #[inline]
     pub fn unoccluded(&self, ray: &Ray, t_max: f32) -> bool {
         if let Some(boxes) = &self.boxes {
-            let (o, inv) = (Vec3A::from(ray.o), Vec3A::ONE / Vec3A::from(ray.d));
-            if boxes
-                .iter()
-                .all(|(lo, hi)| segment_misses_box(o, inv, t_max, *lo, *hi))
-            {
+            let inv = Vec3A::ONE / Vec3A::from(ray.d);
+            if boxes.all_missed(ray.o.to_array(), inv.to_array(), t_max) {
                 return true;
             }
         }
@@ -466,8 +520,8 @@ impl<'a> ShadowTest<'a> {
             t_max[k] = shadow_t_max(dist[k]);
         }
         let culled = &mut culled[..n];
-        for (lo, hi) in boxes {
-            let (lo, hi) = (lo.to_array(), hi.to_array());
+        for b in 0..boxes.n {
+            let (lo, hi) = boxes.get(b);
             for k in 0..n {
                 let (o, inv) = ([ox[k], oy[k], oz[k]], [ix[k], iy[k], iz[k]]);
                 culled[k] &= slab_misses(o, inv, t_max[k], lo, hi);
