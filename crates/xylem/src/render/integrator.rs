@@ -1065,3 +1065,71 @@ fn next_event_frames<const ONE: bool>(
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One segment against the box lanes ([`BoxLanes::all_missed`]) says what the slab test of
+    /// every box one by one says ([`slab_misses`]), for any number of boxes up to the lanes,
+    /// segments that start inside, graze or run parallel to a face included.
+    #[test]
+    fn box_lanes_equal_one_box_at_a_time() {
+        let mut rng = Pcg32::new(29, 7);
+        let mut v = |s: f32| Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * s;
+        let mut checked = [0usize; 2];
+        for trial in 0..4000 {
+            let n = trial % (ShadowTest::MAX_BOXES + 1);
+            let boxes: Vec<(Vec3A, Vec3A)> = (0..n)
+                .map(|_| {
+                    let lo = v(10.0) - Vec3::splat(5.0);
+                    (lo.into(), (lo + v(6.0)).into())
+                })
+                .collect();
+            let lanes = BoxLanes::new(&boxes);
+            let o = v(12.0) - Vec3::splat(6.0);
+            let mut d = v(2.0) - Vec3::ONE;
+            if trial % 5 == 0 {
+                d.x = 0.0; // parallel to the x slabs
+            }
+            let inv = (Vec3A::ONE / Vec3A::from(d)).to_array();
+            let t_max = v(20.0).x;
+            let one_by_one = boxes.iter().all(|(lo, hi)| {
+                slab_misses(o.to_array(), inv, t_max, lo.to_array(), hi.to_array())
+            });
+            assert_eq!(
+                lanes.all_missed(o.to_array(), inv, t_max),
+                one_by_one,
+                "trial {trial}"
+            );
+            checked[one_by_one as usize] += 1;
+        }
+        assert!(checked.iter().all(|&c| c > 200), "{checked:?}");
+    }
+
+    /// `SurfaceBsdf::copy_to` leaves the slot equal to the BSDF, whether the slot held the same
+    /// variant (payload only) or another one.
+    #[test]
+    fn copy_to_equals_the_bsdf_from_any_slot() {
+        use crate::bsdf::{Glass, Lambertian, Mirror};
+        let all = [
+            SurfaceBsdf::Lambertian(Lambertian {
+                albedo: Vec3::new(0.1, 0.2, 0.3),
+            }),
+            SurfaceBsdf::Mirror(Mirror {
+                reflectance: Vec3::splat(0.9),
+            }),
+            SurfaceBsdf::Glass(Glass {
+                eta: 1.5,
+                tint: Vec3::ONE,
+            }),
+        ];
+        for from in &all {
+            for to in &all {
+                let mut slot = to.copied();
+                from.copy_to(&mut slot);
+                assert_eq!(format!("{slot:?}"), format!("{from:?}"));
+            }
+        }
+    }
+}
