@@ -387,6 +387,10 @@ impl Accel {
             )
         });
         let scene_triangles = instances.iter().map(|i| i.mesh.indices.len()).sum();
+        // The frames table once the BVH is built and its buffers freed, so that it does not add
+        // to the build's peak (`resources::BUILD_BYTES_PER_TRIANGLE`).
+        let world_bvh = wide_bvh(&world, &params);
+        drop(world);
         let frames = (instances.iter().zip(&instanced))
             .map(|(inst, &shared)| match shared {
                 true => Vec::new(),
@@ -396,7 +400,7 @@ impl Accel {
             })
             .collect();
         Accel {
-            world: wide_bvh(&world, &params),
+            world: world_bvh,
             offsets,
             flat,
             range_of,
