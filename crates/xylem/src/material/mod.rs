@@ -107,6 +107,21 @@ impl SurfaceBsdf {
         }
     }
 
+    /// [`SurfaceBsdf::copied`] written into `out`, where a shading point keeps it: where `out`
+    /// holds the same variant only the payload is written. (Assigning a whole variant, LLVM
+    /// copied the whole enum, 480 bytes by `memcpy`, for every variant: 2.6 % of a Cornell-box
+    /// render's instructions.)
+    #[inline(always)]
+    pub fn copy_to(&self, out: &mut Self) {
+        match (self, &mut *out) {
+            (SurfaceBsdf::Lambertian(b), SurfaceBsdf::Lambertian(o)) => *o = *b,
+            (SurfaceBsdf::Wood(b), SurfaceBsdf::Wood(o)) => *o = *b,
+            (SurfaceBsdf::Mirror(b), SurfaceBsdf::Mirror(o)) => *o = *b,
+            (SurfaceBsdf::Glass(b), SurfaceBsdf::Glass(o)) => *o = *b,
+            _ => *out = self.copied(),
+        }
+    }
+
     /// True when the BSDF transmits (the renderer must not flip the normal towards the viewer).
     pub(crate) fn is_transmissive(&self) -> bool {
         match self {

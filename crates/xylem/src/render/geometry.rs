@@ -223,6 +223,11 @@ pub struct Accel {
     /// binary search over `offsets` per hit (half of `Accel::intersect`'s own time, ≈ 2 % of a
     /// Cornell-box render); 4 bytes a triangle.
     range_of: Vec<u32>,
+    /// Per instance, the world-constant normals and tangent of each of its triangles
+    /// ([`triangle_frame`]) where the mesh is placed once (flattened); empty for shared meshes,
+    /// whose frames are worked out per hit. A load instead of a cross product, two transforms
+    /// and three normalisations in a chain per hit (`Accel::surface`); 36 bytes a triangle.
+    frames: Vec<Vec<TriangleFrame>>,
     /// One object-space BVH per mesh placed more than once.
     shared: Vec<WideBvh>,
     /// The placements of shared meshes (the top level's primitive ids index this).
@@ -382,11 +387,24 @@ impl Accel {
             )
         });
         let scene_triangles = instances.iter().map(|i| i.mesh.indices.len()).sum();
+        // The frames table once the BVH is built and its buffers freed, so that it does not add
+        // to the build's peak (`resources::BUILD_BYTES_PER_TRIANGLE`).
+        let world_bvh = wide_bvh(&world, &params);
+        drop(world);
+        let frames = (instances.iter().zip(&instanced))
+            .map(|(inst, &shared)| match shared {
+                true => Vec::new(),
+                false => (0..inst.mesh.indices.len())
+                    .map(|t| triangle_frame(inst, t))
+                    .collect(),
+            })
+            .collect();
         Accel {
-            world: wide_bvh(&world, &params),
+            world: world_bvh,
             offsets,
             flat,
             range_of,
+            frames,
             shared,
             placed,
             instanced,
@@ -429,7 +447,9 @@ impl Accel {
             .filter(|i| seen.insert(Arc::as_ptr(&i.mesh)))
             .map(|i| i.mesh.bytes())
             .sum();
-        bvhs + top + mesh_bytes + (self.instances.len() * size_of::<Instance>()) as u64
+        let frames =
+            (self.frames.iter().map(Vec::len).sum::<usize>() * size_of::<TriangleFrame>()) as u64;
+        bvhs + top + mesh_bytes + frames + (self.instances.len() * size_of::<Instance>()) as u64
     }
 
     /// A length that scales ray offsets: the largest coordinate magnitude in the scene (≥ 1 mm).
@@ -570,9 +590,14 @@ impl Accel {
         let w = 1.0 - u - v;
         let p_object = a * w + b * u + c * v;
         let tf = &inst.transform;
-        let n_object = (b - a).cross(c - a).normalize_or_zero();
-        // Normals by the inverse transpose (`Transform::normal_to_world`).
-        let ng = tf.normal_to_world(n_object).normalize_or_zero();
+        let TriangleFrame {
+            n_object,
+            ng,
+            tangent,
+        } = match self.frames[hit.instance as usize].get(hit.triangle as usize) {
+            Some(f) => *f,
+            None => triangle_frame(inst, hit.triangle as usize),
+        };
         let ns = match &mesh.normals {
             Some(n) => {
                 let n_obj = n[i0] * w + n[i1] * u + n[i2] * v;
@@ -592,9 +617,33 @@ impl Accel {
             n_object,
             ng,
             ns,
-            tangent: tf.vector_to_world(b - a).normalize_or_zero(),
+            tangent,
             instance: hit.instance,
         }
+    }
+}
+
+/// The parts of a hit's surface that are constant over its triangle ([`SurfaceHit`]'s
+/// `n_object`, `ng`, `tangent`).
+#[derive(Clone, Copy, Debug)]
+struct TriangleFrame {
+    n_object: Vec3,
+    ng: Vec3,
+    tangent: Vec3,
+}
+
+/// The frame of triangle `t` of `inst`: the object-space geometric normal (v1 − v0) × (v2 − v0)
+/// normalised, the world normal by the inverse transpose (`Transform::normal_to_world`), and the
+/// world tangent along the first edge, each normalised.
+fn triangle_frame(inst: &Instance, t: usize) -> TriangleFrame {
+    let mesh = &inst.mesh;
+    let [a, b, c] = mesh.indices[t].map(|i| mesh.positions[i as usize]);
+    let tf = &inst.transform;
+    let n_object = (b - a).cross(c - a).normalize_or_zero();
+    TriangleFrame {
+        n_object,
+        ng: tf.normal_to_world(n_object).normalize_or_zero(),
+        tangent: tf.vector_to_world(b - a).normalize_or_zero(),
     }
 }
 
@@ -685,15 +734,49 @@ pub(crate) fn slab_misses(
     lo: [f32; 3],
     hi: [f32; 3],
 ) -> bool {
-    let (mut t0, mut t1, mut nan) = (0.0f32, t_max, false);
+    let mut slab = Slab::new(t_max);
     for a in 0..3 {
-        let (ta, tb) = ((lo[a] - o[a]) * inv[a], (hi[a] - o[a]) * inv[a]);
-        nan |= ta.is_nan() | tb.is_nan();
-        let (near, far) = if ta < tb { (ta, tb) } else { (tb, ta) };
-        t0 = if near > t0 { near } else { t0 };
-        t1 = if far < t1 { far } else { t1 };
+        slab.clip(o[a], inv[a], lo[a], hi[a]);
     }
-    !nan & (t0 > t1)
+    slab.missed()
+}
+
+/// The state of [`slab_misses`] after some axes: the parameter interval [t0, t1] left, and
+/// whether a NaN was met. One axis at a time ([`Slab::clip`]), so that a loop over many boxes
+/// or segments keeps one of these per lane.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Slab {
+    t0: f32,
+    t1: f32,
+    nan: bool,
+}
+
+impl Slab {
+    /// The whole segment, t in [0, t_max].
+    #[inline(always)]
+    pub(crate) fn new(t_max: f32) -> Slab {
+        Slab {
+            t0: 0.0,
+            t1: t_max,
+            nan: false,
+        }
+    }
+
+    /// Clipped to the slab [lo, hi] of one axis (origin `o`, 1/direction `inv` on that axis).
+    #[inline(always)]
+    pub(crate) fn clip(&mut self, o: f32, inv: f32, lo: f32, hi: f32) {
+        let (ta, tb) = ((lo - o) * inv, (hi - o) * inv);
+        self.nan |= ta.is_nan() | tb.is_nan();
+        let (near, far) = if ta < tb { (ta, tb) } else { (tb, ta) };
+        self.t0 = if near > self.t0 { near } else { self.t0 };
+        self.t1 = if far < self.t1 { far } else { self.t1 };
+    }
+
+    /// Whether the segment surely misses the box (an empty interval, no NaN).
+    #[inline(always)]
+    pub(crate) fn missed(&self) -> bool {
+        !self.nan & (self.t0 > self.t1)
+    }
 }
 
 #[cfg(test)]
@@ -737,6 +820,47 @@ mod tests {
         assert!((s.ng - Vec3::Z).length() < 1e-6);
         assert!(!accel.unoccluded(&ray, 10.0));
         assert!(accel.unoccluded(&ray, 2.9));
+    }
+
+    /// A hit's surface is the same whether its triangle's frame comes from the table (a mesh
+    /// placed once, flattened) or is worked out per hit (the same mesh placed twice, shared),
+    /// under a transform that shears and scales, so that every normalisation matters.
+    #[test]
+    fn tabled_triangle_frames_equal_per_hit_frames() {
+        let mesh = Arc::new(unit_quad());
+        let to_world = Affine3A::from_cols_array(&[
+            1.3, 0.2, 0.1, -0.4, 0.9, 0.3, 0.2, -0.1, 1.7, 0.5, -0.25, 2.0,
+        ]);
+        let inst = |mesh: &Arc<TriMesh>| Instance {
+            mesh: mesh.clone(),
+            transform: Transform::new(to_world),
+            material: 0,
+            placement: Placement::default(),
+        };
+        let other = Arc::new(unit_quad());
+        let once = Accel::new(vec![inst(&mesh)]);
+        // The first two share one mesh (traced in object space, frames per hit).
+        let twice = Accel::new(vec![inst(&other), inst(&other)]);
+        assert!(!once.is_instanced(0) && twice.is_instanced(0));
+        for (u, v) in [(0.3, 0.6), (0.7, 0.2), (0.5, 0.5)] {
+            let hit = Hit {
+                t: 4.0,
+                instance: 0,
+                triangle: (u > v) as u32,
+                uv: Vec2::new(u, v),
+            };
+            let ray = Ray {
+                o: Vec3::new(0.2, 0.4, 6.0),
+                d: -Vec3::Z,
+            };
+            let (a, b) = (once.surface(&ray, &hit), twice.surface(&ray, &hit));
+            for (x, y) in [(a.n_object, b.n_object), (a.ng, b.ng), (a.ns, b.ns)] {
+                assert_eq!(x.to_array(), y.to_array());
+            }
+            assert_eq!(a.tangent.to_array(), b.tangent.to_array());
+            let f = triangle_frame(&twice.instances[0], hit.triangle as usize);
+            assert_eq!(a.tangent.to_array(), f.tangent.to_array());
+        }
     }
 
     #[test]

@@ -14,7 +14,7 @@
 use super::camera::CameraRays;
 use super::film::Aov;
 use super::frames::LightFrames;
-use super::geometry::{segment_misses_box, slab_misses, Accel, Hit, Ray};
+use super::geometry::{slab_misses, Accel, Hit, Ray, Slab};
 use super::light::{LightSample, LightSamples, LightU};
 use super::sampler::{pixel_sample, PathNumbers};
 use super::Scene;
@@ -156,14 +156,31 @@ pub(crate) fn shading_point(
             coverage: 1.0,
         };
     }
-    *out = Some(ShadingPoint {
-        p: s.p,
-        ng,
-        frame,
-        wo: frame.to_local(wo_world),
-        bsdf: shading.bsdf.copied(),
-        eps: 2e-5 * scene.accel.scale(),
-    });
+    // Field by field into the slot (a shading point built aside and moved in was a `memmove`
+    // of all its bytes per vertex, 2.5 % of a Cornell-box render); an empty slot first gets a
+    // placeholder (once per path at most).
+    let sp = out.get_or_insert_with(ShadingPoint::placeholder);
+    sp.p = s.p;
+    sp.ng = ng;
+    sp.frame = frame;
+    sp.wo = frame.to_local(wo_world);
+    shading.bsdf.copy_to(&mut sp.bsdf);
+    sp.eps = 2e-5 * scene.accel.scale();
+}
+
+impl ShadingPoint {
+    /// A shading point to overwrite ([`shading_point`]): black Lambertian at the origin.
+    #[cold]
+    fn placeholder() -> ShadingPoint {
+        ShadingPoint {
+            p: Vec3::ZERO,
+            ng: Vec3::Z,
+            frame: Frame::from_normal_tangent(Vec3::Z, Vec3::X),
+            wo: Vec3::Z,
+            bsdf: SurfaceBsdf::Lambertian(crate::bsdf::Lambertian { albedo: Vec3::ZERO }),
+            eps: 0.0,
+        }
+    }
 }
 
 /// The share of the pixel footprint each of `spp` camera samples band-limits its first hit by:
@@ -370,8 +387,62 @@ fn eval_then_pdf_each(
 #[derive(Clone)]
 pub struct ShadowTest<'a> {
     accel: &'a Accel,
-    /// Widened world boxes (min, max) of the objects; `None`: always ask the BVH.
-    boxes: Option<Vec<(Vec3A, Vec3A)>>,
+    /// Widened world boxes of the objects, one lane each; `None`: always ask the BVH.
+    boxes: Option<BoxLanes>,
+}
+
+/// Up to [`ShadowTest::MAX_BOXES`] world boxes as structure-of-arrays lanes (lower and upper
+/// corner by axis, one lane per box), so that one segment's slab tests against all of them run
+/// as one loop in SIMD lanes ([`BoxLanes::all_missed`]) instead of one box after the other.
+#[derive(Clone, Debug)]
+struct BoxLanes {
+    lo: [[f32; ShadowTest::MAX_BOXES]; 3],
+    hi: [[f32; ShadowTest::MAX_BOXES]; 3],
+    /// How many lanes hold a box (the rest are not read).
+    n: usize,
+}
+
+impl BoxLanes {
+    /// The boxes (min, max), at most [`ShadowTest::MAX_BOXES`] of them.
+    fn new(boxes: &[(Vec3A, Vec3A)]) -> BoxLanes {
+        assert!(boxes.len() <= ShadowTest::MAX_BOXES);
+        let mut b = BoxLanes {
+            lo: [[0.0; ShadowTest::MAX_BOXES]; 3],
+            hi: [[0.0; ShadowTest::MAX_BOXES]; 3],
+            n: boxes.len(),
+        };
+        for (k, (lo, hi)) in boxes.iter().enumerate() {
+            for a in 0..3 {
+                (b.lo[a][k], b.hi[a][k]) = (lo[a], hi[a]);
+            }
+        }
+        b
+    }
+
+    /// Box `k` as (min, max) arrays.
+    #[inline(always)]
+    fn get(&self, k: usize) -> ([f32; 3], [f32; 3]) {
+        (self.lo.map(|c| c[k]), self.hi.map(|c| c[k]))
+    }
+
+    /// Whether the segment `o + t·d`, t in [0, t_max] (`inv` = 1/d), surely misses every box:
+    /// the slab test ([`slab_misses`]) of every lane at once, axis by axis, the lanes past `n`
+    /// counted as missed.
+    #[inline(always)]
+    fn all_missed(&self, o: [f32; 3], inv: [f32; 3], t_max: f32) -> bool {
+        let mut slab = [Slab::new(t_max); ShadowTest::MAX_BOXES];
+        for a in 0..3 {
+            let (lo, hi) = (&self.lo[a], &self.hi[a]);
+            for (k, s) in slab.iter_mut().enumerate() {
+                s.clip(o[a], inv[a], lo[k], hi[k]);
+            }
+        }
+        let mut all = true;
+        for (k, s) in slab.iter().enumerate() {
+            all &= s.missed() | (k >= self.n);
+        }
+        all
+    }
 }
 
 impl<'a> ShadowTest<'a> {
@@ -410,18 +481,18 @@ impl<'a> ShadowTest<'a> {
             .filter(|b: &Vec<(Vec3A, Vec3A)>| {
                 b.iter().all(|(lo, hi)| lo.is_finite() && hi.is_finite())
             });
-        ShadowTest { accel, boxes }
+        ShadowTest {
+            accel,
+            boxes: boxes.as_deref().map(BoxLanes::new),
+        }
     }
 
     /// True when nothing blocks the segment `o + t·d`, t in (0, t_max) ([`Accel::unoccluded`]).
     #[inline]
     pub fn unoccluded(&self, ray: &Ray, t_max: f32) -> bool {
         if let Some(boxes) = &self.boxes {
-            let (o, inv) = (Vec3A::from(ray.o), Vec3A::ONE / Vec3A::from(ray.d));
-            if boxes
-                .iter()
-                .all(|(lo, hi)| segment_misses_box(o, inv, t_max, *lo, *hi))
-            {
+            let inv = Vec3A::ONE / Vec3A::from(ray.d);
+            if boxes.all_missed(ray.o.to_array(), inv.to_array(), t_max) {
                 return true;
             }
         }
@@ -466,8 +537,8 @@ impl<'a> ShadowTest<'a> {
             t_max[k] = shadow_t_max(dist[k]);
         }
         let culled = &mut culled[..n];
-        for (lo, hi) in boxes {
-            let (lo, hi) = (lo.to_array(), hi.to_array());
+        for b in 0..boxes.n {
+            let (lo, hi) = boxes.get(b);
             for k in 0..n {
                 let (o, inv) = ([ox[k], oy[k], oz[k]], [ix[k], iy[k], iz[k]]);
                 culled[k] &= slab_misses(o, inv, t_max[k], lo, hi);
@@ -747,9 +818,14 @@ pub(crate) struct FramesScratch {
 /// ([`FirstBounce`]): the same values either way, so the same bits. Keeping traces the bounce
 /// even where no frame needs it (every camera ray met a light, or nothing is hittable), since
 /// other frames may.
+///
+/// `ONE` says that `lights` has one frame (a plain render): the frame loops then have the
+/// constant length 1, which the compiler folds into straight code (the per-frame columns cost
+/// ≈ 9 % of a Cornell-box render's instructions otherwise); the same operations, so the same
+/// bits.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-pub(crate) fn radiance_frames(
+pub(crate) fn radiance_frames<const ONE: bool>(
     scene: &Scene,
     lights: &LightFrames,
     shadow: &ShadowTest,
@@ -761,7 +837,8 @@ pub(crate) fn radiance_frames(
     rays: &mut RayCount,
     mut first: FirstBounce,
 ) {
-    let n = lights.len();
+    debug_assert!(!ONE || lights.len() == 1);
+    let n = if ONE { 1 } else { lights.len() };
     resize_columns(out, n);
     for c in out.iter_mut() {
         c.fill(0.0);
@@ -802,11 +879,11 @@ pub(crate) fn radiance_frames(
         let vertex = if at_first { &ps.point } else { &bounce };
         let Some(sp) = vertex else { break };
         let keeping = at_first && matches!(first, FirstBounce::Keep(_));
-        if depth >= max_depth || (!keeping && !scratch.alive.contains(&true)) {
+        if depth >= max_depth || (!keeping && !scratch.alive[..n].contains(&true)) {
             break;
         }
         if !sp.bsdf.is_delta() {
-            next_event_frames(lights, shadow, sp, numbers, depth, scratch, rays);
+            next_event_frames::<ONE>(lights, shadow, sp, numbers, depth, scratch, rays);
             // out += β · nee in the live frames, a channel at a time in lanes.
             let alive = &scratch.alive[..n];
             for ((o, e), b) in out.iter_mut().zip(&scratch.nee).zip(beta.to_array()) {
@@ -912,8 +989,9 @@ pub(crate) fn radiance_frames(
 /// holds for frames no longer alive is not read): one sample of every
 /// light (its two numbers from `numbers`, whatever the light's place), each weighted against BSDF
 /// sampling by the power heuristic (delta lights take weight 1), summed in the lights' order.
+/// `ONE`: one frame, as in [`radiance_frames`].
 #[inline(always)]
-fn next_event_frames(
+fn next_event_frames<const ONE: bool>(
     lights: &LightFrames,
     shadow: &ShadowTest,
     sp: &ShadingPoint,
@@ -922,7 +1000,7 @@ fn next_event_frames(
     scratch: &mut FramesScratch,
     rays: &mut RayCount,
 ) {
-    let n = lights.len();
+    let n = if ONE { 1 } else { lights.len() };
     let FramesScratch {
         alive,
         nee,
@@ -982,6 +1060,74 @@ fn next_event_frames(
         for a in after {
             for e in e.iter_mut() {
                 *e += a[c];
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One segment against the box lanes ([`BoxLanes::all_missed`]) says what the slab test of
+    /// every box one by one says ([`slab_misses`]), for any number of boxes up to the lanes,
+    /// segments that start inside, graze or run parallel to a face included.
+    #[test]
+    fn box_lanes_equal_one_box_at_a_time() {
+        let mut rng = Pcg32::new(29, 7);
+        let mut v = |s: f32| Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * s;
+        let mut checked = [0usize; 2];
+        for trial in 0..4000 {
+            let n = trial % (ShadowTest::MAX_BOXES + 1);
+            let boxes: Vec<(Vec3A, Vec3A)> = (0..n)
+                .map(|_| {
+                    let lo = v(10.0) - Vec3::splat(5.0);
+                    (lo.into(), (lo + v(6.0)).into())
+                })
+                .collect();
+            let lanes = BoxLanes::new(&boxes);
+            let o = v(12.0) - Vec3::splat(6.0);
+            let mut d = v(2.0) - Vec3::ONE;
+            if trial % 5 == 0 {
+                d.x = 0.0; // parallel to the x slabs
+            }
+            let inv = (Vec3A::ONE / Vec3A::from(d)).to_array();
+            let t_max = v(20.0).x;
+            let one_by_one = boxes.iter().all(|(lo, hi)| {
+                slab_misses(o.to_array(), inv, t_max, lo.to_array(), hi.to_array())
+            });
+            assert_eq!(
+                lanes.all_missed(o.to_array(), inv, t_max),
+                one_by_one,
+                "trial {trial}"
+            );
+            checked[one_by_one as usize] += 1;
+        }
+        assert!(checked.iter().all(|&c| c > 200), "{checked:?}");
+    }
+
+    /// `SurfaceBsdf::copy_to` leaves the slot equal to the BSDF, whether the slot held the same
+    /// variant (payload only) or another one.
+    #[test]
+    fn copy_to_equals_the_bsdf_from_any_slot() {
+        use crate::bsdf::{Glass, Lambertian, Mirror};
+        let all = [
+            SurfaceBsdf::Lambertian(Lambertian {
+                albedo: Vec3::new(0.1, 0.2, 0.3),
+            }),
+            SurfaceBsdf::Mirror(Mirror {
+                reflectance: Vec3::splat(0.9),
+            }),
+            SurfaceBsdf::Glass(Glass {
+                eta: 1.5,
+                tint: Vec3::ONE,
+            }),
+        ];
+        for from in &all {
+            for to in &all {
+                let mut slot = to.copied();
+                from.copy_to(&mut slot);
+                assert_eq!(format!("{slot:?}"), format!("{from:?}"));
             }
         }
     }

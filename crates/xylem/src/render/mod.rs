@@ -509,6 +509,23 @@ fn render_tile_in(
     origin: UVec2,
     primary: Primary,
 ) -> TileFrames {
+    // One frame (a plain render): the frame loops of constant length (`radiance_frames`).
+    match lights.len() {
+        1 => tile_frames::<true>(scene, lights, shadow, settings, origin, primary),
+        _ => tile_frames::<false>(scene, lights, shadow, settings, origin, primary),
+    }
+}
+
+/// [`render_tile_in`] for one frame (`ONE`) or any number.
+#[inline(always)]
+fn tile_frames<const ONE: bool>(
+    scene: &Scene,
+    lights: &LightFrames,
+    shadow: &ShadowTest,
+    settings: &RenderSettings,
+    origin: UVec2,
+    primary: Primary,
+) -> TileFrames {
     let (w, h) = (scene.camera.width, scene.camera.height);
     let (tw, th) = (TILE.min(w - origin.x), TILE.min(h - origin.y));
     let n = (tw * th) as usize;
@@ -565,7 +582,7 @@ fn render_tile_in(
                 _ => FirstBounce::Trace,
             };
             let numbers = path_numbers(scene, pixel, s, settings.seed);
-            radiance_frames(
+            radiance_frames::<ONE>(
                 scene,
                 lights,
                 shadow,
