@@ -1068,6 +1068,7 @@ fn next_event_frames<const ONE: bool>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::Pcg32;
 
     /// One segment against the box lanes ([`BoxLanes::all_missed`]) says what the slab test of
     /// every box one by one says ([`slab_misses`]), for any number of boxes up to the lanes,
