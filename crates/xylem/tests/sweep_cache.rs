@@ -235,7 +235,7 @@ fn culled_shadow_test_answers_as_the_bvh() {
     // and from anywhere, in random directions and lengths: the box-culled query must give the
     // BVH's answer every time, blocked and unblocked cases both occurring.
     use xylem::math::{uniform_sphere, Pcg32};
-    use xylem::render::integrator::ShadowTest;
+    use xylem::render::shadow::ShadowTest;
     use xylem::render::Ray;
     let loaded = from_str(WOOD_SCENE, "sweep_cache_wood.toml", Path::new("."), "test").unwrap();
     let accel = &loaded.scene.accel;
@@ -287,8 +287,8 @@ fn batch_culled_shadow_segments_are_unoccluded() {
     // segments the BVH finds unoccluded: from the camera's first hits towards sphere lights at
     // random places, above and below the board's top, both culled and kept segments occurring.
     use xylem::math::Pcg32;
-    use xylem::render::integrator::{Segments, ShadowTest};
     use xylem::render::light::{LightSamples, LightU};
+    use xylem::render::shadow::{Segments, ShadowTest};
     use xylem::render::{primary_sample, Ray};
     let loaded = from_str(WOOD_SCENE, "sweep_cache_wood.toml", Path::new("."), "test").unwrap();
     let scene = &loaded.scene;

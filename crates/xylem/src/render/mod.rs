@@ -15,6 +15,7 @@ pub mod light;
 pub mod lod;
 pub mod resources;
 mod sampler;
+pub mod shadow;
 pub mod wide_bvh;
 
 pub use camera::{Camera, CameraRays, Projection};
@@ -27,6 +28,7 @@ pub use integrator::{primary_sample, Integrator, ShadingPoint};
 pub use light::{
     DistantLight, EnvMap, Environment, Light, PointLight, RectLight, SphereLight, SpotLight,
 };
+use shadow::ShadowTest;
 
 use crate::material::Material;
 use crate::progress::{NoProgress, Progress};
@@ -34,7 +36,7 @@ use crate::simd::{simd_wide, Simd};
 use glam::{UVec2, Vec3};
 use integrator::{
     primary_sample_into, radiance_frames, FirstBounce, FramesScratch, KeptSample, PrimarySample,
-    RayCount, ShadowTest,
+    RayCount,
 };
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
