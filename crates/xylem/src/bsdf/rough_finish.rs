@@ -176,12 +176,12 @@ impl RoughFinish {
 }
 
 /// One finish's tables (α, η fixed) on the μ nodes [`mu_node`], to be interpolated linearly in
-/// √μ between them as [`RoughFinish`] and [`RoughTransmission`] do: for code that evaluates the
+/// √μ between them as `RoughFinish` and [`RoughTransmission`] do: for code that evaluates the
 /// rough finish outside this crate (the Dr.Jit Mitsuba plugin `xylem_wood_baked`, through the
 /// Python extension), so that it reads xylem's numbers instead of re-deriving them.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FinishNodes {
-    /// R(μᵢ) = min(1, R_ss (1 + [`SS_MARGIN`]) + R_ms): all the finish reflects.
+    /// R(μᵢ) = min(1, R_ss (1 + `SS_MARGIN`) + R_ms): all the finish reflects.
     pub reflectance: Vec<f32>,
     /// R_ms(μᵢ): the albedo of the multiple-scattering lobe.
     pub multiple: Vec<f32>,
@@ -196,7 +196,7 @@ pub struct FinishNodes {
 }
 
 /// [`FinishNodes`] of the rough finish of roughness `alpha` in [10⁻³, 1] and index `eta` in
-/// [1, 4] (clamped into the tables' range as [`RoughFinish::new`] does).
+/// [1, 4] (clamped into the tables' range as `RoughFinish::new` does).
 pub fn finish_nodes(alpha: f32, eta: f32) -> FinishNodes {
     let f = RoughFinish::new(alpha, eta);
     let t = RoughTransmission::new(alpha, eta);

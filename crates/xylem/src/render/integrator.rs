@@ -17,6 +17,7 @@ use super::frames::LightFrames;
 use super::geometry::{Hit, Ray};
 use super::light::{LightSample, LightSamples, LightU};
 use super::sampler::{pixel_sample, PathNumbers};
+use super::shading::{offset_origin, ShadingPoint};
 use super::shadow::{shadow_t_max, Segments, ShadowTest};
 use super::Scene;
 use crate::bsdf::{Bsdf, WoodAtWo};
@@ -55,24 +56,6 @@ impl std::fmt::Display for Integrator {
             Integrator::Path { max_depth } => write!(f, "path (max_depth {max_depth})"),
         }
     }
-}
-
-/// A first hit ready to be lit: position, geometric normal, shading frame, outgoing direction in
-/// the local frame and the material's BSDF. `Copy`, so sweeps can cache one per pixel sample.
-#[derive(Clone, Copy, Debug)]
-pub struct ShadingPoint {
-    /// Hit point (world, mm).
-    pub p: Vec3,
-    /// Geometric normal (world), on the side of `wo` unless the BSDF transmits.
-    pub ng: Vec3,
-    /// World shading frame (z = shading normal).
-    pub frame: Frame,
-    /// Direction towards the viewer, in the local frame.
-    pub wo: Vec3,
-    /// The material's BSDF at the hit, in the local shading frame.
-    pub bsdf: SurfaceBsdf,
-    /// Ray-origin offset length for rays leaving this point (mm).
-    pub eps: f32,
 }
 
 /// The light-independent part of one pixel sample.
@@ -167,21 +150,6 @@ pub(crate) fn shading_point(
     sp.wo = frame.to_local(wo_world);
     shading.bsdf.copy_to(&mut sp.bsdf);
     sp.eps = 2e-5 * scene.accel.scale();
-}
-
-impl ShadingPoint {
-    /// A shading point to overwrite ([`shading_point`]): black Lambertian at the origin.
-    #[cold]
-    fn placeholder() -> ShadingPoint {
-        ShadingPoint {
-            p: Vec3::ZERO,
-            ng: Vec3::Z,
-            frame: Frame::from_normal_tangent(Vec3::Z, Vec3::X),
-            wo: Vec3::Z,
-            bsdf: SurfaceBsdf::Lambertian(crate::bsdf::Lambertian { albedo: Vec3::ZERO }),
-            eps: 0.0,
-        }
-    }
 }
 
 /// The share of the pixel footprint each of `spp` camera samples band-limits its first hit by:
@@ -287,13 +255,6 @@ pub(crate) fn primary_sample_into(
 pub(crate) fn path_numbers(scene: &Scene, pixel: UVec2, sample: u32, seed: u64) -> PathNumbers {
     let index = pixel.y as u64 * scene.camera.width as u64 + pixel.x as u64;
     PathNumbers::new(seed, index, sample)
-}
-
-/// Origin of a ray leaving `sp` along `dir`: the hit point moved `eps` along the geometric
-/// normal, to the side `dir` points to, so the ray does not hit the surface it starts on.
-pub(crate) fn offset_origin(sp: &ShadingPoint, dir: Vec3) -> Vec3 {
-    let side = if sp.ng.dot(dir) >= 0.0 { 1.0 } else { -1.0 };
-    sp.p + sp.ng * (side * sp.eps)
 }
 
 /// A shading point's BSDF with `wo` fixed, for lighting it by many light samples: the wood BSDF

@@ -15,6 +15,7 @@ pub mod light;
 pub mod lod;
 pub mod resources;
 mod sampler;
+pub mod shading;
 pub mod shadow;
 pub mod wide_bvh;
 
@@ -24,10 +25,11 @@ pub use film::{Aov, Filter, Image, PixelSum};
 pub use frames::LightFrames;
 pub use geometry::{Accel, Instance, Ray, Transform, TriMesh};
 pub(crate) use integrator::path_numbers;
-pub use integrator::{primary_sample, Integrator, ShadingPoint};
+pub use integrator::{primary_sample, Integrator};
 pub use light::{
     DistantLight, EnvMap, Environment, Light, PointLight, RectLight, SphereLight, SpotLight,
 };
+pub use shading::ShadingPoint;
 use shadow::ShadowTest;
 
 use crate::material::Material;

@@ -2,8 +2,8 @@
 //! where a scene has few objects (a segment that misses every box needs no BVH traversal).
 
 use super::geometry::{slab_misses, Accel, Ray, Slab};
-use super::integrator::{offset_origin, ShadingPoint};
 use super::light::LightSamples;
+use super::shading::{offset_origin, ShadingPoint};
 use glam::{Vec3, Vec3A};
 
 /// Shadow queries, optionally culled: with the world boxes of a scene's few objects, a shadow
