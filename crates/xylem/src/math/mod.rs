@@ -35,6 +35,18 @@ pub(crate) fn safe_acos(x: f32) -> f32 {
     x.clamp(-1.0, 1.0).acos()
 }
 
+/// Hermite smoothstep (Ebert et al., *Texturing and Modeling*, ch. 2): 0 below `e0`, 1 above
+/// `e1`, 3t² − 2t³ between; a step at `e1` when the edges coincide or cross (a spot light whose
+/// inner and outer cones are one, a zero-width threshold), where t would be 0/0.
+#[inline]
+pub fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
+    if e0 >= e1 {
+        return if x >= e1 { 1.0 } else { 0.0 };
+    }
+    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
 /// Degrees to radians (files hold degrees, code works in radians).
 #[inline]
 pub fn radians(deg: f32) -> f32 {

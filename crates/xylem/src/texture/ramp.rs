@@ -3,12 +3,7 @@
 
 use glam::Vec3;
 
-/// `smoothstep(e0, e1, x)`: 0 below e0, 1 above e1, 3t² − 2t³ between.
-#[inline]
-pub fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
-    let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
-    t * t * (3.0 - 2.0 * t)
-}
+pub use crate::math::smoothstep;
 
 /// A multi-stop colour ramp: stops `(t, colour)` with increasing t; clamps outside.
 #[derive(Clone, Debug, PartialEq)]

@@ -1,6 +1,8 @@
 //! Lights against their closed forms: sampling densities, hits, the environment map.
 
+use super::sphere::one_minus_cos_cone;
 use super::*;
+use crate::math::uniform_sphere;
 
 #[test]
 fn cone_of_a_tiny_sphere_keeps_its_solid_angle() {
