@@ -1,12 +1,9 @@
-//! Triangle meshes, instances with affine transforms, and the acceleration structure: meshes
-//! placed once are flattened into world space, a mesh placed several times keeps one BVH in its
-//! object space under a top-level BVH of its placements ([`Accel`]); obvhs builds each BVH2 (PLOC
-//! with reinsertion, its recommended builder), and [`WideBvh`] collapses it into the 8-wide layout
-//! the renderer traverses (faster than obvhs's CWBVH traversal here: notes/render.md).
+//! [`Accel`]: the two-level BVH over the placed meshes, its build, traversal entry points and
+//! the reconstruction of a hit's surface.
 
-use super::wide_bvh::{WideBvh, ROBUST_FAR};
-use crate::material::Placement;
-use glam::{Affine3A, Mat3, Vec2, Vec3, Vec3A};
+use super::{Hit, Instance, Ray, SurfaceHit, TriMesh};
+use crate::render::wide_bvh::{WideBvh, ROBUST_FAR};
+use glam::{Vec3, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::{reinsertion::ReinsertionOptimizer, Bvh2};
 use obvhs::ploc::PlocBuilder;
@@ -19,190 +16,6 @@ use std::collections::{HashMap, HashSet};
 use std::mem::size_of;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-
-/// An indexed triangle mesh in object space (millimetres).
-#[derive(Clone, Debug, Default)]
-pub struct TriMesh {
-    /// Vertex positions (object space, mm).
-    pub positions: Vec<Vec3>,
-    /// Per-vertex shading normals (same length as `positions`), if the mesh has them.
-    pub normals: Option<Vec<Vec3>>,
-    /// Triangles as indices into `positions`; the winding gives the geometric normal
-    /// (v1 − v0) × (v2 − v0).
-    pub indices: Vec<[u32; 3]>,
-}
-
-impl TriMesh {
-    /// Drops triangles with out-of-range indices, non-finite vertices or zero area and returns
-    /// how many were dropped (scene loading reports the count as a warning).
-    pub fn drop_degenerate(&mut self) -> usize {
-        let n = self.positions.len() as u32;
-        let before = self.indices.len();
-        let pos = &self.positions;
-        self.indices.retain(|t| {
-            if t.iter().any(|&i| i >= n) {
-                return false;
-            }
-            let [a, b, c] = t.map(|i| pos[i as usize]);
-            let area2 = (b - a).cross(c - a).length_squared();
-            a.is_finite() && b.is_finite() && c.is_finite() && area2 > 0.0 && area2.is_finite()
-        });
-        if let Some(ns) = &mut self.normals {
-            for v in ns.iter_mut() {
-                *v = v.normalize_or_zero();
-            }
-        }
-        before - self.indices.len()
-    }
-
-    /// Appends `other` (re-indexing its triangles); normals are kept only if both have them.
-    pub fn append(&mut self, other: &TriMesh) {
-        let base = self.positions.len() as u32;
-        let keep_normals =
-            (self.normals.is_some() || self.positions.is_empty()) && other.normals.is_some();
-        self.normals = if keep_normals {
-            let mut n = self.normals.take().unwrap_or_default();
-            n.extend_from_slice(other.normals.as_ref().unwrap());
-            Some(n)
-        } else {
-            None
-        };
-        self.positions.extend_from_slice(&other.positions);
-        self.indices
-            .extend(other.indices.iter().map(|t| t.map(|i| i + base)));
-    }
-
-    /// Bytes of the vertex, normal and index arrays.
-    pub fn bytes(&self) -> u64 {
-        let normals = self.normals.as_ref().map_or(0, Vec::len);
-        ((self.positions.len() + normals) * size_of::<Vec3>()
-            + self.indices.len() * size_of::<[u32; 3]>()) as u64
-    }
-}
-
-/// Object → world placement of one mesh: an affine map, with the inverse and the normal matrix
-/// (inverse transpose of the linear part) precomputed.
-#[derive(Clone, Copy, Debug)]
-pub struct Transform {
-    /// Object → world map.
-    pub to_world: Affine3A,
-    /// World → object map (the inverse of `to_world`).
-    pub to_object: Affine3A,
-    /// Transforms normals and gradients (covectors) from object to world.
-    pub normal_to_world: Mat3,
-}
-
-impl Transform {
-    /// The placement `to_world` with its inverse and normal matrix worked out.
-    pub fn new(to_world: Affine3A) -> Self {
-        let to_object = to_world.inverse();
-        Transform {
-            to_world,
-            to_object,
-            normal_to_world: Mat3::from(to_object.matrix3).transpose(),
-        }
-    }
-
-    /// The placement that leaves the mesh where it is.
-    pub fn identity() -> Self {
-        Transform::new(Affine3A::IDENTITY)
-    }
-
-    /// True when the map is invertible and finite.
-    pub(crate) fn is_valid(&self) -> bool {
-        let d = self.to_world.matrix3.determinant();
-        d.is_finite() && d.abs() > 1e-12 && self.to_object.is_finite()
-    }
-
-    /// A point (object space) in world space.
-    #[inline]
-    pub fn point_to_world(&self, p: Vec3) -> Vec3 {
-        self.to_world.transform_point3(p)
-    }
-
-    /// A point (world space) in object space.
-    #[inline]
-    pub(crate) fn point_to_object(&self, p: Vec3) -> Vec3 {
-        self.to_object.transform_point3(p)
-    }
-
-    /// A direction (object space) in world space, not renormalised.
-    #[inline]
-    pub(crate) fn vector_to_world(&self, v: Vec3) -> Vec3 {
-        self.to_world.transform_vector3(v)
-    }
-
-    /// A normal (object space) in world space by the inverse transpose, not renormalised.
-    #[inline]
-    pub fn normal_to_world(&self, n: Vec3) -> Vec3 {
-        self.normal_to_world * n
-    }
-}
-
-/// One placed mesh: which mesh, where, and which material (index into the scene's materials).
-#[derive(Clone, Debug)]
-pub struct Instance {
-    /// The mesh; instances that share one `Arc` share one object-space BVH.
-    pub mesh: Arc<TriMesh>,
-    /// Where the mesh is placed.
-    pub transform: Transform,
-    /// Index into the scene's materials.
-    pub material: u32,
-    /// Where the object sits in the tree (solid-texture space).
-    pub placement: Placement,
-}
-
-/// A ray in world space; `d` need not be unit length for intersection, but the renderer keeps it unit.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Ray {
-    /// Origin (world, mm).
-    pub o: Vec3,
-    /// Direction (world).
-    pub d: Vec3,
-}
-
-impl Ray {
-    /// The point at parameter `t` (`o + t·d`).
-    #[inline]
-    pub fn at(&self, t: f32) -> Vec3 {
-        self.o + self.d * t
-    }
-}
-
-/// The closest intersection: distance, instance, triangle within the instance's mesh, and
-/// barycentrics (p = (1 − u − v)·v0 + u·v1 + v·v2).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Hit {
-    /// Ray parameter of the hit (mm along a unit-length ray).
-    pub t: f32,
-    /// Index into [`Accel::instances`].
-    pub instance: u32,
-    /// Index into the instance mesh's `indices`.
-    pub triangle: u32,
-    /// Barycentrics (u, v) of the hit in that triangle.
-    pub uv: Vec2,
-}
-
-/// Surface data at a hit: world position, geometric and shading normals (world, unit, not yet
-/// flipped towards the viewer), object-space position.
-#[derive(Clone, Copy, Debug)]
-pub struct SurfaceHit {
-    /// Hit point (world, mm), from the ray equation.
-    pub p: Vec3,
-    /// Hit point in the instance's object space (mm), from the barycentrics.
-    pub p_object: Vec3,
-    /// Geometric normal in object space (unit).
-    pub n_object: Vec3,
-    /// Geometric normal (world, unit).
-    pub ng: Vec3,
-    /// Shading normal (world, unit): the interpolated vertex normals, or `ng` where the mesh has
-    /// none.
-    pub ns: Vec3,
-    /// A tangent along the triangle's first edge (world), for a stable shading frame.
-    pub tangent: Vec3,
-    /// Index into [`Accel::instances`].
-    pub instance: u32,
-}
 
 /// The scene's triangles in two levels (the design's "instancing" row): the meshes placed once
 /// are flattened into one world-space wide BVH (one traversal, as fast as a single mesh); a mesh
@@ -307,6 +120,60 @@ fn used_vertices(mesh: &TriMesh) -> Vec<u32> {
     used
 }
 
+/// The distinct meshes of `instances` by identity (the same `Arc`), in first-use order
+/// (deterministic), each with the instances that place it.
+fn users_by_mesh(instances: &[Instance]) -> Vec<Vec<u32>> {
+    let mut users: Vec<Vec<u32>> = Vec::new();
+    let mut slot: HashMap<*const TriMesh, usize> = HashMap::new();
+    for (i, inst) in instances.iter().enumerate() {
+        let k = *slot.entry(Arc::as_ptr(&inst.mesh)).or_insert(users.len());
+        if k == users.len() {
+            users.push(Vec::new());
+        }
+        users[k].push(i as u32);
+    }
+    users
+}
+
+/// [`Accel`]'s `range_of`: the flattened range of each world triangle, from the ranges' first
+/// triangles `offsets` (plus the total); empty when there is one range.
+fn range_of_triangles(offsets: &[u32]) -> Vec<u32> {
+    let ranges = offsets.len().saturating_sub(1);
+    if ranges <= 1 {
+        return Vec::new();
+    }
+    (0..ranges as u32)
+        .flat_map(|k| {
+            let n = offsets[k as usize + 1] - offsets[k as usize];
+            std::iter::repeat_n(k, n as usize)
+        })
+        .collect()
+}
+
+/// The top-level BVH over the shared meshes' placement boxes (PLOC, one box per leaf).
+fn top_level(boxes: &[Aabb], params: &BvhBuildParams) -> Bvh2 {
+    let indices = (0..boxes.len() as u32).collect();
+    PlocBuilder::with_capacity(boxes.len()).build(
+        params.ploc_search_distance,
+        boxes,
+        indices,
+        params.sort_precision,
+        params.search_depth_threshold,
+    )
+}
+
+/// [`Accel`]'s `frames`: each flattened instance's triangle frames; empty for shared meshes.
+fn frames_table(instances: &[Instance], instanced: &[bool]) -> Vec<Vec<TriangleFrame>> {
+    (instances.iter().zip(instanced))
+        .map(|(inst, &shared)| match shared {
+            true => Vec::new(),
+            false => (0..inst.mesh.indices.len())
+                .map(|t| triangle_frame(inst, t))
+                .collect(),
+        })
+        .collect()
+}
+
 impl Accel {
     /// Builds the acceleration structure over `instances` with [`BUILD_PARAMS`].
     pub fn new(instances: Vec<Instance>) -> Self {
@@ -317,16 +184,7 @@ impl Accel {
     /// builder comparison of `xylem bench trace`).
     pub fn with_params(instances: Vec<Instance>, params: BvhBuildParams) -> Self {
         let start = Instant::now();
-        // Distinct meshes by identity, in first-use order (deterministic), with their users.
-        let mut users: Vec<Vec<u32>> = Vec::new();
-        let mut slot: HashMap<*const TriMesh, usize> = HashMap::new();
-        for (i, inst) in instances.iter().enumerate() {
-            let k = *slot.entry(Arc::as_ptr(&inst.mesh)).or_insert(users.len());
-            if k == users.len() {
-                users.push(Vec::new());
-            }
-            users[k].push(i as u32);
-        }
+        let users = users_by_mesh(&instances);
         let mut world: Vec<Triangle> = Vec::new();
         let (mut offsets, mut flat) = (Vec::new(), Vec::new());
         let (mut shared, mut placed, mut boxes) = (Vec::new(), Vec::new(), Vec::new());
@@ -365,40 +223,15 @@ impl Accel {
             }
         }
         offsets.push(world.len() as u32);
-        let range_of = if flat.len() > 1 {
-            (0..flat.len() as u32)
-                .flat_map(|k| {
-                    let n = offsets[k as usize + 1] - offsets[k as usize];
-                    std::iter::repeat_n(k, n as usize)
-                })
-                .collect()
-        } else {
-            Vec::new()
-        };
+        let range_of = range_of_triangles(&offsets);
         // `bounds_radius` ignores a non-finite vertex as the flat build did (max skips NaN).
-        let top = (!placed.is_empty()).then(|| {
-            let indices = (0..boxes.len() as u32).collect();
-            PlocBuilder::with_capacity(boxes.len()).build(
-                params.ploc_search_distance,
-                &boxes,
-                indices,
-                params.sort_precision,
-                params.search_depth_threshold,
-            )
-        });
+        let top = (!placed.is_empty()).then(|| top_level(&boxes, &params));
         let scene_triangles = instances.iter().map(|i| i.mesh.indices.len()).sum();
         // The frames table once the BVH is built and its buffers freed, so that it does not add
         // to the build's peak (`resources::BUILD_BYTES_PER_TRIANGLE`).
         let world_bvh = wide_bvh(&world, &params);
         drop(world);
-        let frames = (instances.iter().zip(&instanced))
-            .map(|(inst, &shared)| match shared {
-                true => Vec::new(),
-                false => (0..inst.mesh.indices.len())
-                    .map(|t| triangle_frame(inst, t))
-                    .collect(),
-            })
-            .collect();
+        let frames = frames_table(&instances, &instanced);
         Accel {
             world: world_bvh,
             offsets,
@@ -626,16 +459,16 @@ impl Accel {
 /// The parts of a hit's surface that are constant over its triangle ([`SurfaceHit`]'s
 /// `n_object`, `ng`, `tangent`).
 #[derive(Clone, Copy, Debug)]
-struct TriangleFrame {
-    n_object: Vec3,
-    ng: Vec3,
-    tangent: Vec3,
+pub(super) struct TriangleFrame {
+    pub(super) n_object: Vec3,
+    pub(super) ng: Vec3,
+    pub(super) tangent: Vec3,
 }
 
 /// The frame of triangle `t` of `inst`: the object-space geometric normal (v1 − v0) × (v2 − v0)
 /// normalised, the world normal by the inverse transpose (`Transform::normal_to_world`), and the
 /// world tangent along the first edge, each normalised.
-fn triangle_frame(inst: &Instance, t: usize) -> TriangleFrame {
+pub(super) fn triangle_frame(inst: &Instance, t: usize) -> TriangleFrame {
     let mesh = &inst.mesh;
     let [a, b, c] = mesh.indices[t].map(|i| mesh.positions[i as usize]);
     let tf = &inst.transform;
@@ -649,7 +482,7 @@ fn triangle_frame(inst: &Instance, t: usize) -> TriangleFrame {
 
 /// obvhs's BVH2 over `world`, built as its `build_cwbvh_from_tris` helper does up to the BVH2:
 /// optional spatial pre-splits, PLOC (one primitive per leaf), reinsertion.
-pub(crate) fn build_bvh2(world: &[Triangle], params: &BvhBuildParams) -> Bvh2 {
+fn build_bvh2(world: &[Triangle], params: &BvhBuildParams) -> Bvh2 {
     let mut indices: Vec<u32> = (0..world.len() as u32).collect();
     let mut bvh2 = if params.pre_split {
         let mut aabbs: Vec<_> = world.iter().map(|t| t.aabb()).collect();
@@ -708,167 +541,4 @@ pub fn brute_force_closest(accel: &Accel, ray: &Ray, t_max: f32) -> Option<f32> 
         })
         .filter(|t| *t < t_max)
         .min_by(|a, b| a.total_cmp(b))
-}
-
-/// Slab test (Kay & Kajiya 1986) of the segment `o + t·d`, t in [0, t_max], against a box, with
-/// `inv` = 1/d per axis (±∞ for d = 0): true only when the segment surely misses. A NaN (an
-/// origin exactly on a slab plane of an axis the ray runs parallel to) answers "may hit".
-#[inline]
-pub(crate) fn segment_misses_box(o: Vec3A, inv: Vec3A, t_max: f32, lo: Vec3A, hi: Vec3A) -> bool {
-    slab_misses(
-        o.to_array(),
-        inv.to_array(),
-        t_max,
-        lo.to_array(),
-        hi.to_array(),
-    )
-}
-
-/// [`segment_misses_box`] on plain arrays, written with comparisons and selects only so that a
-/// loop of it over many segments vectorises.
-#[inline(always)]
-pub(crate) fn slab_misses(
-    o: [f32; 3],
-    inv: [f32; 3],
-    t_max: f32,
-    lo: [f32; 3],
-    hi: [f32; 3],
-) -> bool {
-    let mut slab = Slab::new(t_max);
-    for a in 0..3 {
-        slab.clip(o[a], inv[a], lo[a], hi[a]);
-    }
-    slab.missed()
-}
-
-/// The state of [`slab_misses`] after some axes: the parameter interval [t0, t1] left, and
-/// whether a NaN was met. One axis at a time ([`Slab::clip`]), so that a loop over many boxes
-/// or segments keeps one of these per lane.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Slab {
-    t0: f32,
-    t1: f32,
-    nan: bool,
-}
-
-impl Slab {
-    /// The whole segment, t in [0, t_max].
-    #[inline(always)]
-    pub(crate) fn new(t_max: f32) -> Slab {
-        Slab {
-            t0: 0.0,
-            t1: t_max,
-            nan: false,
-        }
-    }
-
-    /// Clipped to the slab [lo, hi] of one axis (origin `o`, 1/direction `inv` on that axis).
-    #[inline(always)]
-    pub(crate) fn clip(&mut self, o: f32, inv: f32, lo: f32, hi: f32) {
-        let (ta, tb) = ((lo - o) * inv, (hi - o) * inv);
-        self.nan |= ta.is_nan() | tb.is_nan();
-        let (near, far) = if ta < tb { (ta, tb) } else { (tb, ta) };
-        self.t0 = if near > self.t0 { near } else { self.t0 };
-        self.t1 = if far < self.t1 { far } else { self.t1 };
-    }
-
-    /// Whether the segment surely misses the box (an empty interval, no NaN).
-    #[inline(always)]
-    pub(crate) fn missed(&self) -> bool {
-        !self.nan & (self.t0 > self.t1)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn unit_quad() -> TriMesh {
-        TriMesh {
-            positions: vec![
-                Vec3::new(0.0, 0.0, 0.0),
-                Vec3::new(1.0, 0.0, 0.0),
-                Vec3::new(1.0, 1.0, 0.0),
-                Vec3::new(0.0, 1.0, 0.0),
-            ],
-            normals: None,
-            indices: vec![[0, 1, 2], [0, 2, 3]],
-        }
-    }
-
-    #[test]
-    fn hit_point_matches_ray_equation_and_barycentrics() {
-        let inst = Instance {
-            mesh: Arc::new(unit_quad()),
-            transform: Transform::new(Affine3A::from_translation(Vec3::new(0.0, 0.0, 2.0))),
-            material: 0,
-            placement: Placement::default(),
-        };
-        let accel = Accel::new(vec![inst]);
-        let ray = Ray {
-            o: Vec3::new(0.3, 0.6, 5.0),
-            d: -Vec3::Z,
-        };
-        let hit = accel.intersect(&ray, f32::INFINITY).unwrap();
-        assert!((hit.t - 3.0).abs() < 1e-5);
-        let s = accel.surface(&ray, &hit);
-        // Object-space point from barycentrics must equal the ray point moved back to object space.
-        assert!(
-            (s.p_object - Vec3::new(0.3, 0.6, 0.0)).length() < 1e-5,
-            "{s:?}"
-        );
-        assert!((s.ng - Vec3::Z).length() < 1e-6);
-        assert!(!accel.unoccluded(&ray, 10.0));
-        assert!(accel.unoccluded(&ray, 2.9));
-    }
-
-    /// A hit's surface is the same whether its triangle's frame comes from the table (a mesh
-    /// placed once, flattened) or is worked out per hit (the same mesh placed twice, shared),
-    /// under a transform that shears and scales, so that every normalisation matters.
-    #[test]
-    fn tabled_triangle_frames_equal_per_hit_frames() {
-        let mesh = Arc::new(unit_quad());
-        let to_world = Affine3A::from_cols_array(&[
-            1.3, 0.2, 0.1, -0.4, 0.9, 0.3, 0.2, -0.1, 1.7, 0.5, -0.25, 2.0,
-        ]);
-        let inst = |mesh: &Arc<TriMesh>| Instance {
-            mesh: mesh.clone(),
-            transform: Transform::new(to_world),
-            material: 0,
-            placement: Placement::default(),
-        };
-        let other = Arc::new(unit_quad());
-        let once = Accel::new(vec![inst(&mesh)]);
-        // The first two share one mesh (traced in object space, frames per hit).
-        let twice = Accel::new(vec![inst(&other), inst(&other)]);
-        assert!(!once.is_instanced(0) && twice.is_instanced(0));
-        for (u, v) in [(0.3, 0.6), (0.7, 0.2), (0.5, 0.5)] {
-            let hit = Hit {
-                t: 4.0,
-                instance: 0,
-                triangle: (u > v) as u32,
-                uv: Vec2::new(u, v),
-            };
-            let ray = Ray {
-                o: Vec3::new(0.2, 0.4, 6.0),
-                d: -Vec3::Z,
-            };
-            let (a, b) = (once.surface(&ray, &hit), twice.surface(&ray, &hit));
-            for (x, y) in [(a.n_object, b.n_object), (a.ng, b.ng), (a.ns, b.ns)] {
-                assert_eq!(x.to_array(), y.to_array());
-            }
-            assert_eq!(a.tangent.to_array(), b.tangent.to_array());
-            let f = triangle_frame(&twice.instances[0], hit.triangle as usize);
-            assert_eq!(a.tangent.to_array(), f.tangent.to_array());
-        }
-    }
-
-    #[test]
-    fn degenerate_triangles_are_dropped() {
-        let mut m = unit_quad();
-        m.indices.push([0, 0, 1]);
-        m.indices.push([0, 1, 9]);
-        assert_eq!(m.drop_degenerate(), 2);
-        assert_eq!(m.indices.len(), 2);
-    }
 }
