@@ -9,6 +9,7 @@ mod baked;
 mod face;
 mod measured;
 mod placement;
+mod surface;
 
 pub use baked::{
     across_fiber, fiber_from_anisotropy, BakedFibers, BakedMaps, BakedTexel, BakedWoodMaterial,
@@ -19,13 +20,13 @@ pub use measured::{
     MeasuredMaterial, DEFAULT_FIBER_COLOR_SCALE, DEFAULT_HIGHLIGHT_WIDTH_DEG,
 };
 pub use placement::{CutAt, Cutting, Placement, SawnCut};
+pub(crate) use surface::SurfaceAtWo;
+pub use surface::SurfaceBsdf;
 
-use crate::bsdf::{
-    Bsdf, BsdfSample, FinishModel, Glass, Lambertian, Mirror, WoodBsdf, WoodBsdfParams,
-};
+use crate::bsdf::{FinishModel, Glass, Lambertian, Mirror, WoodBsdf, WoodBsdfParams};
 use crate::math::Frame;
 use crate::wood::{Footprint, Needs, WoodVolume};
-use glam::{Mat3, Vec2, Vec3};
+use glam::{Mat3, Vec3};
 use std::sync::Arc;
 
 /// What a material needs to know about a hit. Built by the renderer.
@@ -65,99 +66,6 @@ pub struct SurfaceAov {
     pub ray_mask: f32,
     /// Growth time (years from the pith) for wood; zero otherwise.
     pub growth_time: f32,
-}
-
-/// The BSDF at one hit, in its local shading frame. Small and `Copy`, so a light sweep can cache
-/// it per pixel sample.
-#[derive(Clone, Copy, Debug)]
-// The wood variant is most of the size, and most hits are wood: a box would add an indirection
-// and an allocation per shading point for the rare small variants' sake.
-#[allow(clippy::large_enum_variant)]
-pub enum SurfaceBsdf {
-    /// Ideal diffuse reflection.
-    Lambertian(Lambertian),
-    /// The finished-wood BSDF (Marschner et al. 2005 fibre lobe under a dielectric finish).
-    Wood(WoodBsdf),
-    /// Perfect specular reflection (a delta lobe).
-    Mirror(Mirror),
-    /// Smooth dielectric reflection and refraction (delta lobes).
-    Glass(Glass),
-}
-
-impl SurfaceBsdf {
-    /// True when every lobe is a delta lobe (light sampling is useless there).
-    pub fn is_delta(&self) -> bool {
-        match self {
-            SurfaceBsdf::Mirror(_) | SurfaceBsdf::Glass(_) => true,
-            SurfaceBsdf::Lambertian(_) | SurfaceBsdf::Wood(_) => false,
-        }
-    }
-
-    /// The same BSDF, copied variant by variant: moving the enum copies all of its bytes (the
-    /// wood variant's hundreds), this only the variant's own (12 for a Lambertian), which the
-    /// path loop's shading points of small materials were spending 3–5 % of a Cornell-box
-    /// render on (`memmove` in `perf`).
-    #[inline(always)]
-    pub fn copied(&self) -> Self {
-        match self {
-            SurfaceBsdf::Lambertian(b) => SurfaceBsdf::Lambertian(*b),
-            SurfaceBsdf::Wood(b) => SurfaceBsdf::Wood(*b),
-            SurfaceBsdf::Mirror(b) => SurfaceBsdf::Mirror(*b),
-            SurfaceBsdf::Glass(b) => SurfaceBsdf::Glass(*b),
-        }
-    }
-
-    /// [`SurfaceBsdf::copied`] written into `out`, where a shading point keeps it: where `out`
-    /// holds the same variant only the payload is written. (Assigning a whole variant, LLVM
-    /// copied the whole enum, 480 bytes by `memcpy`, for every variant: 2.6 % of a Cornell-box
-    /// render's instructions.)
-    #[inline(always)]
-    pub fn copy_to(&self, out: &mut Self) {
-        match (self, &mut *out) {
-            (SurfaceBsdf::Lambertian(b), SurfaceBsdf::Lambertian(o)) => *o = *b,
-            (SurfaceBsdf::Wood(b), SurfaceBsdf::Wood(o)) => *o = *b,
-            (SurfaceBsdf::Mirror(b), SurfaceBsdf::Mirror(o)) => *o = *b,
-            (SurfaceBsdf::Glass(b), SurfaceBsdf::Glass(o)) => *o = *b,
-            _ => *out = self.copied(),
-        }
-    }
-
-    /// True when the BSDF transmits (the renderer must not flip the normal towards the viewer).
-    pub(crate) fn is_transmissive(&self) -> bool {
-        match self {
-            SurfaceBsdf::Glass(_) => true,
-            SurfaceBsdf::Lambertian(_) | SurfaceBsdf::Wood(_) | SurfaceBsdf::Mirror(_) => false,
-        }
-    }
-}
-
-impl Bsdf for SurfaceBsdf {
-    fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
-        match self {
-            SurfaceBsdf::Lambertian(b) => b.eval(wo, wi),
-            SurfaceBsdf::Wood(b) => b.eval(wo, wi),
-            SurfaceBsdf::Mirror(b) => b.eval(wo, wi),
-            SurfaceBsdf::Glass(b) => b.eval(wo, wi),
-        }
-    }
-
-    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        match self {
-            SurfaceBsdf::Lambertian(b) => b.pdf(wo, wi),
-            SurfaceBsdf::Wood(b) => b.pdf(wo, wi),
-            SurfaceBsdf::Mirror(b) => b.pdf(wo, wi),
-            SurfaceBsdf::Glass(b) => b.pdf(wo, wi),
-        }
-    }
-
-    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
-        match self {
-            SurfaceBsdf::Lambertian(b) => b.sample(wo, uc, u),
-            SurfaceBsdf::Wood(b) => b.sample(wo, uc, u),
-            SurfaceBsdf::Mirror(b) => b.sample(wo, uc, u),
-            SurfaceBsdf::Glass(b) => b.sample(wo, uc, u),
-        }
-    }
 }
 
 /// The result of shading a hit: the BSDF, the world shading frame it lives in (z = the possibly

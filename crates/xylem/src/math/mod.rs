@@ -35,6 +35,12 @@ pub(crate) fn safe_acos(x: f32) -> f32 {
     x.clamp(-1.0, 1.0).acos()
 }
 
+/// Whether every component of `v` is 0 (`v == Vec3::ZERO`), without branches.
+#[inline(always)]
+pub(crate) fn is_zero(v: Vec3) -> bool {
+    (v.x == 0.0) & (v.y == 0.0) & (v.z == 0.0)
+}
+
 /// Hermite smoothstep (Ebert et al., *Texturing and Modeling*, ch. 2): 0 below `e0`, 1 above
 /// `e1`, 3t² − 2t³ between; a step at `e1` when the edges coincide or cross (a spot light whose
 /// inner and outer cones are one, a zero-width threshold), where t would be 0/0.

@@ -20,9 +20,9 @@ use super::sampler::{pixel_sample, PathNumbers};
 use super::shading::{offset_origin, ShadingPoint};
 use super::shadow::{shadow_t_max, Segments, ShadowTest};
 use super::Scene;
-use crate::bsdf::{Bsdf, WoodAtWo};
-use crate::material::{MaterialHit, SurfaceBsdf};
-use crate::math::{power_heuristic, Frame};
+use crate::bsdf::Bsdf;
+use crate::material::{MaterialHit, SurfaceAtWo};
+use crate::math::{is_zero, power_heuristic, Frame};
 use glam::{Mat3, UVec2, Vec2, Vec3};
 
 /// Which light transport to simulate.
@@ -257,88 +257,6 @@ pub(crate) fn path_numbers(scene: &Scene, pixel: UVec2, sample: u32, seed: u64) 
     PathNumbers::new(seed, index, sample)
 }
 
-/// A shading point's BSDF with `wo` fixed, for lighting it by many light samples: the wood BSDF
-/// with its `wo`-only terms worked out once (`WoodBsdf::at_wo`), any other BSDF as it is.
-/// Values identical to `eval` and `pdf`.
-#[derive(Clone, Copy, Debug)]
-pub(crate) enum BsdfAtWo<'a> {
-    /// The wood BSDF with its `wo`-only terms worked out.
-    Wood(WoodAtWo<'a>),
-    /// Any other BSDF, with `wo` (local frame).
-    Other(&'a SurfaceBsdf, Vec3),
-}
-
-impl<'a> BsdfAtWo<'a> {
-    /// The BSDF of `sp` with its `wo` fixed.
-    pub fn new(sp: &'a ShadingPoint) -> Self {
-        match &sp.bsdf {
-            SurfaceBsdf::Wood(b) => BsdfAtWo::Wood(b.at_wo(sp.wo)),
-            other @ (SurfaceBsdf::Lambertian(_)
-            | SurfaceBsdf::Mirror(_)
-            | SurfaceBsdf::Glass(_)) => BsdfAtWo::Other(other, sp.wo),
-        }
-    }
-
-    /// `(eval(wo, wi), pdf(wo, wi))`, the density only when `with_pdf` (else 0).
-    #[inline]
-    pub fn eval_pdf(&self, wi: Vec3, with_pdf: bool) -> (Vec3, f32) {
-        match self {
-            BsdfAtWo::Wood(w) => w.eval_pdf(wi, with_pdf),
-            BsdfAtWo::Other(b, wo) => eval_then_pdf(*b, *wo, wi, with_pdf),
-        }
-    }
-
-    /// [`BsdfAtWo::eval_pdf`] of the directions in the columns `wi` (x, y, z; one lane per
-    /// direction) into the colour columns `f` and `pdf` (the wood BSDF in SIMD lanes,
-    /// [`WoodAtWo::eval_pdf_lanes`]; others one by one).
-    #[inline(always)]
-    pub fn eval_pdf_lanes(
-        &self,
-        wi: [&[f32]; 3],
-        with_pdf: bool,
-        f: [&mut [f32]; 3],
-        pdf: &mut [f32],
-    ) {
-        match self {
-            BsdfAtWo::Wood(w) => w.eval_pdf_lanes(wi, with_pdf, f, pdf),
-            // The material's kind chosen once, not per direction.
-            BsdfAtWo::Other(SurfaceBsdf::Lambertian(b), wo) => {
-                eval_then_pdf_each(b, *wo, wi, with_pdf, f, pdf)
-            }
-            BsdfAtWo::Other(b, wo) => eval_then_pdf_each(*b, *wo, wi, with_pdf, f, pdf),
-        }
-    }
-}
-
-/// `(eval(wo, wi), pdf(wo, wi))`, the density only when `with_pdf` and f ≠ 0 (else 0). The
-/// density is worked out in every case and selected (the BSDFs that come here have cheap
-/// ones), so a loop of this over many directions has no branches and runs in SIMD lanes.
-#[inline(always)]
-fn eval_then_pdf(b: &impl Bsdf, wo: Vec3, wi: Vec3, with_pdf: bool) -> (Vec3, f32) {
-    let (f, pdf) = (b.eval(wo, wi), b.pdf(wo, wi));
-    (f, if with_pdf & !is_zero(f) { pdf } else { 0.0 })
-}
-
-/// [`eval_then_pdf`] of every direction of the columns `wi` into the columns `f`, `pdf`.
-#[inline(always)]
-fn eval_then_pdf_each(
-    b: &impl Bsdf,
-    wo: Vec3,
-    wi: [&[f32]; 3],
-    with_pdf: bool,
-    f: [&mut [f32]; 3],
-    pdf: &mut [f32],
-) {
-    let n = pdf.len();
-    let ([wx, wy, wz], [fr, fg, fb]) = (wi, f);
-    let (wx, wy, wz) = (&wx[..n], &wy[..n], &wz[..n]);
-    let (fr, fg, fb) = (&mut fr[..n], &mut fg[..n], &mut fb[..n]);
-    for k in 0..n {
-        let (v, p) = eval_then_pdf(b, wo, Vec3::new(wx[k], wy[k], wz[k]), with_pdf);
-        [fr[k], fg[k], fb[k], pdf[k]] = [v.x, v.y, v.z, p];
-    }
-}
-
 /// The term of one light sample `ls` in next-event estimation: f · Li · |cos θi| · w / pdf when
 /// the light is unoccluded, w the power heuristic against BSDF sampling (1 for delta lights);
 /// zero when the sample failed, the BSDF vanishes or the light is occluded.
@@ -346,7 +264,7 @@ fn eval_then_pdf_each(
 pub(crate) fn light_term(
     shadow: &ShadowTest,
     sp: &ShadingPoint,
-    bsdf: &BsdfAtWo,
+    bsdf: &SurfaceAtWo,
     ls: Option<LightSample>,
     rays: &mut RayCount,
 ) -> Vec3 {
@@ -401,12 +319,6 @@ fn resize_columns(c: &mut Columns, n: usize) {
     }
 }
 
-/// Whether every component of `v` is 0 (`v == Vec3::ZERO`), without branches.
-#[inline(always)]
-fn is_zero(v: Vec3) -> bool {
-    (v.x == 0.0) & (v.y == 0.0) & (v.z == 0.0)
-}
-
 /// Scratch columns of [`light_terms`], reused from call to call.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct TermScratch {
@@ -433,7 +345,7 @@ pub(crate) struct TermScratch {
 pub(crate) fn light_terms(
     shadow: &ShadowTest,
     sp: &ShadingPoint,
-    bsdf: &BsdfAtWo,
+    bsdf: &SurfaceAtWo,
     ls: &LightSamples,
     active: &[bool],
     scratch: &mut TermScratch,
@@ -533,13 +445,98 @@ pub(crate) fn survival(beta: Vec3, eta_scale: f32) -> f32 {
 /// pass over other lights skip that sampling and tracing.
 #[derive(Clone, Debug)]
 pub(crate) struct Continuation {
+    path: PathState,
+    hit: Option<Hit>,
+}
+
+/// A path between two vertices: its throughput β, the product of η'² over its refractions
+/// ([`survival`]), the density of the BSDF sample that made its ray and whether that sample
+/// was a delta lobe (for the MIS weight of the emission the ray meets), the ray and the
+/// distance to what it hit (∞ for nothing).
+#[derive(Clone, Copy, Debug)]
+struct PathState {
     beta: Vec3,
     eta_scale: f32,
     prev_pdf: f32,
     specular: bool,
     ray: Ray,
     t_hit: f32,
-    hit: Option<Hit>,
+}
+
+impl PathState {
+    /// Continues the path from `sp` by sampling its BSDF with the bounce's numbers
+    /// (`PathNumbers::bounce`: direction, lobe, roulette): the throughput takes
+    /// f · |cos θi| / pdf and, from bounce 3 (`depth` counts this one), Russian roulette
+    /// ([`survival`]); the ray leaves `sp` along the sample. False where the path ends.
+    #[inline(always)]
+    fn scatter(
+        &mut self,
+        sp: &ShadingPoint,
+        [u0, u1, uc, u_roulette]: [f32; 4],
+        depth: u32,
+    ) -> bool {
+        let Some(bs) = sp.bsdf.sample(sp.wo, uc, Vec2::new(u0, u1)) else {
+            return false;
+        };
+        if !(bs.pdf > 0.0) {
+            return false;
+        }
+        self.beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
+        self.eta_scale *= bs.eta * bs.eta;
+        self.specular = bs.is_delta;
+        self.prev_pdf = bs.pdf;
+        if depth >= 3 {
+            let q = survival(self.beta, self.eta_scale);
+            if u_roulette >= q {
+                return false;
+            }
+            self.beta /= q;
+        }
+        if !self.beta.is_finite() || self.beta == Vec3::ZERO {
+            return false;
+        }
+        let d = sp.frame.to_world(bs.wi);
+        self.ray = Ray {
+            o: offset_origin(sp, d),
+            d,
+        };
+        true
+    }
+
+    /// Adds to `out` the emission the ray meets before its hit — a light in front of the
+    /// surface, or the environment — in every live frame, weighted by β and the power heuristic
+    /// against light sampling (1 after a delta lobe), and ends those frames' paths.
+    #[inline(always)]
+    fn add_emission(&self, lights: &LightFrames, alive: &mut [bool], out: &mut Columns) {
+        let hit_surface = self.t_hit.is_finite();
+        lights.nearest_per_frame(&self.ray, self.t_hit, |k, (_, hit)| {
+            if alive[k] && (hit.distance < self.t_hit || !hit_surface) {
+                let w = if self.specular {
+                    1.0
+                } else {
+                    power_heuristic(self.prev_pdf, hit.pdf)
+                };
+                let add = self.beta * hit.radiance * w;
+                for (c, a) in out.iter_mut().zip(add.to_array()) {
+                    c[k] += a;
+                }
+                alive[k] = false;
+            }
+        });
+    }
+}
+
+/// out += β · nee over the first `n` frames where `alive`, a channel at a time in lanes.
+#[inline(always)]
+fn add_next_event(out: &mut Columns, nee: &Columns, alive: &[bool], beta: Vec3, n: usize) {
+    let alive = &alive[..n];
+    for ((o, e), b) in out.iter_mut().zip(nee).zip(beta.to_array()) {
+        let (o, e) = (&mut o[..n], &e[..n]);
+        for k in 0..n {
+            let sum = o[k] + b * e[k];
+            o[k] = if alive[k] { sum } else { o[k] };
+        }
+    }
 }
 
 /// One pixel sample kept for later passes: its primary sample and its first bounce's
@@ -617,37 +614,23 @@ pub(crate) fn radiance_frames<const ONE: bool>(
     }
     scratch.alive.clear();
     scratch.alive.resize(n, true);
-    let mut beta = Vec3::ONE;
-    // The product of η'² over the refractions so far (`survival`).
-    let mut eta_scale = 1.0f32;
-    let mut ray = ps.ray;
-    let mut t_hit = ps.t_hit;
+    let mut path = PathState {
+        beta: Vec3::ONE,
+        eta_scale: 1.0,
+        prev_pdf: 0.0,
+        specular: true,
+        ray: ps.ray,
+        t_hit: ps.t_hit,
+    };
     // The first vertex is read where it lies (`ps.point`), the later ones from `bounce`: a
     // shading point holds a whole BSDF (hundreds of bytes), so it is not copied from one to
     // the other.
     let mut bounce: Option<ShadingPoint> = None;
     let mut at_first = true;
-    let mut prev_pdf = 0.0f32;
-    let mut specular = true;
     let mut depth = 0u32;
+    let footprint = || Footprint::AtDepth(ps.bounce_footprint);
     loop {
-        // Emission along the current ray: a light in front of the surface, or the environment.
-        let hit_surface = t_hit.is_finite();
-        let alive = &mut scratch.alive;
-        lights.nearest_per_frame(&ray, t_hit, |k, (_, hit)| {
-            if alive[k] && (hit.distance < t_hit || !hit_surface) {
-                let w = if specular {
-                    1.0
-                } else {
-                    power_heuristic(prev_pdf, hit.pdf)
-                };
-                let add = beta * hit.radiance * w;
-                for (c, a) in out.iter_mut().zip(add.to_array()) {
-                    c[k] += a;
-                }
-                alive[k] = false;
-            }
-        });
+        path.add_emission(lights, &mut scratch.alive, out);
         let vertex = if at_first { &ps.point } else { &bounce };
         let Some(sp) = vertex else { break };
         let keeping = at_first && matches!(first, FirstBounce::Keep(_));
@@ -656,15 +639,7 @@ pub(crate) fn radiance_frames<const ONE: bool>(
         }
         if !sp.bsdf.is_delta() {
             next_event_frames::<ONE>(lights, shadow, sp, numbers, depth, scratch, rays);
-            // out += β · nee in the live frames, a channel at a time in lanes.
-            let alive = &scratch.alive[..n];
-            for ((o, e), b) in out.iter_mut().zip(&scratch.nee).zip(beta.to_array()) {
-                let (o, e) = (&mut o[..n], &e[..n]);
-                for k in 0..n {
-                    let sum = o[k] + b * e[k];
-                    o[k] = if alive[k] { sum } else { o[k] };
-                }
-            }
+            add_next_event(out, &scratch.nee, &scratch.alive, path.beta, n);
         }
         let last = depth + 1 >= max_depth;
         if let (true, FirstBounce::Reuse(kept)) = (at_first, &first) {
@@ -673,86 +648,37 @@ pub(crate) fn radiance_frames<const ONE: bool>(
                 break;
             }
             let Some(c) = kept else { break };
-            (beta, eta_scale, prev_pdf, specular, depth) =
-                (c.beta, c.eta_scale, c.prev_pdf, c.specular, 1);
-            (ray, t_hit) = (c.ray, c.t_hit);
-            at_first = false;
+            (path, depth, at_first) = (c.path, 1, false);
             match c.hit {
-                Some(h) if !last => shading_point(
-                    scene,
-                    &ray,
-                    &h,
-                    Footprint::AtDepth(ps.bounce_footprint),
-                    &mut bounce,
-                ),
+                Some(h) if !last => shading_point(scene, &path.ray, &h, footprint(), &mut bounce),
                 _ => bounce = None,
             }
             continue;
         }
-        let [u0, u1, uc, u_roulette] = numbers.bounce(depth);
-        let u = Vec2::new(u0, u1);
+        let u = numbers.bounce(depth);
         if last && !lights.hittable() && !keeping {
             // The continuation could only collect emission, and no ray meets a delta light.
             break;
         }
-        let Some(bs) = sp.bsdf.sample(sp.wo, uc, u) else {
-            break;
-        };
-        if !(bs.pdf > 0.0) {
-            break;
-        }
-        beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
-        eta_scale *= bs.eta * bs.eta;
-        specular = bs.is_delta;
-        prev_pdf = bs.pdf;
         depth += 1;
-        if depth >= 3 {
-            let q = survival(beta, eta_scale);
-            if u_roulette >= q {
-                break;
-            }
-            beta /= q;
-        }
-        if !beta.is_finite() || beta == Vec3::ZERO {
+        if !path.scatter(sp, u, depth) {
             break;
         }
-        let d = sp.frame.to_world(bs.wi);
-        ray = Ray {
-            o: offset_origin(sp, d),
-            d,
-        };
         rays.0 += 1;
         at_first = false;
-        let hit = scene.accel.intersect(&ray, f32::INFINITY);
+        let hit = scene.accel.intersect(&path.ray, f32::INFINITY);
+        path.t_hit = hit.map_or(f32::INFINITY, |h| h.t);
         // Kept once, at the first bounce (then the path goes on as a traced one).
         if let FirstBounce::Keep(kept) = std::mem::replace(&mut first, FirstBounce::Trace) {
-            *kept = Some(Continuation {
-                beta,
-                eta_scale,
-                prev_pdf,
-                specular,
-                ray,
-                t_hit: hit.map_or(f32::INFINITY, |h| h.t),
-                hit,
-            });
+            *kept = Some(Continuation { path, hit });
             if last && !lights.hittable() {
                 break;
             }
         }
         match hit {
             // The last vertex only needs its distance (emission in front of it), not shading.
-            Some(h) if last => (t_hit, bounce) = (h.t, None),
-            Some(h) => {
-                t_hit = h.t;
-                shading_point(
-                    scene,
-                    &ray,
-                    &h,
-                    Footprint::AtDepth(ps.bounce_footprint),
-                    &mut bounce,
-                );
-            }
-            None => (t_hit, bounce) = (f32::INFINITY, None),
+            Some(h) if !last => shading_point(scene, &path.ray, &h, footprint(), &mut bounce),
+            _ => bounce = None,
         }
     }
 }
@@ -781,7 +707,7 @@ fn next_event_frames<const ONE: bool>(
         moving_terms,
         term_scratch,
     } = scratch;
-    let bsdf = BsdfAtWo::new(sp);
+    let bsdf = sp.bsdf.at_wo(sp.wo);
     let moving = lights.moving_index();
     let mut moving_u = None;
     terms.clear();
@@ -832,37 +758,6 @@ fn next_event_frames<const ONE: bool>(
         for a in after {
             for e in e.iter_mut() {
                 *e += a[c];
-            }
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// `SurfaceBsdf::copy_to` leaves the slot equal to the BSDF, whether the slot held the same
-    /// variant (payload only) or another one.
-    #[test]
-    fn copy_to_equals_the_bsdf_from_any_slot() {
-        use crate::bsdf::{Glass, Lambertian, Mirror};
-        let all = [
-            SurfaceBsdf::Lambertian(Lambertian {
-                albedo: Vec3::new(0.1, 0.2, 0.3),
-            }),
-            SurfaceBsdf::Mirror(Mirror {
-                reflectance: Vec3::splat(0.9),
-            }),
-            SurfaceBsdf::Glass(Glass {
-                eta: 1.5,
-                tint: Vec3::ONE,
-            }),
-        ];
-        for from in &all {
-            for to in &all {
-                let mut slot = to.copied();
-                from.copy_to(&mut slot);
-                assert_eq!(format!("{slot:?}"), format!("{from:?}"));
             }
         }
     }
