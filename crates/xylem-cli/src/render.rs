@@ -244,7 +244,7 @@ fn summary(
 /// PNG), the old PNG is removed, the EXR renamed into place and the PNG last. The PNG therefore
 /// marks a complete pair even when the run is killed between the renames.
 fn write_outputs(
-    image: &xylem::render::Image,
+    image: &xylem::render::RenderedImage,
     exr: &Path,
     png: &Path,
     exposure: f32,

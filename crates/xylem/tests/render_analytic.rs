@@ -173,7 +173,7 @@ fn one_and_two_threads_are_bit_identical() {
         .image
     };
     let (a, b) = (run(1), run(2));
-    let bits = |img: &xylem::render::Image| -> Vec<u32> {
+    let bits = |img: &xylem::render::RenderedImage| -> Vec<u32> {
         img.beauty
             .iter()
             .flat_map(|c| c.to_array())

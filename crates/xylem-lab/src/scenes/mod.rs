@@ -23,8 +23,8 @@ use glam::{Vec2, Vec3};
 use xylem::material::Material;
 use xylem::math::{luminance, Frame};
 use xylem::render::{
-    light::nearest_light, render_frames, DistantLight, Image, Light, LightFrames, PointLight,
-    RenderError, RenderSettings, RunOptions, Scene, SphereLight, SpotLight,
+    light::nearest_light, render_frames, DistantLight, Light, LightFrames, PointLight, RenderError,
+    RenderSettings, RenderedImage, RunOptions, Scene, SphereLight, SpotLight,
 };
 
 mod expect;
@@ -94,7 +94,7 @@ pub fn pixel_hits(scene: &Scene) -> Vec<PixelHit> {
 /// The largest ratio of a pixel's luminance to the median of its 3×3 neighbourhood, over the
 /// pixels whose whole neighbourhood is `keep`; with the pixel index where it occurs. Infinite
 /// when no pixel qualifies (nothing to judge is not clean).
-pub fn firefly_ratio(img: &Image, keep: &[bool]) -> (f64, usize) {
+pub fn firefly_ratio(img: &RenderedImage, keep: &[bool]) -> (f64, usize) {
     let (w, h) = (img.width as usize, img.height as usize);
     let lum: Vec<f64> = img.beauty.iter().map(|c| luminance(*c) as f64).collect();
     let (mut worst, mut judged) = ((0.0, 0), 0usize);
@@ -146,7 +146,7 @@ pub struct Contrast {
 pub const MIN_PIXELS: usize = 20;
 
 /// Mean luminance of the pixels in `a` against those in `b`.
-pub fn contrast(img: &Image, a: &[bool], b: &[bool]) -> Contrast {
+pub fn contrast(img: &RenderedImage, a: &[bool], b: &[bool]) -> Contrast {
     let lum: Vec<f64> = img.beauty.iter().map(|c| luminance(*c) as f64).collect();
     contrast_of(&lum, a, b)
 }
@@ -189,7 +189,7 @@ const RING_WINDOW: usize = 3;
 /// The labels come from the albedo, the numbers from the beauty, so this is the rings' contrast
 /// as rendered; the lighting's slow change across a wall divides out, and Monte Carlo noise
 /// (independent of the label) averages out of both means and only lowers `z`.
-pub fn ring_contrast(img: &Image, set: &[bool]) -> Contrast {
+pub fn ring_contrast(img: &RenderedImage, set: &[bool]) -> Contrast {
     let (w, h) = (img.width as usize, img.height as usize);
     let lum: Vec<f64> = img.beauty.iter().map(|c| luminance(*c) as f64).collect();
     let alb: Vec<f64> = img.aov.iter().map(|a| luminance(a.albedo) as f64).collect();
@@ -229,7 +229,7 @@ pub fn ring_contrast(img: &Image, set: &[bool]) -> Contrast {
 /// Local contrast of the pixels in `set` whose 5×5 neighbourhood lies in `set`: the RMS of each
 /// pixel's luminance minus its 5×5 mean, with the pixels' own noise (their `std_error`²)
 /// subtracted, over the mean luminance.
-pub fn figure_contrast(img: &Image, set: &[bool]) -> f64 {
+pub fn figure_contrast(img: &RenderedImage, set: &[bool]) -> f64 {
     let (w, h) = (img.width as usize, img.height as usize);
     let lum: Vec<f64> = img.beauty.iter().map(|c| luminance(*c) as f64).collect();
     let (mut r2, mut noise2, mut sum, mut n) = (0.0, 0.0, 0.0, 0usize);
@@ -317,7 +317,7 @@ pub struct CurlFlip {
 /// change); with its Monte Carlo variance. The fibre's image direction is the fiber AOV projected
 /// on the camera's film. NaN unless both windows lie wholly in `set`.
 fn band_pattern(
-    img: &Image,
+    img: &RenderedImage,
     set: &[bool],
     film: &Frame,
     along: i32,
@@ -392,8 +392,8 @@ fn band_pattern(
 /// distortion's wander, whose kernels are 12 mm along z (curly_maple), twice the curl's. Pixel pitch: the median world distance between horizontally
 /// neighbouring pixels of `set`.
 pub fn curl_flip(
-    a: &Image,
-    b: &Image,
+    a: &RenderedImage,
+    b: &RenderedImage,
     hits: &[PixelHit],
     set: &[bool],
     film: &Frame,
@@ -482,9 +482,9 @@ pub fn measure_rendered(
     settings: &RenderSettings,
     run: &RunOptions,
     names: &[Option<String>],
-    img: &Image,
+    img: &RenderedImage,
     exposure: f32,
-) -> Result<(Vec<Measure>, Option<Image>), RenderError> {
+) -> Result<(Vec<Measure>, Option<RenderedImage>), RenderError> {
     let companion = match expect.companion {
         Some(c) => {
             let lights = c.lights(scene);
@@ -501,7 +501,7 @@ pub fn measure_rendered(
 /// one face (each pixel's 3×3 neighbourhood on one face, so no pixel mixes faces). About 1 where
 /// the wood runs on around the edge (carved from a block), large where each face is its own
 /// slice (veneer, Liu et al. 2016 Fig. 18).
-pub fn edge_jump(img: &Image, hits: &[PixelHit], object: u32) -> f64 {
+pub fn edge_jump(img: &RenderedImage, hits: &[PixelHit], object: u32) -> f64 {
     let (w, h) = (img.width as usize, img.height as usize);
     let face = |i: usize| match hits[i] {
         PixelHit::Surface {
@@ -546,7 +546,7 @@ pub fn edge_jump(img: &Image, hits: &[PixelHit], object: u32) -> f64 {
 /// only the light (the rays through their centre and four corners all meet it first; the light
 /// is a convex quad, so then the whole pixel does) from its radiance `expected`. Infinite when
 /// no pixel sees only the light.
-pub fn light_error(scene: &Scene, img: &Image, hits: &[PixelHit], expected: Vec3) -> f64 {
+pub fn light_error(scene: &Scene, img: &RenderedImage, hits: &[PixelHit], expected: Vec3) -> f64 {
     let w = img.width as usize;
     let sees_light = |film: Vec2| {
         let ray = scene.camera.ray(film, Vec2::splat(0.5));
@@ -576,7 +576,7 @@ pub fn light_error(scene: &Scene, img: &Image, hits: &[PixelHit], expected: Vec3
 /// pixels in the image's `third`, 0 = left, 2 = right) over the same in the middle third. Above
 /// 1 where the wall on that side tints the white surfaces near it. 0 when either third has
 /// fewer than [`MIN_PIXELS`].
-pub fn bleed_ratio(img: &Image, set: &[bool], third: usize, a: usize, b: usize) -> f64 {
+pub fn bleed_ratio(img: &RenderedImage, set: &[bool], third: usize, a: usize, b: usize) -> f64 {
     let w = img.width as usize;
     let ratio = |t: usize| {
         let (mut sum, mut n) = (glam::DVec3::ZERO, 0usize);
@@ -595,7 +595,7 @@ pub fn bleed_ratio(img: &Image, set: &[bool], third: usize, a: usize, b: usize) 
 }
 
 /// Median of the sRGB-encoded luminance of a pixel set (0–1): how bright it looks in the PNG.
-pub fn median_srgb(img: &Image, set: &[bool], exposure: f32) -> f64 {
+pub fn median_srgb(img: &RenderedImage, set: &[bool], exposure: f32) -> f64 {
     let k = 2f32.powf(exposure);
     let mut v: Vec<f32> = (img.beauty.iter().zip(set))
         .filter(|(_, &s)| s)
@@ -612,12 +612,12 @@ pub fn median_srgb(img: &Image, set: &[bool], exposure: f32) -> f64 {
 mod tests {
     use super::*;
 
-    fn image(w: u32, h: u32, lum: impl Fn(u32, u32) -> f32) -> Image {
+    fn image(w: u32, h: u32, lum: impl Fn(u32, u32) -> f32) -> RenderedImage {
         let beauty = (0..h)
             .flat_map(|y| (0..w).map(move |x| (x, y)))
             .map(|(x, y)| Vec3::splat(lum(x, y)))
             .collect::<Vec<_>>();
-        Image {
+        RenderedImage {
             width: w,
             height: h,
             std_error: vec![0.0; beauty.len()],
@@ -653,7 +653,7 @@ mod tests {
     }
 
     /// An image whose albedo AOV equals its beauty and whose fibre runs along +x.
-    fn textured(w: u32, h: u32, lum: impl Fn(u32, u32) -> f32) -> Image {
+    fn textured(w: u32, h: u32, lum: impl Fn(u32, u32) -> f32) -> RenderedImage {
         let mut img = image(w, h, lum);
         for (a, c) in img.aov.iter_mut().zip(&img.beauty) {
             a.albedo = *c;

@@ -56,7 +56,7 @@ pub const MIN_PORE_RELIEF: f64 = 0.1;
 /// Carlo noise (the pixels' `std_error`²) taken out, over the mean luminance of both. A flat,
 /// isotropic surface looks the same lit from either side (0); a bump's slopes facing one light
 /// face away from the other. 0 where `set` is empty.
-pub fn pore_relief(img: &Image, mirrored: &Image, set: &[bool]) -> f64 {
+pub fn pore_relief(img: &RenderedImage, mirrored: &RenderedImage, set: &[bool]) -> f64 {
     let (mut diff2, mut noise2, mut sum, mut n) = (0.0f64, 0.0f64, 0.0f64, 0usize);
     for (i, _) in set.iter().enumerate().filter(|(_, &s)| s) {
         let (a, b) = (
@@ -126,7 +126,7 @@ fn mask(hits: &[PixelHit], objects: &[u32], face: Option<Vec3>) -> Vec<bool> {
 
 /// Contrast of two object groups on one face direction, as two measures (Weber, z).
 fn step(
-    img: &Image,
+    img: &RenderedImage,
     hits: &[PixelHit],
     names: &[Option<String>],
     what: &str,
@@ -161,7 +161,7 @@ fn visible(what: &str, c: &Contrast) -> Vec<Measure> {
 /// The colour of the light falling on `set`, blue over red: Σ beauty / Σ albedo AOV per channel
 /// (a diffuse surface's beauty is its albedo times its irradiance / π), the blue figure over the
 /// red; 0 when `set` is empty.
-pub fn light_blue_over_red(img: &Image, set: &[bool]) -> f64 {
+pub fn light_blue_over_red(img: &RenderedImage, set: &[bool]) -> f64 {
     let (mut b, mut a) = (glam::DVec3::ZERO, glam::DVec3::ZERO);
     for ((c, aov), _) in (img.beauty.iter().zip(&img.aov).zip(set)).filter(|(_, &s)| s) {
         b += c.as_dvec3();
@@ -183,7 +183,7 @@ const COLOUR_GROUPS: usize = 4;
 /// Each pixel has its own samples, so the groups' noise is independent; each group samples the
 /// whole surface, so their figures differ by noise (and by what little of the texture the grid
 /// aliases, which only makes the error larger). Infinite when a group has no pixel.
-pub fn light_colour_error(img: &Image, set: &[bool]) -> f64 {
+pub fn light_colour_error(img: &RenderedImage, set: &[bool]) -> f64 {
     let w = img.width as usize;
     let g = COLOUR_GROUPS;
     let r: Vec<f64> = (0..g * g)
@@ -215,10 +215,10 @@ pub fn light_colour_error(img: &Image, set: &[bool]) -> f64 {
 /// interreflection outweighs the background, notes/scenes.md), so that is not what is checked.
 fn light_colour(
     scene: &Scene,
-    img: &Image,
+    img: &RenderedImage,
     set: &[bool],
     black: bool,
-    companion: Option<&Image>,
+    companion: Option<&RenderedImage>,
 ) -> Measure {
     let value = light_blue_over_red(img, set);
     if black {
@@ -262,8 +262,8 @@ pub fn measure(
     expect: &Expectations,
     scene: &Scene,
     names: &[Option<String>],
-    img: &Image,
-    companion: Option<&Image>,
+    img: &RenderedImage,
+    companion: Option<&RenderedImage>,
     exposure: f32,
 ) -> Vec<Measure> {
     let s = Subject {
@@ -286,9 +286,9 @@ fn prefixes(v: &[String]) -> Vec<&str> {
 struct Subject<'a> {
     scene: &'a Scene,
     names: &'a [Option<String>],
-    img: &'a Image,
+    img: &'a RenderedImage,
     hits: Vec<PixelHit>,
-    companion: Option<&'a Image>,
+    companion: Option<&'a RenderedImage>,
     exposure: f32,
 }
 

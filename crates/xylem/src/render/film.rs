@@ -256,7 +256,7 @@ impl PixelSum {
 
 /// A finished image with its AOV layers.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Image {
+pub struct RenderedImage {
     /// Image width in pixels.
     pub width: u32,
     /// Image height in pixels.
@@ -271,7 +271,7 @@ pub struct Image {
     pub nonfinite: u64,
 }
 
-impl Image {
+impl RenderedImage {
     /// Averages pixel sums into an image.
     pub(crate) fn from_sums(width: u32, height: u32, sums: &[PixelSum]) -> Self {
         let mut img = Self::from_radiance(width, height, sums.iter().map(|s| s.radiance));
@@ -300,7 +300,7 @@ impl Image {
             std_error.push(error);
             nonfinite += s.nonfinite as u64;
         }
-        Image {
+        RenderedImage {
             width,
             height,
             beauty,
@@ -339,7 +339,7 @@ mod tests {
         let mut p = PixelSum::default();
         p.add(Vec3::ONE, &Aov::default());
         p.add(Vec3::new(f32::NAN, 0.0, 0.0), &Aov::default());
-        let img = Image::from_sums(1, 1, &[p]);
+        let img = RenderedImage::from_sums(1, 1, &[p]);
         assert_eq!(img.nonfinite, 1);
         assert!(img.beauty[0].is_finite());
         assert_eq!(img.beauty[0], Vec3::splat(0.5));
@@ -356,7 +356,7 @@ mod tests {
         for a in [hit(2.0), Aov::default(), hit(4.0), Aov::default()] {
             p.add(Vec3::ONE, &a);
         }
-        let img = Image::from_sums(2, 1, &[p, PixelSum::default()]);
+        let img = RenderedImage::from_sums(2, 1, &[p, PixelSum::default()]);
         // Two of four samples hit at 2 and 4 mm: depth 3, alpha ½.
         assert_eq!((img.aov[0].depth, img.aov[0].coverage), (3.0, 0.5));
         assert_eq!(img.aov[1].depth, f32::INFINITY);

@@ -12,14 +12,18 @@ use std::path::Path;
 /// plus the AOV layers `albedo` (RGB), `normal` (XYZ), `depth` (Z, +∞ where nothing was hit),
 /// `fiber` (XYZ), `ray_mask` (Y), `growth_time` (Y) and `std_error` (Y), with `meta` in the
 /// header ([`stage_exr_layers`]).
-pub fn write_image_exr(path: &Path, image: &super::Image, meta: ExrMeta) -> Result<(), ImageError> {
+pub fn write_image_exr(
+    path: &Path,
+    image: &super::RenderedImage,
+    meta: ExrMeta,
+) -> Result<(), ImageError> {
     commit(stage_image_exr(path, image, meta)?)
 }
 
 /// [`write_image_exr`] staged, to [`commit`] later.
 pub fn stage_image_exr(
     path: &Path,
-    image: &super::Image,
+    image: &super::RenderedImage,
     meta: ExrMeta,
 ) -> Result<Staged, ImageError> {
     let mut layers = vec![beauty_rgba(&image.beauty, &image.aov)];
@@ -109,7 +113,7 @@ mod tests {
             depth: f32::INFINITY,
             ..Default::default()
         };
-        let image = crate::render::Image {
+        let image = crate::render::RenderedImage {
             width: 2,
             height: 1,
             beauty: vec![Vec3::new(0.5, 0.25, 0.125), Vec3::ZERO],

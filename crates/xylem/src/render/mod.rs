@@ -21,7 +21,7 @@ pub mod wide_bvh;
 
 pub use camera::{Camera, CameraRays, Projection};
 pub(crate) use film::FrameSums;
-pub use film::{Aov, Filter, Image, PixelSum};
+pub use film::{Aov, Filter, PixelSum, RenderedImage};
 pub use frames::LightFrames;
 pub use geometry::{Accel, Instance, Ray, Transform, TriMesh};
 pub(crate) use integrator::path_numbers;
@@ -141,7 +141,7 @@ impl Default for RunOptions<'_> {
 #[derive(Clone, Debug)]
 pub struct RenderOutput {
     /// The image with its AOV layers.
-    pub image: Image,
+    pub image: RenderedImage,
     /// Wall time of the render.
     pub elapsed: Duration,
     /// Rays traced (camera, shadow and bounce rays).
@@ -206,7 +206,7 @@ pub fn render(
     let mut frames = render_frames(scene, &LightFrames::fixed(&scene.lights), settings, run)?;
     let frame = frames.frames.swap_remove(0);
     Ok(RenderOutput {
-        image: Image {
+        image: RenderedImage {
             width: frames.width,
             height: frames.height,
             beauty: frame.beauty,
@@ -249,10 +249,10 @@ pub struct Frames {
 }
 
 impl Frames {
-    /// Frame `k` as a renderer [`Image`] (for EXR output with the AOV layers).
-    pub fn image(&self, k: usize) -> Image {
+    /// Frame `k` as a [`RenderedImage`] (for EXR output with the AOV layers).
+    pub fn image(&self, k: usize) -> RenderedImage {
         let f = &self.frames[k];
-        Image {
+        RenderedImage {
             width: self.width,
             height: self.height,
             beauty: f.beauty.clone(),
@@ -446,11 +446,11 @@ fn progress_unit(frames: usize) -> String {
     }
 }
 
-/// One tile's frames (per frame the averaged pixels, an [`Image`] the size of the tile without
+/// One tile's frames (per frame the averaged pixels, a [`RenderedImage`] the size of the tile without
 /// AOVs), its AOVs once, the rays traced and, when asked to keep them, its primary samples.
 struct TileFrames {
     aov: Vec<Aov>,
-    frames: Vec<Image>,
+    frames: Vec<RenderedImage>,
     rays: u64,
     kept: Vec<KeptSample>,
 }
@@ -605,9 +605,9 @@ fn tile_frames<const ONE: bool>(
             aov_sums[i].add(Vec3::ZERO, &ps.aov);
         }
     }
-    let aov = Image::from_sums(tw, th, &aov_sums).aov;
+    let aov = RenderedImage::from_sums(tw, th, &aov_sums).aov;
     let frames = (0..frames)
-        .map(|k| Image::from_radiance(tw, th, sums.frame(k)))
+        .map(|k| RenderedImage::from_radiance(tw, th, sums.frame(k)))
         .collect();
     TileFrames {
         aov,

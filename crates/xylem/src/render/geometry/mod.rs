@@ -1,7 +1,7 @@
 //! Triangle meshes, instances with affine transforms, and the acceleration structure: meshes
 //! placed once are flattened into world space, a mesh placed several times keeps one BVH in its
 //! object space under a top-level BVH of its placements ([`Accel`]); obvhs builds each BVH2 (PLOC
-//! with reinsertion, its recommended builder), and [`WideBvh`] collapses it into the 8-wide layout
+//! with reinsertion, its recommended builder), and `WideBvh` collapses it into the 8-wide layout
 //! the renderer traverses (faster than obvhs's CWBVH traversal here: notes/render.md).
 
 mod accel;

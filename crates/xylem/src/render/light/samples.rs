@@ -4,6 +4,11 @@ use super::sphere::ConeSample;
 use super::{Light, LightSample, LightU};
 use glam::Vec3;
 
+/// Samples of one light from one point at many places of the light (the frames of a light
+/// sweep) with the same numbers, as columns (structure of arrays), for the batch next-event
+/// terms of `render::integrator::light_terms`. A sphere light is sampled by one loop over
+/// the frames' centres ([`LightSamples::sample_sphere`]): no frame depends on another, so the
+/// loop runs in SIMD lanes instead of one latency-bound chain of square roots and divisions per
 /// frame. Values bit-identical to [`Light::sample_at`] (tested).
 #[derive(Clone, Debug, Default)]
 pub struct LightSamples {

@@ -18,7 +18,7 @@ pub struct SphereLight {
 
 impl SphereLight {
     /// Samples the cone the sphere subtends from `p` with numbers `ux` and the azimuth
-    /// `(sin φ, cos φ)` ([`sample_sphere`]).
+    /// `(sin φ, cos φ)` (pbrt-v4 §6.2.4; `sample_sphere`).
     #[inline]
     pub fn sample(&self, p: Vec3, ux: f32, azimuth: (f32, f32)) -> Option<LightSample> {
         sample_sphere(p, self.center, self.radius, self.radiance, ux, azimuth)
@@ -113,12 +113,6 @@ impl ConeSample {
         }
     }
 }
-
-/// Samples of one light from one point at many places of the light (the frames of a light
-/// sweep) with the same numbers, as columns (structure of arrays), for the batch next-event
-/// terms of `render::integrator::light_terms`. A sphere light is sampled by one loop over
-/// the frames' centres ([`LightSamples::sample_sphere`]): no frame depends on another, so the
-/// loop runs in SIMD lanes instead of one latency-bound chain of square roots and divisions per
 
 /// The discriminant of the ray–sphere quadratic in the numerically stable form of Haines et
 /// al. (Ray Tracing Gems ch. 7): r² minus the squared distance of the centre to the ray's line
