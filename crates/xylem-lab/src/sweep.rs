@@ -17,7 +17,7 @@
 //! renderer, so the checks exercise what users run.
 
 use crate::highlight::{inclined_fibre, peak_in_arc_deg};
-use crate::report::markdown_table;
+use crate::report::{checks_table, markdown_table, Check};
 use crate::scene_template::{pair, vec3, SceneTemplate};
 use serde::Serialize;
 use std::path::Path;
@@ -53,10 +53,9 @@ pub enum SweepCheckError {
 /// One check's outcome.
 #[derive(Clone, Debug, Serialize)]
 pub struct CheckOutcome {
-    /// The check's name.
-    pub check: String,
-    /// Whether its criterion held.
-    pub passed: bool,
+    /// The verdict: name, criterion, worst value, case, pass.
+    #[serde(flatten)]
+    pub verdict: Check,
     /// The measured figure, in words and numbers.
     pub figure: String,
     /// The plot, relative to the report's folder.
@@ -253,8 +252,13 @@ pub fn highlight_tracking(
         plot = Some(rel);
     }
     Ok(CheckOutcome {
-        check: format!("highlight tracking, fibres dipping {incl_deg}°"),
-        passed,
+        verdict: Check::new(
+            format!("highlight tracking, fibres dipping {incl_deg}°"),
+            "≥ 99 % of the pixels peak within one frame step of the predicted peak",
+            within,
+            format!("{n} pixels, step {step:.2}°"),
+            passed,
+        ),
         figure: match predicted {
             Some(p) => format!(
                 "predicted peak {p:.2}°; {:.1} % of {n} pixels peak within one frame step ({step:.2}°); largest deviation {max_dev:.2}°",
@@ -312,8 +316,13 @@ pub fn renderer_vs_bsdf(run: &RunOptions) -> Result<CheckOutcome, SweepCheckErro
         }
     }
     Ok(CheckOutcome {
-        check: "renderer against eval(wo, wi)·cos θi·E".into(),
-        passed: worst <= 1e-3,
+        verdict: Check::new(
+            "renderer against eval(wo, wi)·cos θi·E",
+            "largest relative error ≤ 1e-3",
+            worst,
+            format!("{compared} pixel channels, {frames} frames"),
+            worst <= 1e-3,
+        ),
         figure: format!(
             "largest relative error {worst:.2e} over {compared} pixel channels in {frames} frames (allowed 1e-3)"
         ),
@@ -401,8 +410,13 @@ pub fn mahogany_stripes(
         None => None,
     };
     Ok(CheckOutcome {
-        check: "African mahogany: stripe families brighten at different light angles".into(),
-        passed,
+        verdict: Check::new(
+            "African mahogany: stripe families brighten at different light angles",
+            "two stripe families, their mean radiances correlated < −0.3 (shape-divided and raw)",
+            if enough { rho.max(rho_raw) } else { f64::NAN },
+            format!("{} px rising, {} px dipping", fam_a.len(), fam_b.len()),
+            passed,
+        ),
         figure: if enough {
             format!(
                 "correlation of the two families' mean radiance divided by the diffuse shape T(θi)cos θi {rho:.3} (needs < −0.3), of the raw means {rho_raw:.3} (needs < −0.3 too); rising fibres ({} px) peak at {:.1}°, dipping fibres ({} px) at {:.1}°",
@@ -529,8 +543,16 @@ pub fn curly_maple_bands(
         plot = Some(rel);
     }
     Ok(CheckOutcome {
-        check: "curly maple: bright bands shift with the light angle".into(),
-        passed,
+        verdict: Check::new(
+            "curly maple: bright bands shift with the light angle",
+            format!(
+                "spread of the columns' peak angles ≥ {:.1}° (two frame steps) and lag-1 autocorrelation ≥ 0.5",
+                2.0 * step
+            ),
+            spread,
+            format!("lag-1 autocorrelation {lag1:.2}"),
+            passed,
+        ),
         figure: format!(
             "light angle of each column's peak along the grain: spread {spread:.2}° (needs ≥ {:.1}°, two frame steps), lag-1 autocorrelation {lag1:.2} (needs ≥ 0.5: bands, not noise)",
             2.0 * step
@@ -565,24 +587,21 @@ pub fn run_checks(
 
 /// The sweep section of validation/REPORT.md.
 pub fn to_markdown(checks: &[CheckOutcome]) -> String {
-    let passed = checks.iter().filter(|c| c.passed).count();
+    let passed = checks.iter().filter(|c| c.verdict.passed).count();
     let mut s = format!(
         "## Light sweeps\n\n`xylem validate sweep`: {passed} of {} checks pass. Setups and the peak \
          derivation: `crates/xylem-lab/src/sweep.rs`, notes/sweep.md. Plots: luminance (vertical) against light \
          angle in degrees (horizontal) unless stated; the axis ranges are printed at the corners.\n\n",
         checks.len()
     );
+    let verdicts: Vec<Check> = checks.iter().map(|c| c.verdict.clone()).collect();
+    s += &checks_table(&verdicts);
+    s += "\n";
     let rows: Vec<Vec<String>> = checks
         .iter()
-        .map(|c| {
-            vec![
-                c.check.clone(),
-                if c.passed { "pass" } else { "**FAIL**" }.into(),
-                c.figure.clone(),
-            ]
-        })
+        .map(|c| vec![c.verdict.check.clone(), c.figure.clone()])
         .collect();
-    s += &markdown_table(&["check", "result", "measured"], &rows);
+    s += &markdown_table(&["check", "measured"], &rows);
     for c in checks {
         if let Some(p) = &c.plot {
             let caption = if p.contains("tracking") {
@@ -592,7 +611,10 @@ pub fn to_markdown(checks: &[CheckOutcome]) -> String {
             } else {
                 "light angle (vertical, degrees) at which each column along the grain (horizontal, pixels) is brightest"
             };
-            s += &format!("\n**{}** — {caption}\n\n![{}]({p})\n", c.check, c.check);
+            s += &format!(
+                "\n**{}** — {caption}\n\n![{}]({p})\n",
+                c.verdict.check, c.verdict.check
+            );
         }
     }
     s

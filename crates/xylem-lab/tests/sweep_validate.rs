@@ -16,7 +16,7 @@ fn run() -> RunOptions<'static> {
 fn rendered_highlight_peaks_where_the_model_predicts() {
     for incl in [0.0, 30.0] {
         let c = highlight_tracking(incl, None, &run()).unwrap();
-        assert!(c.passed, "{}: {}", c.check, c.figure);
+        assert!(c.verdict.passed, "{}: {}", c.verdict.check, c.figure);
         let within = c.values["fraction_within_step"].as_f64().unwrap();
         assert!(within >= 0.99, "{within}");
     }
@@ -25,6 +25,6 @@ fn rendered_highlight_peaks_where_the_model_predicts() {
 #[test]
 fn rendered_pixels_equal_the_bsdf_times_cosine() {
     let c = renderer_vs_bsdf(&run()).unwrap();
-    assert!(c.passed, "{}", c.figure);
+    assert!(c.verdict.passed, "{}", c.figure);
     assert!(c.values["compared"].as_u64().unwrap() > 1000);
 }

@@ -79,16 +79,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         r
     };
 
-    println!("{:<55} {:<8} {:>14}  case", "check", "result", "worst");
-    for c in &result.checks {
-        println!(
-            "{:<55} {:<8} {:>14.6}  {}",
-            c.check,
-            c.status(),
-            c.worst,
-            c.case
-        );
-    }
+    print!("{}", xylem_lab::report::checks_text(&result.checks));
     if let Some((a, case)) = &result.published_max_albedo {
         println!("(published lobe, not normalised: max albedo {a:.3} at {case})");
     }

@@ -30,14 +30,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let plots = (!args.no_report).then_some(dir.as_path());
     let checks = run_checks(plots, &run, &|name| bar.step(name))?;
     bar.finish();
-    println!("{:<70} {:<6} measured", "check", "result");
+    let verdicts: Vec<_> = checks.iter().map(|c| c.verdict.clone()).collect();
+    print!("{}", xylem_lab::report::checks_text(&verdicts));
     for c in &checks {
-        println!(
-            "{:<70} {:<6} {}",
-            c.check,
-            if c.passed { "pass" } else { "FAIL" },
-            c.figure
-        );
+        println!("{}: {}", c.verdict.check, c.figure);
     }
     if !args.no_report {
         xylem_lab::update_report_section(&report, "sweep", &to_markdown(&checks))
@@ -49,7 +45,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         xylem::output::write_atomic(path, text.as_bytes())
             .with_context(|| format!("writing {}", path.display()))?;
     }
-    Ok(if checks.iter().all(|c| c.passed) {
+    Ok(if xylem_lab::report::all_passed(&verdicts) {
         ExitCode::SUCCESS
     } else {
         ExitCode::FAILURE

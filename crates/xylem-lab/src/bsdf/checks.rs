@@ -1,43 +1,13 @@
 //! The suite's verdicts: each case's numbers summarised into checks (white furnace, sampling,
-//! rough finish), each with its criterion, worst value and case ([`CheckSummary`]).
+//! rough finish), each a [`Check`]: criterion, worst value and case.
 
 use super::*;
-
-/// One line of the summary table.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct CheckSummary {
-    /// The check's name.
-    pub check: String,
-    /// Whether every case met the criterion.
-    pub passed: bool,
-    /// A figure reported without a pass/fail criterion (its criterion reads "reported …"):
-    /// shown as "reported", never as "pass", and it cannot fail the run.
-    #[serde(default)]
-    pub reported: bool,
-    /// The worst figure over the cases.
-    pub worst: f64,
-    /// The case that gave `worst`.
-    pub case: String,
-    /// The criterion, in words.
-    pub criterion: String,
-}
-
-impl CheckSummary {
-    /// "pass", "FAIL" or "reported".
-    pub fn status(&self) -> &'static str {
-        match (self.reported, self.passed) {
-            (true, _) => "reported",
-            (false, true) => "pass",
-            (false, false) => "FAIL",
-        }
-    }
-}
 
 /// The whole run: per-check summary, per-case results and the settings used.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct BsdfValidation {
     /// One summary line per check.
-    pub checks: Vec<CheckSummary>,
+    pub checks: Vec<Check>,
     /// Per-case results.
     pub cases: Vec<CaseResult>,
     /// Each extremes case with its count of NaN / Inf / negative values (0 when clean).
@@ -57,7 +27,7 @@ pub struct BsdfValidation {
 impl BsdfValidation {
     /// True when every check passed ("reported" figures cannot fail).
     pub fn passed(&self) -> bool {
-        self.checks.iter().all(|c| c.passed)
+        all_passed(&self.checks)
     }
 }
 
@@ -152,7 +122,7 @@ fn published_max_albedo(cases: &[CaseResult]) -> Option<(f64, String)> {
 /// Adds to `checks` the check `check` over `items` (figure, case, pass): passed when every item
 /// passes, its worst figure the largest (`larger_is_worse`) or the smallest, with its case.
 fn push_worst(
-    checks: &mut Vec<CheckSummary>,
+    checks: &mut Vec<Check>,
     check: &str,
     criterion: String,
     items: Vec<(f64, String, bool)>,
@@ -170,14 +140,7 @@ fn push_worst(
     let (w, case) = pick
         .map(|x| (x.0, x.1.clone()))
         .unwrap_or((0.0, "-".into()));
-    checks.push(CheckSummary {
-        check: check.into(),
-        passed,
-        reported: criterion.starts_with("reported"),
-        worst: w,
-        case,
-        criterion,
-    });
+    checks.push(Check::new(check, criterion, w, case, passed));
 }
 
 /// `"{case} {extra}"`, the case column of a per-case row.
@@ -187,7 +150,7 @@ fn label(c: &CaseResult, extra: String) -> String {
 
 /// The white-furnace checks: bounded albedo, the smallest albedo, Monte Carlo against
 /// quadrature, and the white substrate under a smooth finish.
-fn furnace_checks(checks: &mut Vec<CheckSummary>, cases: &[CaseResult], s: &Settings) {
+fn furnace_checks(checks: &mut Vec<Check>, cases: &[CaseResult], s: &Settings) {
     let bounded: Vec<&CaseResult> = cases.iter().filter(|c| c.spec.bounded).collect();
     push_worst(
         checks,
@@ -280,7 +243,7 @@ fn furnace_checks(checks: &mut Vec<CheckSummary>, cases: &[CaseResult], s: &Sett
 
 /// Reciprocity, and the sampling checks over the χ² runs: p-values (Šidák-corrected), pdf
 /// normalisation, sample weights.
-fn sampling_checks(checks: &mut Vec<CheckSummary>, cases: &[CaseResult], s: &Settings) {
+fn sampling_checks(checks: &mut Vec<Check>, cases: &[CaseResult], s: &Settings) {
     push_worst(
         checks,
         "reciprocity: max relative error",
@@ -370,7 +333,7 @@ fn sampling_checks(checks: &mut Vec<CheckSummary>, cases: &[CaseResult], s: &Set
 
 /// The rough finish against the layered random walk: white substrate, albedo (Lambertian and
 /// fibre substrates), interface reflection, BSDF shape, the analytic albedo's bound.
-fn rough_checks(checks: &mut Vec<CheckSummary>, rough_rows: &[RoughRow], r: &RoughSettings) {
+fn rough_checks(checks: &mut Vec<Check>, rough_rows: &[RoughRow], r: &RoughSettings) {
     push_worst(
         checks,
         "white substrate under rough finish: min albedo",

@@ -13,7 +13,7 @@
 //! - **rough finish** ([`super::rough_finish`]): the analytic albedo against the layered
 //!   random-walk reference, and a white substrate under a rough finish.
 
-use crate::report::markdown_table;
+use crate::report::{all_passed, checks_table, markdown_table, Check};
 use crate::rough_finish::{run_rough, white_row_checked, white_row_ok, RoughRow, RoughSettings};
 use glam::Vec3;
 use rayon::prelude::*;

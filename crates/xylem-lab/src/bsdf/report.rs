@@ -85,26 +85,7 @@ pub fn to_markdown(v: &BsdfValidation, plots: &[(String, String)]) -> String {
         s.seed,
         if v.passed() { "PASS" } else { "FAIL" }
     );
-    let rows: Vec<Vec<String>> = v
-        .checks
-        .iter()
-        .map(|c| {
-            vec![
-                c.check.clone(),
-                match c.status() {
-                    "FAIL" => "**FAIL**".into(),
-                    s => s.into(),
-                },
-                format!("{:.6}", c.worst),
-                c.case.clone(),
-                c.criterion.clone(),
-            ]
-        })
-        .collect();
-    md += &markdown_table(
-        &["check", "result", "worst value", "case", "criterion"],
-        &rows,
-    );
+    md += &checks_table(&v.checks);
     if let Some(r) = &v.rough_settings {
         md += &rough_markdown(&v.rough_rows, r);
     }
