@@ -101,7 +101,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     let steps = pairs.len() as u64 + if builtin { 3 } else { 0 };
     let bar = crate::progress::Steps::new("validate appearance", steps, "steps");
-    let (md, ok) = run_report(
+    let (md, checks) = run_report(
         Path::new("."),
         args.presets.as_deref(),
         &dir,
@@ -112,7 +112,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     )
     .map_err(anyhow::Error::msg)?;
     bar.finish();
-    super::finish_report(&report, &md, ok)
+    super::finish_report(&report, &md, &checks)
 }
 
 #[cfg(test)]

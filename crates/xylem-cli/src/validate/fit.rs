@@ -30,10 +30,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let dir = report.parent().map(Path::to_path_buf).unwrap_or_default();
     let work = tempfile::tempdir().context("creating a temporary folder for the captures")?;
     let bar = crate::progress::Steps::new("validate fit", 4, "boards");
-    let (md, ok) = run_report(Path::new("."), &dir, work.path(), &spec, &|name| {
+    let (md, checks) = run_report(Path::new("."), &dir, work.path(), &spec, &|name| {
         bar.step(name)
     })
     .map_err(anyhow::Error::msg)?;
     bar.finish();
-    super::finish_report(&report, &md, ok)
+    super::finish_report(&report, &md, &checks)
 }

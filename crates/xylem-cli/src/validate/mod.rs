@@ -29,15 +29,20 @@ enum What {
     Aliasing(aliasing::Args),
 }
 
-/// Writes a report (staged under a unique temporary name, `output::write_atomic`), prints it and
-/// turns `ok` into the exit code.
-fn finish_report(report: &std::path::Path, md: &str, ok: bool) -> anyhow::Result<ExitCode> {
+/// Writes a report (staged under a unique temporary name, `output::write_atomic`), prints it
+/// and the suite's verdict table, and turns the verdict into the exit code.
+fn finish_report(
+    report: &std::path::Path,
+    md: &str,
+    checks: &[xylem_lab::report::Check],
+) -> anyhow::Result<ExitCode> {
     use anyhow::Context;
     xylem::output::write_atomic(report, md.as_bytes())
         .with_context(|| format!("writing {}", report.display()))?;
     println!("{md}");
+    print!("{}", xylem_lab::report::checks_text(checks));
     println!("report: {}", report.display());
-    Ok(if ok {
+    Ok(if xylem_lab::report::all_passed(checks) {
         ExitCode::SUCCESS
     } else {
         ExitCode::FAILURE

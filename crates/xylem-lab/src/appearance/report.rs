@@ -2,6 +2,7 @@
 //! pair's section, the other trees, and the report put together ([`run_report`]).
 
 use super::*;
+use crate::report::{all_passed, checks_table, Check};
 
 /// Walnut against its published character (no measured board): chocolate brown (r > g > b) and
 /// much darker than maple, with its colour varying more in lightness than in hue (Phelps,
@@ -432,7 +433,7 @@ pub fn run_report(
     pairs: &[Pair],
     builtin: bool,
     progress: &dyn Fn(&str),
-) -> Result<(String, bool), String> {
+) -> Result<(String, Vec<Check>), String> {
     let mut md = String::from(
         "# Appearance: presets against measured boards\n\n\
          Written by `xylem validate appearance` (crates/xylem-lab/src/appearance.rs; statistics, sources \
@@ -443,31 +444,39 @@ pub fn run_report(
          (\"pass (25 %)\"). Band continuity compares whole boards (band: the six quarter-pair \
          correlations).\n\n",
     );
-    let mut ok = true;
+    let mut checks = Vec::new();
+    let mut body = String::new();
     if builtin {
         progress("white light");
-        let (section, passed) = white_light_section()?;
-        (md, ok) = (md + &section, ok && passed);
+        let (section, check) = white_light_section()?;
+        (body, checks) = (body + &section, vec![check]);
     }
-    let (section, passed) = pairs_section(pairs, base, preset_dir, dir, sweep, progress)?;
-    (md, ok) = (md + &section, ok && passed);
+    let (section, pair_checks) = pairs_section(pairs, base, preset_dir, dir, sweep, progress)?;
+    body += &section;
+    checks.extend(pair_checks);
     if builtin {
         progress("other trees");
-        md += &generalisation_section(pairs, base, preset_dir, sweep)?;
+        body += &generalisation_section(pairs, base, preset_dir, sweep)?;
         progress("walnut");
-        let (section, passed) = walnut_section(base, preset_dir)?;
-        (md, ok) = (md + &section, ok && passed);
+        let (section, check) = walnut_section(base, preset_dir)?;
+        body += &section;
+        checks.push(check);
         progress("preset sheet");
-        md += &preset_sheet_section(base, preset_dir, dir, sweep)?;
+        body += &preset_sheet_section(base, preset_dir, dir, sweep)?;
     }
+    md += &checks_table(&checks);
+    md += "\n";
+    md += &body;
+    let ok = all_passed(&checks);
     md += &format!("\nOverall: **{}**.\n", if ok { "PASS" } else { "FAIL" });
-    Ok((md, ok))
+    Ok((md, checks))
 }
 
 /// The white-light check of every preset: rendered brightness follows the albedo. Returns its
-/// Markdown and whether every preset passed.
-fn white_light_section() -> Result<(String, bool), String> {
+/// Markdown and its check (worst: the smallest correlation).
+fn white_light_section() -> Result<(String, Check), String> {
     let mut ok = true;
+    let mut worst = (f64::INFINITY, String::from("-"));
     let mut md = String::new();
     md += "## Rendered brightness follows the albedo (uniform white environment)\n\n\
             Each preset's showcase board (the gallery's cut), 200 × 100 mm at 1 mm pixels, \
@@ -480,6 +489,9 @@ fn white_light_section() -> Result<(String, bool), String> {
     for name in xylem::wood::PRESET_NAMES {
         let w = white_light_ring_order(name, 16)?;
         ok &= w.keeps_order();
+        if w.correlation < worst.0 {
+            worst = (w.correlation, name.to_string());
+        }
         rows.push(vec![
             name.to_string(),
             format!("{:.3}", w.correlation),
@@ -498,11 +510,18 @@ fn white_light_section() -> Result<(String, bool), String> {
         ],
         &rows,
     );
-    Ok((md, ok))
+    let check = Check::new(
+        "white light: rendered brightness follows the albedo",
+        "every preset: correlation with albedo > 0 and the palest third renders paler",
+        worst.0,
+        worst.1,
+        ok,
+    );
+    Ok((md, check))
 }
 
 /// Each pair's section ([`pair_section`]) and the share of rows passing only by the 25 % leg.
-/// Returns the Markdown and whether every pair passed.
+/// Returns the Markdown and a check per pair (worst: its rows that miss) and for the share.
 fn pairs_section(
     pairs: &[Pair],
     base: &Path,
@@ -510,21 +529,36 @@ fn pairs_section(
     dir: &Path,
     sweep: SweepSettings,
     progress: &dyn Fn(&str),
-) -> Result<(String, bool), String> {
-    let mut ok = true;
+) -> Result<(String, Vec<Check>), String> {
+    let mut checks = Vec::new();
     let mut md = String::new();
     let (mut rows, mut by_leg) = (0, 0);
     for pair in pairs {
         progress(&pair.preset);
         let r = compare_pair(pair, base, preset_dir, sweep)?;
-        ok &= r.passes() && r.pattern_rows.iter().all(Comparison::passes);
+        let missed: Vec<&Comparison> = (r.rows.iter().chain(&r.pattern_rows))
+            .filter(|c| !c.passes())
+            .collect();
+        checks.push(Check::new(
+            format!("{} against {}", pair.preset, pair.measured_dir),
+            "every board and pattern statistic inside the measured 10–90 % band or within 25 %",
+            missed.len() as f64,
+            missed.first().map_or("-".into(), |c| c.name.clone()),
+            missed.is_empty(),
+        ));
         let (n, leg) = r.rows_by_leg();
         (rows, by_leg) = (rows + n, by_leg + leg);
         md += &pair_section(&r, dir, sweep)?;
     }
     if !pairs.is_empty() {
         let leg_ok = by_leg as f64 <= MAX_LEG_SHARE * rows as f64;
-        ok &= leg_ok;
+        checks.push(Check::new(
+            "rows passing only by the 25 % leg",
+            format!("share ≤ {MAX_LEG_SHARE}"),
+            by_leg as f64 / rows.max(1) as f64,
+            format!("{by_leg} of {rows} rows"),
+            leg_ok,
+        ));
         md += &format!(
             "\n**Rows passing only by the 25 % leg, board and pattern rows together: {by_leg} of \
              {rows}** (goal: at most {:.0} %): {}.\n",
@@ -532,11 +566,12 @@ fn pairs_section(
             if leg_ok { "pass" } else { "FAIL" }
         );
     }
-    Ok((md, ok))
+    Ok((md, checks))
 }
 
-/// Walnut against its published character. Returns the Markdown and whether it passed.
-fn walnut_section(base: &Path, preset_dir: Option<&Path>) -> Result<(String, bool), String> {
+/// Walnut against its published character. Returns the Markdown and its check (worst: the
+/// luminance over maple's).
+fn walnut_section(base: &Path, preset_dir: Option<&Path>) -> Result<(String, Check), String> {
     let w = walnut_character(base, preset_dir)?;
     let md = format!(
         "\n## `walnut` against its published character\n\n\
@@ -556,7 +591,14 @@ fn walnut_section(base: &Path, preset_dir: Option<&Path>) -> Result<(String, boo
         w.hue_cv,
         if w.passes() { "pass" } else { "FAIL" }
     );
-    Ok((md, w.passes()))
+    let check = Check::new(
+        "walnut: its published character",
+        "chromaticity r > g > b, luminance < 0.5 × maple's, CV of luminance > CV of chromaticity r",
+        w.luminance_vs_maple,
+        "walnut",
+        w.passes(),
+    );
+    Ok((md, check))
 }
 
 /// Every preset on true cuts: the sheet (written to `dir/plots/`) and its Markdown.

@@ -10,6 +10,7 @@
 //! gives: 8-bit sRGB PNG frames with Poisson shot noise (notes/fit.md §5).
 
 use crate::appearance::BoardMaps;
+use crate::report::{all_passed, Check};
 use crate::scene_template::{pair, vec3, SceneTemplate};
 use glam::Vec3;
 use std::path::{Path, PathBuf};
@@ -199,11 +200,21 @@ pub const GOALS: FitErrors = FitErrors {
 impl FitErrors {
     /// True when every error is at or below `goal`'s.
     pub fn meets(&self, goal: &FitErrors) -> bool {
-        self.axis_median_deg <= goal.axis_median_deg
-            && self.axis_p90_deg <= goal.axis_p90_deg
-            && self.diffuse_median <= goal.diffuse_median
-            && self.fiber_median <= goal.fiber_median
-            && self.beta_median <= goal.beta_median
+        (self.named().iter().zip(goal.named())).all(|((_, e), (_, g))| *e <= g)
+    }
+
+    /// The five figures with what they measure, in [`FitErrors::cells`]' order.
+    pub fn named(&self) -> [(&'static str, f64); 5] {
+        [
+            ("fibre axis angle, median (degrees)", self.axis_median_deg),
+            (
+                "fibre axis angle, 90th percentile (degrees)",
+                self.axis_p90_deg,
+            ),
+            ("diffuse relative error, median", self.diffuse_median),
+            ("fibre colour relative error, median", self.fiber_median),
+            ("highlight width β relative error, median", self.beta_median),
+        ]
     }
 
     /// A table row: the five figures.

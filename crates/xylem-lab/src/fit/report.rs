@@ -74,8 +74,8 @@ pub fn run_report(
     work: &Path,
     spec: &SweepSpec,
     progress: &dyn Fn(&str),
-) -> Result<(String, bool), String> {
-    use crate::report::markdown_table;
+) -> Result<(String, Vec<Check>), String> {
+    use crate::report::{checks_table, markdown_table};
     let plots = dir.join("plots");
     std::fs::create_dir_all(&plots).map_err(|e| format!("{}: {e}", plots.display()))?;
     let header = [
@@ -90,39 +90,72 @@ pub fn run_report(
         "goals",
     ];
     let mut rows = Vec::new();
-    let mut all_ok = true;
+    let mut errors = Vec::new();
     let mut curves = Curves::default();
     for (k, (name, source)) in sources().into_iter().enumerate() {
         progress(name);
         let w = work.join(format!("board{k}"));
         let rt = render_round_trip(&source, spec, base, &w)?;
-        let (board_rows, ok) = board_rows(name, &rt, &w, spec, &plots)?;
+        let (board_rows, board_errors) = board_rows(name, &rt, &w, spec, &plots)?;
         rows.extend(board_rows);
-        all_ok &= ok;
+        errors.extend(board_errors);
         curves.add(name, &rt, &w, spec)?;
     }
     progress("re-render");
     readme_figure(base, work, spec, &plots.join(README_FIGURE))?;
+    let checks = goal_checks(&errors);
     let mut md = report_intro(spec);
+    md += &checks_table(&checks);
+    md += "\n";
     md += &markdown_table(&header, &rows);
     md += &format!(
         "\n**All goals {}.**\n\n",
-        if all_ok { "met" } else { "NOT met" }
+        if all_passed(&checks) {
+            "met"
+        } else {
+            "NOT met"
+        }
     );
     md += &curves.section(&plots)?;
     md += &maps_section();
-    Ok((md, all_ok))
+    Ok((md, checks))
 }
 
-/// A board's two rows of FIT.md's table, the EXR capture's and the camera PNG's, and whether
-/// both met the goals; writes the board's maps, truth over fit, to `plots/`.
+/// A round trip's errors named by board and capture.
+type NamedErrors = (String, FitErrors);
+
+/// The fit suite's verdict: one check per goal of [`GOALS`], its worst figure over every
+/// board and capture (`(board and capture, errors)`).
+pub fn goal_checks(errors: &[NamedErrors]) -> Vec<Check> {
+    (0..GOALS.named().len())
+        .map(|i| {
+            let (name, goal) = GOALS.named()[i];
+            let (worst, case) = errors
+                .iter()
+                .map(|(case, e)| (e.named()[i].1, case.as_str()))
+                .max_by(|a, b| a.0.total_cmp(&b.0))
+                .unwrap_or((f64::NAN, "-"));
+            let passed = errors.iter().all(|(_, e)| e.named()[i].1 <= goal);
+            Check::new(
+                format!("fit round trip: {name}"),
+                format!("≤ {goal}"),
+                worst,
+                case,
+                passed,
+            )
+        })
+        .collect()
+}
+
+/// A board's two rows of FIT.md's table, the EXR capture's and the camera PNG's, and their
+/// errors (named by board and capture); writes the board's maps, truth over fit, to `plots/`.
 fn board_rows(
     name: &str,
     rt: &RoundTrip,
     w: &Path,
     spec: &SweepSpec,
     plots: &Path,
-) -> Result<(Vec<Vec<String>>, bool), String> {
+) -> Result<(Vec<Vec<String>>, Vec<NamedErrors>), String> {
     let row = |capture: String, e: &FitErrors, t: f64, ok: bool| {
         let mut row = vec![name.to_string(), capture];
         row.extend(e.cells());
@@ -132,7 +165,9 @@ fn board_rows(
     };
     let (e, maps, t) = fit_and_compare(&rt.sweep_dir, None, true, rt)?;
     let exr_ok = e.meets(&GOALS);
-    let exr_row = row(format!("EXR, {} spp", spec.spp), &e, t, exr_ok);
+    let exr_capture = format!("EXR, {} spp", spec.spp);
+    let exr_row = row(exr_capture.clone(), &e, t, exr_ok);
+    let exr_errors = e;
     let sheet = side_by_side(&rt.truth, &maps);
     let file = format!("fit_{}.png", name.replace(' ', "_"));
     xylem::picture::png::write_png_rgb8(&plots.join(&file), sheet.width, sheet.height, &sheet.data)
@@ -142,8 +177,12 @@ fn board_rows(
     let (e, _, t) = fit_and_compare(&png, None, true, rt)?;
     let png_ok = e.meets(&GOALS);
     let capture = format!("8-bit sRGB PNG, shot noise {FULL_WELL} e⁻");
-    let png_row = row(capture, &e, t, png_ok);
-    Ok((vec![exr_row, png_row], exr_ok && png_ok))
+    let png_row = row(capture.clone(), &e, t, png_ok);
+    let errors = vec![
+        (format!("{name}, {exr_capture}"), exr_errors),
+        (format!("{name}, {capture}"), e),
+    ];
+    Ok((vec![exr_row, png_row], errors))
 }
 
 /// One board's errors along a curve: (abscissa, errors) per point.
@@ -395,4 +434,30 @@ pub fn readme_figure(
     let sheet = contact_sheet_rows(&thumbs, &labels, 5, 4);
     xylem::picture::png::write_png_rgb8(path, sheet.width, sheet.height, &sheet.data)
         .map_err(|e| format!("{}: {e}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One check per goal, each failing only where a round trip misses that goal, naming the
+    /// worst case; a round trip at the goals passes (the bounds are inclusive).
+    #[test]
+    fn goal_checks_fail_on_the_goal_missed_and_name_the_worst_case() {
+        let at_goals = GOALS.clone();
+        let mut off = GOALS.clone();
+        off.beta_median = 0.4;
+        let checks = goal_checks(&[("a".into(), at_goals.clone()), ("b".into(), off)]);
+        assert_eq!(checks.len(), 5);
+        let failed: Vec<&str> = (checks.iter())
+            .filter(|c| !c.passed)
+            .map(|c| c.check.as_str())
+            .collect();
+        assert_eq!(
+            failed,
+            ["fit round trip: highlight width β relative error, median"]
+        );
+        assert_eq!((checks[4].worst, checks[4].case.as_str()), (0.4, "b"));
+        assert!(all_passed(&goal_checks(&[("a".into(), at_goals)])));
+    }
 }
