@@ -13,7 +13,7 @@ pub(crate) fn parse_quality(
 
 /// `threads`: 0 (all cores) up to 16 per core, as `--threads`.
 pub(crate) fn check_threads(threads: usize) -> PyResult<()> {
-    use xylem::render::resources::{check_threads, ResourceError};
+    use xylem::resources::{check_threads, ResourceError};
     check_threads(threads).map_err(|e| match e {
         ResourceError::Threads { max, .. } => value_error(format!(
             "threads = {threads}: out of range (allowed 0 = all cores, up to {max})"

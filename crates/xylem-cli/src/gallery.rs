@@ -194,8 +194,7 @@ fn scenes(out: &Path, only: &[String], o: &Overrides) -> anyhow::Result<bool> {
         String::new()
     } else {
         // A table of a few rows (16 MiB bounds `/dev/zero` and the like).
-        xylem::render::resources::read_text_bounded(&file, 16 << 20, "Markdown text")
-            .unwrap_or_default()
+        xylem::resources::read_text_bounded(&file, 16 << 20, "Markdown text").unwrap_or_default()
     };
     xylem::output::write_atomic(&file, merge_check_rows(&old, &rows).as_bytes())
         .with_context(|| format!("writing {}", file.display()))?;

@@ -107,15 +107,15 @@ fn main() -> ExitCode {
 /// The error and its causes joined by `: `, leaving out a cause whose text the message already
 /// holds (our error types print their source, so `{:#}` gave every OS error twice).
 /// `--threads`: 0 (all cores) up to [`MAX_THREADS_PER_CORE`] per core
-/// ([`check_threads`](xylem::render::resources::check_threads)).
+/// ([`check_threads`](xylem::resources::check_threads)).
 ///
-/// [`MAX_THREADS_PER_CORE`]: xylem::render::resources::MAX_THREADS_PER_CORE
+/// [`MAX_THREADS_PER_CORE`]: xylem::resources::MAX_THREADS_PER_CORE
 pub(crate) fn parse_threads(s: &str) -> Result<usize, String> {
     let n: usize = s
         .trim()
         .parse()
         .map_err(|_| format!("`{s}` is not a whole number (allowed 0 = all cores, or more)"))?;
-    xylem::render::resources::check_threads(n).map_err(|e| e.to_string())?;
+    xylem::resources::check_threads(n).map_err(|e| e.to_string())?;
     Ok(n)
 }
 

@@ -249,7 +249,7 @@ fn check_memory(args: &Args, slice: &Slice, format: OutFormat) -> anyhow::Result
             px * EXR_BYTES_PER_PIXEL,
         ),
     };
-    use xylem::render::resources::{available_memory, Bytes};
+    use xylem::resources::{available_memory, Bytes};
     match available_memory() {
         Some(have) if memory > have => bail!(
             "{what} needs about {} of memory but {} is available; lower --res (or --frames)",

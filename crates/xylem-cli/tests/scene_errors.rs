@@ -92,7 +92,7 @@ fn resources_beyond_the_machine_are_refused_up_front() {
     let need = xylem::render::resources::Resources::render(16384, 16384).memory;
     // 16384² pixels hold at least the beauty, the standard error and the AOVs (16 floats).
     assert!(need >= 16384 * 16384 * 16 * 4);
-    if xylem::render::resources::available_memory().is_some_and(|m| m < need) {
+    if xylem::resources::available_memory().is_some_and(|m| m < need) {
         let o = run(&[
             "render",
             s,

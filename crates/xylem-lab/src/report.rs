@@ -142,7 +142,7 @@ pub fn update_report_section(path: &Path, name: &str, markdown: &str) -> io::Res
     // A report is text well under 16 MiB (this bounds `/dev/zero` and the like).
     let old = match std::fs::symlink_metadata(path) {
         Err(e) if e.kind() == io::ErrorKind::NotFound => String::new(),
-        _ => xylem::render::resources::read_text_bounded(path, 16 << 20, "Markdown text")
+        _ => xylem::resources::read_text_bounded(path, 16 << 20, "Markdown text")
             .map_err(|e| io::Error::other(e.to_string()))?,
     };
     let new = replace_section(&old, name, markdown);

@@ -104,15 +104,12 @@ pub fn stand_in(path: &Path) -> Option<(&'static str, &'static [u8])> {
 }
 
 /// The bytes of `path` from disk — a regular file of at most `max` bytes
-/// ([`read_bounded`](crate::render::resources::read_bounded)) — or the embedded copy where the
+/// ([`read_bounded`](crate::resources::read_bounded)) — or the embedded copy where the
 /// path does not exist.
-pub fn read(
-    path: &Path,
-    max: u64,
-) -> Result<Cow<'static, [u8]>, crate::render::resources::ResourceError> {
+pub fn read(path: &Path, max: u64) -> Result<Cow<'static, [u8]>, crate::resources::ResourceError> {
     match stand_in(path) {
         Some((_, bytes)) => Ok(Cow::Borrowed(bytes)),
-        None => crate::render::resources::read_bounded(path, max).map(Cow::Owned),
+        None => crate::resources::read_bounded(path, max).map(Cow::Owned),
     }
 }
 

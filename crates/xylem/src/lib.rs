@@ -20,6 +20,7 @@ pub mod output;
 pub mod picture;
 pub mod progress;
 pub mod render;
+pub mod resources;
 pub mod scene;
 pub mod simd;
 pub mod sweep;

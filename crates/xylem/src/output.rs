@@ -411,7 +411,7 @@ pub fn commit_set(
 
 /// The `files` list of the set record at `path`.
 fn record_files(path: &Path) -> Result<Vec<serde_json::Value>, String> {
-    let text = crate::render::resources::read_text_bounded(path, MAX_RECORD_BYTES, "JSON")
+    let text = crate::resources::read_text_bounded(path, MAX_RECORD_BYTES, "JSON")
         .map_err(|e| format!("{e} (an incomplete set: its record is written last)"))?;
     let v: serde_json::Value =
         serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
@@ -432,8 +432,7 @@ fn member_status(dir: &Path, entry: &serde_json::Value) -> Result<(String, bool)
         ));
     }
     let member = dir.join(name);
-    let file =
-        crate::render::resources::open_regular(&member, u64::MAX).map_err(|e| e.to_string())?;
+    let file = crate::resources::open_regular(&member, u64::MAX).map_err(|e| e.to_string())?;
     let (len, crc) = checksum(file).map_err(|e| format!("{}: {e}", member.display()))?;
     let crc = format!("{crc:08x}");
     let want = (

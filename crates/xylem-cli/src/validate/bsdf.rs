@@ -69,7 +69,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
     let result: BsdfValidation = if let Some(path) = &args.from_json {
         // A results file: text well under 16 MiB (bounds `/dev/zero` and the like).
-        let text = xylem::render::resources::read_text_bounded(path, 16 << 20, "JSON text")?;
+        let text = xylem::resources::read_text_bounded(path, 16 << 20, "JSON text")?;
         serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))?
     } else {
         let n = suite.cases.len() as u64;

@@ -10,7 +10,8 @@
 //! corner; tangent-space x points to the image's right (+u, along the board's length), y to the
 //! image's top, z out of the face. Data maps (anisotropy, normal) are stored linearly, not sRGB.
 
-pub use crate::material::{across_fiber, BakedMaps, FaceRect};
+pub use crate::material::{across_fiber, anisotropy_texel, bake_face, BakedMaps, FaceRect};
+pub(crate) use crate::material::{texel_values, TexelFrame};
 use crate::output::Staged;
 use crate::picture::exr::{stage_exr_layers, ExrCompression, ExrLayer};
 use crate::picture::png::{stage_png_rgb8, stage_png_tagged, PngTag};
@@ -23,9 +24,8 @@ pub mod preview;
 pub mod raster;
 pub mod usd;
 pub mod uv_mesh;
-use crate::wood::{Needs, WoodTexel, WoodVolume};
+use crate::wood::WoodVolume;
 use glam::{Affine3A, Mat3, Vec2, Vec3};
-use rayon::prelude::*;
 
 /// Which face of the log the board shows (Liu et al. 2016 §7.2; the classical sawing terms).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -181,120 +181,10 @@ const ATLAS_GUTTER: f32 = 0.02;
 /// the 4th mip level 8 texels of the base level: 4 covers bilinear lookup to the 2nd level).
 pub const PAD_TEXELS: u32 = 4;
 
-/// The anisotropy texel of a fibre direction `f` on a face with tangent-space axes `right`, `up`.
-/// KHR_materials_anisotropy's direction is the one in which the highlight *stretches* (its
-/// roughness α_t = mix(α, 1, s²) acts along it; the extension's "BRDF" section), and a fibre's
-/// highlight stretches *across* the fibre (Marschner et al. 2005 §4.2: a cylinder scatters into a
-/// cone about its axis, narrow along the axis, wide around it). So the direction is f projected
-/// into the face, normalised and turned 90° ([`across_fiber`]); the strength is the length of
-/// that projection — 1 for fibres lying in the face, 0 for fibres straight out of it (end grain),
-/// where the highlight is no longer stretched along the face. Encoded as the extension stores
-/// it: red, green = 0.5 + 0.5·direction, blue = strength.
-pub fn anisotropy_texel(f: Vec3, right: Vec3, up: Vec3) -> Vec3 {
-    let proj = Vec2::new(f.dot(right), f.dot(up));
-    let strength = proj.length().min(1.0);
-    let fiber = if strength > 1e-6 {
-        proj / proj.length()
-    } else {
-        Vec2::X
-    };
-    let dir = across_fiber(fiber);
-    Vec3::new(0.5 + 0.5 * dir.x, 0.5 + 0.5 * dir.y, strength)
-}
-
-/// The tangent-space normal of a height field h with tree-space gradient `g` seen on a face with
-/// axes `right`, `up`: n ∝ (−∂h/∂x, −∂h/∂y, 1) (the surface z = h(x, y)).
-pub(crate) fn bump_normal(g: Vec3, right: Vec3, up: Vec3) -> Vec3 {
-    let n = Vec3::new(-g.dot(right), -g.dot(up), 1.0);
-    let n = n.normalize_or_zero();
-    if n == Vec3::ZERO {
-        Vec3::Z
-    } else {
-        n
-    }
-}
-
 /// Bakes `volume` over the board's face at `res` texels along its length, one sample at each
 /// texel centre.
 pub fn bake(volume: &WoodVolume, board: &BoardCut, res: u32) -> BakedMaps {
     bake_face(volume, &board.rect(), Affine3A::IDENTITY, res)
-}
-
-/// Bakes `volume` over `face`, a rectangle in a space that `to_tree` maps into the tree (an
-/// object's space and its placement, or tree space itself), one sample at each texel centre.
-/// Fibre directions go back contravariantly (L⁻¹ f, L the linear part of `to_tree`) and the bump
-/// gradient covariantly (Lᵀ g), as the renderer's materials transport them (Liu et al. 2016 §6.2).
-pub fn bake_face(volume: &WoodVolume, face: &FaceRect, to_tree: Affine3A, res: u32) -> BakedMaps {
-    let (w, h) = face.texture_size(res);
-    let (right, up) = (face.right, -face.down);
-    let frame = TexelFrame {
-        right,
-        up,
-        normal: right.cross(up),
-    };
-    let texels: Vec<_> = (0..h)
-        .into_par_iter()
-        .flat_map_iter(|y| {
-            (0..w).map(move |x| {
-                let uv = Vec2::new((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
-                let p = to_tree.transform_point3(face.point(uv));
-                Some((volume.eval(p, Needs::ALL), frame))
-            })
-        })
-        .collect();
-    texel_values(w, h, &texels, Mat3::from(to_tree.matrix3))
-}
-
-/// A texel's tangent space in object space: x to the image's right (+u), y to its up (−v), z out
-/// of the surface (unit, right-handed up to the mesh's handedness).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct TexelFrame {
-    pub right: Vec3,
-    pub up: Vec3,
-    pub normal: Vec3,
-}
-
-/// The maps of `w` × `h` texels from the wood at each texel (`None`: not on the surface, zeros
-/// for the caller to fill) seen in its frame. `l` is the linear part of the object → tree map:
-/// fibre directions go back contravariantly (L⁻¹ f) and the bump gradient covariantly (Lᵀ g), as
-/// the renderer's materials transport them (Liu et al. 2016 §6.2).
-pub(crate) fn texel_values(
-    w: u32,
-    h: u32,
-    texels: &[Option<(WoodTexel, TexelFrame)>],
-    l: Mat3,
-) -> BakedMaps {
-    let l_inv = l.inverse();
-    let each = |f: &dyn Fn(&WoodTexel, &TexelFrame) -> Vec3| -> Vec<Vec3> {
-        texels
-            .iter()
-            .map(|t| t.as_ref().map_or(Vec3::ZERO, |(t, fr)| f(t, fr)))
-            .collect()
-    };
-    let scalar = |f: &dyn Fn(&WoodTexel) -> f32| -> Vec<f32> {
-        texels
-            .iter()
-            .map(|t| t.as_ref().map_or(0.0, |(t, _)| f(t)))
-            .collect()
-    };
-    // Directions go back contravariantly: object-space unit vectors, then their components in
-    // the texel's frame.
-    let obj_dir = |d: Vec3| (l_inv * d).normalize_or_zero();
-    let tangent =
-        |d: Vec3, fr: &TexelFrame| Vec3::new(d.dot(fr.right), d.dot(fr.up), d.dot(fr.normal));
-    let obj_fiber = |t: &WoodTexel| obj_dir(t.fiber_dir);
-    BakedMaps {
-        width: w,
-        height: h,
-        base_color: each(&|t, _| t.diffuse),
-        fiber_color: each(&|t, _| t.fiber_color),
-        fiber: each(&|t, fr| tangent(obj_fiber(t), fr)),
-        ray: each(&|t, fr| tangent(obj_dir(t.ray_dir), fr)),
-        anisotropy: each(&|t, fr| anisotropy_texel(obj_fiber(t), fr.right, fr.up)),
-        highlight_width: scalar(&|t| t.highlight_width),
-        ray_mask: scalar(&|t| t.ray_mask),
-        normal: each(&|t, fr| bump_normal(l.transpose() * t.bump_grad, fr.right, fr.up)),
-    }
 }
 
 /// Data (not colour) texels as 8-bit codes: `v` in [0, 1] → round(255 v), no transfer curve.
@@ -467,18 +357,6 @@ mod tests {
         let d = Vec2::new(2.0 * a.x - 1.0, 2.0 * a.y - 1.0);
         assert!(d.dot(Vec2::new(0.6, 0.8)).abs() < 1e-6 && (d.length() - 1.0).abs() < 1e-6);
         assert!((crate::material::fiber_from_anisotropy(a) - f).length() < 1e-5);
-    }
-
-    #[test]
-    fn bump_normal_tilts_against_the_slope() {
-        // h = 0.5 x: the surface rises to the right, so its normal leans left (−x).
-        let n = bump_normal(Vec3::new(0.5, 0.0, 0.0), Vec3::X, Vec3::Y);
-        assert!((n - Vec3::new(-0.5, 0.0, 1.0).normalize()).length() < 1e-6);
-        assert_eq!(bump_normal(Vec3::ZERO, Vec3::X, Vec3::Y), Vec3::Z);
-        assert_eq!(
-            bump_normal(Vec3::splat(f32::NAN), Vec3::X, Vec3::Y),
-            Vec3::Z
-        );
     }
 
     #[test]

@@ -487,7 +487,7 @@ impl Capture {
 fn read_png(
     path: &Path,
     srgb: bool,
-    size_ok: crate::render::resources::SizeCheck,
+    size_ok: crate::resources::SizeCheck,
 ) -> Result<Image, String> {
     use crate::picture::png::{decode_png, open_png, rgb_samples, sample_max};
     let px_bytes = std::mem::size_of::<Vec3>() as u64;

@@ -8,7 +8,7 @@
 //! 20 % or more); `fit.json` reports the run.
 
 use super::model::TexelFit;
-use crate::material::MeasuredBoard;
+use crate::material::{MeasuredBoard, FIT_PNG_MARK, FIT_RECORD};
 use crate::output::{FolderLock, LockError, LockMode, Staged};
 use crate::picture::exr::{stage_exr_layers, ExrCompression, ExrLayer};
 use crate::picture::png::{stage_png_rgb8, stage_png_rgb8_text};
@@ -144,11 +144,6 @@ fn rgb8(v: &[Vec3], f: impl Fn(Vec3) -> Vec3) -> Vec<u8> {
     v.iter().flat_map(|c| f(*c).to_array()).map(byte).collect()
 }
 
-/// The `tEXt` chunk (`Software`) that marks a PNG map written by `xylem fit`: a reader of such
-/// a map requires the fit's record `fit.json` beside it (`material::measured`), so the maps of
-/// a fit killed while committing are never read as a complete set.
-pub(crate) const FIT_PNG_MARK: (&str, &str) = ("Software", "xylem fit");
-
 /// Stages the PNG maps of `board` in the `measured` encoding into `dir` (β map if it has one).
 pub fn stage_board_pngs(dir: &Path, board: &MeasuredBoard) -> Result<Vec<Staged>, MapsError> {
     stage_board_pngs_text(dir, board, &[])
@@ -180,9 +175,6 @@ fn stage_board_pngs_text(
     }
     Ok(staged)
 }
-
-/// The record of a fit's outputs: the report, with the maps' sizes and CRC-32s, written last.
-pub(crate) const FIT_RECORD: &str = "fit.json";
 
 /// Writes the maps, the residual map, `maps.exr` and `report` (as `fit.json`) into `dir`,
 /// holding the folder's lock; every file is staged first, and all are committed as one set

@@ -69,9 +69,9 @@ pub enum FitError {
         /// Frames in the capture.
         frames: usize,
         /// The estimate.
-        need: crate::render::resources::Bytes,
+        need: crate::resources::Bytes,
         /// What is available.
-        have: crate::render::resources::Bytes,
+        have: crate::resources::Bytes,
     },
     /// The worker thread pool could not be started.
     #[error("cannot start {threads} worker threads: {cause}")]
@@ -402,8 +402,8 @@ pub fn fit(capture: &Capture, opts: &FitOptions) -> Result<(FittedMaps, FitStats
     };
     let pixels = capture.camera.width as u64 * capture.camera.height as u64;
     let need = fit_memory(w * h, frames, pixels, threads);
-    if let Some(have) = crate::render::resources::available_memory().filter(|&a| need > a) {
-        use crate::render::resources::Bytes;
+    if let Some(have) = crate::resources::available_memory().filter(|&a| need > a) {
+        use crate::resources::Bytes;
         return Err(FitError::Memory {
             w,
             h,

@@ -10,11 +10,17 @@
 //! across the fibre, as on a quartersawn face), and the fibre colour, rebuilt from the base colour
 //! as c^s with the preset's fibre saturation s (exact for the Beer's-law colours of
 //! `wood::BeerColor`, whose fibre colour is exp(−s a) = c^s).
+//!
+//! The maps are baked here too ([`bake_face`], and `bake::raster` over a mesh's UV layout through
+//! [`texel_values`]), below `scene`, whose `[quality]` presets may swap a wood material for its
+//! baked maps; `bake` writes them out as files for other tools.
 
 use super::face::{bilinear_taps, face_shading, FaceRect, FaceTexel};
 use super::{MaterialHit, Shading, ShadingSwitches};
 use crate::math::safe_sqrt;
-use glam::{Vec2, Vec3};
+use crate::wood::{Needs, WoodTexel, WoodVolume};
+use glam::{Affine3A, Mat3, Vec2, Vec3};
+use rayon::prelude::*;
 use std::sync::Arc;
 
 /// Baked maps, row-major, top row first; texel (0, 0) is the top-left corner (glTF).
@@ -113,7 +119,7 @@ fn unit_or(v: Vec3, fallback: Vec3) -> Vec3 {
 
 /// The in-face direction a fibre with in-face direction `d` stretches its highlight along: `d`
 /// turned 90° counter-clockwise, (−d_y, d_x). KHR_materials_anisotropy stores this direction
-/// ([`crate::bake::anisotropy_texel`] says why); the sign is immaterial to the extension.
+/// ([`anisotropy_texel`] says why); the sign is immaterial to the extension.
 pub fn across_fiber(d: Vec2) -> Vec2 {
     Vec2::new(-d.y, d.x)
 }
@@ -200,9 +206,131 @@ impl BakedWoodMaterial {
     }
 }
 
+/// The anisotropy texel of a fibre direction `f` on a face with tangent-space axes `right`, `up`.
+/// KHR_materials_anisotropy's direction is the one in which the highlight *stretches* (its
+/// roughness α_t = mix(α, 1, s²) acts along it; the extension's "BRDF" section), and a fibre's
+/// highlight stretches *across* the fibre (Marschner et al. 2005 §4.2: a cylinder scatters into a
+/// cone about its axis, narrow along the axis, wide around it). So the direction is f projected
+/// into the face, normalised and turned 90° ([`across_fiber`]); the strength is the length of
+/// that projection — 1 for fibres lying in the face, 0 for fibres straight out of it (end grain),
+/// where the highlight is no longer stretched along the face. Encoded as the extension stores
+/// it: red, green = 0.5 + 0.5·direction, blue = strength.
+pub fn anisotropy_texel(f: Vec3, right: Vec3, up: Vec3) -> Vec3 {
+    let proj = Vec2::new(f.dot(right), f.dot(up));
+    let strength = proj.length().min(1.0);
+    let fiber = if strength > 1e-6 {
+        proj / proj.length()
+    } else {
+        Vec2::X
+    };
+    let dir = across_fiber(fiber);
+    Vec3::new(0.5 + 0.5 * dir.x, 0.5 + 0.5 * dir.y, strength)
+}
+
+/// The tangent-space normal of a height field h with tree-space gradient `g` seen on a face with
+/// axes `right`, `up`: n ∝ (−∂h/∂x, −∂h/∂y, 1) (the surface z = h(x, y)).
+pub(crate) fn bump_normal(g: Vec3, right: Vec3, up: Vec3) -> Vec3 {
+    let n = Vec3::new(-g.dot(right), -g.dot(up), 1.0);
+    let n = n.normalize_or_zero();
+    if n == Vec3::ZERO {
+        Vec3::Z
+    } else {
+        n
+    }
+}
+
+/// Bakes `volume` over `face`, a rectangle in a space that `to_tree` maps into the tree (an
+/// object's space and its placement, or tree space itself), one sample at each texel centre.
+/// Fibre directions go back contravariantly (L⁻¹ f, L the linear part of `to_tree`) and the bump
+/// gradient covariantly (Lᵀ g), as the renderer's materials transport them (Liu et al. 2016 §6.2).
+pub fn bake_face(volume: &WoodVolume, face: &FaceRect, to_tree: Affine3A, res: u32) -> BakedMaps {
+    let (w, h) = face.texture_size(res);
+    let (right, up) = (face.right, -face.down);
+    let frame = TexelFrame {
+        right,
+        up,
+        normal: right.cross(up),
+    };
+    let texels: Vec<_> = (0..h)
+        .into_par_iter()
+        .flat_map_iter(|y| {
+            (0..w).map(move |x| {
+                let uv = Vec2::new((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
+                let p = to_tree.transform_point3(face.point(uv));
+                Some((volume.eval(p, Needs::ALL), frame))
+            })
+        })
+        .collect();
+    texel_values(w, h, &texels, Mat3::from(to_tree.matrix3))
+}
+
+/// A texel's tangent space in object space: x to the image's right (+u), y to its up (−v), z out
+/// of the surface (unit, right-handed up to the mesh's handedness).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct TexelFrame {
+    pub right: Vec3,
+    pub up: Vec3,
+    pub normal: Vec3,
+}
+
+/// The maps of `w` × `h` texels from the wood at each texel (`None`: not on the surface, zeros
+/// for the caller to fill) seen in its frame. `l` is the linear part of the object → tree map:
+/// fibre directions go back contravariantly (L⁻¹ f) and the bump gradient covariantly (Lᵀ g), as
+/// the renderer's materials transport them (Liu et al. 2016 §6.2).
+pub(crate) fn texel_values(
+    w: u32,
+    h: u32,
+    texels: &[Option<(WoodTexel, TexelFrame)>],
+    l: Mat3,
+) -> BakedMaps {
+    let l_inv = l.inverse();
+    let each = |f: &dyn Fn(&WoodTexel, &TexelFrame) -> Vec3| -> Vec<Vec3> {
+        texels
+            .iter()
+            .map(|t| t.as_ref().map_or(Vec3::ZERO, |(t, fr)| f(t, fr)))
+            .collect()
+    };
+    let scalar = |f: &dyn Fn(&WoodTexel) -> f32| -> Vec<f32> {
+        texels
+            .iter()
+            .map(|t| t.as_ref().map_or(0.0, |(t, _)| f(t)))
+            .collect()
+    };
+    // Directions go back contravariantly: object-space unit vectors, then their components in
+    // the texel's frame.
+    let obj_dir = |d: Vec3| (l_inv * d).normalize_or_zero();
+    let tangent =
+        |d: Vec3, fr: &TexelFrame| Vec3::new(d.dot(fr.right), d.dot(fr.up), d.dot(fr.normal));
+    let obj_fiber = |t: &WoodTexel| obj_dir(t.fiber_dir);
+    BakedMaps {
+        width: w,
+        height: h,
+        base_color: each(&|t, _| t.diffuse),
+        fiber_color: each(&|t, _| t.fiber_color),
+        fiber: each(&|t, fr| tangent(obj_fiber(t), fr)),
+        ray: each(&|t, fr| tangent(obj_dir(t.ray_dir), fr)),
+        anisotropy: each(&|t, fr| anisotropy_texel(obj_fiber(t), fr.right, fr.up)),
+        highlight_width: scalar(&|t| t.highlight_width),
+        ray_mask: scalar(&|t| t.ray_mask),
+        normal: each(&|t, fr| bump_normal(l.transpose() * t.bump_grad, fr.right, fr.up)),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn bump_normal_tilts_against_the_slope() {
+        // h = 0.5 x: the surface rises to the right, so its normal leans left (−x).
+        let n = bump_normal(Vec3::new(0.5, 0.0, 0.0), Vec3::X, Vec3::Y);
+        assert!((n - Vec3::new(-0.5, 0.0, 1.0).normalize()).length() < 1e-6);
+        assert_eq!(bump_normal(Vec3::ZERO, Vec3::X, Vec3::Y), Vec3::Z);
+        assert_eq!(
+            bump_normal(Vec3::splat(f32::NAN), Vec3::X, Vec3::Y),
+            Vec3::Z
+        );
+    }
 
     fn maps_2x1() -> BakedMaps {
         BakedMaps {

@@ -203,11 +203,18 @@ fn read_png8(
     Ok(decoded_rgb8(&info, buf))
 }
 
+/// The `tEXt` chunk (`Software`) that marks a PNG map written by `xylem fit`: a reader of such
+/// a map requires the fit's record [`FIT_RECORD`] beside it, so the maps of a fit killed while
+/// committing are never read as a complete set. Here, with the encoding `fit` writes in.
+pub(crate) const FIT_PNG_MARK: (&str, &str) = ("Software", "xylem fit");
+
+/// The record of a fit's outputs: the report, with the maps' sizes and CRC-32s, written last.
+pub(crate) const FIT_RECORD: &str = "fit.json";
+
 /// A map beside a fit's record (`fit.json`) must be the file it lists, and a map `xylem fit`
 /// wrote (its `Software` text chunk) must have that record beside it: a fit killed while
 /// committing leaves maps without a record, never a set of two runs read as one.
 fn check_fit_record(path: &Path, text: &[(String, String)]) -> Result<(), String> {
-    use crate::fit::maps::{FIT_PNG_MARK, FIT_RECORD};
     let dir = path.parent().unwrap_or(Path::new("."));
     let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
     let by_fit = (text.iter()).any(|(k, v)| k == FIT_PNG_MARK.0 && v == FIT_PNG_MARK.1);

@@ -12,13 +12,16 @@ mod placement;
 mod surface;
 
 pub use baked::{
-    across_fiber, fiber_from_anisotropy, BakedFibers, BakedMaps, BakedTexel, BakedWoodMaterial,
+    across_fiber, anisotropy_texel, bake_face, fiber_from_anisotropy, BakedFibers, BakedMaps,
+    BakedTexel, BakedWoodMaterial,
 };
+pub(crate) use baked::{texel_values, TexelFrame};
 pub use face::FaceRect;
 pub use measured::{
     energy_bounded_fiber_color, BoardFace, ColorSpace, MeasuredBoard, MeasuredError, MeasuredFiles,
     MeasuredMaterial, DEFAULT_FIBER_COLOR_SCALE, DEFAULT_HIGHLIGHT_WIDTH_DEG,
 };
+pub(crate) use measured::{FIT_PNG_MARK, FIT_RECORD};
 pub use placement::{CutAt, Cutting, Placement, SawnCut};
 pub(crate) use surface::SurfaceAtWo;
 pub use surface::SurfaceBsdf;

@@ -7,7 +7,7 @@
 use super::file::{commit, stage, ImageError};
 use super::Image;
 use crate::output::Staged;
-use crate::render::resources::{any_size, SizeCheck};
+use crate::resources::{any_size, SizeCheck};
 use glam::Vec3;
 use std::path::Path;
 
@@ -265,8 +265,8 @@ fn exr_read_failed(path: &Path, message: impl ToString) -> ImageError {
 
 /// Opens an EXR and reads its headers, refusing before any pixel (or offset table) is read a
 /// file that is not a regular file of at most
-/// [`MAX_IMAGE_BYTES`](crate::render::resources::MAX_IMAGE_BYTES) or a layer whose declared size fails
-/// [`check_image`](crate::render::resources::check_image) with 8 bytes per channel (the decoded
+/// [`MAX_IMAGE_BYTES`](crate::resources::MAX_IMAGE_BYTES) or a layer whose declared size fails
+/// [`check_image`](crate::resources::check_image) with 8 bytes per channel (the decoded
 /// samples and a float copy of them) plus `extra_bytes_per_pixel` (what the caller builds).
 /// Every layer's declared size must also pass `size_ok` (the size the caller expects).
 fn open_exr(
@@ -274,7 +274,7 @@ fn open_exr(
     extra_bytes_per_pixel: u64,
     size_ok: SizeCheck,
 ) -> Result<exr::block::reader::Reader<std::io::BufReader<std::fs::File>>, ImageError> {
-    use crate::render::resources::{check_image, open_regular, MAX_IMAGE_BYTES};
+    use crate::resources::{check_image, open_regular, MAX_IMAGE_BYTES};
     use std::io::{BufReader, Seek};
     let fail = |message: String| exr_read_failed(path, message);
     let mut file = open_regular(path, MAX_IMAGE_BYTES).map_err(|e| fail(e.reason()))?;

@@ -7,7 +7,7 @@ use super::file::{commit, ImageError};
 use super::png::{read_png_linear, stage_png_linear};
 use super::srgb::{srgb8_to_linear, Srgb8};
 use crate::output::Staged;
-use crate::render::resources::{any_size, SizeCheck};
+use crate::resources::{any_size, SizeCheck};
 use glam::Vec3;
 use std::path::Path;
 

@@ -6,7 +6,7 @@ use super::file::{commit, stage, ImageError};
 use super::image::{Image, Rgb8};
 use super::srgb::{srgb_to_linear, to_srgb8};
 use crate::output::Staged;
-use crate::render::resources::{any_size, SizeCheck};
+use crate::resources::{any_size, SizeCheck};
 use glam::Vec3;
 use std::path::Path;
 
@@ -315,7 +315,7 @@ const PNG_DECODER_BYTES: usize = 64 << 20;
 /// A PNG decoded into one buffer after its header's size was checked: the declared size must
 /// pass `size_ok` (the size the caller expects, e.g. the camera's for a fit's frame), and the
 /// decoded buffer plus `extra_bytes_per_pixel` (what the caller builds from it) must pass
-/// [`check_image`](crate::render::resources::check_image), before anything is allocated.
+/// [`check_image`](crate::resources::check_image), before anything is allocated.
 /// Errors name no file: callers do.
 pub(crate) fn decode_png(
     path: &Path,
@@ -357,13 +357,8 @@ pub(crate) fn decode_png_text(
     };
     let decoded = color.samples() as u64 * sample_bytes;
     size_ok(w, h)?;
-    crate::render::resources::check_image(
-        path,
-        w as u64,
-        h as u64,
-        decoded + extra_bytes_per_pixel,
-    )
-    .map_err(|e| e.reason())?;
+    crate::resources::check_image(path, w as u64, h as u64, decoded + extra_bytes_per_pixel)
+        .map_err(|e| e.reason())?;
     let mut buf = vec![0; reader.output_buffer_size()];
     let info = reader.next_frame(&mut buf).map_err(|e| e.to_string())?;
     buf.truncate(info.buffer_size());
@@ -371,9 +366,9 @@ pub(crate) fn decode_png_text(
 }
 
 /// Opens `path` for [`decode_png`] (a regular file of at most
-/// [`MAX_IMAGE_BYTES`](crate::render::resources::MAX_IMAGE_BYTES)).
+/// [`MAX_IMAGE_BYTES`](crate::resources::MAX_IMAGE_BYTES)).
 pub(crate) fn open_png(path: &Path) -> Result<std::io::Take<std::fs::File>, String> {
-    use crate::render::resources::{open_regular, MAX_IMAGE_BYTES};
+    use crate::resources::{open_regular, MAX_IMAGE_BYTES};
     use std::io::Read;
     let file = open_regular(path, MAX_IMAGE_BYTES).map_err(|e| e.reason())?;
     Ok(file.take(MAX_IMAGE_BYTES))

@@ -34,7 +34,7 @@ fn bad(path: &Path, message: impl Into<String>) -> MeshError {
 }
 
 /// Loads an OBJ or PLY file by extension (a regular file of at most
-/// [`MAX_MESH_BYTES`](crate::render::resources::MAX_MESH_BYTES); a FIFO or `/dev/zero` is
+/// [`MAX_MESH_BYTES`](crate::resources::MAX_MESH_BYTES); a FIFO or `/dev/zero` is
 /// refused), or the embedded copy of a built-in scene's mesh where the disk has none
 /// (`crate::builtin`).
 pub fn load_mesh(path: &Path) -> Result<TriMesh, MeshError> {
@@ -88,7 +88,7 @@ pub(crate) const PLY_PARSE_BYTES_PER_BYTE: u64 = 4;
 /// (a 4 GiB OBJ needs about 64 GiB); the BVH's own estimate comes after
 /// ([`crate::render::resources::Resources::geometry`]).
 fn check_parse_memory(path: &Path, bytes: u64, obj: bool) -> Result<(), MeshError> {
-    use crate::render::resources::{available_memory, Bytes};
+    use crate::resources::{available_memory, Bytes};
     let per = if obj {
         OBJ_PARSE_BYTES_PER_BYTE
     } else {
@@ -148,10 +148,10 @@ fn check_finite(path: &Path, mesh: &TriMesh) -> Result<(), MeshError> {
 }
 
 /// Opens a mesh file: a regular file of at most
-/// [`MAX_MESH_BYTES`](crate::render::resources::MAX_MESH_BYTES), read no further than that,
+/// [`MAX_MESH_BYTES`](crate::resources::MAX_MESH_BYTES), read no further than that,
 /// whose parse fits the memory available ([`check_parse_memory`]).
 fn open_mesh(path: &Path, obj: bool) -> Result<std::io::Take<std::fs::File>, MeshError> {
-    use crate::render::resources::{open_regular, MAX_MESH_BYTES};
+    use crate::resources::{open_regular, MAX_MESH_BYTES};
     let file = open_regular(path, MAX_MESH_BYTES).map_err(|e| bad(path, e.reason()))?;
     let bytes = file.metadata().map_or(0, |m| m.len());
     check_parse_memory(path, bytes, obj)?;

@@ -55,9 +55,9 @@ pub enum SceneError {
         message: String,
     },
     /// The scene file itself is missing, not a regular file or larger than
-    /// [`MAX_SCENE_BYTES`](crate::render::resources::MAX_SCENE_BYTES).
+    /// [`MAX_SCENE_BYTES`](crate::resources::MAX_SCENE_BYTES).
     #[error("cannot read scene {0}")]
-    Input(crate::render::resources::ResourceError),
+    Input(crate::resources::ResourceError),
     /// The geometry's BVH build would need more memory than the machine has (estimated before
     /// it starts; `--ignore-limits` skips the check).
     #[error("scene {path}: {source}")]
@@ -65,7 +65,7 @@ pub enum SceneError {
         /// The scene file.
         path: String,
         /// The estimate and what is available.
-        source: crate::render::resources::ResourceError,
+        source: crate::resources::ResourceError,
     },
     /// A field's value is out of range or inconsistent with the rest of the scene.
     #[error("scene {path}: field `{field}`: {message}")]
@@ -139,9 +139,9 @@ pub fn load_with(path: &Path, ignore_limits: bool) -> Result<LoadedScene, SceneE
 /// file's own folder, or `scenes/` for a built-in scene named by a path that does not exist
 /// here (an installed binary run from another folder; `crate::builtin`), whose meshes and maps
 /// then come from the embedded copies too. Bounded by
-/// [`MAX_SCENE_BYTES`](crate::render::resources::MAX_SCENE_BYTES).
+/// [`MAX_SCENE_BYTES`](crate::resources::MAX_SCENE_BYTES).
 pub fn source(path: &Path) -> Result<(std::borrow::Cow<'static, [u8]>, PathBuf), SceneError> {
-    use crate::render::resources::MAX_SCENE_BYTES;
+    use crate::resources::MAX_SCENE_BYTES;
     let bytes = crate::builtin::read(path, MAX_SCENE_BYTES).map_err(SceneError::Input)?;
     let base = match crate::builtin::stand_in(path) {
         Some((repo_path, _)) => Path::new(repo_path).parent().unwrap().to_path_buf(),
@@ -164,19 +164,19 @@ pub fn source_text(path: &Path) -> Result<(String, PathBuf), SceneError> {
 #[derive(Debug, thiserror::Error)]
 pub enum PresetFileError {
     /// Missing, not a regular file (a FIFO, a device) or larger than
-    /// [`MAX_SCENE_BYTES`](crate::render::resources::MAX_SCENE_BYTES).
+    /// [`MAX_SCENE_BYTES`](crate::resources::MAX_SCENE_BYTES).
     #[error("preset file {0}")]
-    Read(crate::render::resources::ResourceError),
+    Read(crate::resources::ResourceError),
     /// Not a valid preset (the error names the file, the field and the range).
     #[error(transparent)]
     Wood(#[from] crate::wood::WoodError),
 }
 
 /// Reads a species preset file (`preset_file` of a wood material, `--preset-file`): regular
-/// TOML text of at most [`MAX_SCENE_BYTES`](crate::render::resources::MAX_SCENE_BYTES), so a
+/// TOML text of at most [`MAX_SCENE_BYTES`](crate::resources::MAX_SCENE_BYTES), so a
 /// FIFO or a device is refused instead of blocking or reading forever.
 pub fn read_preset_file(path: &Path) -> Result<crate::wood::WoodParams, PresetFileError> {
-    use crate::render::resources::{read_text_bounded, MAX_SCENE_BYTES};
+    use crate::resources::{read_text_bounded, MAX_SCENE_BYTES};
     let text =
         read_text_bounded(path, MAX_SCENE_BYTES, "TOML text").map_err(PresetFileError::Read)?;
     Ok(crate::wood::WoodParams::from_toml_str(

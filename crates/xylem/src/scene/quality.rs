@@ -2,10 +2,9 @@
 //! `--quality` presets chosen from their measurements (validation/TRADEOFF.md, made by
 //! `xylem tradeoff`), and applying them to a loaded scene.
 
-use crate::bake::bake_face;
 use crate::bsdf::FinishModel;
 use crate::field::JacobianModel;
-use crate::material::{BakedFibers, BakedWoodMaterial, FaceRect, Material};
+use crate::material::{bake_face, BakedFibers, BakedWoodMaterial, FaceRect, Material};
 use crate::scene::LoadedScene;
 use crate::wood::{NoiseParams, WoodParams, WoodVolume};
 use serde::{Deserialize, Serialize};

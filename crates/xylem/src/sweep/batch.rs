@@ -6,8 +6,9 @@
 //! batch; figures in notes/cluster.md). A frame has the same bits in any batch, kept or not
 //! (crates/xylem/tests/sweep_cache.rs: a frame of a one-pass sweep equals that frame rendered alone).
 
-use crate::render::resources::{available_memory, Bytes, Resources};
+use crate::render::resources::Resources;
 use crate::render::Primaries;
+use crate::resources::{available_memory, Bytes};
 use std::ops::Range;
 
 /// The budget when `--memory` is not given and the machine's memory is unknown.

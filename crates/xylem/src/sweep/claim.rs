@@ -13,7 +13,7 @@
 use super::job::SweepError;
 use super::sequence::{SweepSettings, MAX_RECORD_BYTES};
 use crate::output::{stage_bytes, write_atomic};
-use crate::render::resources::read_text_bounded;
+use crate::resources::read_text_bounded;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 

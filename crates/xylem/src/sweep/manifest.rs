@@ -20,8 +20,8 @@ pub const MAX_MANIFEST_BYTES: u64 = 64 << 20;
 
 /// Reads a manifest's text: a regular file of at most [`MAX_MANIFEST_BYTES`] (a FIFO or a
 /// device is refused at once instead of blocking or reading forever).
-pub fn read_text(path: &Path) -> Result<String, crate::render::resources::ResourceError> {
-    crate::render::resources::read_text_bounded(path, MAX_MANIFEST_BYTES, "JSON text")
+pub fn read_text(path: &Path) -> Result<String, crate::resources::ResourceError> {
+    crate::resources::read_text_bounded(path, MAX_MANIFEST_BYTES, "JSON text")
 }
 
 /// The format tag the manifest carries.

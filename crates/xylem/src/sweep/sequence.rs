@@ -14,7 +14,7 @@ use crate::picture::png::{
 };
 use crate::picture::ImageError;
 use crate::picture::Rgb8;
-use crate::render::resources::read_text_bounded;
+use crate::resources::read_text_bounded;
 use serde::{Deserialize, Serialize};
 use std::ops::Range;
 use std::path::{Path, PathBuf};

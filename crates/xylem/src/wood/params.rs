@@ -632,9 +632,9 @@ impl WoodParams {
     }
 
     /// Read and validate a parameter file (a regular file of at most
-    /// [`MAX_SCENE_BYTES`](crate::render::resources::MAX_SCENE_BYTES), as scene files).
+    /// [`MAX_SCENE_BYTES`](crate::resources::MAX_SCENE_BYTES), as scene files).
     pub fn from_toml_file(path: impl AsRef<Path>) -> Result<WoodParams, WoodError> {
-        use crate::render::resources::{read_text_bounded, MAX_SCENE_BYTES};
+        use crate::resources::{read_text_bounded, MAX_SCENE_BYTES};
         let path = path.as_ref();
         let text =
             read_text_bounded(path, MAX_SCENE_BYTES, "TOML text").map_err(|e| WoodError::Io {
