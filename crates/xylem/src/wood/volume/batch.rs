@@ -55,18 +55,12 @@ impl WoodVolume {
         self.color_block(p, out)
     }
 
-    simd_level! { Avx512
-        unsafe fn color_block_avx512(
+    simd_wide! {
+        unsafe fn color_block_avx2 / color_block_avx512(
             &self,
             p: &[Vec3; BATCH],
             out: &mut [WoodTexel; BATCH],
         ) -> bool {
-            self.color_block(p, out)
-        }
-    }
-
-    simd_level! { Avx2
-        unsafe fn color_block_avx2(&self, p: &[Vec3; BATCH], out: &mut [WoodTexel; BATCH]) -> bool {
             self.color_block(p, out)
         }
     }

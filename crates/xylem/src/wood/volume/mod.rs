@@ -17,7 +17,7 @@ use crate::field::{
 };
 use crate::math::Frame;
 use crate::noise::SparseConvolution1;
-use crate::simd::{simd_level, Simd};
+use crate::simd::{simd_wide, Simd};
 use glam::Vec3;
 use std::sync::Arc;
 
