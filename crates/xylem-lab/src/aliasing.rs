@@ -12,11 +12,11 @@
 //! jackknife standard error ([`energies`]), and ratios between settings with Fieller's interval
 //! ([`ratio_interval`]). Derivation: notes/render.md, "The aliasing estimator".
 
-use crate::tradeoff::{render_with, Knobs, Rendered};
+use crate::tradeoff::{apply, process_cpu_seconds, Knobs};
 use glam::Vec3;
 use std::path::Path;
 use xylem::math::luminance;
-use xylem::render::RunOptions;
+use xylem::render::{render, RunOptions};
 use xylem::scene::LoadedScene;
 
 /// The pixels of `mask` (row-major, `width` × `height`) whose 3 × 3 neighbourhood lies inside
@@ -291,10 +291,43 @@ fn children_cpu_seconds() -> f64 {
     s(ru.ru_utime) + s(ru.ru_stime)
 }
 
+/// One render's images: the beauty and the first hits' albedo AOV (the wood's colour averaged
+/// over the pixel's samples: the texture alone, without the lighting's noise).
+#[derive(Clone, Debug)]
+pub struct Frame {
+    pub beauty: Vec<Vec3>,
+    pub albedo: Vec<Vec3>,
+    /// The pixels whose first hits are wood (fibre AOV not zero); empty from another binary.
+    pub wood: Vec<bool>,
+    /// CPU seconds: of the render alone in this process, of the whole child process for
+    /// another binary.
+    pub cpu: f64,
+}
+
+/// The RGB layer `layer` (channels `layer.R`, `.G`, `.B`, whether stored as a part of that
+/// name or as prefixed channels) of an EXR that `xylem render` wrote.
+fn read_exr_rgb_layer(path: &Path, layer: &str) -> Result<Vec<Vec3>, String> {
+    let image = exr::prelude::read_all_flat_layers_from_file(path)
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    let channel = |name: &str| -> Result<Vec<f32>, String> {
+        let want = format!("{layer}.{name}");
+        (image.layer_data.iter())
+            .flat_map(|l| {
+                let prefix = (l.attributes.layer_name.as_ref())
+                    .map_or(String::new(), |n| format!("{n}."));
+                l.channel_data.list.iter().map(move |c| (format!("{prefix}{}", c.name), c))
+            })
+            .find(|(full, _)| *full == want)
+            .map(|(_, c)| c.sample_data.values_as_f32().collect())
+            .ok_or_else(|| format!("{}: no channel {want}", path.display()))
+    };
+    let (r, g, b) = (channel("R")?, channel("G")?, channel("B")?);
+    Ok((0..r.len()).map(|i| Vec3::new(r[i], g[i], b[i])).collect())
+}
+
 /// Renders built-in scene `scene` (as `xylem render` takes it) with another `xylem` binary —
 /// the default of another commit, e.g. the one issue 28 was filed against — at `size`, `spp`
-/// and `seed`, the footprint filter on or off, into `dir`; returns its beauty and the child's
-/// CPU seconds (its whole run: loading, BVH, writing the EXR, as well as rendering).
+/// and `seed`, the footprint filter on or off, into `dir`, and reads its beauty and albedo back.
 pub fn render_with_binary(
     binary: &Path,
     scene: &str,
@@ -303,7 +336,7 @@ pub fn render_with_binary(
     seed: u64,
     filter: bool,
     dir: &Path,
-) -> Result<(Vec<Vec3>, f64), String> {
+) -> Result<Frame, String> {
     let cpu0 = children_cpu_seconds();
     let out = std::process::Command::new(binary)
         .arg("render")
@@ -335,23 +368,41 @@ pub fn render_with_binary(
             size
         ));
     }
-    Ok((img.pixels, cpu))
+    let albedo = read_exr_rgb_layer(&path, "albedo")?;
+    if albedo.len() != img.pixels.len() {
+        return Err(format!("{}: albedo of another size", path.display()));
+    }
+    Ok(Frame {
+        beauty: img.pixels,
+        albedo,
+        wood: Vec::new(),
+        cpu,
+    })
 }
 
-/// [`render_with`] at seed `seed`.
+/// Renders the scene `base` loads with `knobs` at seed `seed` in this process.
 fn render_seeded(
     base: &dyn Fn() -> Result<LoadedScene, String>,
     knobs: &Knobs,
     seed: u64,
     run: &RunOptions,
-) -> Result<Rendered, String> {
-    let seeded = || {
-        base().map(|mut l| {
-            l.settings.seed = seed;
-            l
-        })
+) -> Result<Frame, String> {
+    let mut loaded = base()?;
+    loaded.settings.seed = seed;
+    apply(&mut loaded, knobs).map_err(|e| e.to_string())?;
+    let cpu0 = process_cpu_seconds();
+    let out = render(&loaded.scene, &loaded.settings, run).map_err(|e| e.to_string())?;
+    let cpu = match (cpu0, process_cpu_seconds()) {
+        (Some(a), Some(b)) => b - a,
+        _ => out.elapsed.as_secs_f64(),
     };
-    render_with(&seeded, knobs, run)
+    let aov = &out.image.aov;
+    Ok(Frame {
+        wood: aov.iter().map(|a| a.fiber != Vec3::ZERO).collect(),
+        albedo: aov.iter().map(|a| a.albedo).collect(),
+        beauty: out.image.beauty,
+        cpu,
+    })
 }
 
 /// How many renders of each setting and reference parts [`measure`] takes.
@@ -377,6 +428,8 @@ pub const LABELS: [&str; 3] = [
 pub struct SettingRow {
     /// Energies over the reference's wood luminance power (standard errors likewise).
     pub energy: Energy,
+    /// The same of the albedo AOV (the first hits' colour: the texture alone, no lighting).
+    pub texture: Energy,
     /// Net relative MSE against the converged image (RGB), mean over the renders.
     pub mse: f64,
     /// CPU seconds of one render, median over the renders.
@@ -405,6 +458,10 @@ pub struct Row {
     pub vs_point: Ratio,
     /// Total energy, today's default over the issue-time default.
     pub vs_issue: Option<Ratio>,
+    /// The same two ratios of the albedo AOV's energies (texture alone).
+    pub texture_vs_point: Ratio,
+    /// See `texture_vs_point`.
+    pub texture_vs_issue: Option<Ratio>,
 }
 
 impl Row {
@@ -435,6 +492,48 @@ pub fn verdict(r: &Ratio) -> &'static str {
     }
 }
 
+/// The energies of one channel of every setting ([`energies`]) over the reference's wood power
+/// in that channel, and the ratios of today's default's total to each other setting's.
+fn channel(
+    reference: &[Frame],
+    settings: &[Vec<Frame>],
+    pick: fn(&Frame) -> &[Vec3],
+    mask: &[bool],
+    pixels: &[usize],
+    width: usize,
+) -> (Vec<Energy>, Vec<Ratio>, usize) {
+    let lum = |c: &[Vec3]| -> Vec<f64> { c.iter().map(|&v| luminance(v) as f64).collect() };
+    let hp = |f: &Frame| high_pass(&lum(pick(f)), pixels, width);
+    let parts: Vec<Vec<f64>> = reference.iter().map(hp).collect();
+    let renders: Vec<Vec<Vec<f64>>> = settings.iter().map(|s| s.iter().map(hp).collect()).collect();
+    let n = reference.len() as f64;
+    let power: f64 = (0..mask.len())
+        .filter(|&i| mask[i])
+        .map(|i| (reference.iter().map(|f| luminance(pick(f)[i]) as f64).sum::<f64>() / n).powi(2))
+        .sum::<f64>()
+        .max(1e-30);
+    let (energy, cov, dof) = energies(&parts, &renders);
+    let t = t95(dof);
+    let ratios = (1..settings.len())
+        .map(|b| {
+            let (nu, de) = (energy[0].total.value, energy[b].total.value);
+            ratio_interval(nu, de, cov[0][0], cov[b][b], cov[0][b], t)
+        })
+        .collect();
+    let scale = |e: Estimate| Estimate {
+        value: e.value / power,
+        se: e.se / power,
+    };
+    let scaled = (energy.iter())
+        .map(|e| Energy {
+            total: scale(e.total),
+            bias: scale(e.bias),
+            noise: scale(e.noise),
+        })
+        .collect();
+    (scaled, ratios, dof)
+}
+
 /// Measures one scene: `base` loads it at `size` (the size judged); `baseline`, when given,
 /// renders the issue-time default with that binary ([`render_with_binary`]; the scene's name
 /// `name` is what it is given).
@@ -448,52 +547,37 @@ pub fn measure(
     run: &RunOptions,
 ) -> Result<Row, String> {
     let (w, h) = (size.0 as usize, size.1 as usize);
-    let lum = |c: &[Vec3]| -> Vec<f64> { c.iter().map(|&v| luminance(v) as f64).collect() };
     let part = Knobs {
         footprint_filter: false,
         ..Knobs::full((design.reference_spp / design.parts).max(1))
     };
-    let mut parts = Vec::new();
-    let mut mask = Vec::new();
-    for k in 0..design.parts {
-        let r = render_seeded(base, &part, 1000 + u64::from(k), run)?;
-        if k == 0 {
-            mask = r.wood.clone();
-        }
-        parts.push(r.image);
-    }
+    let reference = (0..design.parts)
+        .map(|k| render_seeded(base, &part, 1000 + u64::from(k), run))
+        .collect::<Result<Vec<Frame>, String>>()?;
+    let mask = reference[0].wood.clone();
     let pixels = judged_pixels(&mask, w, h);
     let mean_image: Vec<Vec3> = (0..w * h)
-        .map(|i| parts.iter().map(|p| p[i]).sum::<Vec3>() / parts.len() as f32)
+        .map(|i| reference.iter().map(|p| p.beauty[i]).sum::<Vec3>() / reference.len() as f32)
         .collect();
     // The reference mean's own noise, Σ|r_k − r̄|² / (R (R − 1)), comes off each MSE.
-    let r = parts.len() as f64;
-    let reference_noise = (parts.iter())
+    let r = reference.len() as f64;
+    let reference_noise = (reference.iter())
         .map(|p| {
-            p.iter()
-                .zip(&mean_image)
+            (p.beauty.iter().zip(&mean_image))
                 .map(|(a, b)| (*a - *b).length_squared() as f64)
                 .sum::<f64>()
         })
         .sum::<f64>()
         / (r * (r - 1.0));
-    let power: f64 = (lum(&mean_image).iter().zip(&mask))
-        .filter(|(_, &m)| m)
-        .map(|(x, _)| x * x)
-        .sum::<f64>()
-        .max(1e-30);
-    let hp = |img: &[Vec3]| high_pass(&lum(img), &pixels, w);
-    let reference: Vec<Vec<f64>> = parts.iter().map(|p| hp(p)).collect();
 
     let scratch = tempfile::tempdir().map_err(|e| e.to_string())?;
-    let mut renders: Vec<Vec<Vec<f64>>> = Vec::new();
-    let mut summaries = Vec::new();
     let count = if baseline.is_some() { 3 } else { 2 };
+    let mut frames: Vec<Vec<Frame>> = Vec::new();
     for s in 0..count {
-        let (mut hps, mut mses, mut cpus) = (Vec::new(), Vec::new(), Vec::new());
+        let mut setting = Vec::new();
         for i in 0..design.renders {
             let seed = 100 * (s as u64 + 1) + u64::from(i);
-            let (image, cpu) = match (s, baseline) {
+            setting.push(match (s, baseline) {
                 (2, Some(bin)) => {
                     render_with_binary(bin, name, size, spp, seed, false, scratch.path())?
                 }
@@ -502,43 +586,29 @@ pub fn measure(
                         footprint_filter: s == 0,
                         ..Knobs::full(spp)
                     };
-                    let x = render_seeded(base, &knobs, seed, run)?;
-                    (x.image, x.cpu_seconds)
+                    render_seeded(base, &knobs, seed, run)?
                 }
-            };
-            hps.push(hp(&image));
-            mses.push(crate::tradeoff::relative_mse_net(
-                &image,
-                &mean_image,
-                reference_noise,
-            ));
-            cpus.push(cpu);
+            });
         }
-        renders.push(hps);
-        let mse = mses.iter().sum::<f64>() / mses.len() as f64;
-        summaries.push((mse, crate::tradeoff::median_range(&cpus).0));
+        frames.push(setting);
     }
-    let (energy, cov, dof) = energies(&reference, &renders);
-    let t = t95(dof);
-    let scale = |e: Estimate| Estimate {
-        value: e.value / power,
-        se: e.se / power,
-    };
-    let settings: Vec<SettingRow> = (energy.iter().zip(&summaries))
-        .map(|(e, &(mse, cpu))| SettingRow {
-            energy: Energy {
-                total: scale(e.total),
-                bias: scale(e.bias),
-                noise: scale(e.noise),
-            },
-            mse,
-            cpu,
+    let (energy, ratios, dof) = channel(&reference, &frames, |f| &f.beauty, &mask, &pixels, w);
+    let (texture, texture_ratios, _) =
+        channel(&reference, &frames, |f| &f.albedo, &mask, &pixels, w);
+    let settings = (frames.iter().enumerate())
+        .map(|(s, f)| {
+            let mses: Vec<f64> = (f.iter())
+                .map(|x| crate::tradeoff::relative_mse_net(&x.beauty, &mean_image, reference_noise))
+                .collect();
+            let cpus: Vec<f64> = f.iter().map(|x| x.cpu).collect();
+            SettingRow {
+                energy: energy[s],
+                texture: texture[s],
+                mse: mses.iter().sum::<f64>() / mses.len() as f64,
+                cpu: crate::tradeoff::median_range(&cpus).0,
+            }
         })
         .collect();
-    let ratio = |a: usize, b: usize| {
-        let (n, d) = (energy[a].total.value, energy[b].total.value);
-        ratio_interval(n, d, cov[a][a], cov[b][b], cov[a][b], t)
-    };
     Ok(Row {
         scene: name.to_string(),
         size,
@@ -547,8 +617,10 @@ pub fn measure(
         pixels: pixels.len(),
         dof,
         settings,
-        vs_point: ratio(0, 1),
-        vs_issue: baseline.map(|_| ratio(0, 2)),
+        vs_point: ratios[0],
+        vs_issue: ratios.get(1).copied(),
+        texture_vs_point: texture_ratios[0],
+        texture_vs_issue: texture_ratios.get(1).copied(),
     })
 }
 
@@ -586,7 +658,10 @@ pub fn report_md(rows: &[Row], command: &str) -> (String, bool) {
          departure from the pixel average) and *noise* part (the spread between seeds: Monte \
          Carlo noise, including the sub-pixel texture that random point samples turn into \
          noise). Each ± is a delete-one jackknife standard error over the renders and \
-         reference parts; ratios of totals carry Fieller's 95 % interval (Student's t). Goal: \
+         reference parts; ratios of totals carry Fieller's 95 % interval (Student's t). \
+         **Texture only**: the same measured on the albedo AOV (the first hits' colour averaged \
+         over the pixel's samples), which carries the wood's pattern and none of the lighting's \
+         noise. Goal: \
          today's total ≤ 0.3× the issue-time default's — *met* when the whole interval is ≤ 0.3, \
          *missed* when it lies above, else *undecided*.\n\n",
     );
@@ -597,15 +672,15 @@ pub fn report_md(rows: &[Row], command: &str) -> (String, bool) {
             d.renders, d.reference_spp, d.parts
         );
     }
-    md += "| scene | size, spp | wood px | today / issue-time (total) [95 %] | goal ≤ 0.3 | today / point-sampled (total) [95 %] | equal-time error, filtered / point |\n";
-    md += "| --- | --- | --- | --- | --- | --- | --- |\n";
+    md += "| scene | size, spp | wood px | today / issue-time (total) [95 %] | goal ≤ 0.3 | today / point-sampled (total) [95 %] | texture only (albedo): today / issue-time | today / point | equal-time error, filtered / point |\n";
+    md += "| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
     let mut ok = true;
     for r in rows {
         let issue = r.vs_issue.as_ref().map_or("—".to_string(), ratio_text);
         let v = verdict(&r.goal_ratio());
         ok &= v == "met";
         md += &format!(
-            "| `{}` | {}×{}, {} | {} | {} | {}{} | {} | {:.2} |\n",
+            "| `{}` | {}×{}, {} | {} | {} | {}{} | {} | {} | {} | {:.2} |\n",
             r.scene,
             r.size.0,
             r.size.1,
@@ -619,20 +694,24 @@ pub fn report_md(rows: &[Row], command: &str) -> (String, bool) {
                 ""
             },
             ratio_text(&r.vs_point),
+            r.texture_vs_issue.as_ref().map_or("—".to_string(), ratio_text),
+            ratio_text(&r.texture_vs_point),
             r.equal_time_ratio()
         );
     }
-    md += "\n| scene | setting | total | bias | noise | rel. MSE | CPU s |\n";
-    md += "| --- | --- | --- | --- | --- | --- | --- |\n";
+    md += "\n| scene | setting | total | bias | noise | albedo total | albedo bias | rel. MSE | CPU s |\n";
+    md += "| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
     for r in rows {
         for (label, s) in LABELS.iter().zip(&r.settings) {
             md += &format!(
-                "| `{}` | {} | {} | {} | {} | {:.2e} | {:.2} |\n",
+                "| `{}` | {} | {} | {} | {} | {} | {} | {:.2e} | {:.2} |\n",
                 r.scene,
                 label,
                 pm(s.energy.total),
                 pm(s.energy.bias),
                 pm(s.energy.noise),
+                pm(s.texture.total),
+                pm(s.texture.bias),
                 s.mse,
                 s.cpu
             );
