@@ -137,8 +137,14 @@ fn validate_aliasing_writes_its_table() {
     assert!(o.status.code().is_some_and(|c| c <= 1), "{o:?}");
     let md = std::fs::read_to_string(dir.join("out/A.md")).unwrap();
     assert!(md.contains("| `grazing_oak` | 16×16, 16 |"), "{md}");
-    assert!(md.contains("K = 3, reference 64 spp in R = 8 parts"), "{md}");
-    assert!(md.contains("| `grazing_oak` | today's default (filter on) | "), "{md}");
+    assert!(
+        md.contains("K = 3, reference 64 spp in R = 8 parts"),
+        "{md}"
+    );
+    assert!(
+        md.contains("| `grazing_oak` | today's default (filter on) | "),
+        "{md}"
+    );
     assert_eq!(files(dir), ["out/A.md"]);
 }
 

@@ -116,8 +116,9 @@ fn spread(v: &[&[f64]], mean: &[f64]) -> f64 {
 
 /// The three energies of one setting from the high-passed reference parts `g` (R ≥ 2) and
 /// renders `h` (K ≥ 2), all independent: [total, bias, noise], with
-/// total = mean_i ‖h_i − ḡ‖² − s_g/R, noise = s_h, bias = total − noise, where s is
-/// [`spread`]. Unbiased: E total = ‖Hβ‖² + E‖Hn‖², E noise = E‖Hn‖² (notes/render.md).
+/// total = mean_i ‖h_i − ḡ‖² − s_g/R, noise = s_h, bias = total − noise, where s is the
+/// sample variance summed over pixels. Unbiased: E total = ‖Hβ‖² + E‖Hn‖², E noise = E‖Hn‖²
+/// (notes/render.md).
 pub fn energy_terms(g: &[&[f64]], h: &[&[f64]]) -> [f64; 3] {
     let (gm, hm) = (mean_of(g), mean_of(h));
     let reference_noise = spread(g, &gm) / g.len() as f64;
@@ -142,11 +143,14 @@ pub struct Jackknifed {
     pub dof: usize,
 }
 
+/// Groups of units, each unit a vector ([`jackknife`]).
+pub type Groups<'a> = [Vec<&'a [f64]>];
+
 /// Delete-one jackknife over several independent groups of units (Efron & Stein 1981; for
 /// several samples Arvesen 1969): the statistic recomputed with each unit left out in turn, and
 /// cov = Σ_groups (n − 1)/n Σ_i (θ₋ᵢ − θ̄)(θ₋ᵢ − θ̄)ᵀ. Every group needs ≥ 3 units (the
 /// statistic's spreads need 2 after one is left out).
-pub fn jackknife(groups: &[Vec<&[f64]>], stat: &dyn Fn(&[Vec<&[f64]>]) -> Vec<f64>) -> Jackknifed {
+pub fn jackknife(groups: &Groups, stat: &dyn Fn(&Groups) -> Vec<f64>) -> Jackknifed {
     let value = stat(groups);
     let m = value.len();
     let mut cov = vec![vec![0.0; m]; m];
@@ -313,9 +317,12 @@ fn read_exr_rgb_layer(path: &Path, layer: &str) -> Result<Vec<Vec3>, String> {
         let want = format!("{layer}.{name}");
         (image.layer_data.iter())
             .flat_map(|l| {
-                let prefix = (l.attributes.layer_name.as_ref())
-                    .map_or(String::new(), |n| format!("{n}."));
-                l.channel_data.list.iter().map(move |c| (format!("{prefix}{}", c.name), c))
+                let prefix =
+                    (l.attributes.layer_name.as_ref()).map_or(String::new(), |n| format!("{n}."));
+                l.channel_data
+                    .list
+                    .iter()
+                    .map(move |c| (format!("{prefix}{}", c.name), c))
             })
             .find(|(full, _)| *full == want)
             .map(|(_, c)| c.sample_data.values_as_f32().collect())
@@ -505,11 +512,21 @@ fn channel(
     let lum = |c: &[Vec3]| -> Vec<f64> { c.iter().map(|&v| luminance(v) as f64).collect() };
     let hp = |f: &Frame| high_pass(&lum(pick(f)), pixels, width);
     let parts: Vec<Vec<f64>> = reference.iter().map(hp).collect();
-    let renders: Vec<Vec<Vec<f64>>> = settings.iter().map(|s| s.iter().map(hp).collect()).collect();
+    let renders: Vec<Vec<Vec<f64>>> = settings
+        .iter()
+        .map(|s| s.iter().map(hp).collect())
+        .collect();
     let n = reference.len() as f64;
     let power: f64 = (0..mask.len())
         .filter(|&i| mask[i])
-        .map(|i| (reference.iter().map(|f| luminance(pick(f)[i]) as f64).sum::<f64>() / n).powi(2))
+        .map(|i| {
+            (reference
+                .iter()
+                .map(|f| luminance(pick(f)[i]) as f64)
+                .sum::<f64>()
+                / n)
+                .powi(2)
+        })
         .sum::<f64>()
         .max(1e-30);
     let (energy, cov, dof) = energies(&parts, &renders);
@@ -694,7 +711,9 @@ pub fn report_md(rows: &[Row], command: &str) -> (String, bool) {
                 ""
             },
             ratio_text(&r.vs_point),
-            r.texture_vs_issue.as_ref().map_or("—".to_string(), ratio_text),
+            r.texture_vs_issue
+                .as_ref()
+                .map_or("—".to_string(), ratio_text),
             ratio_text(&r.texture_vs_point),
             r.equal_time_ratio()
         );
