@@ -26,8 +26,8 @@ const PARTS: u32 = 8;
 
 #[derive(clap::Args, Debug, Default)]
 pub struct Args {
-    /// Report to write [default: validation/ALIASING.md]; a reduced run (other scenes, divisor
-    /// or reference spp) must name it.
+    /// Report to write [default: validation/ALIASING.md]; a reduced run (other scenes, divisor,
+    /// reference spp or renders) must name it.
     #[arg(long)]
     report: Option<PathBuf>,
     /// Only these built-in scenes (file stems) [default: every scene with procedural wood].
@@ -36,15 +36,17 @@ pub struct Args {
     /// Render at 1/N of each scene's size, 1 to 16 [default: 4].
     #[arg(long)]
     div: Option<u32>,
-    /// Samples per pixel of the reference (two halves), at least 4× the scene's [default: 256].
+    /// Samples per pixel of the reference (8 independent parts), at least 4× the scene's
+    /// [default: 256].
     #[arg(long)]
     reference_spp: Option<u32>,
     /// Renders of each setting, seeds of their own, 3 to 64 [default: 8].
     #[arg(long)]
     renders: Option<u32>,
-    /// Another `xylem` binary rendering the issue-time default (independent samples,
-    /// point-sampled wood: the build of 5a8ffa9^), judged against; without it the goal is
-    /// judged against today's samples point-sampled.
+    /// Another `xylem` binary rendering the issue-time default, judged against: independent
+    /// samples, point-sampled wood (the build of 5a8ffa9^ = 2934293, run with
+    /// `--footprint-filter off`); without it the goal is judged against today's samples
+    /// point-sampled.
     #[arg(long)]
     baseline: Option<PathBuf>,
 }
