@@ -113,7 +113,7 @@ fn reduced_runs_never_overwrite_the_full_results() {
 }
 
 /// `validate aliasing` on one small scene writes its table (the footprint filter against point
-/// sampling, issue 28) and nothing else.
+/// sampling, issue 28: energies with standard errors, ratios with intervals) and nothing else.
 #[test]
 fn validate_aliasing_writes_its_table() {
     let tmp = tempfile::tempdir().unwrap();
@@ -127,6 +127,8 @@ fn validate_aliasing_writes_its_table() {
         "16",
         "--reference-spp",
         "64",
+        "--renders",
+        "3",
         "--report",
         "out/A.md",
     ];
@@ -134,7 +136,15 @@ fn validate_aliasing_writes_its_table() {
     // A missed goal is a failing exit, not an error: the table is written either way.
     assert!(o.status.code().is_some_and(|c| c <= 1), "{o:?}");
     let md = std::fs::read_to_string(dir.join("out/A.md")).unwrap();
-    assert!(md.contains("| `grazing_oak` | 16×16, 16 (64) |"), "{md}");
+    assert!(md.contains("| `grazing_oak` | 16×16, 16 |"), "{md}");
+    assert!(
+        md.contains("K = 3, reference 64 spp in R = 8 parts"),
+        "{md}"
+    );
+    assert!(
+        md.contains("| `grazing_oak` | today's default (filter on) | "),
+        "{md}"
+    );
     assert_eq!(files(dir), ["out/A.md"]);
 }
 

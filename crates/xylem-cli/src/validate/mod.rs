@@ -24,8 +24,9 @@ enum What {
     Appearance(appearance::Args),
     /// `xylem fit` by round trip on known boards → validation/FIT.md.
     Fit(fit::Args),
-    /// The wood scenes with and without the footprint filter: aliasing energy and error at
-    /// equal time → validation/ALIASING.md.
+    /// The wood scenes with and without the footprint filter, and with `--baseline` against
+    /// another binary's default: aliasing energy with standard errors, ratio intervals and error
+    /// at equal time → validation/ALIASING.md.
     Aliasing(aliasing::Args),
 }
 
