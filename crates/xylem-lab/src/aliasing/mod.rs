@@ -12,6 +12,7 @@
 //! jackknife standard error ([`energies`]), and ratios between settings with Fieller's interval
 //! ([`ratio_interval`]). Derivation: notes/render.md, "The aliasing estimator".
 
+use crate::report::{checks_table, Check};
 use crate::tradeoff::{apply, process_cpu_seconds, Knobs};
 use glam::Vec3;
 use std::path::Path;
@@ -83,206 +84,11 @@ pub fn aliasing_power(
     (err - noise, noise, n)
 }
 
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
+mod estimator;
+#[cfg(test)]
+mod tests;
 
-/// The mean of equally long vectors.
-fn mean_of(v: &[&[f64]]) -> Vec<f64> {
-    let mut m = vec![0.0; v[0].len()];
-    for x in v {
-        for (a, b) in m.iter_mut().zip(x.iter()) {
-            *a += b;
-        }
-    }
-    let k = v.len() as f64;
-    m.iter_mut().for_each(|a| *a /= k);
-    m
-}
-
-/// Σ_i ‖v_i − v̄‖² / (k − 1): the sample variance of `k` vectors, summed over their entries.
-fn spread(v: &[&[f64]], mean: &[f64]) -> f64 {
-    let s: f64 = v
-        .iter()
-        .map(|x| {
-            x.iter()
-                .zip(mean)
-                .map(|(a, m)| (a - m).powi(2))
-                .sum::<f64>()
-        })
-        .sum();
-    s / (v.len() as f64 - 1.0)
-}
-
-/// The three energies of one setting from the high-passed reference parts `g` (R ≥ 2) and
-/// renders `h` (K ≥ 2), all independent: [total, bias, noise], with
-/// total = mean_i ‖h_i − ḡ‖² − s_g/R, noise = s_h, bias = total − noise, where s is the
-/// sample variance summed over pixels. Unbiased: E total = ‖Hβ‖² + E‖Hn‖², E noise = E‖Hn‖²
-/// (notes/render.md).
-pub fn energy_terms(g: &[&[f64]], h: &[&[f64]]) -> [f64; 3] {
-    let (gm, hm) = (mean_of(g), mean_of(h));
-    let reference_noise = spread(g, &gm) / g.len() as f64;
-    let total = h
-        .iter()
-        .map(|x| x.iter().zip(&gm).map(|(a, m)| (a - m).powi(2)).sum::<f64>())
-        .sum::<f64>()
-        / h.len() as f64
-        - reference_noise;
-    let noise = spread(h, &hm);
-    [total, total - noise, noise]
-}
-
-/// A statistic and the jackknife covariance of its outputs.
-#[derive(Clone, Debug)]
-pub struct Jackknifed {
-    /// The statistic on all units.
-    pub value: Vec<f64>,
-    /// Covariance of the outputs (row-major, n × n).
-    pub cov: Vec<Vec<f64>>,
-    /// The smallest group's size less one: the degrees of freedom the intervals use.
-    pub dof: usize,
-}
-
-/// Groups of units, each unit a vector ([`jackknife`]).
-pub type Groups<'a> = [Vec<&'a [f64]>];
-
-/// Delete-one jackknife over several independent groups of units (Efron & Stein 1981; for
-/// several samples Arvesen 1969): the statistic recomputed with each unit left out in turn, and
-/// cov = Σ_groups (n − 1)/n Σ_i (θ₋ᵢ − θ̄)(θ₋ᵢ − θ̄)ᵀ. Every group needs ≥ 3 units (the
-/// statistic's spreads need 2 after one is left out).
-pub fn jackknife(groups: &Groups, stat: &dyn Fn(&Groups) -> Vec<f64>) -> Jackknifed {
-    let value = stat(groups);
-    let m = value.len();
-    let mut cov = vec![vec![0.0; m]; m];
-    for (gi, group) in groups.iter().enumerate() {
-        let n = group.len();
-        let replicates: Vec<Vec<f64>> = (0..n)
-            .map(|leave| {
-                let mut g = groups.to_vec();
-                g[gi] = (group.iter().enumerate())
-                    .filter(|(i, _)| *i != leave)
-                    .map(|(_, v)| *v)
-                    .collect();
-                stat(&g)
-            })
-            .collect();
-        let mean: Vec<f64> = (0..m)
-            .map(|j| replicates.iter().map(|r| r[j]).sum::<f64>() / n as f64)
-            .collect();
-        let f = (n as f64 - 1.0) / n as f64;
-        for r in &replicates {
-            for a in 0..m {
-                for b in 0..m {
-                    cov[a][b] += f * (r[a] - mean[a]) * (r[b] - mean[b]);
-                }
-            }
-        }
-    }
-    let dof = groups.iter().map(|g| g.len()).min().unwrap_or(1) - 1;
-    Jackknifed { value, cov, dof }
-}
-
-/// Student's t quantile for a two-sided 95 % interval with `dof` degrees of freedom.
-pub fn t95(dof: usize) -> f64 {
-    use statrs::distribution::{ContinuousCDF, StudentsT};
-    StudentsT::new(0.0, 1.0, dof.max(1) as f64)
-        .map(|t| t.inverse_cdf(0.975))
-        .unwrap_or(1.96)
-}
-
-/// A figure and its standard error.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Estimate {
-    pub value: f64,
-    pub se: f64,
-}
-
-impl Estimate {
-    /// The 95 % interval, value ± t · se.
-    pub fn interval(&self, t: f64) -> (f64, f64) {
-        (self.value - t * self.se, self.value + t * self.se)
-    }
-}
-
-/// One setting's high-frequency error energy ([`energy_terms`]), each part with its standard
-/// error.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Energy {
-    /// Of one render: bias + noise (the issue's "aliasing energy").
-    pub total: Estimate,
-    /// What every render shares: the filter's departure from the pixel average, a fixed
-    /// sampling pattern's aliasing, a model difference.
-    pub bias: Estimate,
-    /// What changes with the seed: Monte Carlo noise, including the sub-pixel texture's
-    /// aliasing that random point samples turn into noise.
-    pub noise: Estimate,
-}
-
-/// A ratio of two energies' totals with its 95 % interval.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Ratio {
-    pub value: f64,
-    /// Fieller's interval; None when the denominator is not significantly above 0 (the
-    /// interval is then unbounded).
-    pub interval: Option<(f64, f64)>,
-}
-
-/// The energies of several settings against one reference, from the high-passed reference parts
-/// and, per setting, its renders (all independent of one another), with their jackknife
-/// covariance; `totals_cov[a][b]` is the covariance of setting a's and b's totals (they share
-/// the reference). Returns (energies, totals' covariance, degrees of freedom).
-pub fn energies(
-    reference: &[Vec<f64>],
-    settings: &[Vec<Vec<f64>>],
-) -> (Vec<Energy>, Vec<Vec<f64>>, usize) {
-    let mut groups: Vec<Vec<&[f64]>> = vec![reference.iter().map(|v| v.as_slice()).collect()];
-    groups.extend(
-        settings
-            .iter()
-            .map(|s| s.iter().map(|v| v.as_slice()).collect()),
-    );
-    let stat = |g: &[Vec<&[f64]>]| -> Vec<f64> {
-        (1..g.len())
-            .flat_map(|s| energy_terms(&g[0], &g[s]))
-            .collect()
-    };
-    let jk = jackknife(&groups, &stat);
-    let est = |j: usize| Estimate {
-        value: jk.value[j],
-        se: jk.cov[j][j].max(0.0).sqrt(),
-    };
-    let out = (0..settings.len())
-        .map(|s| Energy {
-            total: est(3 * s),
-            bias: est(3 * s + 1),
-            noise: est(3 * s + 2),
-        })
-        .collect();
-    let totals_cov = (0..settings.len())
-        .map(|a| (0..settings.len()).map(|b| jk.cov[3 * a][3 * b]).collect())
-        .collect();
-    (out, totals_cov, jk.dof)
-}
-
-/// Fieller's interval (Fieller 1954) for the ratio ρ = n/d of two estimates with variances
-/// `vn`, `vd` and covariance `c`, at quantile `t`: the ρ with (n − ρd)² ≤ t²(vn − 2ρc + ρ²vd),
-/// bounded when d is significant (d² > t² vd). Unlike the delta method it stays right when d's
-/// relative error is large.
-pub fn ratio_interval(n: f64, d: f64, vn: f64, vd: f64, c: f64, t: f64) -> Ratio {
-    let t2 = t * t;
-    let a = d * d - t2 * vd;
-    let b = n * d - t2 * c;
-    let cc = n * n - t2 * vn;
-    let disc = b * b - a * cc;
-    let interval = (a > 0.0 && disc >= 0.0).then(|| {
-        let r = disc.sqrt();
-        ((b - r) / a, (b + r) / a)
-    });
-    Ratio {
-        value: n / d,
-        interval,
-    }
-}
+pub use estimator::*;
 
 /// CPU seconds of this process's waited-for children so far (user + system).
 fn children_cpu_seconds() -> f64 {
@@ -658,7 +464,7 @@ fn ratio_text(r: &Ratio) -> String {
 /// (issue 28: aliasing energy ≤ 0.3× the issue-time default's, judged on the issue-time
 /// binary where given, else on point sampling) met when the whole interval is ≤ 0.3. Returns
 /// (markdown, every scene met).
-pub fn report_md(rows: &[Row], command: &str) -> (String, bool) {
+pub fn report_md(rows: &[Row], command: &str) -> (String, Vec<Check>) {
     let design = rows.first().map(|r| r.design);
     let mut md = String::from(
         "# Aliasing energy: today's default against point sampling and the issue-time default (issue 28)\n\n\
@@ -691,11 +497,24 @@ pub fn report_md(rows: &[Row], command: &str) -> (String, bool) {
     }
     md += "| scene | size, spp | wood px | today / issue-time (total) [95 %] | goal ≤ 0.3 | today / point-sampled (total) [95 %] | texture only (albedo): today / issue-time | today / point | equal-time error, filtered / point |\n";
     md += "| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
-    let mut ok = true;
+    let mut checks = Vec::new();
     for r in rows {
         let issue = r.vs_issue.as_ref().map_or("—".to_string(), ratio_text);
         let v = verdict(&r.goal_ratio());
-        ok &= v == "met";
+        checks.push(Check::new(
+            format!("aliasing energy of `{}`", r.scene),
+            format!(
+                "today's total over the {} default's ≤ {GOAL} (the whole 95 % interval)",
+                if r.vs_issue.is_some() {
+                    "issue-time"
+                } else {
+                    "point-sampled"
+                }
+            ),
+            r.goal_ratio().value,
+            format!("{} ({v})", ratio_text(&r.goal_ratio())),
+            v == "met",
+        ));
         md += &format!(
             "| `{}` | {}×{}, {} | {} | {} | {}{} | {} | {} | {} | {:.2} |\n",
             r.scene,
@@ -740,235 +559,7 @@ pub fn report_md(rows: &[Row], command: &str) -> (String, bool) {
            are unbiased for the pixel average; the reference is that average), so its figure is \
            a check of the estimator. CPU seconds of the other binary are its whole process \
            (loading, BVH, EXR) and not comparable with the in-process renders'.\n";
-    (md, ok)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use xylem::math::Pcg32;
-
-    /// Gaussian noise of variance `v` by Box–Muller.
-    fn noise(rng: &mut Pcg32, v: f64) -> f64 {
-        let (u1, u2) = (rng.next_f32().max(1e-7) as f64, rng.next_f32() as f64);
-        v.sqrt() * (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-    }
-
-    /// Pixel noise correlated with its neighbours, as a pixel filter wider than a pixel makes
-    /// it: white noise of variance `v` smoothed by [1, 2, 1]/4 along rows.
-    fn correlated_noise(rng: &mut Pcg32, v: f64, w: usize, h: usize) -> Vec<f64> {
-        let white: Vec<f64> = (0..w * h).map(|_| noise(rng, v)).collect();
-        (0..w * h)
-            .map(|i| {
-                let x = i % w;
-                let l = white[if x > 0 { i - 1 } else { i }];
-                let r = white[if x + 1 < w { i + 1 } else { i }];
-                (l + 2.0 * white[i] + r) / 4.0
-            })
-            .collect()
-    }
-
-    #[test]
-    fn correlated_noise_leaves_no_aliasing_power_and_stripes_do() {
-        let (w, h) = (128, 128);
-        let mut rng = Pcg32::new(3, 28);
-        let mask = vec![true; w * h];
-        let truth = vec![0.5; w * h];
-        let field = |rng: &mut Pcg32, v: f64, extra: &dyn Fn(usize) -> f64| -> Vec<f64> {
-            (correlated_noise(rng, v, w, h).into_iter().enumerate())
-                .map(|(i, n)| truth[i] + n + extra(i))
-                .collect()
-        };
-        let none = |_: usize| 0.0;
-        let (a, b) = (field(&mut rng, 0.01, &none), field(&mut rng, 0.01, &none));
-        let (x1, x2) = (field(&mut rng, 0.04, &none), field(&mut rng, 0.04, &none));
-        let (net, removed, n) = aliasing_power([&x1, &x2], [&a, &b], &mask, w, h);
-        assert_eq!(n, (w - 2) * (h - 2));
-        // The noise's share matches the error's power within 5 % (≈ 1.5 % standard error).
-        assert!(net.abs() < 0.05 * removed, "net {net} of {removed}");
-        // The control: subtracting independent-pixel noise, (8/9)² + 8/81 of each pixel's
-        // variance, over-subtracts correlated noise by far.
-        let var_x = 0.04 * 6.0 / 16.0;
-        let var_r = 0.01 * 6.0 / 16.0 / 2.0;
-        let independent = (n as f64) * (var_x + var_r) * (64.0 + 8.0) / 81.0;
-        assert!(independent > 1.2 * removed, "{independent} vs {removed}");
-        // Moiré-like stripes two pixels wide survive at their power: ±0.3 keeps ±0.2 after the
-        // 3 × 3 mean, 0.04 a pixel.
-        let stripes = |i: usize| {
-            if ((i % w) / 2).is_multiple_of(2) {
-                0.3
-            } else {
-                -0.3
-            }
-        };
-        let (y1, y2) = (
-            field(&mut rng, 0.04, &stripes),
-            field(&mut rng, 0.04, &stripes),
-        );
-        let (net_s, _, _) = aliasing_power([&y1, &y2], [&a, &b], &mask, w, h);
-        assert!(
-            (net_s / n as f64 - 0.04).abs() < 0.004,
-            "{}",
-            net_s / n as f64
-        );
-    }
-
-    /// A 1D pattern of `nu` cycles a pixel along x, amplitude 0.3 about 0.5, at film x.
-    fn pattern(nu: f64, x: f64) -> f64 {
-        0.5 + 0.3 * (std::f64::consts::TAU * nu * x).sin()
-    }
-
-    /// Its exact average over pixel column `p` (the box pixel filter): the converged image.
-    fn pixel_average(nu: f64, p: f64) -> f64 {
-        let k = std::f64::consts::TAU * nu;
-        0.5 + 0.3 * ((k * p).cos() - (k * (p + 1.0)).cos()) / k
-    }
-
-    /// `k` images of `w` × `h` from `pixel(rng, x, y)`, high-passed over the whole interior.
-    fn high_passed(
-        rng: &mut Pcg32,
-        k: usize,
-        (w, h): (usize, usize),
-        pixel: &dyn Fn(&mut Pcg32, usize, usize) -> f64,
-    ) -> Vec<Vec<f64>> {
-        let pixels = judged_pixels(&vec![true; w * h], w, h);
-        (0..k)
-            .map(|_| {
-                let img: Vec<f64> = (0..w * h).map(|i| pixel(rng, i % w, i / w)).collect();
-                high_pass(&img, &pixels, w)
-            })
-            .collect()
-    }
-
-    /// The negative and positive controls of the estimator: a pattern of 0.7 cycles a pixel
-    /// (above the pixel's Nyquist 0.5) point-sampled at pixel centres aliases into a bias every
-    /// render shares, found significantly above 0 and at its exact value; sampled at random
-    /// points in the pixel it is unbiased (bias consistent with 0) and its aliasing is noise,
-    /// which the total counts.
-    #[test]
-    fn point_sampled_pattern_aliases_and_jitter_turns_it_into_noise() {
-        let (w, h, nu) = (48, 32, 0.7);
-        let mut rng = Pcg32::new(28, 5);
-        let reference = high_passed(&mut rng, 8, (w, h), &|rng, x, _| {
-            pixel_average(nu, x as f64) + noise(rng, 1e-4)
-        });
-        let centre = high_passed(&mut rng, 8, (w, h), &|rng, x, _| {
-            pattern(nu, x as f64 + 0.5) + noise(rng, 1e-3)
-        });
-        let jitter = high_passed(&mut rng, 8, (w, h), &|rng, x, _| {
-            let s: f64 = (0..4)
-                .map(|_| pattern(nu, x as f64 + rng.next_f32() as f64))
-                .sum();
-            s / 4.0 + noise(rng, 1e-3)
-        });
-        let (e, cov, dof) = energies(&reference, &[centre, jitter]);
-        let t = t95(dof);
-        // The exact bias energy of centre sampling: ‖H(f(centre) − pixel average)‖².
-        let pixels = judged_pixels(&vec![true; w * h], w, h);
-        let beta: Vec<f64> = (0..w * h)
-            .map(|i| pattern(nu, (i % w) as f64 + 0.5) - pixel_average(nu, (i % w) as f64))
-            .collect();
-        let truth = high_pass(&beta, &pixels, w)
-            .iter()
-            .map(|v| v * v)
-            .sum::<f64>();
-        let (lo, hi) = e[0].bias.interval(t);
-        assert!(lo > 0.0, "centre sampling's bias {:?}", e[0].bias);
-        assert!(lo < truth && truth < hi, "{truth} outside {lo}..{hi}");
-        let (lo, hi) = e[1].bias.interval(t);
-        assert!(lo < 0.0 && 0.0 < hi, "jitter's bias {:?}", e[1].bias);
-        assert!(
-            e[1].total.interval(t).0 > 0.0,
-            "jitter's total {:?}",
-            e[1].total
-        );
-        // The ratio of the two totals has a bounded interval holding its value.
-        let r = ratio_interval(
-            e[0].total.value,
-            e[1].total.value,
-            cov[0][0],
-            cov[1][1],
-            cov[0][1],
-            t,
-        );
-        let (lo, hi) = r.interval.expect("jitter's total is significant");
-        assert!(lo < r.value && r.value < hi, "{r:?}");
-    }
-
-    /// Noise alone (correlated between neighbouring pixels, as a wide pixel filter makes it)
-    /// leaves a bias energy consistent with 0. Over 200 independent trials: the bias's mean is
-    /// within 3 standard errors of 0 (unbiased), its 95 % interval holds 0 in ≥ 90 % of them
-    /// (the jackknife is conservative for a bias of 0, a degenerate U-statistic: its standard
-    /// error comes out ≈ 1.5× the trials' spread), and the total's jackknife standard error
-    /// matches the trials' spread within 0.8–1.4×.
-    #[test]
-    fn noise_only_gives_bias_consistent_with_zero() {
-        let (w, h) = (24, 24);
-        let mut rng = Pcg32::new(7, 28);
-        let pixels = judged_pixels(&vec![true; w * h], w, h);
-        let images = |rng: &mut Pcg32, k: usize, v: f64| -> Vec<Vec<f64>> {
-            (0..k)
-                .map(|_| {
-                    let n = correlated_noise(rng, v, w, h);
-                    let img: Vec<f64> = (0..w * h)
-                        .map(|i| 0.5 + 0.1 * (i % w) as f64 / w as f64 + n[i])
-                        .collect();
-                    high_pass(&img, &pixels, w)
-                })
-                .collect()
-        };
-        let trials = 200;
-        let mut covered = 0;
-        let (mut bias, mut total, mut total_se) = (vec![], vec![], vec![]);
-        for _ in 0..trials {
-            let reference = images(&mut rng, 8, 0.002);
-            let renders = images(&mut rng, 8, 0.02);
-            let (e, _, dof) = energies(&reference, &[renders]);
-            let (lo, hi) = e[0].bias.interval(t95(dof));
-            covered += usize::from(lo <= 0.0 && 0.0 <= hi);
-            bias.push(e[0].bias.value);
-            total.push(e[0].total.value);
-            total_se.push(e[0].total.se);
-        }
-        let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
-        let sd = |v: &[f64]| {
-            let m = mean(v);
-            (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() as f64 - 1.0)).sqrt()
-        };
-        let n = trials as f64;
-        assert!(
-            mean(&bias).abs() < 3.0 * sd(&bias) / n.sqrt(),
-            "{}",
-            mean(&bias)
-        );
-        assert!(covered as f64 / n >= 0.9, "covered {covered} of {trials}");
-        let se_ratio = mean(&total_se) / sd(&total);
-        assert!(
-            (0.8..1.4).contains(&se_ratio),
-            "total's se / spread {se_ratio}"
-        );
-    }
-
-    #[test]
-    fn fieller_interval_bounded_only_for_a_significant_denominator() {
-        let r = ratio_interval(1.0, 4.0, 0.01, 0.04, 0.0, 2.0);
-        let (lo, hi) = r.interval.unwrap();
-        assert!((r.value - 0.25).abs() < 1e-12 && lo < 0.25 && 0.25 < hi && lo > 0.15 && hi < 0.4);
-        // d = 0.1 ± 0.1: not significant, no bounded interval.
-        assert!(ratio_interval(1.0, 0.1, 0.01, 0.01, 0.0, 2.0)
-            .interval
-            .is_none());
-    }
-
-    #[test]
-    fn the_mask_excludes_edges_and_outside_pixels() {
-        let (w, h) = (8, 8);
-        let d = vec![1.0; w * h];
-        let mut mask = vec![true; w * h];
-        mask[3 * w + 3] = false;
-        let (p, n) = high_pass_power(&d, &mask, w, h);
-        assert_eq!(p, 0.0);
-        // 6 × 6 interior pixels less the 9 whose window holds (3, 3).
-        assert_eq!(n, 36 - 9);
-    }
+    md += "\n";
+    md += &checks_table(&checks);
+    (md, checks)
 }
