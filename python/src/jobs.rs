@@ -144,7 +144,7 @@ pub(crate) fn render<'py>(
 
 /// `sweep(scene, frames=None, arc=None, spp=None, res=None, seed=None, threads=0, quality=None,
 /// footprint_filter=None)`: renders the
-/// light sweep of a scene's (a path, a name, a dict or a `Scene`, as `render` takes) `[sweep]` table (with the per-sweep cache, as `xylem sweep` does)
+/// light sweep of a scene's (a path, a name, a dict or a `Scene`, as `render` takes) `[sweep]` table (frames sharing their light-independent work, as `xylem sweep` does)
 /// without writing files; `arc` = (from_deg, to_deg). Returns a dict: `frames` (F, H, W, 3),
 /// `std_error` (F, H, W), `light_deg` (F,), `seconds`. The GIL is released while rendering;
 /// Ctrl-C stops it within a tile and raises KeyboardInterrupt.

@@ -37,7 +37,7 @@ pub struct Args {
     /// `--spp` still overrides its sample count.
     #[arg(long, value_parser = crate::named::<Quality>(&Quality::NAMES))]
     pub quality: Option<Quality>,
-    /// Render each frame from scratch, without the per-sweep cache (to time or check it).
+    /// Render each frame from scratch, without the work frames share (to time or check the sharing).
     #[arg(long)]
     pub naive: bool,
     /// Worker threads (0 = all cores; at most 16 per core).
@@ -136,7 +136,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Says on stderr what is about to be rendered: scene, size, spp, integrator, cache.
+/// Says on stderr what is about to be rendered: scene, size, spp, integrator, one pass or not.
 fn announce(loaded: &xylem::scene::LoadedScene, job: &SweepJob) {
     let cam = &loaded.scene.camera;
     eprintln!(
@@ -147,9 +147,9 @@ fn announce(loaded: &xylem::scene::LoadedScene, job: &SweepJob) {
         loaded.settings.spp,
         loaded.settings.integrator,
         if job.naive {
-            "naive (no cache)"
+            "each frame alone (--naive)"
         } else {
-            "cached primary samples"
+            "frames in one pass"
         }
     );
 }

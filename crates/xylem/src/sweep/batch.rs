@@ -4,7 +4,7 @@
 //! is kept from the first batch for the others when it fits and measures cheaper
 //! ([`plan`]: it costs [`Primaries::bytes`] of memory, recomputing it costs a primary pass per
 //! batch; figures in notes/cluster.md). A frame has the same bits in any batch, kept or not
-//! (crates/xylem/tests/sweep_cache.rs: a frame of a one-pass sweep equals that frame rendered alone).
+//! (crates/xylem/tests/sweep_frames.rs: a frame of a one-pass sweep equals that frame rendered alone).
 
 use crate::render::resources::Resources;
 use crate::render::Primaries;

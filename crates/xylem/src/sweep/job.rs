@@ -1,5 +1,5 @@
-//! A whole `xylem sweep` job: set up the path from the scene, render the selected frames (cached
-//! or naive), write each frame's EXR, PNG and record, and assemble the sequence once every frame
+//! A whole `xylem sweep` job: set up the path from the scene, render the selected frames (in one
+//! pass or each alone), write each frame's EXR, PNG and record, and assemble the sequence once every frame
 //! of the sweep is in the output folder.
 
 use super::batch::{batches, default_plan, plan, BudgetError, Plan, PrimaryMode, SweepSize};
@@ -94,7 +94,7 @@ pub struct SweepJob<'a> {
     pub range: Option<String>,
     /// Output folder of the frames, records and assembled sequence.
     pub out: PathBuf,
-    /// Render every frame from scratch instead of caching (for timing and checking the cache).
+    /// Render every frame from scratch instead of in one pass (for timing and checking the sharing).
     pub naive: bool,
     /// Threads and progress reporting (never change a pixel).
     pub run: RunOptions<'a>,

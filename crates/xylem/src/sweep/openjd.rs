@@ -1,7 +1,7 @@
 //! A sweep as an Open Job Description job template (`xylem sweep --emit-openjd DIR`), for
 //! OpenJD runners such as AWS Deadline Cloud or `openjd run`: a `Render` step whose one task
 //! parameter is a `CHUNK[INT]` range of frames (the `TASK_CHUNKING` extension; each chunk runs
-//! `--frames-range` on a contiguous run, so the per-sweep cache still pays), and an `Assemble`
+//! `--frames-range` on a contiguous run, so the work its frames share still pays), and an `Assemble`
 //! step that depends on it. Specification: jobtemplate-2023-09 and RFC 0001 (task chunking).
 
 use serde_json::{json, Value};
@@ -43,7 +43,7 @@ xylem="$1"; scene="$2"; out="$3"; shift 4
 exec "$xylem" sweep "$scene" --out "$out" --frames-range "${a}..=${b}" --quiet "$@""#;
 
 /// The default frames per chunk for `frames` frames: about 8 chunks (few enough that the
-/// per-sweep cache pays, enough to spread), within the specification's limit.
+/// work shared between frames pays, enough to spread), within the specification's limit.
 pub fn default_chunk(frames: usize) -> usize {
     frames.div_ceil(8).clamp(1, MAX_CHUNK)
 }
@@ -82,7 +82,7 @@ pub(crate) fn job_template(sweep: &OpenJdSweep) -> Value {
              "description": "The output folder the tasks share (absolute)"},
             {"name": "ChunkSize", "type": "INT", "default": sweep.chunk.clamp(1, MAX_CHUNK),
              "minValue": 1, "maxValue": MAX_CHUNK,
-             "description": "Frames per render task (consecutive frames share the per-sweep cache)"}
+             "description": "Frames per render task (consecutive frames share their light-independent work)"}
         ],
         "steps": [
             {

@@ -125,7 +125,7 @@ radius = 200.0
 "#;
 
 fn load() -> LoadedScene {
-    from_str(SCENE, "sweep_cache_test.toml", Path::new("."), "test").unwrap()
+    from_str(SCENE, "sweep_frames_test.toml", Path::new("."), "test").unwrap()
 }
 
 fn max_relative_difference(a: &[glam::Vec3], b: &[glam::Vec3]) -> f32 {
@@ -165,12 +165,12 @@ fn check_scene(loaded: &LoadedScene, integrator: Integrator, frames: std::ops::R
         let alone = LightFrames::fixed(all.frame(k));
         let naive = render_frames(&loaded.scene, &alone, &settings, &run).unwrap();
         let naive = naive.image(0);
-        let cached = sweep.image(k);
-        assert_eq!(cached.beauty, naive.beauty, "frame {f}: beauty");
-        assert_eq!(cached.aov, naive.aov, "frame {f}: AOVs");
-        assert_eq!(cached.std_error, naive.std_error, "frame {f}: std error");
-        assert_eq!(cached.nonfinite, naive.nonfinite, "frame {f}");
-        lit += cached
+        let swept = sweep.image(k);
+        assert_eq!(swept.beauty, naive.beauty, "frame {f}: beauty");
+        assert_eq!(swept.aov, naive.aov, "frame {f}: AOVs");
+        assert_eq!(swept.std_error, naive.std_error, "frame {f}: std error");
+        assert_eq!(swept.nonfinite, naive.nonfinite, "frame {f}");
+        lit += swept
             .beauty
             .iter()
             .filter(|c| c.max_element() > 0.0)
@@ -184,18 +184,18 @@ fn check_scene(loaded: &LoadedScene, integrator: Integrator, frames: std::ops::R
 }
 
 #[test]
-fn cached_direct_lighting_equals_naive_frames() {
+fn swept_direct_lighting_equals_frames_alone() {
     check(Integrator::Direct, 0..7);
 }
 
 #[test]
-fn cached_path_tracing_equals_naive_frames_for_a_slice() {
+fn swept_path_tracing_equals_frames_alone_for_a_slice() {
     check(Integrator::Path { max_depth: 3 }, 2..5);
 }
 
 #[test]
-fn cached_wood_under_a_sphere_light_between_fixed_lights_equals_naive_frames() {
-    let loaded = from_str(WOOD_SCENE, "sweep_cache_wood.toml", Path::new("."), "test").unwrap();
+fn swept_wood_under_a_sphere_light_between_fixed_lights_equals_frames_alone() {
+    let loaded = from_str(WOOD_SCENE, "sweep_frames_wood.toml", Path::new("."), "test").unwrap();
     check_scene(&loaded, Integrator::Direct, 0..9);
     // The sphere is seen directly in some frames (the camera's view of it), which the check
     // above covers only if it happens: make sure it does.
@@ -237,7 +237,7 @@ fn culled_shadow_test_answers_as_the_bvh() {
     use xylem::math::{uniform_sphere, Pcg32};
     use xylem::render::shadow::ShadowTest;
     use xylem::render::Ray;
-    let loaded = from_str(WOOD_SCENE, "sweep_cache_wood.toml", Path::new("."), "test").unwrap();
+    let loaded = from_str(WOOD_SCENE, "sweep_frames_wood.toml", Path::new("."), "test").unwrap();
     let accel = &loaded.scene.accel;
     let (culled, bvh) = (ShadowTest::culled(accel), ShadowTest::bvh(accel));
     let eps = 2e-5 * accel.scale();
@@ -290,7 +290,7 @@ fn batch_culled_shadow_segments_are_unoccluded() {
     use xylem::render::light::{LightSamples, LightU};
     use xylem::render::shadow::{Segments, ShadowTest};
     use xylem::render::{primary_sample, Ray};
-    let loaded = from_str(WOOD_SCENE, "sweep_cache_wood.toml", Path::new("."), "test").unwrap();
+    let loaded = from_str(WOOD_SCENE, "sweep_frames_wood.toml", Path::new("."), "test").unwrap();
     let scene = &loaded.scene;
     let (culled_test, bvh) = (
         ShadowTest::culled(&scene.accel),
