@@ -3,6 +3,7 @@
 //! against a high-quality reference (relative MSE and SSIM). The named `--quality` presets are
 //! chosen from these measurements (validation/TRADEOFF.md).
 
+pub use crate::bench::clock::process_cpu_seconds;
 use serde::Serialize;
 use xylem::bsdf::FinishModel;
 use xylem::material::BakedFibers;
@@ -288,18 +289,6 @@ pub fn render_with(
     })
 }
 
-/// CPU seconds this process has run so far, user + system over all its threads (Linux:
-/// /proc/self/stat fields 14–15, clock ticks of 10 ms); `None` elsewhere. Unlike wall clock it
-/// does not grow while other jobs hold the cores (cache and SMT contention still show).
-pub fn process_cpu_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
-    // Fields after the command name, which is in parentheses and may hold spaces.
-    let rest = &stat[stat.rfind(')')? + 2..];
-    let fields: Vec<&str> = rest.split_whitespace().collect();
-    let ticks: f64 = fields.get(11)?.parse::<f64>().ok()? + fields.get(12)?.parse::<f64>().ok()?;
-    Some(ticks / 100.0)
-}
-
 /// (median, smallest, largest) of `xs` (the median of an even count is the mean of the middle
 /// two); (NaN, NaN, NaN) when empty.
 pub fn median_range(xs: &[f64]) -> (f64, f64, f64) {
@@ -327,13 +316,6 @@ mod tests {
         assert_eq!(median_range(&[3.0, 1.0, 2.0]), (2.0, 1.0, 3.0));
         assert_eq!(median_range(&[4.0, 1.0, 2.0, 10.0]), (3.0, 1.0, 10.0));
         assert!(median_range(&[]).0.is_nan());
-        // The process's CPU clock runs forward while it works.
-        let a = process_cpu_seconds().expect("Linux /proc/self/stat");
-        let mut x = 0u64;
-        while process_cpu_seconds().unwrap() < a + 0.05 {
-            x = x.wrapping_add(std::hint::black_box(1));
-        }
-        assert!(x > 0);
     }
 
     #[test]

@@ -5,6 +5,7 @@ use glam::Vec3;
 use std::process::ExitCode;
 use std::time::Instant;
 use xylem::wood::{self, Needs, WoodVolume};
+use xylem_lab::bench::clock::thread_cpu_seconds;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -27,16 +28,6 @@ pub struct Args {
     /// With `--passes`: only this level of `needs` (colour, fibres or all; default: the three).
     #[arg(long)]
     needs: Option<String>,
-}
-
-/// CPU time of the calling thread in seconds (Linux: /proc/thread-self/stat, clock ticks of
-/// 10 ms); `None` elsewhere. On a shared machine this excludes the time other jobs hold the core.
-fn thread_cpu_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/thread-self/stat").ok()?;
-    let rest = &stat[stat.rfind(')')? + 2..];
-    let fields: Vec<&str> = rest.split_whitespace().collect();
-    let ticks: f64 = fields.get(11)?.parse::<f64>().ok()? + fields.get(12)?.parse::<f64>().ok()?;
-    Some(ticks / 100.0)
 }
 
 /// Texels per CPU second of `volume` over `points` (one thread; wall clock where thread CPU time

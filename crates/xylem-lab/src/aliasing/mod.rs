@@ -12,8 +12,9 @@
 //! jackknife standard error ([`energies`]), and ratios between settings with Fieller's interval
 //! ([`ratio_interval`]). Derivation: notes/render.md, "The aliasing estimator".
 
+use crate::bench::clock::{children_cpu_seconds, process_cpu_seconds};
 use crate::report::{checks_table, Check};
-use crate::tradeoff::{apply, process_cpu_seconds, Knobs};
+use crate::tradeoff::{apply, Knobs};
 use glam::Vec3;
 use std::path::Path;
 use xylem::math::luminance;
@@ -90,17 +91,6 @@ mod tests;
 
 pub use estimator::*;
 
-/// CPU seconds of this process's waited-for children so far (user + system).
-fn children_cpu_seconds() -> f64 {
-    // SAFETY: getrusage writes the struct it is given and nothing else.
-    let mut ru: libc::rusage = unsafe { std::mem::zeroed() };
-    if unsafe { libc::getrusage(libc::RUSAGE_CHILDREN, &mut ru) } != 0 {
-        return f64::NAN;
-    }
-    let s = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
-    s(ru.ru_utime) + s(ru.ru_stime)
-}
-
 /// One render's images: the beauty and the first hits' albedo AOV (the wood's colour averaged
 /// over the pixel's samples: the texture alone, without the lighting's noise).
 #[derive(Clone, Debug)]
@@ -162,7 +152,10 @@ pub fn render_with_binary(
         .arg("--quiet")
         .output()
         .map_err(|e| format!("running {}: {e}", binary.display()))?;
-    let cpu = children_cpu_seconds() - cpu0;
+    let cpu = match (cpu0, children_cpu_seconds()) {
+        (Some(a), Some(b)) => b - a,
+        _ => f64::NAN,
+    };
     if !out.status.success() {
         return Err(format!(
             "{} render {scene} failed: {}",

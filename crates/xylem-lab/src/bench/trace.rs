@@ -3,6 +3,7 @@
 //! time and closest-hit / any-hit rays per second on one core, for xylem's wide BVH and, on the
 //! same mesh and rays, obvhs's CWBVH traversal (and Embree 3 with the feature `embree-anchor`).
 
+pub(crate) use super::clock::ThreadTimer;
 use glam::{Vec2, Vec3};
 use obvhs::cwbvh::{builder::build_cwbvh_from_tris, CwBvh};
 use obvhs::ray::{Ray as BvhRay, RayHit};
@@ -207,49 +208,6 @@ pub struct EmbreeFigures {
     pub closest_ratio_coherent: f64,
     /// xylem's closest-hit speed over Embree's, incoherent rays.
     pub closest_ratio_incoherent: f64,
-}
-
-/// A stopwatch over the calling thread's CPU time (`CLOCK_THREAD_CPUTIME_ID` on Linux, wall time
-/// elsewhere): on a shared machine the time the tracing thread waits descheduled is not counted,
-/// for xylem and Embree alike.
-#[derive(Clone, Copy)]
-pub(crate) struct ThreadTimer(Duration);
-
-impl ThreadTimer {
-    /// Starts the stopwatch.
-    pub fn start() -> Self {
-        ThreadTimer(thread_time())
-    }
-
-    /// CPU time of the calling thread since [`ThreadTimer::start`].
-    pub fn elapsed(&self) -> Duration {
-        thread_time().saturating_sub(self.0)
-    }
-}
-
-#[cfg(target_os = "linux")]
-fn thread_time() -> Duration {
-    let mut ts = libc::timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: `ts` is a valid timespec for clock_gettime to write.
-    let ok = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) } == 0;
-    if ok {
-        Duration::new(ts.tv_sec as u64, ts.tv_nsec as u32)
-    } else {
-        wall_time()
-    }
-}
-
-#[cfg(not(target_os = "linux"))]
-fn thread_time() -> Duration {
-    wall_time()
-}
-
-fn wall_time() -> Duration {
-    static START: std::sync::OnceLock<Instant> = std::sync::OnceLock::new();
-    START.get_or_init(Instant::now).elapsed()
 }
 
 /// Traces `rays` closest-hit and any-hit on the calling thread and times both.
