@@ -215,7 +215,6 @@ pub(super) fn gallery(
     presets: Option<&Path>,
 ) -> anyhow::Result<()> {
     use xylem::picture::contact::contact_sheet_rows;
-    use xylem::picture::png::write_png_rgb8;
     use xylem::picture::srgb::to_srgb8;
     use xylem::picture::Rgb8;
     use xylem::sweep::{render_sweep, SweepPath};
@@ -274,17 +273,12 @@ pub(super) fn gallery(
             labels.push(format!("{name} {angle:+.0}°"));
         }
         let sheet = contact_sheet_rows(&row, &labels[labels.len() - row.len()..], row.len(), 4);
-        write_png_rgb8(
-            &out.join(format!("{name}.png")),
-            sheet.width,
-            sheet.height,
-            &sheet.data,
-        )?;
+        sheet.write_png(&out.join(format!("{name}.png")))?;
         thumbs.extend(row);
     }
     let sheet = contact_sheet_rows(&thumbs, &labels, angles.len(), 4);
     let path = out.join("gallery.png");
-    write_png_rgb8(&path, sheet.width, sheet.height, &sheet.data)?;
+    sheet.write_png(&path)?;
     println!("wrote {} presets and {}", names.len(), path.display());
     Ok(())
 }

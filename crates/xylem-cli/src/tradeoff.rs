@@ -380,7 +380,7 @@ fn write_plot(path: &Path, rows: &[Measurement]) -> anyhow::Result<()> {
     if let Some(p) = path.parent() {
         std::fs::create_dir_all(p)?;
     }
-    xylem::picture::png::write_png_rgb8(path, img.width, img.height, &img.data)?;
+    img.write_png(path)?;
     Ok(())
 }
 

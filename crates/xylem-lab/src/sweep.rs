@@ -189,8 +189,7 @@ fn write_plot(
     if let Some(p) = path.parent() {
         std::fs::create_dir_all(p).map_err(|e| err(e.to_string()))?;
     }
-    xylem::picture::png::write_png_rgb8(&path, img.width, img.height, &img.data)
-        .map_err(|e| err(e.to_string()))
+    img.write_png(&path).map_err(|e| err(e.to_string()))
 }
 
 /// Check 1 for one inclination.

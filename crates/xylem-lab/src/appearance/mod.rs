@@ -12,7 +12,6 @@ use xylem::material::{MeasuredBoard, Placement, SawnCut};
 use xylem::math::luminance;
 use xylem::picture::contact::contact_sheet_rows;
 use xylem::picture::plot::{line_plot, PlotOptions, Series, PALETTE};
-use xylem::picture::png::write_png_rgb8;
 use xylem::picture::srgb::to_srgb8;
 use xylem::picture::Rgb8;
 use xylem::render::{render, RunOptions};

@@ -109,7 +109,7 @@ fn write_png(dir: &Path, rel: &str, img: &Rgb8) -> Result<(), String> {
     if let Some(p) = path.parent() {
         std::fs::create_dir_all(p).map_err(|e| format!("{}: {e}", p.display()))?;
     }
-    write_png_rgb8(&path, img.width, img.height, &img.data)
+    img.write_png(&path)
         .map_err(|e| format!("{}: {e}", path.display()))
 }
 

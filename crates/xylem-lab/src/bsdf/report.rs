@@ -197,7 +197,7 @@ pub fn write_polar_plot(spec: &CaseSpec, path: &Path) -> Result<(), PolarPlotErr
             source,
         })?;
     }
-    xylem::picture::png::write_png_rgb8(path, img.width, img.height, &img.data)?;
+    img.write_png(path)?;
     Ok(())
 }
 

@@ -18,7 +18,7 @@ fn plot_png(
         },
     );
     let path = dir.join(name);
-    xylem::picture::png::write_png_rgb8(&path, img.width, img.height, &img.data)
+    img.write_png(&path)
         .map_err(|e| format!("{}: {e}", path.display()))
 }
 
@@ -170,7 +170,8 @@ fn board_rows(
     let exr_errors = e;
     let sheet = side_by_side(&rt.truth, &maps);
     let file = format!("fit_{}.png", name.replace(' ', "_"));
-    xylem::picture::png::write_png_rgb8(&plots.join(&file), sheet.width, sheet.height, &sheet.data)
+    sheet
+        .write_png(&plots.join(&file))
         .map_err(|e| e.to_string())?;
     let png = w.join("camera");
     to_camera_frames(&rt.sweep_dir, &png, Some(FULL_WELL), 17, Exposure::Wood)?;
@@ -432,7 +433,8 @@ pub fn readme_figure(
     .map(|s| s.to_string())
     .collect();
     let sheet = contact_sheet_rows(&thumbs, &labels, 5, 4);
-    xylem::picture::png::write_png_rgb8(path, sheet.width, sheet.height, &sheet.data)
+    sheet
+        .write_png(path)
         .map_err(|e| format!("{}: {e}", path.display()))
 }
 

@@ -122,6 +122,11 @@ pub struct Rgb8 {
 }
 
 impl Rgb8 {
+    /// Writes the picture as an sRGB-tagged PNG, whole or not at all (`png::write_png_rgb8`).
+    pub fn write_png(&self, path: &Path) -> Result<(), ImageError> {
+        super::png::write_png_rgb8(path, self.width, self.height, &self.data)
+    }
+
     /// A `width × height` image filled with one colour.
     pub fn filled(width: u32, height: u32, rgb: [u8; 3]) -> Self {
         let data = rgb

@@ -16,7 +16,7 @@ pub use environment::{EnvMap, Environment};
 pub use rect::RectLight;
 pub use samples::LightSamples;
 pub(crate) use sphere::sphere_line_misses;
-pub use sphere::{intersect_sphere, SphereLight};
+pub use sphere::SphereLight;
 
 use super::geometry::Ray;
 use crate::math::PI;

@@ -132,7 +132,7 @@ pub(crate) fn sphere_line_misses(ray: &Ray, center: Vec3, radius: f32) -> bool {
 }
 
 /// Nearest positive distance at which `ray` (unit direction) meets a sphere.
-pub fn intersect_sphere(ray: &Ray, center: Vec3, radius: f32) -> Option<f32> {
+pub(crate) fn intersect_sphere(ray: &Ray, center: Vec3, radius: f32) -> Option<f32> {
     let oc = ray.o - center;
     let b = oc.dot(ray.d);
     // The test of `sphere_line_misses`, on the same values.
