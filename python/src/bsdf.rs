@@ -3,17 +3,17 @@
 
 use crate::*;
 
-/// The fields of `WoodBsdfParams`, in the order the constructor documents them.
-pub(crate) const BSDF_FIELDS: [&str; 8] = [
-    "diffuse",
-    "fiber_color",
-    "fiber_dir",
-    "ray_dir",
-    "ray_mask",
-    "highlight_width",
-    "eta",
-    "roughness",
-];
+/// The fields of `WoodBsdfParams`, in the order the constructor documents them: the names of
+/// the engine's parameter table `xylem::bsdf::WOOD_BSDF_PARAMS`.
+pub(crate) const BSDF_FIELDS: [&str; 8] = {
+    let mut names = [""; 8];
+    let mut i = 0;
+    while i < names.len() {
+        names[i] = xylem::bsdf::WOOD_BSDF_PARAMS[i].name;
+        i += 1;
+    }
+    names
+};
 
 /// Per-shading-point BSDF parameters from a dict of fields, each a scalar / 3-vector or an array
 /// of them over any leading shape (broadcast together); missing fields take

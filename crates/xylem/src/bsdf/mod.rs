@@ -125,6 +125,142 @@ pub struct WoodBsdfParams {
     pub roughness: f32,
 }
 
+/// How a field of a parameter table is checked.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ParamKind {
+    /// Linear RGB, every channel finite and in [0, 1].
+    Colour,
+    /// A direction: finite, its length within 1e-3 of 1 (normalised when used).
+    UnitVector,
+    /// A finite scalar in `[min, max]`.
+    Scalar {
+        /// Smallest allowed value.
+        min: f32,
+        /// Largest allowed value.
+        max: f32,
+    },
+}
+
+/// One field of a parameter table: its name, how it is checked and the allowed range in words.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ParamSpec {
+    /// The field's name (as in the struct, Python's keyword arguments and scene files).
+    pub name: &'static str,
+    /// How it is checked.
+    pub kind: ParamKind,
+    /// The allowed range, in words (for error messages and documentation).
+    pub range: &'static str,
+}
+
+/// A field's value, as [`ParamSpec::check`] takes it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ParamValue {
+    /// A colour or a direction.
+    Vec3(Vec3),
+    /// A scalar.
+    Scalar(f32),
+}
+
+impl ParamSpec {
+    /// `Ok` when `v` is finite and in range, else the field's [`BsdfError::OutOfRange`].
+    pub fn check(&self, v: ParamValue) -> Result<(), BsdfError> {
+        let ok = match (self.kind, v) {
+            (ParamKind::Colour, ParamValue::Vec3(c)) => {
+                c.is_finite() && c.min_element() >= 0.0 && c.max_element() <= 1.0
+            }
+            (ParamKind::UnitVector, ParamValue::Vec3(d)) => {
+                d.is_finite() && (d.length() - 1.0).abs() <= 1e-3
+            }
+            (ParamKind::Scalar { min, max }, ParamValue::Scalar(x)) => {
+                x.is_finite() && x >= min && x <= max
+            }
+            _ => false,
+        };
+        ok.then_some(()).ok_or_else(|| BsdfError::OutOfRange {
+            field: self.name,
+            value: match v {
+                ParamValue::Vec3(c) => format!("{c}"),
+                ParamValue::Scalar(x) => format!("{x}"),
+            },
+            range: self.range,
+        })
+    }
+}
+
+/// The unit interval [0, 1], the range of masks, weights and roughness.
+const UNIT: ParamKind = ParamKind::Scalar { min: 0.0, max: 1.0 };
+
+/// The fields of [`WoodBsdfParams`] in declaration order, with their checks: the one list that
+/// [`WoodBsdf::new`] validates against, Python's `WoodBsdf` takes as keyword arguments (its
+/// `FIELDS`) and scenes/README.md documents for the `fiber` material (tested there).
+pub const WOOD_BSDF_PARAMS: [ParamSpec; 8] = [
+    ParamSpec {
+        name: "diffuse",
+        kind: ParamKind::Colour,
+        range: "finite channels in [0, 1]",
+    },
+    ParamSpec {
+        name: "fiber_color",
+        kind: ParamKind::Colour,
+        range: "finite channels in [0, 1]",
+    },
+    ParamSpec {
+        name: "fiber_dir",
+        kind: ParamKind::UnitVector,
+        range: "a finite unit vector (length within 1e-3 of 1)",
+    },
+    ParamSpec {
+        name: "ray_dir",
+        kind: ParamKind::UnitVector,
+        range: "a finite unit vector (length within 1e-3 of 1)",
+    },
+    ParamSpec {
+        name: "ray_mask",
+        kind: UNIT,
+        range: "a finite value in [0, 1]",
+    },
+    ParamSpec {
+        name: "highlight_width",
+        kind: ParamKind::Scalar {
+            min: 1e-3,
+            max: 0.5 * std::f32::consts::PI,
+        },
+        range: "radians in [0.001, π/2]",
+    },
+    ParamSpec {
+        name: "eta",
+        kind: ParamKind::Scalar { min: 1.0, max: 4.0 },
+        range: "a finite index in [1, 4]",
+    },
+    ParamSpec {
+        name: "roughness",
+        kind: UNIT,
+        range: "a finite value in [0, 1]",
+    },
+];
+
+impl WoodBsdfParams {
+    /// The fields' values in [`WOOD_BSDF_PARAMS`]' order.
+    pub fn values(&self) -> [ParamValue; 8] {
+        use ParamValue::{Scalar, Vec3 as V};
+        [
+            V(self.diffuse),
+            V(self.fiber_color),
+            V(self.fiber_dir),
+            V(self.ray_dir),
+            Scalar(self.ray_mask),
+            Scalar(self.highlight_width),
+            Scalar(self.eta),
+            Scalar(self.roughness),
+        ]
+    }
+
+    /// The spec of field `name` in [`WOOD_BSDF_PARAMS`].
+    pub fn spec(name: &str) -> Option<&'static ParamSpec> {
+        WOOD_BSDF_PARAMS.iter().find(|p| p.name == name)
+    }
+}
+
 impl Default for WoodBsdfParams {
     fn default() -> Self {
         WoodBsdfParams {

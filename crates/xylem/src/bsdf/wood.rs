@@ -9,7 +9,7 @@ use super::fiber_albedo::{dip_of, max_lobe_albedo};
 use super::fresnel::{fresnel_dielectric, fresnel_diffuse_reflectance, refract_in, refract_out};
 use super::rough_finish::RoughFinish;
 use super::rough_transmission::RoughTransmission;
-use super::{Bsdf, BsdfError, BsdfSample, WoodBsdfParams};
+use super::{Bsdf, BsdfError, BsdfSample, WoodBsdfParams, WOOD_BSDF_PARAMS};
 use crate::math::{cosine_hemisphere, luminance, safe_sqrt, INV_PI, PI};
 use glam::{Vec2, Vec3};
 
@@ -77,61 +77,6 @@ pub enum FinishModel {
     ClosedForm,
     /// k = 0 only: one pass through the finish, no internal reflections.
     SingleBounce,
-}
-
-fn check_unit_interval(field: &'static str, v: f32) -> Result<(), BsdfError> {
-    if v.is_finite() && (0.0..=1.0).contains(&v) {
-        Ok(())
-    } else {
-        Err(BsdfError::OutOfRange {
-            field,
-            value: format!("{v}"),
-            range: "a finite value in [0, 1]",
-        })
-    }
-}
-
-fn check_colour(field: &'static str, c: Vec3) -> Result<(), BsdfError> {
-    if c.is_finite() && c.min_element() >= 0.0 && c.max_element() <= 1.0 {
-        Ok(())
-    } else {
-        Err(BsdfError::OutOfRange {
-            field,
-            value: format!("{c}"),
-            range: "finite channels in [0, 1]",
-        })
-    }
-}
-
-fn check_unit_vector(field: &'static str, v: Vec3) -> Result<Vec3, BsdfError> {
-    let len = v.length();
-    if v.is_finite() && (len - 1.0).abs() <= 1e-3 {
-        Ok(v / len)
-    } else {
-        Err(BsdfError::OutOfRange {
-            field,
-            value: format!("{v}"),
-            range: "a finite unit vector (length within 1e-3 of 1)",
-        })
-    }
-}
-
-fn check_range(
-    field: &'static str,
-    v: f32,
-    lo: f32,
-    hi: f32,
-    range: &'static str,
-) -> Result<(), BsdfError> {
-    if v.is_finite() && v >= lo && v <= hi {
-        Ok(())
-    } else {
-        Err(BsdfError::OutOfRange {
-            field,
-            value: format!("{v}"),
-            range,
-        })
-    }
 }
 
 /// The diffuse albedo scaled uniformly, s = min(1, min_c (1 − k_f,c Ā)/ρ_c), so that the diffuse
@@ -209,20 +154,13 @@ fn sampling_about(spread: &[PsiSpread; 2], beta: f32) -> (f32, f32) {
 impl WoodBsdf {
     /// Validates `params` (every field finite and in range) and precomputes what every call needs.
     pub fn new(params: WoodBsdfParams) -> Result<WoodBsdf, BsdfError> {
-        check_colour("diffuse", params.diffuse)?;
-        check_colour("fiber_color", params.fiber_color)?;
-        let fiber_dir = check_unit_vector("fiber_dir", params.fiber_dir)?;
-        let ray_dir = check_unit_vector("ray_dir", params.ray_dir)?;
-        check_unit_interval("ray_mask", params.ray_mask)?;
-        check_range(
-            "highlight_width",
-            params.highlight_width,
-            1e-3,
-            0.5 * PI,
-            "radians in [0.001, π/2]",
-        )?;
-        check_range("eta", params.eta, 1.0, 4.0, "a finite index in [1, 4]")?;
-        check_unit_interval("roughness", params.roughness)?;
+        for (spec, v) in WOOD_BSDF_PARAMS.iter().zip(params.values()) {
+            spec.check(v)?;
+        }
+        let (fiber_dir, ray_dir) = (
+            params.fiber_dir / params.fiber_dir.length(),
+            params.ray_dir / params.ray_dir.length(),
+        );
         let mut params = params;
         params.fiber_dir = fiber_dir;
         params.ray_dir = ray_dir;

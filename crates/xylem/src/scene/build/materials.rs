@@ -3,6 +3,15 @@
 use crate::scene::*;
 
 impl Builder<'_> {
+    /// `x` checked against the range of the wood BSDF's scalar field `name`
+    /// ([`WOOD_BSDF_PARAMS`](crate::bsdf::WOOD_BSDF_PARAMS)), reported as the scene's `field`.
+    pub(crate) fn bsdf_range(&self, field: &str, x: f32, name: &str) -> Result<f32, SceneError> {
+        match WoodBsdfParams::spec(name).map(|p| p.kind) {
+            Some(crate::bsdf::ParamKind::Scalar { min, max }) => self.range(field, x, min, max),
+            _ => unreachable!("`{name}` is a scalar field of WOOD_BSDF_PARAMS"),
+        }
+    }
+
     pub(in crate::scene) fn materials(
         &mut self,
         tables: &BTreeMap<String, MaterialTable>,
@@ -30,12 +39,12 @@ impl Builder<'_> {
                         fiber_color: self.color(&f("fiber_color"), *fiber_color, 1.0)?,
                         fiber_dir: self.unit3(&f("fiber_dir"), *fiber_dir)?,
                         ray_dir: self.unit3(&f("ray_dir"), *ray_dir)?,
-                        ray_mask: self.range(&f("ray_mask"), *ray_mask, 0.0, 1.0)?,
+                        ray_mask: self.bsdf_range(&f("ray_mask"), *ray_mask, "ray_mask")?,
                         highlight_width: self
                             .range(&f("highlight_width_deg"), *highlight_width_deg, 0.06, 90.0)?
                             .to_radians(),
-                        eta: self.range(&f("eta"), *eta, 1.0, 4.0)?,
-                        roughness: self.range(&f("roughness"), *roughness, 0.0, 1.0)?,
+                        eta: self.bsdf_range(&f("eta"), *eta, "eta")?,
+                        roughness: self.bsdf_range(&f("roughness"), *roughness, "roughness")?,
                     };
                     // Let the BSDF itself check the combination once, here, with a clear message.
                     WoodBsdf::new(params).map_err(|e| self.invalid(f("type"), e.to_string()))?;
@@ -72,8 +81,8 @@ impl Builder<'_> {
                         .map_err(|e| self.invalid(f("preset"), e.to_string()))?;
                     Material::Wood(Box::new(WoodMaterial {
                         volume: Arc::new(volume),
-                        eta: self.range(&f("eta"), *eta, 1.0, 4.0)?,
-                        roughness: self.range(&f("roughness"), *roughness, 0.0, 1.0)?,
+                        eta: self.bsdf_range(&f("eta"), *eta, "eta")?,
+                        roughness: self.bsdf_range(&f("roughness"), *roughness, "roughness")?,
                         bump,
                         switches: Default::default(),
                     }))
@@ -173,8 +182,8 @@ impl Builder<'_> {
             face.rect(size),
             scale,
             beta.to_radians(),
-            self.range(&f("eta"), *eta, 1.0, 4.0)?,
-            self.range(&f("roughness"), *roughness, 0.0, 1.0)?,
+            self.bsdf_range(&f("eta"), *eta, "eta")?,
+            self.bsdf_range(&f("roughness"), *roughness, "roughness")?,
         );
         if m.clamped > 0 {
             self.warnings.push(format!(
