@@ -121,6 +121,75 @@ def _albedo_table():
                     dtype=np.float32)
 
 
+def _shading_maps(mi, dr, maps, bump, f_int):
+    """The texture the BSDF looks up, derived once per texel from the bake's maps (an (H, W,
+    14 or 17) tensor, `_maps`) as `Texel` used to derive it at every lookup: the bounded
+    diffuse rho'' (3, wood.rs `bounded_diffuse`; notes/bsdf.md §1.3, §2.3), beta, the fibre
+    colour (3) and the ray mask, clamped as material/baked.rs `BakedWoodMaterial::shade` clamps
+    them, the unit tangent-space fibre and ray axes (3 + 3; a zero fibre axis is x, a zero ray
+    axis in the face across the fibre, face.rs: xylem's frame.t = n x s) and, with `bump` > 0,
+    the unit bumped normal (3; the baked normal's slope times `bump`, Blinn 1978). (H, W, 14),
+    or 17 with the normal.
+
+    Only the axes' dips below the bumped normal enter rho''s bound (its lobe albedos), and the
+    tangent-space axes and normal hold them, so nothing here depends on the hit's frame. At
+    texel centres the BSDF is what deriving these at the lookup gave; between them rho'' is
+    interpolated instead of its inputs. Computed with Dr.Jit ops, so in AD variants the
+    gradients of `maps` (what ``mi.traverse`` lists) flow through it; the scalar variant
+    derives them with Dr.Jit's LLVM backend."""
+    if dr.is_jit_v(mi.Float):
+        Float, UInt, Vec, Tensor, Tex = mi.Float, mi.UInt32, mi.Vector3f, mi.TensorXf, mi.Texture2f
+        Point2f, src = mi.Point2f, maps
+    else:
+        import drjit.llvm as jit
+        Float, UInt, Vec, Tensor, Tex = (jit.Float, jit.UInt32, jit.Array3f, jit.TensorXf,
+                                         jit.Texture2f)
+        Point2f, src = jit.Array2f, jit.TensorXf(np.array(maps))
+    h, w, c = src.shape
+    idx = dr.arange(UInt, h * w)
+    ch = [dr.gather(Float, src.array, idx * c + k) for k in range(c)]
+
+    def unit(v, fallback):
+        return dr.select(dr.squared_norm(v) < 1e-12, fallback, dr.normalize(v))
+
+    diffuse = Vec(*(dr.clip(x, 0.0, 1.0) for x in ch[0:3]))
+    beta = dr.clip(ch[3], 1e-3, 0.5 * math.pi)
+    fiber = Vec(*(dr.clip(x, 0.0, 1.0) for x in ch[4:7]))
+    m = dr.clip(ch[7], 0.0, 1.0)
+    u = unit(Vec(ch[8], ch[9], ch[10]), Vec(1.0, 0.0, 0.0))
+    s = unit(Vec(u.x, u.y, 0.0), Vec(1.0, 0.0, 0.0))
+    r = unit(Vec(ch[11], ch[12], ch[13]), Vec(-s.y, s.x, 0.0))
+    out = [*diffuse, beta, *fiber, m, *u, *r]
+    nb = Vec(0.0, 0.0, 1.0)
+    if bump > 0:
+        nb = unit(Vec(bump * ch[14], bump * ch[15], ch[16]), nb)
+        out += [*nb]
+    albedo = Tex(Tensor(_albedo_table()[..., None]), filter_mode=dr.FilterMode.Linear,
+                 wrap_mode=dr.WrapMode.Clamp)
+
+    def bound(axis):
+        """The lobe albedo bound of `axis` at the texel's beta and the axis's dip below the
+        bumped normal (the 121-node table, bilinear: xylem's own)."""
+        dip = dr.asin(dr.minimum(dr.abs(dr.dot(axis, nb)), 1.0))
+        scale = 2.0 / math.pi * (ALBEDO_NODES - 1) / ALBEDO_NODES
+        pos = Point2f(beta * scale + 0.5 / ALBEDO_NODES, dip * scale + 0.5 / ALBEDO_NODES)
+        return albedo.eval(pos)[0]
+
+    # rho'' = rho' / (1 - rho' F_int), rho' = s rho, s = min(1, min_c room_c / rho_c), room =
+    # 1 - k_f A, A the ray-mask blend of the lobes' albedo bounds.
+    room = 1.0 - fiber * ((1.0 - m) * bound(u) + m * bound(r))
+    ratio = dr.select(diffuse > room, room / dr.maximum(diffuse, 1e-30), 1.0)
+    rho = diffuse * dr.minimum(dr.minimum(ratio.x, ratio.y), dr.minimum(ratio.z, 1.0))
+    out[0:3] = rho / (1.0 - rho * f_int)
+    flat = dr.zeros(Float, h * w * len(out))
+    for k, x in enumerate(out):
+        dr.scatter(flat, x, idx * len(out) + k)
+    shape = (h, w, len(out))
+    if Tensor is mi.TensorXf:
+        return Tensor(flat, shape)
+    return mi.TensorXf(np.array(flat, dtype=np.float32).reshape(shape))
+
+
 def _frame_axes(mi, dr, si):
     """Tangent-space x ("right") and y ("up") in the shading frame's coordinates: x = dp/du
     projected into the surface (the shading frame's s where dp/du is unset), y = n x right,
@@ -283,69 +352,39 @@ def bsdf_class(mi, dr):
 
     class Texel:
         """The BSDF's parameters at the interaction (wood.rs `WoodBsdf::new` for the texel's
-        values), in the coordinates of the BSDF's frame: the shading frame, or the frame about
-        the bumped normal (`local` / `world` map directions between the two)."""
+        values; `_shading_maps` derived them per texel) and its frame: the tangent frame (x
+        along dp/du, y against dp/dv, z the shading normal; `_frame_axes`) or, with the bump, a
+        frame about the bumped normal in it. `local` / `world` map Mitsuba's shading-frame
+        directions to and from it; the lobes depend only on dot products with the normal and
+        the axes, so any frame about the normal will do."""
 
         def __init__(self, bsdf, si, active):
-            uv = si.uv
-            v = bsdf._texture.eval(uv, active)
-            a, b, f, g = v[0:4], v[4:8], v[8:11], v[11:14]
-            # Clamped as material/baked.rs `BakedWoodMaterial::shade` clamps the lookup.
-            self.diffuse = dr.clip(mi.Color3f(a[0], a[1], a[2]), 0.0, 1.0)
-            self.fiber_color = dr.clip(mi.Color3f(b[0], b[1], b[2]), 0.0, 1.0)
-            self.beta = dr.clip(a[3], 1e-3, 0.5 * math.pi)
-            self.m = dr.clip(b[3], 0.0, 1.0)
-            right, up = _frame_axes(mi, dr, si)
+            v = bsdf._texture.eval(si.uv, active)
+            self.diffuse_eff = mi.Color3f(v[0], v[1], v[2])
+            self.beta, self.m = v[3], v[7]
+            self.fiber_color = mi.Color3f(v[4], v[5], v[6])
+            self.right, self.up = _frame_axes(mi, dr, si)
 
-            def axis(t):
-                return right * t[0] + up * t[1] + mi.Vector3f(0, 0, 1) * t[2]
+            def unit(a, b, c, fallback):
+                """An interpolated unit vector renormalised."""
+                x = mi.Vector3f(a, b, c)
+                return dr.select(dr.squared_norm(x) < 1e-12, fallback, dr.normalize(x))
 
-            u = axis(f)
-            self.u = dr.select(dr.squared_norm(u) < 1e-12, right, dr.normalize(u))
-            # The ray axis: the baked one (the volume's, as the solid wood's material.rs
-            # `WoodMaterial` gives it), else in the face across the fibre (face.rs: xylem's
-            # frame.t = n x s).
-            s = mi.Vector3f(self.u.x, self.u.y, 0.0)
-            s = dr.select(dr.squared_norm(s) > 1e-12, dr.normalize(s), mi.Vector3f(1, 0, 0))
-            r = axis(g)
-            self.r = dr.select(dr.squared_norm(r) < 1e-12, mi.Vector3f(-s.y, s.x, 0.0),
-                               dr.normalize(r))
+            self.u = unit(v[8], v[9], v[10], mi.Vector3f(1, 0, 0))
+            self.r = unit(v[11], v[12], v[13], mi.Vector3f(0, 1, 0))
             self.frame = None
             if bsdf.bump > 0:
-                # The pore bump (Blinn 1978), as material.rs `WoodMaterial` tilts the normal:
-                # the baked tangent-space normal (-dh/dx, -dh/dy, 1) normalised, its slope scaled
-                # by `bump`; the BSDF is evaluated in a frame about it, the fibre and ray axes
-                # expressed there unprojected, as xylem's Frame::from_normal_tangent does.
-                n = v[14:17]
-                nb = axis((bsdf.bump * n[0], bsdf.bump * n[1], n[2]))
-                nb = dr.select(dr.squared_norm(nb) < 1e-12, mi.Vector3f(0, 0, 1), dr.normalize(nb))
-                self.frame = mi.Frame3f(nb)
+                self.frame = mi.Frame3f(unit(v[14], v[15], v[16], mi.Vector3f(0, 0, 1)))
                 self.u, self.r = self.frame.to_local(self.u), self.frame.to_local(self.r)
-            self.diffuse_eff = self._diffuse(bsdf)
 
         def local(self, w):
-            """A shading-frame direction in the BSDF's frame (the bumped one, if any)."""
+            """A shading-frame direction in the BSDF's frame."""
+            w = mi.Vector3f(dr.dot(w, self.right), dr.dot(w, self.up), w.z)
             return w if self.frame is None else self.frame.to_local(w)
 
         def world(self, w):
-            return w if self.frame is None else self.frame.to_world(w)
-
-        def _diffuse(self, bsdf):
-            """rho'' = rho' / (1 - rho' F_int), rho' = s rho, s = min(1, min_c room_c / rho_c),
-            room = 1 - k_f A with A the ray-mask blend of the lobes' albedo bounds (wood.rs
-            `bounded_diffuse`; notes/bsdf.md §1.3, §2.3)."""
-            def bound(axis_z):
-                dip = dr.asin(dr.minimum(dr.abs(axis_z), 1.0))
-                scale = 2.0 / math.pi * (ALBEDO_NODES - 1) / ALBEDO_NODES
-                pos = mi.Point2f(self.beta * scale + 0.5 / ALBEDO_NODES,
-                                 dip * scale + 0.5 / ALBEDO_NODES)
-                return bsdf._albedo.eval(pos)[0]
-
-            albedo = (1.0 - self.m) * bound(self.u.z) + self.m * bound(self.r.z)
-            room, rho = 1.0 - self.fiber_color * albedo, self.diffuse
-            ratio = dr.select(rho > room, room / dr.maximum(rho, 1e-30), 1.0)
-            rho = rho * dr.minimum(dr.minimum(ratio.x, ratio.y), dr.minimum(ratio.z, 1.0))
-            return rho / (1.0 - rho * bsdf._f_int)
+            w = w if self.frame is None else self.frame.to_world(w)
+            return self.right * w.x + self.up * w.y + mi.Vector3f(0, 0, w.z)
 
     class View:
         """What the BSDF needs of the view wo (Mitsuba's si.wi) alone, shared by every wi: the
@@ -389,8 +428,6 @@ def bsdf_class(mi, dr):
             # One texture (14 channels, 17 with the normal): a lookup computes its taps and
             # weights once.
             self._tensor = mi.TensorXf(_maps(self.maps, normal=self.bump > 0))
-            self._texture = mi.Texture2f(self._tensor, **linear)
-            self._albedo = mi.Texture2f(mi.TensorXf(_albedo_table()[..., None]), **linear)
             eta = self.eta
             # As WoodBsdf: below roughness 1e-3 the finish is smooth (wood.rs MIN_ROUGHNESS).
             self._rough = None
@@ -417,6 +454,9 @@ def bsdf_class(mi, dr):
             # 1 - R_int = (1 - R_avg) / eta^2 (wood.rs `escape`; notes/bsdf.md §1.3, §4.3).
             self._escape = (1.0 - avg_reflectance) / (eta * eta)
             self._f_int = 1.0 - self._escape
+            # What the BSDF looks up (`_shading_maps`): one texture, so that a lookup computes
+            # its taps and weights once.
+            self._texture = mi.Texture2f(self._shading(), **linear)
             self._z_crit = math.sqrt(max(0.0, 1.0 - 1.0 / (eta * eta)))
             self._delta = eta > 1.0 and self._rough is None
             lobes = (mi.BSDFFlags.DiffuseReflection | mi.BSDFFlags.GlossyReflection
@@ -601,8 +641,11 @@ def bsdf_class(mi, dr):
         def traverse(self, callback):
             callback.put("maps", self._tensor, mi.ParamFlags.Differentiable)
 
+        def _shading(self):
+            return _shading_maps(mi, dr, self._tensor, self.bump, self._f_int)
+
         def parameters_changed(self, keys=None):
-            self._texture.set_tensor(self._tensor)
+            self._texture.set_tensor(self._shading())
 
         def to_string(self):
             return (f"XylemWoodBaked[maps={self.maps}, eta={self.eta}, "
