@@ -221,9 +221,10 @@ def _fresnel(mi, dr, cos, eta):
     return mi.fresnel(dr.clip(cos, 0.0, 1.0), eta)[0]
 
 
-def _gaussian(dr, beta, x):
-    """g(beta, x) = exp(-x^2 / 2 beta^2) / (beta sqrt(2 pi)) (Marschner et al. 2005 §4.2)."""
-    return dr.exp(-0.5 * dr.square(x / beta)) / (beta * math.sqrt(2.0 * math.pi))
+def _gaussian(dr, inv_beta, x):
+    """g(beta, x) = exp(-x^2 / 2 beta^2) / (beta sqrt(2 pi)) (Marschner et al. 2005 §4.2), of
+    1 / beta (a division per width, shared by its Gaussians)."""
+    return dr.exp(-0.5 * dr.square(x * inv_beta)) * (inv_beta / math.sqrt(2.0 * math.pi))
 
 
 class _Angles:
@@ -236,11 +237,11 @@ class _Angles:
         self.cos = dr.safe_sqrt(1.0 - self.sin * self.sin)
 
 
-def _lobe(dr, o, i, beta):
+def _lobe(dr, o, i, inv_beta):
     """The energy-bounded fibre lobe g(beta, psi_i + psi_o) / (2 pi max(cos psi_i, cos psi_o))
     (fiber.rs lobe_value; notes/bsdf.md §2), without its colour; o, i: `_Angles`."""
     c = dr.maximum(dr.maximum(i.cos, o.cos), MIN_COS_PSI)
-    return _gaussian(dr, beta, i.psi + o.psi) / (2.0 * math.pi * c)
+    return _gaussian(dr, inv_beta, i.psi + o.psi) / (2.0 * math.pi * c)
 
 
 def _arc(dr, u, sin_psi, cos_psi, z_min):
@@ -252,13 +253,13 @@ def _arc(dr, u, sin_psi, cos_psi, z_min):
     return dr.select(t <= -1.0, math.pi, dr.select(t >= 1.0, 0.0, dr.acos(dr.clip(t, -1.0, 1.0))))
 
 
-def _lobe_pdf(dr, u, psi_o, i, wi_z, beta, z_min):
+def _lobe_pdf(dr, u, psi_o, i, wi_z, inv_beta, z_min):
     """Density of `_lobe_sample` about psi_o per interior solid angle at the interior direction
     with angles i and z = wi_z: g(beta, psi_i + psi_o) / (2 max(Delta, MIN_ARC) cos psi_i)
     (fiber.rs pdf_about; notes/bsdf.md §3)."""
     delta = _arc(dr, u, i.sin, i.cos, z_min)
     ok = (wi_z > z_min) & (i.cos >= MIN_COS_PSI) & (delta > 0)
-    g = _gaussian(dr, beta, i.psi + psi_o)
+    g = _gaussian(dr, inv_beta, i.psi + psi_o)
     width = 2.0 * dr.maximum(delta, MIN_ARC) * dr.maximum(i.cos, MIN_COS_PSI)
     return dr.select(ok, g / width, 0.0)
 
@@ -301,41 +302,67 @@ class _Spread:
     share, mean longitudinal angle psi = asin E[t.u], cos psi, and var psi = var(t.u) / (1 -
     E[t.u]^2) (fiber.rs `FiberAxis::spread`); E and var of t.u from the part's mean and
     covariance turned to w's azimuth (rough_transmission.rs `TransmittedPart::along`). `part`:
-    (share, mean x, mean z, cov xx, cov yy, cov xz)."""
+    (share, mean x, mean z, cov xx, cov yy, cov xz). Also 1 / max(cos psi, MIN_COS_PSI), for
+    the lobe's 1 / max(cos_a, cos_b) = min(1 / max(cos_a, .), 1 / max(cos_b, .))."""
 
     def __init__(self, dr, w, part, u):
         share, mx, mz, cxx, cyy, cxz = part
         r2 = w.x * w.x + w.y * w.y
-        r = dr.sqrt(dr.maximum(r2, 1e-12))
-        c, s = dr.select(r2 > 1e-12, w.x / r, 1.0), dr.select(r2 > 1e-12, w.y / r, 0.0)
+        inv_r = dr.rsqrt(dr.maximum(r2, 1e-12))
+        c, s = dr.select(r2 > 1e-12, w.x * inv_r, 1.0), dr.select(r2 > 1e-12, w.y * inv_r, 0.0)
         ux, uy = c * u.x + s * u.y, c * u.y - s * u.x
         czz = dr.maximum(1.0 - cxx - cyy - mx * mx - mz * mz, 0.0)
         mean = dr.clip(mx * ux + mz * u.z, -0.9999, 0.9999)
         var = dr.maximum(cxx * ux * ux + cyy * uy * uy + czz * u.z * u.z + 2.0 * cxz * ux * u.z,
                          0.0)
         cos2 = 1.0 - mean * mean
-        self.share, self.psi, self.cos, self.var = share, dr.asin(mean), dr.sqrt(cos2), var / cos2
+        self.share, self.psi, self.var = share, dr.asin(mean), var / cos2
+        self.inv_cos = 1.0 / dr.maximum(dr.sqrt(cos2), MIN_COS_PSI)
 
 
 def _lobe_spread(dr, o, i, beta):
     """The energy-bounded fibre lobe seen through a rough finish (notes/bsdf.md §4.6; fiber.rs
     `FiberAxis::eval_spread`): sum over the parts a of wo's and b of wi's `_Spread`s of
-    share_a share_b g(sqrt(beta^2 + var_a + var_b), psi_a + psi_b) / (2 pi max(cos_a, cos_b))."""
+    share_a share_b g(sqrt(beta^2 + var_a + var_b), psi_a + psi_b) / (2 pi max(cos_a, cos_b)),
+    the constant factors 1 / (2 pi sqrt(2 pi)) taken out of the sum."""
     f = 0.0
     for a in o:
         for b in i:
-            g = _gaussian(dr, dr.sqrt(beta * beta + a.var + b.var), a.psi + b.psi)
-            c = dr.maximum(dr.maximum(b.cos, a.cos), MIN_COS_PSI)
-            f += a.share * b.share * g / (2.0 * math.pi * c)
-    return f
+            inv_var = 1.0 / (beta * beta + a.var + b.var)
+            g = dr.exp(-0.5 * dr.square(a.psi + b.psi) * inv_var) * dr.sqrt(inv_var)
+            f += (a.share * b.share) * g * dr.minimum(a.inv_cos, b.inv_cos)
+    return f * (1.0 / (2.0 * math.pi * math.sqrt(2.0 * math.pi)))
 
 
 def _sampling_about(dr, spread, beta):
-    """(psi, width) a fibre lobe's samples are drawn with under a rough finish: the single
-    scattering part's mean angle, beta widened by twice the mean variance (wood.rs
+    """(psi, width, 1 / width) a fibre lobe's samples are drawn with under a rough finish: the
+    single scattering part's mean angle, beta widened by twice the mean variance (wood.rs
     `sampling_about`)."""
     var = spread[0].share * spread[0].var + spread[1].share * spread[1].var
-    return spread[0].psi, dr.minimum(dr.sqrt(beta * beta + 2.0 * var), 0.5 * math.pi)
+    width = dr.minimum(dr.sqrt(beta * beta + 2.0 * var), 0.5 * math.pi)
+    return spread[0].psi, width, 1.0 / width
+
+
+def _axis_view(dr, wo, wo_in, parts, axis, beta, inv_beta):
+    """How the view sees one axis (fibre or ray), shared by every wi: under a smooth finish
+    (`parts` None) the refracted view's `_Angles`, under a rough one the `_Spread`s of the
+    transmitted `parts`; and the (psi, width, 1 / width) its lobe's samples are drawn about."""
+    if parts is None:
+        a = _Angles(dr, wo_in, axis)
+        return a, (a.psi, beta, inv_beta)
+    spread = [_Spread(dr, wo, p, axis) for p in parts]
+    return spread, _sampling_about(dr, spread, beta)
+
+
+def _axis_terms(dr, seen, about, axis, wi, wi_in, parts_i, beta, inv_beta, z_min):
+    """One axis's lobe at wi (no colour; `_lobe`, or `_lobe_spread` under a rough finish) and
+    its sampling density per interior solid angle (`_lobe_pdf`); `seen`, `about`: `_axis_view`."""
+    angles = _Angles(dr, wi_in, axis)
+    if parts_i is None:
+        lobe = _lobe(dr, seen, angles, inv_beta)
+    else:
+        lobe = _lobe_spread(dr, seen, [_Spread(dr, wi, p, axis) for p in parts_i], beta)
+    return lobe, _lobe_pdf(dr, axis, about[0], angles, wi_in.z, about[2], z_min)
 
 
 _CLASSES = {}
@@ -362,6 +389,7 @@ def bsdf_class(mi, dr):
             v = bsdf._texture.eval(si.uv, active)
             self.diffuse_eff = mi.Color3f(v[0], v[1], v[2])
             self.beta, self.m = v[3], v[7]
+            self.inv_beta = 1.0 / self.beta
             self.fiber_color = mi.Color3f(v[4], v[5], v[6])
             self.right, self.up = _frame_axes(mi, dr, si)
 
@@ -388,23 +416,24 @@ def bsdf_class(mi, dr):
 
     class View:
         """What the BSDF needs of the view wo (Mitsuba's si.wi) alone, shared by every wi: the
-        finish's transmittance T(wo); smooth: wo refracted into the finish and its angles about
-        the fibre and ray axes; rough: R(wo), R_ms(wo) and how each axis sees the transmitted
-        light (`_Spread`s) with the (psi, width) its samples are drawn about (wood.rs
-        `RoughView`)."""
+        finish's transmittance T(wo); smooth: wo refracted into the finish; rough: R(wo),
+        R_ms(wo) and the transmitted light's parts (wood.rs `RoughView`); and how the fibre
+        axis sees it (`_axis_view`). The ray axis's view is computed where it is used, in
+        `rays` branches."""
 
         def __init__(self, bsdf, t, wo):
-            self.wo = wo
+            self.wo, self.wo_in, self.parts = wo, None, None
             if bsdf._rough is None:
                 self.trans = bsdf._transmittance(wo.z)
-                wo_in = _refract_in(mi, dr, wo, bsdf.eta)
-                self.angles = [_Angles(dr, wo_in, ax) for ax in (t.u, t.r)]
-                self.about = [(a.psi, t.beta) for a in self.angles]
-                return
-            self.reflectance, self.multiple, parts = bsdf._finish_at(wo.z)
-            self.trans = 1.0 - self.reflectance
-            self.spreads = [[_Spread(dr, wo, p, ax) for p in parts] for ax in (t.u, t.r)]
-            self.about = [_sampling_about(dr, sp, t.beta) for sp in self.spreads]
+                self.wo_in = _refract_in(mi, dr, wo, bsdf.eta)
+            else:
+                self.reflectance, self.multiple, self.parts = bsdf._finish_at(wo.z)
+                self.trans = 1.0 - self.reflectance
+            self.fiber = _axis_view(dr, wo, self.wo_in, self.parts, t.u, t.beta, t.inv_beta)
+
+        def ray_args(self, t):
+            """What the ray axis's view is made of (`_axis_view`'s arguments)."""
+            return (self.wo, self.wo_in, self.parts, t.r, t.beta, t.inv_beta)
 
     class XylemWoodBaked(mi.BSDF):
         def __init__(self, props):
@@ -536,6 +565,12 @@ def bsdf_class(mi, dr):
             inv = dr.select(total > 0, 1.0 / total, 0.0)
             return spec * inv, diff * inv, fib * inv, ray * inv
 
+        def _rays(self, t, fn, args):
+            """fn(*args), two Floats, where the texel has rays (ray mask m > 0), zeros where it
+            has none (m multiplies the ray lobe and its probability). A symbolic branch: a packet
+            of lanes with no rays skips it (86 % of a mahogany board's texels have m = 0)."""
+            return dr.if_stmt(args, t.m > 0.0, fn, lambda *_: (mi.Float(0.0), mi.Float(0.0)))
+
         def _eval_pdf(self, t, view, probs, wi):
             """xylem's f (no cosine) and the sampling density, sharing the refracted directions
             and the longitudinal angles. f = T(wo) T(wi) / eta^2 (rho''/pi + k_f ((1 - m)
@@ -546,19 +581,23 @@ def bsdf_class(mi, dr):
             d w_ext = cos theta_i / (eta^2 cos theta_i') (notes/bsdf.md §1.1), a rough
             finish's visible-normal density. Zero where either cosine is <= 0 or where not
             finite."""
-            eta, wo = self.eta, view.wo
+            eta, wo, z_crit = self.eta, view.wo, self._z_crit
             wi_in = _refract_in(mi, dr, wi, eta)
+            parts = None
             if self._rough is None:
                 trans_i = self._transmittance(wi.z)
-                lobes = [_lobe(dr, o, _Angles(dr, wi_in, ax), t.beta)
-                         for o, ax in zip(view.angles, (t.u, t.r))]
             else:
                 reflectance_i, multiple_i, parts = self._finish_at(wi.z)
                 trans_i = 1.0 - reflectance_i
-                lobes = [_lobe_spread(dr, sp, [_Spread(dr, wi, p, ax) for p in parts], t.beta)
-                         for sp, ax in zip(view.spreads, (t.u, t.r))]
-            dens = [_lobe_pdf(dr, ax, psi, _Angles(dr, wi_in, ax), wi_in.z, width, self._z_crit)
-                    for ax, (psi, width) in zip((t.u, t.r), view.about)]
+            fiber = _axis_terms(dr, *view.fiber, t.u, wi, wi_in, parts, t.beta, t.inv_beta,
+                                z_crit)
+
+            def ray(wo, wo_in, parts_o, r, beta, inv_beta, wi, wi_in, parts):
+                seen, about = _axis_view(dr, wo, wo_in, parts_o, r, beta, inv_beta)
+                return _axis_terms(dr, seen, about, r, wi, wi_in, parts, beta, inv_beta, z_crit)
+
+            ray = self._rays(t, ray, view.ray_args(t) + (wi, wi_in, parts))
+            lobes, dens = (fiber[0], ray[0]), (fiber[1], ray[1])
             substrate = t.diffuse_eff / math.pi + t.fiber_color * (
                 (1.0 - t.m) * lobes[0] + t.m * lobes[1])
             f = substrate * (view.trans * trans_i / (eta * eta))
@@ -602,9 +641,12 @@ def bsdf_class(mi, dr):
             c1, c2 = probs[0] + probs[1], probs[0] + probs[1] + probs[2]
             spec = sample1 < probs[0]
             diff = (sample1 >= probs[0]) & (sample1 < c1)
-            fib = (sample1 >= c1) & (sample1 < c2)
+            # (A ray lobe of probability 0 is never picked, also where c2 rounds below 1.)
+            fib = (sample1 >= c1) & ((sample1 < c2) | (probs[3] <= 0))
             axis = dr.select(fib, t.u, t.r)
-            psi, width = (dr.select(fib, a, b) for a, b in zip(*view.about))
+            ray_about = self._rays(t, lambda *args: _axis_view(dr, *args)[1][:2],
+                                   view.ray_args(t))
+            psi, width = (dr.select(fib, a, b) for a, b in zip(view.fiber[1], ray_about))
             wi_in, lobe_ok = _lobe_sample(mi, dr, axis, psi, sample2, width, self._z_crit)
             wi_lobe, leaves = _refract_out(mi, dr, wi_in, self.eta)
             if self._rough is None:
