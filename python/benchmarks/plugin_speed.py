@@ -22,7 +22,12 @@ Three renders per repeat, in turn:
   1.5), in Dr.Jit's default symbolic modes like ``roughplastic``. ``--maps DIR`` gives a bake
   folder; otherwise the script bakes one with ``$XYLEM_BIN`` or target/release/xylem;
 - ``xylem_wood_baked_rough``: the same with a rough finish (roughness 0.25, as
-  ``roughplastic``'s alpha): xylem's energy-compensated GGX finish.
+  ``roughplastic``'s alpha): xylem's energy-compensated GGX finish;
+- ``xylem_wood_baked_rough_mip``: the same with mip-mapped lookups (``pixel_angle`` from the
+  camera, ``xylem.mitsuba_baked.set_pixel_angle``).
+
+``--cases a,b`` runs only those (and ``roughplastic``, the ratios' base); ``--before DIR`` runs
+each plugin case again with the package in DIR (``CASE_before``): the A/B pair of a change.
 
 Both baked cases use the plugin's pore bump at ``--bump`` (default 1, the plugin's default;
 0: the normal map is not read).
@@ -82,7 +87,7 @@ def bake(exe, res, out):
 
 def scene(bsdf, res, spp, maps=None, bump=1.0):
     T = mi.ScalarTransform4f
-    return mi.load_dict({
+    sc = mi.load_dict({
         "type": "scene",
         "integrator": {"type": "path", "max_depth": 4},
         "sensor": {
@@ -97,10 +102,15 @@ def scene(bsdf, res, spp, maps=None, bump=1.0):
         "sky": {"type": "constant", "radiance": {"type": "rgb", "value": [0.2, 0.2, 0.25]}},
         "board": {"type": "rectangle", "to_world": T().scale([0.15, 0.15, 1.0]),
                   "bsdf": ({"type": "xylem_wood_baked", "maps": maps, "eta": 1.5,
-                            "roughness": 0.25 if bsdf.endswith("_rough") else 0.0,
+                            "roughness": 0.25 if "_rough" in bsdf else 0.0,
                             "bump": bump}
                            if bsdf.startswith("xylem_wood_baked") else dict(BSDFS[bsdf]))},
     })
+    if bsdf.endswith("_mip"):
+        import xylem.mitsuba_baked
+
+        xylem.mitsuba_baked.set_pixel_angle(sc)
+    return sc
 
 
 def render(sc, seed, evaluated):
@@ -142,7 +152,8 @@ def main():
              ("roughplastic_evaluated", "roughplastic", True),
              ("xylem_wood", "xylem_wood", True),
              ("xylem_wood_baked", "xylem_wood_baked", False),
-             ("xylem_wood_baked_rough", "xylem_wood_baked_rough", False)]
+             ("xylem_wood_baked_rough", "xylem_wood_baked_rough", False),
+             ("xylem_wood_baked_rough_mip", "xylem_wood_baked_rough_mip", False)]
     if args.cases and not args.one:
         keep = set(args.cases.split(",")) | {"roughplastic"}
         unknown = keep - {c[0] for c in cases}

@@ -12,15 +12,21 @@ megakernel and is differentiable.
 (an OBJ with ``vt`` whose same file Mitsuba loads: its OBJ loader flips v as xylem's reader
 does, so si.uv is the bake's uv): the plugin reads ``base_color.exr``, ``fiber_color.exr``,
 ``fiber_direction.exr`` and ``ray_direction.exr`` (the signed tangent-space fibre and ray
-axes), ``highlight_width.exr`` (beta, radians) and ``ray_mask.exr`` into one 14-channel
-``mi.Texture2f`` (bilinear, clamped at the edges, texel
-centres at (i + 1/2)/W as xylem's own ``BakedMaps::lookup``; one texture, so a lookup computes
-its taps once) and looks them up at ``si.uv`` (texel (0, 0) is the image's top-left, v runs
-down the rows, as glTF and the bake write them). ``eta`` is the finish's index (1-4,
+axes), ``highlight_width.exr`` (beta, radians) and ``ray_mask.exr``, derives from them once
+per texel what the BSDF needs (``_shading_maps``: the bounded diffuse, clamped values, unit
+axes and bumped normal) into one 14- or 17-channel ``mi.Texture2f`` (bilinear, clamped at the
+edges, texel centres at (i + 1/2)/W as xylem's own ``BakedMaps::lookup``; one texture, so a
+lookup computes its taps once) and looks it up at ``si.uv`` (texel (0, 0) is the image's
+top-left, v runs down the rows, as glTF and the bake write them). ``eta`` is the finish's index (1-4,
 default 1.5) and ``roughness`` its GGX roughness (0-1, default 0; below 1e-3 the finish is
 smooth, as in ``WoodBsdf``). ``bump`` (0-100, default 1) scales the slope of the baked normal
 map (``normal.exr``, the pore bump at the strength xylem's ``bump = 1``; 0 leaves it unread):
 the BSDF is evaluated in a frame about the tilted normal, as xylem's solid wood is.
+``pixel_angle`` (radians, default 0: none) turns on mip-mapped lookups: the ray-cone angle of a
+camera sample, which ``set_pixel_angle(scene)`` computes from the scene's camera and sets on
+every ``xylem_wood_baked`` there (Mitsuba's integrators give a BSDF no uv footprint); the
+lookups are then trilinear between the mip levels about the footprint (``_halve``,
+``_lookup``).
 
 The BSDF at a texel is xylem's ``WoodBsdf`` (crates/xylem/src/bsdf/wood.rs) for the parameters
 xylem's own baked-map material builds there (``material/face.rs`` ``face_shading``): the
@@ -52,7 +58,8 @@ texels; pores and ray flecks narrower than that blur); the tangent frame is Mits
 triangle (dp/du, dp/dv) where the bake interpolated vertex tangents; a bake without
 ``ray_direction.exr`` gets the ray axis in the face across the fibre; the pore bump is the
 baked normal map's, bilinear between texel centres (pores are about a texel wide at
-``--res 1024``), no mip maps. ``BSDFContext`` masks are honoured per component (0: the diffuse and fibre lobes and
+``--res 1024``); mip levels average the BSDF's parameters (colours, axes with beta widened by
+their spread, the normal), not the BSDF. ``BSDFContext`` masks are honoured per component (0: the diffuse and fibre lobes and
 a rough finish's reflection, 1: a smooth finish's mirror), with the lobe probabilities
 renormalised over what is enabled.
 """
@@ -121,7 +128,34 @@ def _albedo_table():
                     dtype=np.float32)
 
 
-def _shading_maps(mi, dr, maps, bump, f_int):
+class _Jit:
+    """The Dr.Jit types that derive the shading maps and their mip levels: the variant's own in
+    JIT variants (so that AD flows), Dr.Jit's LLVM backend's in the scalar variant; and
+    `out`, which makes a tensor of them the variant's."""
+
+    def __init__(self, mi, dr):
+        if dr.is_jit_v(mi.Float):
+            self.Float, self.UInt, self.Vec, self.Tensor, self.Tex, self.Point2f = (
+                mi.Float, mi.UInt32, mi.Vector3f, mi.TensorXf, mi.Texture2f, mi.Point2f)
+            self.out = lambda t: t
+        else:
+            import drjit.llvm as jit
+            self.Float, self.UInt, self.Vec, self.Tensor, self.Tex, self.Point2f = (
+                jit.Float, jit.UInt32, jit.Array3f, jit.TensorXf, jit.Texture2f, jit.Array2f)
+            self.out = lambda t: mi.TensorXf(np.array(t, dtype=np.float32))
+
+    def tensor(self, dr, channels, h, w):
+        """An (h, w, len(channels)) tensor of per-texel Floats."""
+        c = len(channels)
+        flat = dr.zeros(self.Float, h * w * c)
+        idx = dr.arange(self.UInt, h * w)
+        dr.make_opaque(flat)
+        for k, x in enumerate(channels):
+            dr.scatter(flat, x, idx * c + k)
+        return self.Tensor(flat, (h, w, c))
+
+
+def _shading_maps(mi, dr, jit, maps, bump, f_int):
     """The texture the BSDF looks up, derived once per texel from the bake's maps (an (H, W,
     14 or 17) tensor, `_maps`) as `Texel` used to derive it at every lookup: the bounded
     diffuse rho'' (3, wood.rs `bounded_diffuse`; notes/bsdf.md §1.3, §2.3), beta, the fibre
@@ -136,15 +170,9 @@ def _shading_maps(mi, dr, maps, bump, f_int):
     texel centres the BSDF is what deriving these at the lookup gave; between them rho'' is
     interpolated instead of its inputs. Computed with Dr.Jit ops, so in AD variants the
     gradients of `maps` (what ``mi.traverse`` lists) flow through it; the scalar variant
-    derives them with Dr.Jit's LLVM backend."""
-    if dr.is_jit_v(mi.Float):
-        Float, UInt, Vec, Tensor, Tex = mi.Float, mi.UInt32, mi.Vector3f, mi.TensorXf, mi.Texture2f
-        Point2f, src = mi.Point2f, maps
-    else:
-        import drjit.llvm as jit
-        Float, UInt, Vec, Tensor, Tex = (jit.Float, jit.UInt32, jit.Array3f, jit.TensorXf,
-                                         jit.Texture2f)
-        Point2f, src = jit.Array2f, jit.TensorXf(np.array(maps))
+    derives them with Dr.Jit's LLVM backend (`_Jit`; the result is in its types)."""
+    Float, UInt, Vec, Tex, Point2f = jit.Float, jit.UInt, jit.Vec, jit.Tex, jit.Point2f
+    src = maps if dr.is_jit_v(mi.Float) else jit.Tensor(np.array(maps))
     h, w, c = src.shape
     idx = dr.arange(UInt, h * w)
     ch = [dr.gather(Float, src.array, idx * c + k) for k in range(c)]
@@ -164,7 +192,7 @@ def _shading_maps(mi, dr, maps, bump, f_int):
     if bump > 0:
         nb = unit(Vec(bump * ch[14], bump * ch[15], ch[16]), nb)
         out += [*nb]
-    albedo = Tex(Tensor(_albedo_table()[..., None]), filter_mode=dr.FilterMode.Linear,
+    albedo = Tex(jit.Tensor(_albedo_table()[..., None]), filter_mode=dr.FilterMode.Linear,
                  wrap_mode=dr.WrapMode.Clamp)
 
     def bound(axis):
@@ -181,13 +209,73 @@ def _shading_maps(mi, dr, maps, bump, f_int):
     ratio = dr.select(diffuse > room, room / dr.maximum(diffuse, 1e-30), 1.0)
     rho = diffuse * dr.minimum(dr.minimum(ratio.x, ratio.y), dr.minimum(ratio.z, 1.0))
     out[0:3] = rho / (1.0 - rho * f_int)
-    flat = dr.zeros(Float, h * w * len(out))
-    for k, x in enumerate(out):
-        dr.scatter(flat, x, idx * len(out) + k)
-    shape = (h, w, len(out))
-    if Tensor is mi.TensorXf:
-        return Tensor(flat, shape)
-    return mi.TensorXf(np.array(flat, dtype=np.float32).reshape(shape))
+    return jit.tensor(dr, out, h, w)
+
+
+def _halve(dr, jit, t):
+    """The next mip level of shading maps `t` (`_shading_maps`' channels): each texel the box
+    average of its 2 x 2 parents (the last row or column counted twice where a size is odd).
+    Colours and the ray mask are averaged; the axes are averaged and renormalised (each parent
+    first turned to the side of the first, as a fibre axis and its opposite are the same lobe),
+    and the normal too, so that the pore bump fades to its mean; beta is widened by the spread
+    of the fibre axes, beta^2 = mean(beta^2) + (1 - L) / L with L the length of their mean
+    (Toksvig 2005), so that fibre wander finer than a texel widens the highlight."""
+    h, w, c = t.shape
+    h2, w2 = (h + 1) // 2, (w + 1) // 2
+    idx = dr.arange(jit.UInt, h2 * w2)
+    # The sizes as opaque variables: one kernel for every level, not one compiled for each.
+    w_, w2_ = dr.opaque(jit.UInt, w), dr.opaque(jit.UInt, w2)
+    i, j = idx // w2_, idx % w2_
+    rows = (2 * i, dr.minimum(2 * i + 1, dr.opaque(jit.UInt, h - 1)))
+    cols = (2 * j, dr.minimum(2 * j + 1, w_ - 1))
+    taps = [(r * w_ + q) * c for r in rows for q in cols]
+
+    def channel(k):
+        return [dr.gather(jit.Float, t.array, tap + k) for tap in taps]
+
+    def mean(xs):
+        return (xs[0] + xs[1] + xs[2] + xs[3]) * 0.25
+
+    def axis(k, aligned):
+        vs = [jit.Vec(*x) for x in zip(*(channel(k + d) for d in range(3)))]
+        if aligned:
+            vs = [vs[0]] + [dr.select(dr.dot(v, vs[0]) < 0, -v, v) for v in vs[1:]]
+        m = mean(vs)
+        length = dr.norm(m)
+        return dr.select(length > 1e-6, m / dr.maximum(length, 1e-6), vs[0]), length
+
+    out = [mean(channel(k)) for k in range(c)]
+    u, length = axis(8, True)
+    r, _ = axis(11, True)
+    spread = (1.0 - dr.minimum(length, 1.0)) / dr.maximum(length, 1e-3)
+    beta2 = mean([b * b for b in channel(3)])
+    out[3] = dr.minimum(dr.sqrt(beta2 + spread), 0.5 * math.pi)
+    out[8:14] = [*u, *r]
+    if c > 14:
+        out[14:17] = [*axis(14, False)[0]]
+    return jit.tensor(dr, out, h2, w2)
+
+
+def _atlas(dr, jit, levels):
+    """The mip levels side by side in one (H, W0 + W1, C) tensor: level 0 at the left, the
+    others in a column right of it, top to bottom; and each level's (width, height, x offset,
+    y offset) in texels. A lookup clamped to within a level's texel centres reads its
+    neighbours only with weight 0, so levels do not bleed into each other."""
+    h0, w0, c = levels[0].shape
+    boxes, y = [(w0, h0, 0, 0)], 0
+    for lv in levels[1:]:
+        boxes.append((lv.shape[1], lv.shape[0], w0, y))
+        y += lv.shape[0]
+    height, width = max(h0, y), w0 + (levels[1].shape[1] if len(levels) > 1 else 0)
+    flat = dr.zeros(jit.Float, height * width * c)
+    for lv, (w, h, ox, oy) in zip(levels, boxes):
+        idx = dr.arange(jit.UInt, h * w * c)
+        texel, k = idx // c, idx % c
+        # Opaque sizes: one kernel for every level.
+        w_, ox_, oy_ = (dr.opaque(jit.UInt, x) for x in (w, ox, oy))
+        row, col = texel // w_, texel % w_
+        dr.scatter(flat, lv.array, ((row + oy_) * width + col + ox_) * c + k)
+    return jit.Tensor(flat, (height, width, c)), boxes
 
 
 def _frame_axes(mi, dr, si):
@@ -386,7 +474,7 @@ def bsdf_class(mi, dr):
         the axes, so any frame about the normal will do."""
 
         def __init__(self, bsdf, si, active):
-            v = bsdf._texture.eval(si.uv, active)
+            v = bsdf._lookup(si, active)
             self.diffuse_eff = mi.Color3f(v[0], v[1], v[2])
             self.beta, self.m = v[3], v[7]
             self.inv_beta = 1.0 / self.beta
@@ -453,9 +541,13 @@ def bsdf_class(mi, dr):
             if not 0.0 <= self.roughness <= 1.0:
                 raise ValueError(
                     f"xylem_wood_baked: `roughness` = {self.roughness}: expected 0 (smooth) to 1")
+            self.pixel_angle = float(props.get("pixel_angle", 0.0))
+            if not 0.0 <= self.pixel_angle <= 0.1:
+                raise ValueError(f"xylem_wood_baked: `pixel_angle` = {self.pixel_angle}: "
+                                 "expected 0 (no mip maps) to 0.1 rad (`pixel_angle(scene)`)")
+            self._pixel_angle = mi.Float(self.pixel_angle)
             linear = dict(filter_mode=dr.FilterMode.Linear, wrap_mode=dr.WrapMode.Clamp)
-            # One texture (14 channels, 17 with the normal): a lookup computes its taps and
-            # weights once.
+            self._linear = linear
             self._tensor = mi.TensorXf(_maps(self.maps, normal=self.bump > 0))
             eta = self.eta
             # As WoodBsdf: below roughness 1e-3 the finish is smooth (wood.rs MIN_ROUGHNESS).
@@ -483,9 +575,7 @@ def bsdf_class(mi, dr):
             # 1 - R_int = (1 - R_avg) / eta^2 (wood.rs `escape`; notes/bsdf.md §1.3, §4.3).
             self._escape = (1.0 - avg_reflectance) / (eta * eta)
             self._f_int = 1.0 - self._escape
-            # What the BSDF looks up (`_shading_maps`): one texture, so that a lookup computes
-            # its taps and weights once.
-            self._texture = mi.Texture2f(self._shading(), **linear)
+            self._build()
             self._z_crit = math.sqrt(max(0.0, 1.0 - 1.0 / (eta * eta)))
             self._delta = eta > 1.0 and self._rough is None
             lobes = (mi.BSDFFlags.DiffuseReflection | mi.BSDFFlags.GlossyReflection
@@ -682,16 +772,102 @@ def bsdf_class(mi, dr):
 
         def traverse(self, callback):
             callback.put("maps", self._tensor, mi.ParamFlags.Differentiable)
+            callback.put("pixel_angle", self._pixel_angle, mi.ParamFlags.NonDifferentiable)
 
-        def _shading(self):
-            return _shading_maps(mi, dr, self._tensor, self.bump, self._f_int)
+        def _build(self):
+            """What the BSDF looks up (`_shading_maps`), one texture a level, so that a lookup
+            computes its taps and weights once; with a `pixel_angle`, its mip levels down to
+            one texel (`_halve`)."""
+            jit = _Jit(mi, dr)
+            level = _shading_maps(mi, dr, jit, self._tensor, self.bump, self._f_int)
+            levels = [level]
+            while self.pixel_angle > 0 and max(level.shape[:2]) > 1:
+                level = _halve(dr, jit, level)
+                levels.append(level)
+            self._levels = len(levels)
+            if len(levels) == 1:
+                self._texture = mi.Texture2f(jit.out(level), **self._linear)
+                return
+            atlas, boxes = _atlas(dr, jit, levels)
+            self._texture = mi.Texture2f(jit.out(atlas), **self._linear)
+            self._boxes = [mi.Float(np.array(b, np.float32)) for b in zip(*boxes)]
 
         def parameters_changed(self, keys=None):
-            self._texture.set_tensor(self._shading())
+            angle = self._pixel_angle
+            self.pixel_angle = float(angle if isinstance(angle, float) else angle[0])
+            self._build()
+
+        def _lookup(self, si, active):
+            """The shading maps at si.uv: bilinear in level 0 or, with a `pixel_angle`,
+            trilinear between the two mip levels about log2 of the footprint's width in
+            texels (each level looked up in the atlas, `_atlas`, clamped to its texels). The
+            footprint is a ray cone's (Amanatides 1984; Akenine-Moeller et al. 2019): width
+            pixel_angle * si.t across the ray, 1 / cos theta longer along the surface, in
+            texels by the texels per unit area, W H / |dp/du x dp/dv|. At a camera hit si.t is
+            the distance from the camera; at later bounces the segment from the last vertex,
+            which underestimates the cone (sharper, never blurrier)."""
+            if self._levels == 1:
+                return self._texture.eval(si.uv, active)
+            h, w = self._tensor.shape[:2]
+            area = dr.norm(dr.cross(si.dp_du, si.dp_dv))
+            per_length = dr.select(area > 1e-20, dr.rsqrt(dr.maximum(area, 1e-20)), 0.0)
+            texels = (self._pixel_angle * si.t * math.sqrt(h * w) * per_length
+                      / dr.maximum(dr.abs(si.wi.z), 1e-3))
+            lam = dr.clip(dr.log2(dr.maximum(texels, 1.0)), 0.0, self._levels - 1.0)
+            lower = mi.UInt32(dr.floor(lam))
+            frac = lam - mi.Float(lower)
+            atlas = self._texture.shape
+
+            def at(level, uv, active):
+                w, h, ox, oy = (dr.gather(mi.Float, b, level, active) for b in self._boxes)
+                x = dr.clip(uv.x * w, 0.5, w - 0.5) + ox
+                y = dr.clip(uv.y * h, 0.5, h - 0.5) + oy
+                return self._texture.eval(mi.Point2f(x / atlas[1], y / atlas[0]), active)
+
+            def upper(lower, uv, frac, active):
+                return tuple(x * frac for x in at(lower + 1, uv, active & (frac > 0.0)))
+
+            def none(lower, uv, frac, active):
+                return tuple(mi.Float(0.0) for _ in range(atlas[2]))
+
+            top = dr.if_stmt((lower, si.uv, frac, active), frac > 0.0, upper, none)
+            return [a * (1.0 - frac) + b for a, b in zip(at(lower, si.uv, active), top)]
 
         def to_string(self):
             return (f"XylemWoodBaked[maps={self.maps}, eta={self.eta}, "
-                    f"roughness={self.roughness}, bump={self.bump}]")
+                    f"roughness={self.roughness}, bump={self.bump}, "
+                    f"pixel_angle={self.pixel_angle}]")
 
     _CLASSES[key] = XylemWoodBaked
     return XylemWoodBaked
+
+
+def pixel_angle(scene, sensor=0):
+    """The ray-cone angle of one camera sample of `scene`'s sensor (radians): for a
+    ``perspective`` camera 2 tan(fov_x / 2) / width, the angle a pixel subtends at the image
+    centre, divided by sqrt(spp) (each sample's share of the pixel, as Mitsuba scales ray
+    differentials). Give it to ``xylem_wood_baked`` as ``pixel_angle`` for mip-mapped lookups
+    (`set_pixel_angle` does so for every one in the scene)."""
+    import mitsuba as mi
+
+    cam = scene.sensors()[sensor]
+    params = mi.traverse(cam)
+    fov = next(float(params[k][0] if hasattr(params[k], "__len__") else params[k])
+               for k in params.keys() if k.endswith("x_fov"))
+    width = cam.film().crop_size()[0]
+    spp = cam.sampler().sample_count()
+    return 2.0 * math.tan(math.radians(fov) / 2.0) / width / math.sqrt(spp)
+
+
+def set_pixel_angle(scene, angle=None):
+    """Sets ``pixel_angle`` (default `pixel_angle(scene)`) on every ``xylem_wood_baked`` in
+    `scene` and updates them; returns the angle."""
+    import mitsuba as mi
+
+    angle = pixel_angle(scene) if angle is None else float(angle)
+    params = mi.traverse(scene)
+    keys = [k for k in params.keys() if k.endswith(".pixel_angle") or k == "pixel_angle"]
+    for k in keys:
+        params[k] = mi.Float(angle)
+    params.update()
+    return angle
