@@ -395,11 +395,23 @@ TEAPOT_VIEW = {"eye": [0.0, -330.0, 190.0], "target": [10.0, 0.0, 45.0], "up": [
                "light": list(np.array([0.5, -0.4, 0.75]) / np.linalg.norm([0.5, -0.4, 0.75]))}
 
 
+# The built-in bowl as `xylem bake --mesh bowl` places it (scenes/turned_bowl.toml: the lathe
+# profile at 128 segments, tree (0, 250, 300), the tree axis across the bowl along x), seen from
+# that scene's camera, lit from its key light's side.
+BOWL_PROFILE = [[0.0, 0.0], [40.0, 0.0], [44.0, 4.0], [70.0, 25.0], [92.0, 55.0], [100.0, 75.0],
+                [96.0, 77.0], [88.0, 60.0], [66.0, 32.0], [40.0, 14.0], [0.0, 10.0]]
+BOWL_TREE = {"origin": [0.0, 250.0, 300.0], "axis": [1.0, 0.0, 0.0]}
+BOWL_VIEW = {"eye": [0.0, -200.0, 330.0], "target": [0.0, 0.0, 35.0], "up": [0.0, 0.0, 1.0],
+             "fov_deg": 36.0, "width": 64, "height": 48,
+             "light": list(np.array([0.45, -0.25, 0.86]) / np.linalg.norm([0.45, -0.25, 0.86]))}
+
+
 @pytest.fixture(scope="session")
 def mesh_bakes(tmp_path_factory, root):
     """{subject: (its OBJ, its `xylem bake --mesh` folder, the xylem object table, the view)}:
-    the sphere in both UV layouts (the OBJ the test writes) and the built-in teapot (the OBJ
-    the bake writes beside its maps; xylem renders its own `teapot` shape)."""
+    the sphere in both UV layouts (the OBJ the test writes) and the built-in teapot and bowl
+    (the OBJ the bake writes beside its maps; xylem renders its own `teapot` and `lathe`
+    shapes)."""
     out = {}
     for mirrored in (False, True):
         d = tmp_path_factory.mktemp("sphere")
@@ -413,6 +425,10 @@ def mesh_bakes(tmp_path_factory, root):
     out["teapot"] = (maps / f"{PRESET}.obj", maps, {"shape": "teapot", "size": [30.0],
                                                     "resolution": 10, "tree": TEAPOT_TREE},
                      TEAPOT_VIEW)
+    maps = xylem_bake(root, tmp_path_factory.mktemp("bowl") / "maps", "--mesh", "bowl")
+    out["bowl"] = (maps / f"{PRESET}.obj", maps, {"shape": "lathe", "segments": 128,
+                                                  "profile": BOWL_PROFILE, "tree": BOWL_TREE},
+                   BOWL_VIEW)
     return out
 
 
@@ -455,7 +471,8 @@ def mesh_xylem(view, obj_table, roughness, bump, spp):
 # Mitsuba's `twosided` wraps the plugin there, as xylem's renderer shades both sides.
 MESH_CASES = [("sphere_smooth", "sphere", 0.0, 0.0, "sphere_mirrored"),
               ("sphere_rough_bump_mirrored_uv", "sphere_mirrored", 0.2, 1.0, "sphere"),
-              ("teapot_rough_bump", "teapot", 0.2, 1.0, "sphere")]
+              ("teapot_rough_bump", "teapot", 0.2, 1.0, "sphere"),
+              ("bowl_rough_bump", "bowl", 0.2, 1.0, "teapot")]
 
 
 @pytest.mark.parametrize("name,subject,roughness,bump,wrong", MESH_CASES,
