@@ -657,8 +657,14 @@ def bsdf_class(mi, dr):
 
         def _rays(self, t, fn, args):
             """fn(*args), two Floats, where the texel has rays (ray mask m > 0), zeros where it
-            has none (m multiplies the ray lobe and its probability). A symbolic branch: a packet
-            of lanes with no rays skips it (86 % of a mahogany board's texels have m = 0)."""
+            has none (m multiplies the ray lobe and its probability). Under a rough finish a
+            symbolic branch, which a packet of lanes with no rays skips (86 % of a mahogany
+            board's texels have m = 0): 0.93x the render's time. The smooth finish's ray lobe
+            is cheap (no spreads), and there the branch saved nothing measurable (0.98x,
+            0.93-1.14) while tracing it cost every render 3.5 ms more, so it is computed
+            everywhere."""
+            if self._rough is None:
+                return fn(*args)
             return dr.if_stmt(args, t.m > 0.0, fn, lambda *_: (mi.Float(0.0), mi.Float(0.0)))
 
         def _eval_pdf(self, t, view, probs, wi):
