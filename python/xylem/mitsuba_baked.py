@@ -22,6 +22,9 @@ default 1.5) and ``roughness`` its GGX roughness (0-1, default 0; below 1e-3 the
 smooth, as in ``WoodBsdf``). ``bump`` (0-100, default 1) scales the slope of the baked normal
 map (``normal.exr``, the pore bump at the strength xylem's ``bump = 1``; 0 leaves it unread):
 the BSDF is evaluated in a frame about the tilted normal, as xylem's solid wood is.
+``two_sided`` (default false) shades a hit seen from behind as xylem's renderer does, the
+frame turned half round the fibre's projection into the face (Mitsuba's ``twosided`` mirrors
+the directions instead, which differs for the ray axis's in-face part).
 ``pixel_angle`` (radians, default 0: none) turns on mip-mapped lookups: the ray-cone angle of a
 camera sample, which ``set_pixel_angle(scene)`` computes from the scene's camera and sets on
 every ``xylem_wood_baked`` there (Mitsuba's integrators give a BSDF no uv footprint); the
@@ -492,13 +495,28 @@ def bsdf_class(mi, dr):
             if bsdf.bump > 0:
                 self.frame = mi.Frame3f(unit(v[14], v[15], v[16], mi.Vector3f(0, 0, 1)))
                 self.u, self.r = self.frame.to_local(self.u), self.frame.to_local(self.r)
+            self.back = None
+            if bsdf.two_sided:
+                # Seen from behind (si.wi below the shading frame, Mitsuba's `twosided` test),
+                # the frame turns half round the fibre's projection into the face, s: (s, t, n)
+                # -> (s, -t, -n), as xylem's renderer faces an opaque surface to its viewer
+                # (render/integrator.rs; its frame's s is that projection).
+                self.back = si.wi.z < 0.0
+                self.s = unit(self.u.x, self.u.y, 0.0, mi.Vector3f(1, 0, 0))
+
+        def _turn(self, w):
+            """w turned half round s where the hit is seen from behind (an involution)."""
+            if self.back is None:
+                return w
+            return dr.select(self.back, 2.0 * dr.dot(self.s, w) * self.s - w, w)
 
         def local(self, w):
             """A shading-frame direction in the BSDF's frame."""
             w = mi.Vector3f(dr.dot(w, self.right), dr.dot(w, self.up), w.z)
-            return w if self.frame is None else self.frame.to_local(w)
+            return self._turn(w if self.frame is None else self.frame.to_local(w))
 
         def world(self, w):
+            w = self._turn(w)
             w = w if self.frame is None else self.frame.to_world(w)
             return self.right * w.x + self.up * w.y + mi.Vector3f(0, 0, w.z)
 
@@ -533,6 +551,7 @@ def bsdf_class(mi, dr):
             self.eta = float(props.get("eta", 1.5))
             self.roughness = float(props.get("roughness", 0.0))
             self.bump = float(props.get("bump", 1.0))
+            self.two_sided = bool(props.get("two_sided", False))
             if not 0.0 <= self.bump <= 100.0:
                 raise ValueError(f"xylem_wood_baked: `bump` = {self.bump}: expected 0 (off) to "
                                  "100 (1: the baked normal map as it is)")
@@ -582,6 +601,8 @@ def bsdf_class(mi, dr):
                      | mi.BSDFFlags.FrontSide | mi.BSDFFlags.SpatiallyVarying
                      | mi.BSDFFlags.Anisotropic)
             delta = mi.BSDFFlags.DeltaReflection | mi.BSDFFlags.FrontSide
+            if self.two_sided:
+                lobes, delta = lobes | mi.BSDFFlags.BackSide, delta | mi.BSDFFlags.BackSide
             # Component 0: everything but a smooth finish's mirror (a rough finish's reflection
             # included); component 1: the mirror.
             self.m_components = [lobes, delta] if self._delta else [lobes]
@@ -842,7 +863,7 @@ def bsdf_class(mi, dr):
         def to_string(self):
             return (f"XylemWoodBaked[maps={self.maps}, eta={self.eta}, "
                     f"roughness={self.roughness}, bump={self.bump}, "
-                    f"pixel_angle={self.pixel_angle}]")
+                    f"pixel_angle={self.pixel_angle}, two_sided={self.two_sided}]")
 
     _CLASSES[key] = XylemWoodBaked
     return XylemWoodBaked
