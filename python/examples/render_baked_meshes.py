@@ -29,7 +29,8 @@ import xylem.mitsuba_baked  # noqa: E402
 xylem.mitsuba.register()
 
 # name: (preset, camera eye, target, key light direction (towards the light), two-sided: the
-# teapot's patches are not all oriented alike, and Mitsuba's BSDFs are one-sided)
+# teapot's patches are not all oriented alike, and Mitsuba's BSDFs are one-sided; the plugin's
+# `two_sided` shades the back of a face as xylem's renderer does)
 SUBJECTS = {
     "teapot": ("walnut", [0.0, -330.0, 190.0], [10.0, 0.0, 45.0], [-0.55, -0.45, 0.7], True),
     "bowl": ("red_oak", [0.0, -200.0, 330.0], [0.0, 0.0, 35.0], [0.45, -0.25, 0.86], False),
@@ -44,7 +45,8 @@ def bake(exe, preset, mesh, res, out):
 
 def scene(obj, maps, eye, target, light, two_sided, width, height, spp):
     T = mi.ScalarTransform4f
-    wood = {"type": "xylem_wood_baked", "maps": str(maps), "eta": 1.5, "roughness": 0.15}
+    wood = {"type": "xylem_wood_baked", "maps": str(maps), "eta": 1.5, "roughness": 0.15,
+            "two_sided": two_sided}
     return mi.load_dict({
         "type": "scene",
         "integrator": {"type": "path", "max_depth": 5},
@@ -58,8 +60,7 @@ def scene(obj, maps, eye, target, light, two_sided, width, height, spp):
         "table": {"type": "rectangle", "to_world": T().scale([1000.0, 1000.0, 1.0]),
                   "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb",
                                                               "value": [0.15, 0.15, 0.16]}}},
-        "mesh": {"type": "obj", "filename": str(obj),
-                 "bsdf": {"type": "twosided", "bsdf": wood} if two_sided else wood},
+        "mesh": {"type": "obj", "filename": str(obj), "bsdf": wood},
     })
 
 
