@@ -236,7 +236,8 @@ def main():
         print(f"{kind}: {case} / {base} {med:.2f}x (per repeat median "
               f"{statistics.median(per):.2f}, {min(per):.2f}-{max(per):.2f})")
 
-    pairs = [(c, "roughplastic") for c in times if c != "roughplastic" and not c.endswith("_before")]
+    pairs = [(c, "roughplastic") for c in times
+             if c != "roughplastic" and not c.endswith("_before")]
     if "xylem_wood" in times and "roughplastic_evaluated" in times:
         pairs.append(("xylem_wood", "roughplastic_evaluated"))
     pairs += [(c[:-len("_before")], c) for c in times if c.endswith("_before")]

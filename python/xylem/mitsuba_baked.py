@@ -17,9 +17,9 @@ per texel what the BSDF needs (``_shading_maps``: the bounded diffuse, clamped v
 axes and bumped normal) into one 14- or 17-channel ``mi.Texture2f`` (bilinear, clamped at the
 edges, texel centres at (i + 1/2)/W as xylem's own ``BakedMaps::lookup``; one texture, so a
 lookup computes its taps once) and looks it up at ``si.uv`` (texel (0, 0) is the image's
-top-left, v runs down the rows, as glTF and the bake write them). ``eta`` is the finish's index (1-4,
-default 1.5) and ``roughness`` its GGX roughness (0-1, default 0; below 1e-3 the finish is
-smooth, as in ``WoodBsdf``). ``bump`` (0-100, default 1) scales the slope of the baked normal
+top-left, v runs down the rows, as glTF and the bake write them). ``eta`` is the finish's
+index (1-4, default 1.5) and ``roughness`` its GGX roughness (0-1, default 0; below 1e-3 the
+finish is smooth, as in ``WoodBsdf``). ``bump`` (0-100, default 1) scales the slope of the baked normal
 map (``normal.exr``, the pore bump at the strength xylem's ``bump = 1``; 0 leaves it unread):
 the BSDF is evaluated in a frame about the tilted normal, as xylem's solid wood is.
 ``two_sided`` (default false) shades a hit seen from behind as xylem's renderer does, the
@@ -62,9 +62,9 @@ triangle (dp/du, dp/dv) where the bake interpolated vertex tangents; a bake with
 ``ray_direction.exr`` gets the ray axis in the face across the fibre; the pore bump is the
 baked normal map's, bilinear between texel centres (pores are about a texel wide at
 ``--res 1024``); mip levels average the BSDF's parameters (colours, axes with beta widened by
-their spread, the normal), not the BSDF. ``BSDFContext`` masks are honoured per component (0: the diffuse and fibre lobes and
-a rough finish's reflection, 1: a smooth finish's mirror), with the lobe probabilities
-renormalised over what is enabled.
+their spread, the normal), not the BSDF. ``BSDFContext`` masks are honoured per component
+(0: the diffuse and fibre lobes and a rough finish's reflection, 1: a smooth finish's mirror),
+with the lobe probabilities renormalised over what is enabled.
 """
 
 import math
