@@ -19,9 +19,10 @@ edges, texel centres at (i + 1/2)/W as xylem's own ``BakedMaps::lookup``; one te
 lookup computes its taps once) and looks it up at ``si.uv`` (texel (0, 0) is the image's
 top-left, v runs down the rows, as glTF and the bake write them). ``eta`` is the finish's
 index (1-4, default 1.5) and ``roughness`` its GGX roughness (0-1, default 0; below 1e-3 the
-finish is smooth, as in ``WoodBsdf``). ``bump`` (0-100, default 1) scales the slope of the baked normal
-map (``normal.exr``, the pore bump at the strength xylem's ``bump = 1``; 0 leaves it unread):
-the BSDF is evaluated in a frame about the tilted normal, as xylem's solid wood is.
+finish is smooth, as in ``WoodBsdf``). ``bump`` (0-100, default 1) scales the slope of the
+baked normal map (``normal.exr``, the pore bump at the strength xylem's ``bump = 1``; 0 leaves
+it unread): the BSDF is evaluated in a frame about the tilted normal, as xylem's solid wood
+is.
 ``two_sided`` (default false) shades a hit seen from behind as xylem's renderer does, the
 frame turned half round the fibre's projection into the face (Mitsuba's ``twosided`` mirrors
 the directions instead, which differs for the ray axis's in-face part).
