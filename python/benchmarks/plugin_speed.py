@@ -22,7 +22,12 @@ Three renders per repeat, in turn:
   1.5), in Dr.Jit's default symbolic modes like ``roughplastic``. ``--maps DIR`` gives a bake
   folder; otherwise the script bakes one with ``$XYLEM_BIN`` or target/release/xylem;
 - ``xylem_wood_baked_rough``: the same with a rough finish (roughness 0.25, as
-  ``roughplastic``'s alpha): xylem's energy-compensated GGX finish.
+  ``roughplastic``'s alpha): xylem's energy-compensated GGX finish;
+- ``xylem_wood_baked_rough_mip``: the same with mip-mapped lookups (``pixel_angle`` from the
+  camera, ``xylem.mitsuba_baked.set_pixel_angle``).
+
+``--cases a,b`` runs only those (and ``roughplastic``, the ratios' base); ``--before DIR`` runs
+each plugin case again with the package in DIR (``CASE_before``): the A/B pair of a change.
 
 Both baked cases use the plugin's pore bump at ``--bump`` (default 1, the plugin's default;
 0: the normal map is not read).
@@ -82,7 +87,7 @@ def bake(exe, res, out):
 
 def scene(bsdf, res, spp, maps=None, bump=1.0):
     T = mi.ScalarTransform4f
-    return mi.load_dict({
+    sc = mi.load_dict({
         "type": "scene",
         "integrator": {"type": "path", "max_depth": 4},
         "sensor": {
@@ -97,10 +102,15 @@ def scene(bsdf, res, spp, maps=None, bump=1.0):
         "sky": {"type": "constant", "radiance": {"type": "rgb", "value": [0.2, 0.2, 0.25]}},
         "board": {"type": "rectangle", "to_world": T().scale([0.15, 0.15, 1.0]),
                   "bsdf": ({"type": "xylem_wood_baked", "maps": maps, "eta": 1.5,
-                            "roughness": 0.25 if bsdf.endswith("_rough") else 0.0,
+                            "roughness": 0.25 if "_rough" in bsdf else 0.0,
                             "bump": bump}
                            if bsdf.startswith("xylem_wood_baked") else dict(BSDFS[bsdf]))},
     })
+    if bsdf.endswith("_mip"):
+        import xylem.mitsuba_baked
+
+        xylem.mitsuba_baked.set_pixel_angle(sc)
+    return sc
 
 
 def render(sc, seed, evaluated):
@@ -124,15 +134,16 @@ def main():
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--profile", action="store_true")
     ap.add_argument("--json", help="write the figures to this file")
-    ap.add_argument("--before", help="a folder holding an older `xylem` package (its plugin "
-                    "runs as the extra case xylem_wood_before, with this folder first on "
-                    "PYTHONPATH)")
+    ap.add_argument("--before", help="a folder holding an older `xylem` package (each plugin "
+                    "case runs again with it, as CASE_before, this folder first on PYTHONPATH)")
     ap.add_argument("--maps", help="a `xylem bake` folder for xylem_wood_baked (default: bake "
                     "one into a temporary folder)")
     ap.add_argument("--bake-res", type=int, default=1024, help="texels along the board when "
                     "baking (default 1024)")
     ap.add_argument("--bump", type=float, default=1.0, help="the baked cases' pore bump "
                     "(default 1; 0 leaves the normal map unread)")
+    ap.add_argument("--cases", help="comma-separated cases to run (default: all); "
+                    "roughplastic is always run, as the ratios' base")
     ap.add_argument("--one", help=argparse.SUPPRESS)         # child process: this case only
     ap.add_argument("--seed", type=int, default=1, help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -141,9 +152,18 @@ def main():
              ("roughplastic_evaluated", "roughplastic", True),
              ("xylem_wood", "xylem_wood", True),
              ("xylem_wood_baked", "xylem_wood_baked", False),
-             ("xylem_wood_baked_rough", "xylem_wood_baked_rough", False)]
-    if args.before or args.one == "xylem_wood_before":
-        cases.append(("xylem_wood_before", "xylem_wood", True))
+             ("xylem_wood_baked_rough", "xylem_wood_baked_rough", False),
+             ("xylem_wood_baked_rough_mip", "xylem_wood_baked_rough_mip", False)]
+    if args.cases and not args.one:
+        keep = set(args.cases.split(",")) | {"roughplastic"}
+        unknown = keep - {c[0] for c in cases}
+        if unknown:
+            ap.error(f"--cases: unknown {sorted(unknown)}")
+        cases = [c for c in cases if c[0] in keep]
+    if args.before or (args.one or "").endswith("_before"):
+        # Each plugin case again with the older package: the A/B pair of a change.
+        cases += [(name + "_before", b, ev) for name, b, ev in cases
+                  if name.startswith("xylem_wood")]
     if args.one:                                 # child: one warm-up, one timed render
         name, b, ev = next(c for c in cases if c[0] == args.one)
         sc = scene(b, args.res, args.spp, args.maps, args.bump)
@@ -167,7 +187,7 @@ def main():
                "--bump", str(args.bump)] + (
                    ["--profile"] if profile else [])
         env = dict(os.environ)
-        if name == "xylem_wood_before":
+        if name.endswith("_before"):
             env["PYTHONPATH"] = os.pathsep.join([args.before, env.get("PYTHONPATH", "")])
         out = subprocess.run(cmd, check=True, capture_output=True, text=True, env=env)
         if profile:
@@ -199,47 +219,31 @@ def main():
            "cpus": os.cpu_count(), "load_avg": os.getloadavg(),
            "cases": {k: summary(v) for k, v in times.items()},
            "cpu": {k: summary(v) for k, v in cpu_times.items()}}
-    base = statistics.median(times["roughplastic"])
-    base_ev = statistics.median(times["roughplastic_evaluated"])
-    wood = statistics.median(times["xylem_wood"])
-    # Ratios of medians, and their spread over the repeats (ratio of each repeat's pair).
-    if args.before:
-        before = [w / b for w, b in zip(times["xylem_wood"], times["xylem_wood_before"])]
-        out["ratio_vs_before"] = wood / statistics.median(times["xylem_wood_before"])
-        out["ratio_vs_before_range"] = [min(before), max(before)]
-    pairs = [w / b for w, b in zip(times["xylem_wood"], times["roughplastic"])]
-    pairs_ev = [w / b for w, b in zip(times["xylem_wood"], times["roughplastic_evaluated"])]
-    out["ratio_vs_roughplastic"] = wood / base
-    out["ratio_vs_roughplastic_range"] = [min(pairs), max(pairs)]
-    out["ratio_vs_roughplastic_evaluated"] = wood / base_ev
-    out["ratio_vs_roughplastic_evaluated_range"] = [min(pairs_ev), max(pairs_ev)]
-
     for name, s in out["cases"].items():
         c = out["cpu"][name]
         print(f"{name:24s} wall median {s['median_s']:.3f} s (min {s['min_s']:.3f}, "
               f"max {s['max_s']:.3f});  CPU median {c['median_s']:.3f} s (min "
               f"{c['min_s']:.3f}, max {c['max_s']:.3f})")
-    cpu_med = {k: statistics.median(v) for k, v in cpu_times.items()}
-    out["cpu_ratio_vs_roughplastic"] = cpu_med["xylem_wood"] / cpu_med["roughplastic"]
-    out["cpu_ratio_vs_roughplastic_evaluated"] = (cpu_med["xylem_wood"]
-                                                  / cpu_med["roughplastic_evaluated"])
-    for case, key in (("xylem_wood_baked", "baked"), ("xylem_wood_baked_rough", "baked_rough")):
-        per = [w / b for w, b in zip(cpu_times[case], cpu_times["roughplastic"])]
-        out[f"cpu_ratio_{key}_vs_roughplastic"] = cpu_med[case] / cpu_med["roughplastic"]
-        out[f"cpu_ratio_{key}_vs_roughplastic_range"] = [min(per), max(per)]
-        print(f"CPU: {case} / roughplastic {cpu_med[case] / cpu_med['roughplastic']:.2f}x "
-              f"(per repeat {min(per):.2f}-{max(per):.2f})")
-    print(f"CPU: xylem_wood / roughplastic {out['cpu_ratio_vs_roughplastic']:.2f}x, "
-          f"/ roughplastic evaluated {out['cpu_ratio_vs_roughplastic_evaluated']:.2f}x"
-          + (f", / before {cpu_med['xylem_wood'] / cpu_med['xylem_wood_before']:.2f}x"
-             if args.before else ""))
-    print(f"xylem_wood / roughplastic            {out['ratio_vs_roughplastic']:.2f}x "
-          f"(per repeat {min(pairs):.2f}-{max(pairs):.2f})")
-    print(f"xylem_wood / roughplastic evaluated  {out['ratio_vs_roughplastic_evaluated']:.2f}x "
-          f"(per repeat {min(pairs_ev):.2f}-{max(pairs_ev):.2f})")
-    if args.before:
-        print(f"xylem_wood / xylem_wood_before       {out['ratio_vs_before']:.2f}x "
-              f"(per repeat {min(before):.2f}-{max(before):.2f})")
+
+    def ratio(kind, series, case, base):
+        """Ratio of medians of `case` over `base`, and its spread over the repeats (the ratio
+        of each repeat's pair, the two renders run next to each other)."""
+        per = [a / b for a, b in zip(series[case], series[base])]
+        med = statistics.median(series[case]) / statistics.median(series[base])
+        out.setdefault("ratios", {})[f"{kind} {case} / {base}"] = {
+            "ratio_of_medians": med, "median_of_ratios": statistics.median(per),
+            "min": min(per), "max": max(per)}
+        print(f"{kind}: {case} / {base} {med:.2f}x (per repeat median "
+              f"{statistics.median(per):.2f}, {min(per):.2f}-{max(per):.2f})")
+
+    pairs = [(c, "roughplastic") for c in times
+             if c != "roughplastic" and not c.endswith("_before")]
+    if "xylem_wood" in times and "roughplastic_evaluated" in times:
+        pairs.append(("xylem_wood", "roughplastic_evaluated"))
+    pairs += [(c[:-len("_before")], c) for c in times if c.endswith("_before")]
+    for kind, series in (("CPU", cpu_times), ("wall", times)):
+        for case, base in pairs:
+            ratio(kind, series, case, base)
     print(f"load average {out['load_avg']}, {out['cpus']} CPUs, {mi.variant()}, "
           f"{args.res[0]}x{args.res[1]}, {args.spp} spp")
 

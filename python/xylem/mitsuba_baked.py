@@ -12,15 +12,25 @@ megakernel and is differentiable.
 (an OBJ with ``vt`` whose same file Mitsuba loads: its OBJ loader flips v as xylem's reader
 does, so si.uv is the bake's uv): the plugin reads ``base_color.exr``, ``fiber_color.exr``,
 ``fiber_direction.exr`` and ``ray_direction.exr`` (the signed tangent-space fibre and ray
-axes), ``highlight_width.exr`` (beta, radians) and ``ray_mask.exr`` into one 14-channel
-``mi.Texture2f`` (bilinear, clamped at the edges, texel
-centres at (i + 1/2)/W as xylem's own ``BakedMaps::lookup``; one texture, so a lookup computes
-its taps once) and looks them up at ``si.uv`` (texel (0, 0) is the image's top-left, v runs
-down the rows, as glTF and the bake write them). ``eta`` is the finish's index (1-4,
-default 1.5) and ``roughness`` its GGX roughness (0-1, default 0; below 1e-3 the finish is
-smooth, as in ``WoodBsdf``). ``bump`` (0-100, default 1) scales the slope of the baked normal
-map (``normal.exr``, the pore bump at the strength xylem's ``bump = 1``; 0 leaves it unread):
-the BSDF is evaluated in a frame about the tilted normal, as xylem's solid wood is.
+axes), ``highlight_width.exr`` (beta, radians) and ``ray_mask.exr``, derives from them once
+per texel what the BSDF needs (``_shading_maps``: the bounded diffuse, clamped values, unit
+axes and bumped normal) into one 14- or 17-channel ``mi.Texture2f`` (bilinear, clamped at the
+edges, texel centres at (i + 1/2)/W as xylem's own ``BakedMaps::lookup``; one texture, so a
+lookup computes its taps once) and looks it up at ``si.uv`` (texel (0, 0) is the image's
+top-left, v runs down the rows, as glTF and the bake write them). ``eta`` is the finish's
+index (1-4, default 1.5) and ``roughness`` its GGX roughness (0-1, default 0; below 1e-3 the
+finish is smooth, as in ``WoodBsdf``). ``bump`` (0-100, default 1) scales the slope of the
+baked normal map (``normal.exr``, the pore bump at the strength xylem's ``bump = 1``; 0 leaves
+it unread): the BSDF is evaluated in a frame about the tilted normal, as xylem's solid wood
+is.
+``two_sided`` (default false) shades a hit seen from behind as xylem's renderer does, the
+frame turned half round the fibre's projection into the face (Mitsuba's ``twosided`` mirrors
+the directions instead, which differs for the ray axis's in-face part).
+``pixel_angle`` (radians, default 0: none) turns on mip-mapped lookups: the ray-cone angle of a
+camera sample, which ``set_pixel_angle(scene)`` computes from the scene's camera and sets on
+every ``xylem_wood_baked`` there (Mitsuba's integrators give a BSDF no uv footprint); the
+lookups are then trilinear between the mip levels about the footprint (``_halve``,
+``_lookup``).
 
 The BSDF at a texel is xylem's ``WoodBsdf`` (crates/xylem/src/bsdf/wood.rs) for the parameters
 xylem's own baked-map material builds there (``material/face.rs`` ``face_shading``): the
@@ -52,9 +62,10 @@ texels; pores and ray flecks narrower than that blur); the tangent frame is Mits
 triangle (dp/du, dp/dv) where the bake interpolated vertex tangents; a bake without
 ``ray_direction.exr`` gets the ray axis in the face across the fibre; the pore bump is the
 baked normal map's, bilinear between texel centres (pores are about a texel wide at
-``--res 1024``), no mip maps. ``BSDFContext`` masks are honoured per component (0: the diffuse and fibre lobes and
-a rough finish's reflection, 1: a smooth finish's mirror), with the lobe probabilities
-renormalised over what is enabled.
+``--res 1024``); mip levels average the BSDF's parameters (colours, axes with beta widened by
+their spread, the normal), not the BSDF. ``BSDFContext`` masks are honoured per component
+(0: the diffuse and fibre lobes and a rough finish's reflection, 1: a smooth finish's mirror),
+with the lobe probabilities renormalised over what is enabled.
 """
 
 import math
@@ -121,6 +132,156 @@ def _albedo_table():
                     dtype=np.float32)
 
 
+class _Jit:
+    """The Dr.Jit types that derive the shading maps and their mip levels: the variant's own in
+    JIT variants (so that AD flows), Dr.Jit's LLVM backend's in the scalar variant; and
+    `out`, which makes a tensor of them the variant's."""
+
+    def __init__(self, mi, dr):
+        if dr.is_jit_v(mi.Float):
+            self.Float, self.UInt, self.Vec, self.Tensor, self.Tex, self.Point2f = (
+                mi.Float, mi.UInt32, mi.Vector3f, mi.TensorXf, mi.Texture2f, mi.Point2f)
+            self.out = lambda t: t
+        else:
+            import drjit.llvm as jit
+            self.Float, self.UInt, self.Vec, self.Tensor, self.Tex, self.Point2f = (
+                jit.Float, jit.UInt32, jit.Array3f, jit.TensorXf, jit.Texture2f, jit.Array2f)
+            self.out = lambda t: mi.TensorXf(np.array(t, dtype=np.float32))
+
+    def tensor(self, dr, channels, h, w):
+        """An (h, w, len(channels)) tensor of per-texel Floats."""
+        c = len(channels)
+        flat = dr.zeros(self.Float, h * w * c)
+        idx = dr.arange(self.UInt, h * w)
+        dr.make_opaque(flat)
+        for k, x in enumerate(channels):
+            dr.scatter(flat, x, idx * c + k)
+        return self.Tensor(flat, (h, w, c))
+
+
+def _shading_maps(mi, dr, jit, maps, bump, f_int):
+    """The texture the BSDF looks up, derived once per texel from the bake's maps (an (H, W,
+    14 or 17) tensor, `_maps`) as `Texel` used to derive it at every lookup: the bounded
+    diffuse rho'' (3, wood.rs `bounded_diffuse`; notes/bsdf.md §1.3, §2.3), beta, the fibre
+    colour (3) and the ray mask, clamped as material/baked.rs `BakedWoodMaterial::shade` clamps
+    them, the unit tangent-space fibre and ray axes (3 + 3; a zero fibre axis is x, a zero ray
+    axis in the face across the fibre, face.rs: xylem's frame.t = n x s) and, with `bump` > 0,
+    the unit bumped normal (3; the baked normal's slope times `bump`, Blinn 1978). (H, W, 14),
+    or 17 with the normal.
+
+    Only the axes' dips below the bumped normal enter rho''s bound (its lobe albedos), and the
+    tangent-space axes and normal hold them, so nothing here depends on the hit's frame. At
+    texel centres the BSDF is what deriving these at the lookup gave; between them rho'' is
+    interpolated instead of its inputs. Computed with Dr.Jit ops, so in AD variants the
+    gradients of `maps` (what ``mi.traverse`` lists) flow through it; the scalar variant
+    derives them with Dr.Jit's LLVM backend (`_Jit`; the result is in its types)."""
+    Float, UInt, Vec, Tex, Point2f = jit.Float, jit.UInt, jit.Vec, jit.Tex, jit.Point2f
+    src = maps if dr.is_jit_v(mi.Float) else jit.Tensor(np.array(maps))
+    h, w, c = src.shape
+    idx = dr.arange(UInt, h * w)
+    ch = [dr.gather(Float, src.array, idx * c + k) for k in range(c)]
+
+    def unit(v, fallback):
+        return dr.select(dr.squared_norm(v) < 1e-12, fallback, dr.normalize(v))
+
+    diffuse = Vec(*(dr.clip(x, 0.0, 1.0) for x in ch[0:3]))
+    beta = dr.clip(ch[3], 1e-3, 0.5 * math.pi)
+    fiber = Vec(*(dr.clip(x, 0.0, 1.0) for x in ch[4:7]))
+    m = dr.clip(ch[7], 0.0, 1.0)
+    u = unit(Vec(ch[8], ch[9], ch[10]), Vec(1.0, 0.0, 0.0))
+    s = unit(Vec(u.x, u.y, 0.0), Vec(1.0, 0.0, 0.0))
+    r = unit(Vec(ch[11], ch[12], ch[13]), Vec(-s.y, s.x, 0.0))
+    out = [*diffuse, beta, *fiber, m, *u, *r]
+    nb = Vec(0.0, 0.0, 1.0)
+    if bump > 0:
+        nb = unit(Vec(bump * ch[14], bump * ch[15], ch[16]), nb)
+        out += [*nb]
+    albedo = Tex(jit.Tensor(_albedo_table()[..., None]), filter_mode=dr.FilterMode.Linear,
+                 wrap_mode=dr.WrapMode.Clamp)
+
+    def bound(axis):
+        """The lobe albedo bound of `axis` at the texel's beta and the axis's dip below the
+        bumped normal (the 121-node table, bilinear: xylem's own)."""
+        dip = dr.asin(dr.minimum(dr.abs(dr.dot(axis, nb)), 1.0))
+        scale = 2.0 / math.pi * (ALBEDO_NODES - 1) / ALBEDO_NODES
+        pos = Point2f(beta * scale + 0.5 / ALBEDO_NODES, dip * scale + 0.5 / ALBEDO_NODES)
+        return albedo.eval(pos)[0]
+
+    # rho'' = rho' / (1 - rho' F_int), rho' = s rho, s = min(1, min_c room_c / rho_c), room =
+    # 1 - k_f A, A the ray-mask blend of the lobes' albedo bounds.
+    room = 1.0 - fiber * ((1.0 - m) * bound(u) + m * bound(r))
+    ratio = dr.select(diffuse > room, room / dr.maximum(diffuse, 1e-30), 1.0)
+    rho = diffuse * dr.minimum(dr.minimum(ratio.x, ratio.y), dr.minimum(ratio.z, 1.0))
+    out[0:3] = rho / (1.0 - rho * f_int)
+    return jit.tensor(dr, out, h, w)
+
+
+def _halve(dr, jit, t):
+    """The next mip level of shading maps `t` (`_shading_maps`' channels): each texel the box
+    average of its 2 x 2 parents (the last row or column counted twice where a size is odd).
+    Colours and the ray mask are averaged; the axes are averaged and renormalised (each parent
+    first turned to the side of the first, as a fibre axis and its opposite are the same lobe),
+    and the normal too, so that the pore bump fades to its mean; beta is widened by the spread
+    of the fibre axes, beta^2 = mean(beta^2) + (1 - L) / L with L the length of their mean
+    (Toksvig 2005), so that fibre wander finer than a texel widens the highlight."""
+    h, w, c = t.shape
+    h2, w2 = (h + 1) // 2, (w + 1) // 2
+    idx = dr.arange(jit.UInt, h2 * w2)
+    # The sizes as opaque variables: one kernel for every level, not one compiled for each.
+    w_, w2_ = dr.opaque(jit.UInt, w), dr.opaque(jit.UInt, w2)
+    i, j = idx // w2_, idx % w2_
+    rows = (2 * i, dr.minimum(2 * i + 1, dr.opaque(jit.UInt, h - 1)))
+    cols = (2 * j, dr.minimum(2 * j + 1, w_ - 1))
+    taps = [(r * w_ + q) * c for r in rows for q in cols]
+
+    def channel(k):
+        return [dr.gather(jit.Float, t.array, tap + k) for tap in taps]
+
+    def mean(xs):
+        return (xs[0] + xs[1] + xs[2] + xs[3]) * 0.25
+
+    def axis(k, aligned):
+        vs = [jit.Vec(*x) for x in zip(*(channel(k + d) for d in range(3)))]
+        if aligned:
+            vs = [vs[0]] + [dr.select(dr.dot(v, vs[0]) < 0, -v, v) for v in vs[1:]]
+        m = mean(vs)
+        length = dr.norm(m)
+        return dr.select(length > 1e-6, m / dr.maximum(length, 1e-6), vs[0]), length
+
+    out = [mean(channel(k)) for k in range(c)]
+    u, length = axis(8, True)
+    r, _ = axis(11, True)
+    spread = (1.0 - dr.minimum(length, 1.0)) / dr.maximum(length, 1e-3)
+    beta2 = mean([b * b for b in channel(3)])
+    out[3] = dr.minimum(dr.sqrt(beta2 + spread), 0.5 * math.pi)
+    out[8:14] = [*u, *r]
+    if c > 14:
+        out[14:17] = [*axis(14, False)[0]]
+    return jit.tensor(dr, out, h2, w2)
+
+
+def _atlas(dr, jit, levels):
+    """The mip levels side by side in one (H, W0 + W1, C) tensor: level 0 at the left, the
+    others in a column right of it, top to bottom; and each level's (width, height, x offset,
+    y offset) in texels. A lookup clamped to within a level's texel centres reads its
+    neighbours only with weight 0, so levels do not bleed into each other."""
+    h0, w0, c = levels[0].shape
+    boxes, y = [(w0, h0, 0, 0)], 0
+    for lv in levels[1:]:
+        boxes.append((lv.shape[1], lv.shape[0], w0, y))
+        y += lv.shape[0]
+    height, width = max(h0, y), w0 + (levels[1].shape[1] if len(levels) > 1 else 0)
+    flat = dr.zeros(jit.Float, height * width * c)
+    for lv, (w, h, ox, oy) in zip(levels, boxes):
+        idx = dr.arange(jit.UInt, h * w * c)
+        texel, k = idx // c, idx % c
+        # Opaque sizes: one kernel for every level.
+        w_, ox_, oy_ = (dr.opaque(jit.UInt, x) for x in (w, ox, oy))
+        row, col = texel // w_, texel % w_
+        dr.scatter(flat, lv.array, ((row + oy_) * width + col + ox_) * c + k)
+    return jit.Tensor(flat, (height, width, c)), boxes
+
+
 def _frame_axes(mi, dr, si):
     """Tangent-space x ("right") and y ("up") in the shading frame's coordinates: x = dp/du
     projected into the surface (the shading frame's s where dp/du is unset), y = n x right,
@@ -152,9 +313,10 @@ def _fresnel(mi, dr, cos, eta):
     return mi.fresnel(dr.clip(cos, 0.0, 1.0), eta)[0]
 
 
-def _gaussian(dr, beta, x):
-    """g(beta, x) = exp(-x^2 / 2 beta^2) / (beta sqrt(2 pi)) (Marschner et al. 2005 §4.2)."""
-    return dr.exp(-0.5 * dr.square(x / beta)) / (beta * math.sqrt(2.0 * math.pi))
+def _gaussian(dr, inv_beta, x):
+    """g(beta, x) = exp(-x^2 / 2 beta^2) / (beta sqrt(2 pi)) (Marschner et al. 2005 §4.2), of
+    1 / beta (a division per width, shared by its Gaussians)."""
+    return dr.exp(-0.5 * dr.square(x * inv_beta)) * (inv_beta / math.sqrt(2.0 * math.pi))
 
 
 class _Angles:
@@ -167,11 +329,11 @@ class _Angles:
         self.cos = dr.safe_sqrt(1.0 - self.sin * self.sin)
 
 
-def _lobe(dr, o, i, beta):
+def _lobe(dr, o, i, inv_beta):
     """The energy-bounded fibre lobe g(beta, psi_i + psi_o) / (2 pi max(cos psi_i, cos psi_o))
     (fiber.rs lobe_value; notes/bsdf.md §2), without its colour; o, i: `_Angles`."""
     c = dr.maximum(dr.maximum(i.cos, o.cos), MIN_COS_PSI)
-    return _gaussian(dr, beta, i.psi + o.psi) / (2.0 * math.pi * c)
+    return _gaussian(dr, inv_beta, i.psi + o.psi) / (2.0 * math.pi * c)
 
 
 def _arc(dr, u, sin_psi, cos_psi, z_min):
@@ -183,13 +345,13 @@ def _arc(dr, u, sin_psi, cos_psi, z_min):
     return dr.select(t <= -1.0, math.pi, dr.select(t >= 1.0, 0.0, dr.acos(dr.clip(t, -1.0, 1.0))))
 
 
-def _lobe_pdf(dr, u, psi_o, i, wi_z, beta, z_min):
+def _lobe_pdf(dr, u, psi_o, i, wi_z, inv_beta, z_min):
     """Density of `_lobe_sample` about psi_o per interior solid angle at the interior direction
     with angles i and z = wi_z: g(beta, psi_i + psi_o) / (2 max(Delta, MIN_ARC) cos psi_i)
     (fiber.rs pdf_about; notes/bsdf.md §3)."""
     delta = _arc(dr, u, i.sin, i.cos, z_min)
     ok = (wi_z > z_min) & (i.cos >= MIN_COS_PSI) & (delta > 0)
-    g = _gaussian(dr, beta, i.psi + psi_o)
+    g = _gaussian(dr, inv_beta, i.psi + psi_o)
     width = 2.0 * dr.maximum(delta, MIN_ARC) * dr.maximum(i.cos, MIN_COS_PSI)
     return dr.select(ok, g / width, 0.0)
 
@@ -232,41 +394,67 @@ class _Spread:
     share, mean longitudinal angle psi = asin E[t.u], cos psi, and var psi = var(t.u) / (1 -
     E[t.u]^2) (fiber.rs `FiberAxis::spread`); E and var of t.u from the part's mean and
     covariance turned to w's azimuth (rough_transmission.rs `TransmittedPart::along`). `part`:
-    (share, mean x, mean z, cov xx, cov yy, cov xz)."""
+    (share, mean x, mean z, cov xx, cov yy, cov xz). Also 1 / max(cos psi, MIN_COS_PSI), for
+    the lobe's 1 / max(cos_a, cos_b) = min(1 / max(cos_a, .), 1 / max(cos_b, .))."""
 
     def __init__(self, dr, w, part, u):
         share, mx, mz, cxx, cyy, cxz = part
         r2 = w.x * w.x + w.y * w.y
-        r = dr.sqrt(dr.maximum(r2, 1e-12))
-        c, s = dr.select(r2 > 1e-12, w.x / r, 1.0), dr.select(r2 > 1e-12, w.y / r, 0.0)
+        inv_r = dr.rsqrt(dr.maximum(r2, 1e-12))
+        c, s = dr.select(r2 > 1e-12, w.x * inv_r, 1.0), dr.select(r2 > 1e-12, w.y * inv_r, 0.0)
         ux, uy = c * u.x + s * u.y, c * u.y - s * u.x
         czz = dr.maximum(1.0 - cxx - cyy - mx * mx - mz * mz, 0.0)
         mean = dr.clip(mx * ux + mz * u.z, -0.9999, 0.9999)
         var = dr.maximum(cxx * ux * ux + cyy * uy * uy + czz * u.z * u.z + 2.0 * cxz * ux * u.z,
                          0.0)
         cos2 = 1.0 - mean * mean
-        self.share, self.psi, self.cos, self.var = share, dr.asin(mean), dr.sqrt(cos2), var / cos2
+        self.share, self.psi, self.var = share, dr.asin(mean), var / cos2
+        self.inv_cos = 1.0 / dr.maximum(dr.sqrt(cos2), MIN_COS_PSI)
 
 
 def _lobe_spread(dr, o, i, beta):
     """The energy-bounded fibre lobe seen through a rough finish (notes/bsdf.md §4.6; fiber.rs
     `FiberAxis::eval_spread`): sum over the parts a of wo's and b of wi's `_Spread`s of
-    share_a share_b g(sqrt(beta^2 + var_a + var_b), psi_a + psi_b) / (2 pi max(cos_a, cos_b))."""
+    share_a share_b g(sqrt(beta^2 + var_a + var_b), psi_a + psi_b) / (2 pi max(cos_a, cos_b)),
+    the constant factors 1 / (2 pi sqrt(2 pi)) taken out of the sum."""
     f = 0.0
     for a in o:
         for b in i:
-            g = _gaussian(dr, dr.sqrt(beta * beta + a.var + b.var), a.psi + b.psi)
-            c = dr.maximum(dr.maximum(b.cos, a.cos), MIN_COS_PSI)
-            f += a.share * b.share * g / (2.0 * math.pi * c)
-    return f
+            inv_var = 1.0 / (beta * beta + a.var + b.var)
+            g = dr.exp(-0.5 * dr.square(a.psi + b.psi) * inv_var) * dr.sqrt(inv_var)
+            f += (a.share * b.share) * g * dr.minimum(a.inv_cos, b.inv_cos)
+    return f * (1.0 / (2.0 * math.pi * math.sqrt(2.0 * math.pi)))
 
 
 def _sampling_about(dr, spread, beta):
-    """(psi, width) a fibre lobe's samples are drawn with under a rough finish: the single
-    scattering part's mean angle, beta widened by twice the mean variance (wood.rs
+    """(psi, width, 1 / width) a fibre lobe's samples are drawn with under a rough finish: the
+    single scattering part's mean angle, beta widened by twice the mean variance (wood.rs
     `sampling_about`)."""
     var = spread[0].share * spread[0].var + spread[1].share * spread[1].var
-    return spread[0].psi, dr.minimum(dr.sqrt(beta * beta + 2.0 * var), 0.5 * math.pi)
+    width = dr.minimum(dr.sqrt(beta * beta + 2.0 * var), 0.5 * math.pi)
+    return spread[0].psi, width, 1.0 / width
+
+
+def _axis_view(dr, wo, wo_in, parts, axis, beta, inv_beta):
+    """How the view sees one axis (fibre or ray), shared by every wi: under a smooth finish
+    (`parts` None) the refracted view's `_Angles`, under a rough one the `_Spread`s of the
+    transmitted `parts`; and the (psi, width, 1 / width) its lobe's samples are drawn about."""
+    if parts is None:
+        a = _Angles(dr, wo_in, axis)
+        return a, (a.psi, beta, inv_beta)
+    spread = [_Spread(dr, wo, p, axis) for p in parts]
+    return spread, _sampling_about(dr, spread, beta)
+
+
+def _axis_terms(dr, seen, about, axis, wi, wi_in, parts_i, beta, inv_beta, z_min):
+    """One axis's lobe at wi (no colour; `_lobe`, or `_lobe_spread` under a rough finish) and
+    its sampling density per interior solid angle (`_lobe_pdf`); `seen`, `about`: `_axis_view`."""
+    angles = _Angles(dr, wi_in, axis)
+    if parts_i is None:
+        lobe = _lobe(dr, seen, angles, inv_beta)
+    else:
+        lobe = _lobe_spread(dr, seen, [_Spread(dr, wi, p, axis) for p in parts_i], beta)
+    return lobe, _lobe_pdf(dr, axis, about[0], angles, wi_in.z, about[2], z_min)
 
 
 _CLASSES = {}
@@ -283,89 +471,76 @@ def bsdf_class(mi, dr):
 
     class Texel:
         """The BSDF's parameters at the interaction (wood.rs `WoodBsdf::new` for the texel's
-        values), in the coordinates of the BSDF's frame: the shading frame, or the frame about
-        the bumped normal (`local` / `world` map directions between the two)."""
+        values; `_shading_maps` derived them per texel) and its frame: the tangent frame (x
+        along dp/du, y against dp/dv, z the shading normal; `_frame_axes`) or, with the bump, a
+        frame about the bumped normal in it. `local` / `world` map Mitsuba's shading-frame
+        directions to and from it; the lobes depend only on dot products with the normal and
+        the axes, so any frame about the normal will do."""
 
         def __init__(self, bsdf, si, active):
-            uv = si.uv
-            v = bsdf._texture.eval(uv, active)
-            a, b, f, g = v[0:4], v[4:8], v[8:11], v[11:14]
-            # Clamped as material/baked.rs `BakedWoodMaterial::shade` clamps the lookup.
-            self.diffuse = dr.clip(mi.Color3f(a[0], a[1], a[2]), 0.0, 1.0)
-            self.fiber_color = dr.clip(mi.Color3f(b[0], b[1], b[2]), 0.0, 1.0)
-            self.beta = dr.clip(a[3], 1e-3, 0.5 * math.pi)
-            self.m = dr.clip(b[3], 0.0, 1.0)
-            right, up = _frame_axes(mi, dr, si)
+            v = bsdf._lookup(si, active)
+            self.diffuse_eff = mi.Color3f(v[0], v[1], v[2])
+            self.beta, self.m = v[3], v[7]
+            self.inv_beta = 1.0 / self.beta
+            self.fiber_color = mi.Color3f(v[4], v[5], v[6])
+            self.right, self.up = _frame_axes(mi, dr, si)
 
-            def axis(t):
-                return right * t[0] + up * t[1] + mi.Vector3f(0, 0, 1) * t[2]
+            def unit(a, b, c, fallback):
+                """An interpolated unit vector renormalised."""
+                x = mi.Vector3f(a, b, c)
+                return dr.select(dr.squared_norm(x) < 1e-12, fallback, dr.normalize(x))
 
-            u = axis(f)
-            self.u = dr.select(dr.squared_norm(u) < 1e-12, right, dr.normalize(u))
-            # The ray axis: the baked one (the volume's, as the solid wood's material.rs
-            # `WoodMaterial` gives it), else in the face across the fibre (face.rs: xylem's
-            # frame.t = n x s).
-            s = mi.Vector3f(self.u.x, self.u.y, 0.0)
-            s = dr.select(dr.squared_norm(s) > 1e-12, dr.normalize(s), mi.Vector3f(1, 0, 0))
-            r = axis(g)
-            self.r = dr.select(dr.squared_norm(r) < 1e-12, mi.Vector3f(-s.y, s.x, 0.0),
-                               dr.normalize(r))
+            self.u = unit(v[8], v[9], v[10], mi.Vector3f(1, 0, 0))
+            self.r = unit(v[11], v[12], v[13], mi.Vector3f(0, 1, 0))
             self.frame = None
             if bsdf.bump > 0:
-                # The pore bump (Blinn 1978), as material.rs `WoodMaterial` tilts the normal:
-                # the baked tangent-space normal (-dh/dx, -dh/dy, 1) normalised, its slope scaled
-                # by `bump`; the BSDF is evaluated in a frame about it, the fibre and ray axes
-                # expressed there unprojected, as xylem's Frame::from_normal_tangent does.
-                n = v[14:17]
-                nb = axis((bsdf.bump * n[0], bsdf.bump * n[1], n[2]))
-                nb = dr.select(dr.squared_norm(nb) < 1e-12, mi.Vector3f(0, 0, 1), dr.normalize(nb))
-                self.frame = mi.Frame3f(nb)
+                self.frame = mi.Frame3f(unit(v[14], v[15], v[16], mi.Vector3f(0, 0, 1)))
                 self.u, self.r = self.frame.to_local(self.u), self.frame.to_local(self.r)
-            self.diffuse_eff = self._diffuse(bsdf)
+            self.back = None
+            if bsdf.two_sided:
+                # Seen from behind (si.wi below the shading frame, Mitsuba's `twosided` test),
+                # the frame turns half round the fibre's projection into the face, s: (s, t, n)
+                # -> (s, -t, -n), as xylem's renderer faces an opaque surface to its viewer
+                # (render/integrator.rs; its frame's s is that projection).
+                self.back = si.wi.z < 0.0
+                self.s = unit(self.u.x, self.u.y, 0.0, mi.Vector3f(1, 0, 0))
+
+        def _turn(self, w):
+            """w turned half round s where the hit is seen from behind (an involution)."""
+            if self.back is None:
+                return w
+            return dr.select(self.back, 2.0 * dr.dot(self.s, w) * self.s - w, w)
 
         def local(self, w):
-            """A shading-frame direction in the BSDF's frame (the bumped one, if any)."""
-            return w if self.frame is None else self.frame.to_local(w)
+            """A shading-frame direction in the BSDF's frame."""
+            w = mi.Vector3f(dr.dot(w, self.right), dr.dot(w, self.up), w.z)
+            return self._turn(w if self.frame is None else self.frame.to_local(w))
 
         def world(self, w):
-            return w if self.frame is None else self.frame.to_world(w)
-
-        def _diffuse(self, bsdf):
-            """rho'' = rho' / (1 - rho' F_int), rho' = s rho, s = min(1, min_c room_c / rho_c),
-            room = 1 - k_f A with A the ray-mask blend of the lobes' albedo bounds (wood.rs
-            `bounded_diffuse`; notes/bsdf.md §1.3, §2.3)."""
-            def bound(axis_z):
-                dip = dr.asin(dr.minimum(dr.abs(axis_z), 1.0))
-                scale = 2.0 / math.pi * (ALBEDO_NODES - 1) / ALBEDO_NODES
-                pos = mi.Point2f(self.beta * scale + 0.5 / ALBEDO_NODES,
-                                 dip * scale + 0.5 / ALBEDO_NODES)
-                return bsdf._albedo.eval(pos)[0]
-
-            albedo = (1.0 - self.m) * bound(self.u.z) + self.m * bound(self.r.z)
-            room, rho = 1.0 - self.fiber_color * albedo, self.diffuse
-            ratio = dr.select(rho > room, room / dr.maximum(rho, 1e-30), 1.0)
-            rho = rho * dr.minimum(dr.minimum(ratio.x, ratio.y), dr.minimum(ratio.z, 1.0))
-            return rho / (1.0 - rho * bsdf._f_int)
+            w = self._turn(w)
+            w = w if self.frame is None else self.frame.to_world(w)
+            return self.right * w.x + self.up * w.y + mi.Vector3f(0, 0, w.z)
 
     class View:
         """What the BSDF needs of the view wo (Mitsuba's si.wi) alone, shared by every wi: the
-        finish's transmittance T(wo); smooth: wo refracted into the finish and its angles about
-        the fibre and ray axes; rough: R(wo), R_ms(wo) and how each axis sees the transmitted
-        light (`_Spread`s) with the (psi, width) its samples are drawn about (wood.rs
-        `RoughView`)."""
+        finish's transmittance T(wo); smooth: wo refracted into the finish; rough: R(wo),
+        R_ms(wo) and the transmitted light's parts (wood.rs `RoughView`); and how the fibre
+        axis sees it (`_axis_view`). The ray axis's view is computed where it is used, in
+        `rays` branches."""
 
         def __init__(self, bsdf, t, wo):
-            self.wo = wo
+            self.wo, self.wo_in, self.parts = wo, None, None
             if bsdf._rough is None:
                 self.trans = bsdf._transmittance(wo.z)
-                wo_in = _refract_in(mi, dr, wo, bsdf.eta)
-                self.angles = [_Angles(dr, wo_in, ax) for ax in (t.u, t.r)]
-                self.about = [(a.psi, t.beta) for a in self.angles]
-                return
-            self.reflectance, self.multiple, parts = bsdf._finish_at(wo.z)
-            self.trans = 1.0 - self.reflectance
-            self.spreads = [[_Spread(dr, wo, p, ax) for p in parts] for ax in (t.u, t.r)]
-            self.about = [_sampling_about(dr, sp, t.beta) for sp in self.spreads]
+                self.wo_in = _refract_in(mi, dr, wo, bsdf.eta)
+            else:
+                self.reflectance, self.multiple, self.parts = bsdf._finish_at(wo.z)
+                self.trans = 1.0 - self.reflectance
+            self.fiber = _axis_view(dr, wo, self.wo_in, self.parts, t.u, t.beta, t.inv_beta)
+
+        def ray_args(self, t):
+            """What the ray axis's view is made of (`_axis_view`'s arguments)."""
+            return (self.wo, self.wo_in, self.parts, t.r, t.beta, t.inv_beta)
 
     class XylemWoodBaked(mi.BSDF):
         def __init__(self, props):
@@ -377,6 +552,7 @@ def bsdf_class(mi, dr):
             self.eta = float(props.get("eta", 1.5))
             self.roughness = float(props.get("roughness", 0.0))
             self.bump = float(props.get("bump", 1.0))
+            self.two_sided = bool(props.get("two_sided", False))
             if not 0.0 <= self.bump <= 100.0:
                 raise ValueError(f"xylem_wood_baked: `bump` = {self.bump}: expected 0 (off) to "
                                  "100 (1: the baked normal map as it is)")
@@ -385,12 +561,14 @@ def bsdf_class(mi, dr):
             if not 0.0 <= self.roughness <= 1.0:
                 raise ValueError(
                     f"xylem_wood_baked: `roughness` = {self.roughness}: expected 0 (smooth) to 1")
+            self.pixel_angle = float(props.get("pixel_angle", 0.0))
+            if not 0.0 <= self.pixel_angle <= 0.1:
+                raise ValueError(f"xylem_wood_baked: `pixel_angle` = {self.pixel_angle}: "
+                                 "expected 0 (no mip maps) to 0.1 rad (`pixel_angle(scene)`)")
+            self._pixel_angle = mi.Float(self.pixel_angle)
             linear = dict(filter_mode=dr.FilterMode.Linear, wrap_mode=dr.WrapMode.Clamp)
-            # One texture (14 channels, 17 with the normal): a lookup computes its taps and
-            # weights once.
+            self._linear = linear
             self._tensor = mi.TensorXf(_maps(self.maps, normal=self.bump > 0))
-            self._texture = mi.Texture2f(self._tensor, **linear)
-            self._albedo = mi.Texture2f(mi.TensorXf(_albedo_table()[..., None]), **linear)
             eta = self.eta
             # As WoodBsdf: below roughness 1e-3 the finish is smooth (wood.rs MIN_ROUGHNESS).
             self._rough = None
@@ -417,12 +595,15 @@ def bsdf_class(mi, dr):
             # 1 - R_int = (1 - R_avg) / eta^2 (wood.rs `escape`; notes/bsdf.md §1.3, §4.3).
             self._escape = (1.0 - avg_reflectance) / (eta * eta)
             self._f_int = 1.0 - self._escape
+            self._build()
             self._z_crit = math.sqrt(max(0.0, 1.0 - 1.0 / (eta * eta)))
             self._delta = eta > 1.0 and self._rough is None
             lobes = (mi.BSDFFlags.DiffuseReflection | mi.BSDFFlags.GlossyReflection
                      | mi.BSDFFlags.FrontSide | mi.BSDFFlags.SpatiallyVarying
                      | mi.BSDFFlags.Anisotropic)
             delta = mi.BSDFFlags.DeltaReflection | mi.BSDFFlags.FrontSide
+            if self.two_sided:
+                lobes, delta = lobes | mi.BSDFFlags.BackSide, delta | mi.BSDFFlags.BackSide
             # Component 0: everything but a smooth finish's mirror (a rough finish's reflection
             # included); component 1: the mirror.
             self.m_components = [lobes, delta] if self._delta else [lobes]
@@ -496,6 +677,18 @@ def bsdf_class(mi, dr):
             inv = dr.select(total > 0, 1.0 / total, 0.0)
             return spec * inv, diff * inv, fib * inv, ray * inv
 
+        def _rays(self, t, fn, args):
+            """fn(*args), two Floats, where the texel has rays (ray mask m > 0), zeros where it
+            has none (m multiplies the ray lobe and its probability). Under a rough finish a
+            symbolic branch, which a packet of lanes with no rays skips (86 % of a mahogany
+            board's texels have m = 0): 0.93x the render's time. The smooth finish's ray lobe
+            is cheap (no spreads), and there the branch saved nothing measurable (0.98x,
+            0.93-1.14) while tracing it cost every render 3.5 ms more, so it is computed
+            everywhere."""
+            if self._rough is None:
+                return fn(*args)
+            return dr.if_stmt(args, t.m > 0.0, fn, lambda *_: (mi.Float(0.0), mi.Float(0.0)))
+
         def _eval_pdf(self, t, view, probs, wi):
             """xylem's f (no cosine) and the sampling density, sharing the refracted directions
             and the longitudinal angles. f = T(wo) T(wi) / eta^2 (rho''/pi + k_f ((1 - m)
@@ -506,19 +699,23 @@ def bsdf_class(mi, dr):
             d w_ext = cos theta_i / (eta^2 cos theta_i') (notes/bsdf.md §1.1), a rough
             finish's visible-normal density. Zero where either cosine is <= 0 or where not
             finite."""
-            eta, wo = self.eta, view.wo
+            eta, wo, z_crit = self.eta, view.wo, self._z_crit
             wi_in = _refract_in(mi, dr, wi, eta)
+            parts = None
             if self._rough is None:
                 trans_i = self._transmittance(wi.z)
-                lobes = [_lobe(dr, o, _Angles(dr, wi_in, ax), t.beta)
-                         for o, ax in zip(view.angles, (t.u, t.r))]
             else:
                 reflectance_i, multiple_i, parts = self._finish_at(wi.z)
                 trans_i = 1.0 - reflectance_i
-                lobes = [_lobe_spread(dr, sp, [_Spread(dr, wi, p, ax) for p in parts], t.beta)
-                         for sp, ax in zip(view.spreads, (t.u, t.r))]
-            dens = [_lobe_pdf(dr, ax, psi, _Angles(dr, wi_in, ax), wi_in.z, width, self._z_crit)
-                    for ax, (psi, width) in zip((t.u, t.r), view.about)]
+            fiber = _axis_terms(dr, *view.fiber, t.u, wi, wi_in, parts, t.beta, t.inv_beta,
+                                z_crit)
+
+            def ray(wo, wo_in, parts_o, r, beta, inv_beta, wi, wi_in, parts):
+                seen, about = _axis_view(dr, wo, wo_in, parts_o, r, beta, inv_beta)
+                return _axis_terms(dr, seen, about, r, wi, wi_in, parts, beta, inv_beta, z_crit)
+
+            ray = self._rays(t, ray, view.ray_args(t) + (wi, wi_in, parts))
+            lobes, dens = (fiber[0], ray[0]), (fiber[1], ray[1])
             substrate = t.diffuse_eff / math.pi + t.fiber_color * (
                 (1.0 - t.m) * lobes[0] + t.m * lobes[1])
             f = substrate * (view.trans * trans_i / (eta * eta))
@@ -562,9 +759,12 @@ def bsdf_class(mi, dr):
             c1, c2 = probs[0] + probs[1], probs[0] + probs[1] + probs[2]
             spec = sample1 < probs[0]
             diff = (sample1 >= probs[0]) & (sample1 < c1)
-            fib = (sample1 >= c1) & (sample1 < c2)
+            # (A ray lobe of probability 0 is never picked, also where c2 rounds below 1.)
+            fib = (sample1 >= c1) & ((sample1 < c2) | (probs[3] <= 0))
             axis = dr.select(fib, t.u, t.r)
-            psi, width = (dr.select(fib, a, b) for a, b in zip(*view.about))
+            ray_about = self._rays(t, lambda *args: _axis_view(dr, *args)[1][:2],
+                                   view.ray_args(t))
+            psi, width = (dr.select(fib, a, b) for a, b in zip(view.fiber[1], ray_about))
             wi_in, lobe_ok = _lobe_sample(mi, dr, axis, psi, sample2, width, self._z_crit)
             wi_lobe, leaves = _refract_out(mi, dr, wi_in, self.eta)
             if self._rough is None:
@@ -600,13 +800,102 @@ def bsdf_class(mi, dr):
 
         def traverse(self, callback):
             callback.put("maps", self._tensor, mi.ParamFlags.Differentiable)
+            callback.put("pixel_angle", self._pixel_angle, mi.ParamFlags.NonDifferentiable)
+
+        def _build(self):
+            """What the BSDF looks up (`_shading_maps`), one texture a level, so that a lookup
+            computes its taps and weights once; with a `pixel_angle`, its mip levels down to
+            one texel (`_halve`)."""
+            jit = _Jit(mi, dr)
+            level = _shading_maps(mi, dr, jit, self._tensor, self.bump, self._f_int)
+            levels = [level]
+            while self.pixel_angle > 0 and max(level.shape[:2]) > 1:
+                level = _halve(dr, jit, level)
+                levels.append(level)
+            self._levels = len(levels)
+            if len(levels) == 1:
+                self._texture = mi.Texture2f(jit.out(level), **self._linear)
+                return
+            atlas, boxes = _atlas(dr, jit, levels)
+            self._texture = mi.Texture2f(jit.out(atlas), **self._linear)
+            self._boxes = [mi.Float(np.array(b, np.float32)) for b in zip(*boxes)]
 
         def parameters_changed(self, keys=None):
-            self._texture.set_tensor(self._tensor)
+            angle = self._pixel_angle
+            self.pixel_angle = float(angle if isinstance(angle, float) else angle[0])
+            self._build()
+
+        def _lookup(self, si, active):
+            """The shading maps at si.uv: bilinear in level 0 or, with a `pixel_angle`,
+            trilinear between the two mip levels about log2 of the footprint's width in
+            texels (each level looked up in the atlas, `_atlas`, clamped to its texels). The
+            footprint is a ray cone's (Amanatides 1984; Akenine-Moeller et al. 2019): width
+            pixel_angle * si.t across the ray, 1 / cos theta longer along the surface, in
+            texels by the texels per unit area, W H / |dp/du x dp/dv|. At a camera hit si.t is
+            the distance from the camera; at later bounces the segment from the last vertex,
+            which underestimates the cone (sharper, never blurrier)."""
+            if self._levels == 1:
+                return self._texture.eval(si.uv, active)
+            h, w = self._tensor.shape[:2]
+            area = dr.norm(dr.cross(si.dp_du, si.dp_dv))
+            per_length = dr.select(area > 1e-20, dr.rsqrt(dr.maximum(area, 1e-20)), 0.0)
+            texels = (self._pixel_angle * si.t * math.sqrt(h * w) * per_length
+                      / dr.maximum(dr.abs(si.wi.z), 1e-3))
+            lam = dr.clip(dr.log2(dr.maximum(texels, 1.0)), 0.0, self._levels - 1.0)
+            lower = mi.UInt32(dr.floor(lam))
+            frac = lam - mi.Float(lower)
+            atlas = self._texture.shape
+
+            def at(level, uv, active):
+                w, h, ox, oy = (dr.gather(mi.Float, b, level, active) for b in self._boxes)
+                x = dr.clip(uv.x * w, 0.5, w - 0.5) + ox
+                y = dr.clip(uv.y * h, 0.5, h - 0.5) + oy
+                return self._texture.eval(mi.Point2f(x / atlas[1], y / atlas[0]), active)
+
+            def upper(lower, uv, frac, active):
+                return tuple(x * frac for x in at(lower + 1, uv, active & (frac > 0.0)))
+
+            def none(lower, uv, frac, active):
+                return tuple(mi.Float(0.0) for _ in range(atlas[2]))
+
+            top = dr.if_stmt((lower, si.uv, frac, active), frac > 0.0, upper, none)
+            return [a * (1.0 - frac) + b for a, b in zip(at(lower, si.uv, active), top)]
 
         def to_string(self):
             return (f"XylemWoodBaked[maps={self.maps}, eta={self.eta}, "
-                    f"roughness={self.roughness}, bump={self.bump}]")
+                    f"roughness={self.roughness}, bump={self.bump}, "
+                    f"pixel_angle={self.pixel_angle}, two_sided={self.two_sided}]")
 
     _CLASSES[key] = XylemWoodBaked
     return XylemWoodBaked
+
+
+def pixel_angle(scene, sensor=0):
+    """The ray-cone angle of one camera sample of `scene`'s sensor (radians): for a
+    ``perspective`` camera 2 tan(fov_x / 2) / width, the angle a pixel subtends at the image
+    centre, divided by sqrt(spp) (each sample's share of the pixel, as Mitsuba scales ray
+    differentials). Give it to ``xylem_wood_baked`` as ``pixel_angle`` for mip-mapped lookups
+    (`set_pixel_angle` does so for every one in the scene)."""
+    import mitsuba as mi
+
+    cam = scene.sensors()[sensor]
+    params = mi.traverse(cam)
+    fov = next(float(params[k][0] if hasattr(params[k], "__len__") else params[k])
+               for k in params.keys() if k.endswith("x_fov"))
+    width = cam.film().crop_size()[0]
+    spp = cam.sampler().sample_count()
+    return 2.0 * math.tan(math.radians(fov) / 2.0) / width / math.sqrt(spp)
+
+
+def set_pixel_angle(scene, angle=None):
+    """Sets ``pixel_angle`` (default `pixel_angle(scene)`) on every ``xylem_wood_baked`` in
+    `scene` and updates them; returns the angle."""
+    import mitsuba as mi
+
+    angle = pixel_angle(scene) if angle is None else float(angle)
+    params = mi.traverse(scene)
+    keys = [k for k in params.keys() if k.endswith(".pixel_angle") or k == "pixel_angle"]
+    for k in keys:
+        params[k] = mi.Float(angle)
+    params.update()
+    return angle
