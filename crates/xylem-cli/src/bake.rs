@@ -210,6 +210,54 @@ fn mesh_of(spec: &str) -> anyhow::Result<(UvMesh, [f32; 3], [f32; 3])> {
     })
 }
 
+/// Warns about texels under more than one UV triangle and triangles reaching outside UV [0, 1]².
+fn warn_about_layout(spec: &str, bake: &MeshBake) {
+    if bake.overlapping > 0 {
+        eprintln!(
+            "warning: --mesh {spec}: {} texels lie under more than one UV triangle \
+             (overlapping or mirrored charts); each keeps the first triangle's wood",
+            bake.overlapping
+        );
+    }
+    if bake.outside > 0 {
+        eprintln!(
+            "warning: --mesh {spec}: {} triangles reach outside UV [0, 1]²; only their part \
+             inside is baked",
+            bake.outside
+        );
+    }
+}
+
+/// The optional outputs of a mesh bake, staged: the preview picture (--preview), and the
+/// MaterialX document with a USD stage binding it (--materialx).
+fn stage_mesh_extras(
+    args: &Args,
+    mesh: &xylem::bake::uv_mesh::UvMesh,
+    maps: &xylem::bake::BakedMaps,
+) -> anyhow::Result<Vec<xylem::output::Staged>> {
+    let (name, mut staged) = (&args.preset, Vec::new());
+    if args.preview {
+        let (w, h) = (480, 360);
+        let px = xylem::bake::preview::preview(mesh, maps, w, h);
+        staged.push(xylem::picture::png::stage_png_rgb8(
+            &args.out.join("preview.png"),
+            w,
+            h,
+            &xylem::picture::srgb::to_srgb8(&px, 0.0),
+        )?);
+    }
+    if args.materialx {
+        staged.extend(stage_materialx(&args.out, maps, name)?);
+        let usda = args.out.join(format!("{name}.usda"));
+        let text = xylem::bake::usd::usda_mesh_stage(mesh, name, &format!("{name}.mtlx"));
+        staged.push(
+            xylem::output::stage_bytes(&usda, text.as_bytes())
+                .with_context(|| format!("writing {}", usda.display()))?,
+        );
+    }
+    Ok(staged)
+}
+
 /// `xylem bake PRESET --mesh …`: the maps over the mesh's UV layout, its coverage mask, the
 /// mesh as a `.glb` and as an `.obj` (for Mitsuba), and (with --preview) a picture of it.
 fn run_mesh(args: &Args, volume: &xylem::wood::WoodVolume) -> anyhow::Result<ExitCode> {
@@ -239,20 +287,7 @@ fn run_mesh(args: &Args, volume: &xylem::wood::WoodVolume) -> anyhow::Result<Exi
     );
     let seconds = start.elapsed().as_secs_f64();
     let count = |c: Coverage| bake.coverage.iter().filter(|&&x| x == c).count();
-    if bake.overlapping > 0 {
-        eprintln!(
-            "warning: --mesh {spec}: {} texels lie under more than one UV triangle \
-             (overlapping or mirrored charts); each keeps the first triangle's wood",
-            bake.overlapping
-        );
-    }
-    if bake.outside > 0 {
-        eprintln!(
-            "warning: --mesh {spec}: {} triangles reach outside UV [0, 1]²; only their part \
-             inside is baked",
-            bake.outside
-        );
-    }
+    warn_about_layout(spec, &bake);
     let maps = &bake.maps;
     let _lock = FolderLock::try_new(&args.out, LockMode::Exclusive)?;
     let mut staged = stage_maps(&args.out, maps)?;
@@ -266,25 +301,7 @@ fn run_mesh(args: &Args, volume: &xylem::wood::WoodVolume) -> anyhow::Result<Exi
         xylem::output::stage_bytes(&obj, mesh.to_obj().as_bytes())
             .with_context(|| format!("writing {}", obj.display()))?,
     );
-    if args.preview {
-        let (w, h) = (480, 360);
-        let px = xylem::bake::preview::preview(&mesh, maps, w, h);
-        staged.push(xylem::picture::png::stage_png_rgb8(
-            &args.out.join("preview.png"),
-            w,
-            h,
-            &xylem::picture::srgb::to_srgb8(&px, 0.0),
-        )?);
-    }
-    if args.materialx {
-        staged.extend(stage_materialx(&args.out, maps, name)?);
-        let usda = args.out.join(format!("{name}.usda"));
-        let text = xylem::bake::usd::usda_mesh_stage(&mesh, name, &format!("{name}.mtlx"));
-        staged.push(
-            xylem::output::stage_bytes(&usda, text.as_bytes())
-                .with_context(|| format!("writing {}", usda.display()))?,
-        );
-    }
+    staged.extend(stage_mesh_extras(args, &mesh, maps)?);
     let record = serde_json::json!({
         "preset": name,
         "mesh": spec,
