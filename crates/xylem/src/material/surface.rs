@@ -110,6 +110,7 @@ pub(crate) enum SurfaceAtWo<'a> {
 
 impl SurfaceBsdf {
     /// This BSDF with its `wo` fixed (local frame).
+    #[inline]
     pub(crate) fn at_wo(&self, wo: Vec3) -> SurfaceAtWo<'_> {
         match self {
             SurfaceBsdf::Wood(b) => SurfaceAtWo::Wood(b.at_wo(wo)),

@@ -41,6 +41,7 @@ pub struct DistantLight {
 
 impl PointLight {
     /// The light arriving at `p`: irradiance at normal incidence I/d² (inverse-square law).
+    #[inline]
     pub fn sample(&self, p: Vec3) -> Option<LightSample> {
         delta_point(p, self.position, self.intensity)
     }
@@ -48,6 +49,7 @@ impl PointLight {
 
 impl SpotLight {
     /// The light arriving at `p`: a point light's I/d² times the cone's smoothstep falloff.
+    #[inline]
     pub fn sample(&self, p: Vec3) -> Option<LightSample> {
         let mut s = delta_point(p, self.position, self.intensity)?;
         let cos = (-s.wi).dot(self.direction);
@@ -58,6 +60,7 @@ impl SpotLight {
 
 impl DistantLight {
     /// The light arriving anywhere: irradiance `irradiance` from `direction`.
+    #[inline]
     pub fn sample(&self) -> LightSample {
         LightSample {
             wi: self.direction,
@@ -69,6 +72,7 @@ impl DistantLight {
     }
 }
 
+#[inline]
 fn delta_point(p: Vec3, position: Vec3, intensity: Vec3) -> Option<LightSample> {
     let to = position - p;
     let d2 = to.length_squared();

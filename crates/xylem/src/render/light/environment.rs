@@ -34,6 +34,7 @@ pub struct EnvMap {
 
 impl Environment {
     /// Radiance arriving from direction `-d`, i.e. seen looking along `d`.
+    #[inline]
     pub fn radiance(&self, d: Vec3) -> Vec3 {
         match &self.map {
             None => self.scale,
@@ -43,6 +44,7 @@ impl Environment {
 
     /// A direction from the map's luminance distribution (uniform on the sphere for a constant
     /// environment), with its radiance and solid-angle density.
+    #[inline]
     pub fn sample(&self, u: Vec2) -> Option<LightSample> {
         let (wi, pdf) = match &self.map {
             None => (uniform_sphere(u), UNIFORM_SPHERE_PDF),
@@ -59,6 +61,7 @@ impl Environment {
 
     /// What a ray that meets nothing sees, at infinity, with the density of
     /// [`Environment::sample`].
+    #[inline]
     pub fn hit(&self, ray: &Ray) -> LightHit {
         let pdf = match &self.map {
             None => UNIFORM_SPHERE_PDF,

@@ -54,6 +54,7 @@ impl RectLight {
 
     /// Samples the point `corner + u.x·edge_u + u.y·edge_v` uniformly by area; the solid-angle
     /// density is d² / (cos θ_l · area) (pbrt-v4 §12.5.1). `None` behind the light.
+    #[inline]
     pub fn sample(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
         let q = self.corner + self.edge_u * u.x + self.edge_v * u.y;
         let to = q - p;
@@ -75,6 +76,7 @@ impl RectLight {
 
     /// Where `ray` meets the front of the parallelogram, with the density [`RectLight::sample`]
     /// gives that direction.
+    #[inline]
     pub fn hit(&self, ray: &Ray) -> Option<LightHit> {
         let [uu, uv, vv, det] = self.gram;
         let (n, area) = (self.normal, self.area);

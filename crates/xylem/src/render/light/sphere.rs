@@ -26,6 +26,7 @@ impl SphereLight {
 
     /// Where `ray` meets the sphere, with the cone density of [`SphereLight::sample`]; `None`
     /// from inside.
+    #[inline]
     pub fn hit(&self, ray: &Ray) -> Option<LightHit> {
         let t = intersect_sphere(ray, self.center, self.radius)?;
         let d2 = (self.center - ray.o).length_squared();
