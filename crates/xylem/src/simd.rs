@@ -82,6 +82,16 @@ macro_rules! with_features {
 }
 pub(crate) use with_features;
 
+/// An `XYLEM_SIMD` value that names no level.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("XYLEM_SIMD={value} is not one of {levels}")]
+pub struct UnknownSimdLevel {
+    /// The value given (quoted).
+    pub value: String,
+    /// The levels' names.
+    pub levels: String,
+}
+
 impl Simd {
     /// Every level, narrowest first.
     pub const ALL: [Simd; 4] = [Simd::Scalar, Simd::Sse2, Simd::Avx2, Simd::Avx512];
@@ -144,15 +154,17 @@ impl Simd {
     }
 
     /// The level named by `XYLEM_SIMD`, if set; an error naming the allowed values if unknown.
-    pub fn from_env() -> Result<Option<Simd>, String> {
+    pub fn from_env() -> Result<Option<Simd>, UnknownSimdLevel> {
+        let unknown = |value: String| UnknownSimdLevel {
+            value,
+            levels: Simd::names(),
+        };
         match std::env::var("XYLEM_SIMD") {
             Err(std::env::VarError::NotPresent) => Ok(None),
-            Err(std::env::VarError::NotUnicode(v)) => {
-                Err(format!("XYLEM_SIMD={v:?} is not one of {}", Simd::names()))
-            }
+            Err(std::env::VarError::NotUnicode(v)) => Err(unknown(format!("{v:?}"))),
             Ok(v) => Simd::parse(&v)
                 .map(Some)
-                .ok_or_else(|| format!("XYLEM_SIMD={v:?} is not one of {}", Simd::names())),
+                .ok_or_else(|| unknown(format!("{v:?}"))),
         }
     }
 

@@ -223,9 +223,28 @@ pub fn batches(range: Range<usize>, per: usize) -> impl Iterator<Item = Range<us
         .map(move |a| a..a.saturating_add(per).min(range.end))
 }
 
+/// A byte count [`parse_bytes`] cannot read, with the text given.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ByteCountError {
+    /// A unit other than K, M, G, T (and their `KiB`, `MB`, … forms).
+    #[error("`{text}`: unknown unit `{unit}` (use K, M, G or T, e.g. 512M)")]
+    UnknownUnit {
+        /// The text given.
+        text: String,
+        /// The unit found.
+        unit: String,
+    },
+    /// No number before the unit.
+    #[error("`{0}` is not a byte count (e.g. 512M, 2G)")]
+    NotANumber(String),
+    /// Below 1 byte or above 16 EiB.
+    #[error("`{0}` is out of range (1 byte to 16 EiB)")]
+    OutOfRange(String),
+}
+
 /// Parses a byte count: a number with an optional unit `K`, `M`, `G`, `T` (powers of 1024;
 /// `KiB`, `MB`, … and lower case alike), e.g. `512M`, `1.5G`, `4000000`.
-pub fn parse_bytes(s: &str) -> Result<u64, String> {
+pub fn parse_bytes(s: &str) -> Result<u64, ByteCountError> {
     let t = s.trim();
     let split = t
         .find(|c: char| !(c.is_ascii_digit() || c == '.'))
@@ -238,18 +257,18 @@ pub fn parse_bytes(s: &str) -> Result<u64, String> {
         "g" | "gb" | "gib" => 30,
         "t" | "tb" | "tib" => 40,
         _ => {
-            return Err(format!(
-                "`{s}`: unknown unit `{}` (use K, M, G or T, e.g. 512M)",
-                unit.trim()
-            ))
+            return Err(ByteCountError::UnknownUnit {
+                text: s.into(),
+                unit: unit.trim().into(),
+            })
         }
     };
     let value: f64 = num
         .parse()
-        .map_err(|_| format!("`{s}` is not a byte count (e.g. 512M, 2G)"))?;
+        .map_err(|_| ByteCountError::NotANumber(s.into()))?;
     let bytes = value * (1u64 << shift) as f64;
     if !(1.0..=u64::MAX as f64).contains(&bytes) {
-        return Err(format!("`{s}` is out of range (1 byte to 16 EiB)"));
+        return Err(ByteCountError::OutOfRange(s.into()));
     }
     Ok(bytes as u64)
 }
@@ -263,8 +282,14 @@ mod tests {
         assert_eq!(parse_bytes("512M"), Ok(512 << 20));
         assert_eq!(parse_bytes("1.5GiB"), Ok(3 << 29));
         assert_eq!(parse_bytes(" 4000 "), Ok(4000));
-        assert!(parse_bytes("12X").unwrap_err().contains("unknown unit"));
-        assert!(parse_bytes("0").unwrap_err().contains("out of range"));
+        assert!(parse_bytes("12X")
+            .unwrap_err()
+            .to_string()
+            .contains("unknown unit"));
+        assert_eq!(
+            parse_bytes("0"),
+            Err(ByteCountError::OutOfRange("0".into()))
+        );
         assert!(parse_bytes("M").is_err());
     }
 
