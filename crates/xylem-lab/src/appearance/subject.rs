@@ -98,7 +98,8 @@ impl Subject {
                 .map_err(|e| e.to_string())?;
                 let volume = WoodVolume::new(params, *seed).map_err(|e| e.to_string())?;
                 let placement =
-                    Placement::sawn(Vec3::X, 1.0, &SawnCut::showcase_board(*ring_angle_deg))?;
+                    Placement::sawn(Vec3::X, 1.0, &SawnCut::showcase_board(*ring_angle_deg))
+                        .map_err(|e| e.to_string())?;
                 let n = 390;
                 Ok(BoardMaps::from_preset(
                     &volume,

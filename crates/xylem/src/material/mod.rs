@@ -22,7 +22,7 @@ pub use measured::{
     MeasuredMaterial, DEFAULT_FIBER_COLOR_SCALE, DEFAULT_HIGHLIGHT_WIDTH_DEG,
 };
 pub(crate) use measured::{FIT_PNG_MARK, FIT_RECORD};
-pub use placement::{CutAt, Cutting, Placement, SawnCut};
+pub use placement::{CutAt, Cutting, Placement, SawnCut, SawnCutError};
 pub(crate) use surface::SurfaceAtWo;
 pub use surface::SurfaceBsdf;
 

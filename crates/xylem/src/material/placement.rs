@@ -6,6 +6,16 @@ use crate::wood::{board_at, board_to_tree, veneer_to_tree, BoardLayout, TreeRegi
 use glam::{Affine3A, Mat3, Quat, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 
+/// A [`SawnCut`] out of range, naming the field ([`Placement::sawn`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{message}")]
+pub struct SawnCutError {
+    /// The `SawnCut` field at fault.
+    pub field: &'static str,
+    /// What is wrong, naming the field and its allowed range.
+    pub message: String,
+}
+
 /// A solid board's cut stated as a sawyer states it (`tree.sawn` in a scene): how far its face
 /// lies from the pith, at what angle to the growth rings, and how high up the stem. Flat-sawn
 /// (plain-sawn) faces are tangential to the rings (angle 0°) and show cathedral arches; quartersawn
@@ -182,51 +192,55 @@ impl Placement {
     /// `pith_distance`, `azimuth_deg` and `height`; the object is turned about the pith so that
     /// the face normal lies at `ring_angle_deg` from the radial direction there (n = cos φ r̂ +
     /// sin φ θ̂), which makes the face meet the rings at φ. Errors name the field.
-    pub fn sawn(axis: Vec3, scale: f32, cut: &SawnCut) -> Result<Placement, String> {
+    pub fn sawn(axis: Vec3, scale: f32, cut: &SawnCut) -> Result<Placement, SawnCutError> {
+        let err = |field: &'static str, message: String| Err(SawnCutError { field, message });
         let finite = |v: [f32; 3]| v.iter().all(|x| x.is_finite());
-        if !(cut.pith_distance.is_finite() && cut.pith_distance > 0.0 && cut.pith_distance <= 1e6) {
-            return Err(format!(
-                "pith_distance {} is out of range (allowed above 0 to 1e6 mm)",
-                cut.pith_distance
-            ));
+        let d = cut.pith_distance;
+        if !(d.is_finite() && d > 0.0 && d <= 1e6) {
+            let m = format!("pith_distance {d} is out of range (allowed above 0 to 1e6 mm)");
+            return err("pith_distance", m);
         }
         if !(0.0..=90.0).contains(&cut.ring_angle_deg) {
-            return Err(format!(
+            let m = format!(
                 "ring_angle_deg {} is out of range (allowed 0 = flat-sawn to 90 = quartersawn)",
                 cut.ring_angle_deg
-            ));
+            );
+            return err("ring_angle_deg", m);
         }
         if !(cut.height.is_finite() && cut.height.abs() <= 1e7) {
-            return Err(format!(
-                "height {} is out of range (allowed ±1e7 mm)",
-                cut.height
-            ));
+            let m = format!("height {} is out of range (allowed ±1e7 mm)", cut.height);
+            return err("height", m);
         }
         if !(-360.0..=360.0).contains(&cut.azimuth_deg) {
-            return Err(format!(
+            let m = format!(
                 "azimuth_deg {} is out of range (allowed -360 to 360)",
                 cut.azimuth_deg
-            ));
+            );
+            return err("azimuth_deg", m);
         }
         if !(-45.0..=45.0).contains(&cut.slope_deg) {
-            return Err(format!(
+            let m = format!(
                 "slope_deg {} is out of range (allowed -45 to 45)",
                 cut.slope_deg
-            ));
+            );
+            return err("slope_deg", m);
         }
         if !finite(cut.face_point) || Vec3::from(cut.face_point).abs().max_element() > 1e7 {
-            return Err("face_point must be finite, each coordinate within ±1e7".into());
+            let m = "face_point must be finite, each coordinate within ±1e7".into();
+            return err("face_point", m);
         }
         let (axis, normal) = (axis.normalize_or_zero(), Vec3::from(cut.face_normal));
         if !finite(cut.face_normal) || normal.length() < 1e-6 {
-            return Err("face_normal must be a finite non-zero direction".into());
+            let m = "face_normal must be a finite non-zero direction".into();
+            return err("face_normal", m);
         }
         let normal = normal.normalize();
         if axis.dot(normal).abs() > 1e-3 {
-            return Err(format!(
+            let m = format!(
                 "face_normal {normal} must be perpendicular to the grain axis {axis} (the face \
                  of a board contains its grain)"
-            ));
+            );
+            return err("face_normal", m);
         }
         let a = Quat::from_rotation_arc(axis, Vec3::Z);
         let n = a * normal;
@@ -387,16 +401,23 @@ mod tests {
     fn sawn_cut_rejects_what_no_saw_can_cut() {
         let face = Vec3::ZERO;
         let bad = [
-            SawnCut::flat(0.0, face),
-            SawnCut::new(100.0, 91.0, face),
-            SawnCut::flat(f32::NAN, face),
-            SawnCut {
-                face_normal: [1.0, 0.0, 0.0],
-                ..SawnCut::flat(100.0, face)
-            },
+            (SawnCut::flat(0.0, face), "pith_distance"),
+            (SawnCut::new(100.0, 91.0, face), "ring_angle_deg"),
+            (SawnCut::flat(f32::NAN, face), "pith_distance"),
+            (
+                SawnCut {
+                    face_normal: [1.0, 0.0, 0.0],
+                    ..SawnCut::flat(100.0, face)
+                },
+                "face_normal",
+            ),
         ];
-        for cut in bad {
-            assert!(Placement::sawn(Vec3::X, 1.0, &cut).is_err(), "{cut:?}");
+        for (cut, field) in bad {
+            let e = Placement::sawn(Vec3::X, 1.0, &cut).unwrap_err();
+            assert!(
+                e.field == field && e.message.contains(field),
+                "{cut:?}: {e:?}"
+            );
         }
     }
 

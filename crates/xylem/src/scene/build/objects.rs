@@ -139,8 +139,8 @@ impl Builder<'_> {
                     "`sawn` places a solid cut by itself: give it or `origin`/`rotation_deg`, not both",
                 ));
             }
-            let mut p =
-                Placement::sawn(axis, scale, sawn).map_err(|e| self.invalid(f("sawn"), e))?;
+            let mut p = Placement::sawn(axis, scale, sawn)
+                .map_err(|e| self.invalid(f(&format!("sawn.{}", e.field)), e.message))?;
             p.world_space = t.space == SpaceName::World;
             return Ok(p);
         }
