@@ -409,31 +409,59 @@ pub fn commit_set(
     Ok(record_path)
 }
 
+/// Why a folder does not hold the complete set its record describes ([`verify_set`]).
+#[derive(Debug, thiserror::Error)]
+pub enum SetError {
+    /// The record is missing, unreadable, not JSON or without a `files` list.
+    #[error("{0}")]
+    Record(String),
+    /// A member the record names is not a plain file name in the folder, or cannot be read.
+    #[error("{0}")]
+    Member(String),
+    /// A member is not the file the record lists (another run's, or changed since).
+    #[error("{}: not the file {} lists (another run's)", file.display(), record.display())]
+    Mismatch {
+        /// The member.
+        file: std::path::PathBuf,
+        /// The record.
+        record: std::path::PathBuf,
+    },
+}
+
 /// The `files` list of the set record at `path`.
-fn record_files(path: &Path) -> Result<Vec<serde_json::Value>, String> {
-    let text = crate::resources::read_text_bounded(path, MAX_RECORD_BYTES, "JSON")
-        .map_err(|e| format!("{e} (an incomplete set: its record is written last)"))?;
-    let v: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+fn record_files(path: &Path) -> Result<Vec<serde_json::Value>, SetError> {
+    let text =
+        crate::resources::read_text_bounded(path, MAX_RECORD_BYTES, "JSON").map_err(|e| {
+            SetError::Record(format!(
+                "{e} (an incomplete set: its record is written last)"
+            ))
+        })?;
+    let v: serde_json::Value = serde_json::from_str(&text)
+        .map_err(|e| SetError::Record(format!("{}: {e}", path.display())))?;
     match v.get(SET_FILES) {
         Some(serde_json::Value::Array(files)) => Ok(files.clone()),
-        _ => Err(format!("{}: no `{SET_FILES}` list", path.display())),
+        _ => Err(SetError::Record(format!(
+            "{}: no `{SET_FILES}` list",
+            path.display()
+        ))),
     }
 }
 
 /// A record entry's member in `dir`: its name, and whether the file has the size and CRC-32
 /// the entry lists. Only a plain name is accepted (a record cannot point outside its folder).
-fn member_status(dir: &Path, entry: &serde_json::Value) -> Result<(String, bool), String> {
+fn member_status(dir: &Path, entry: &serde_json::Value) -> Result<(String, bool), SetError> {
     let name = entry.get("name").and_then(|n| n.as_str()).unwrap_or("");
     if name.is_empty() || name.contains('/') || name == "." || name == ".." {
-        return Err(format!(
+        return Err(SetError::Member(format!(
             "{}: member `{name}` (allowed: a file name in the folder)",
             dir.display()
-        ));
+        )));
     }
     let member = dir.join(name);
-    let file = crate::resources::open_regular(&member, u64::MAX).map_err(|e| e.to_string())?;
-    let (len, crc) = checksum(file).map_err(|e| format!("{}: {e}", member.display()))?;
+    let file = crate::resources::open_regular(&member, u64::MAX)
+        .map_err(|e| SetError::Member(e.to_string()))?;
+    let (len, crc) =
+        checksum(file).map_err(|e| SetError::Member(format!("{}: {e}", member.display())))?;
     let crc = format!("{crc:08x}");
     let want = (
         entry.get("bytes").and_then(|b| b.as_u64()),
@@ -455,16 +483,15 @@ const MAX_RECORD_BYTES: u64 = 1 << 20;
 
 /// Checks that `dir` holds the complete set `record` describes: the record exists and every
 /// member has the size and CRC-32 it lists. The error names the record or the member at fault.
-pub fn verify_set(dir: &Path, record: &str) -> Result<(), String> {
+pub fn verify_set(dir: &Path, record: &str) -> Result<(), SetError> {
     let path = dir.join(record);
     for f in record_files(&path)? {
         let (name, same) = member_status(dir, &f)?;
         if !same {
-            return Err(format!(
-                "{}: not the file {} lists (another run's)",
-                dir.join(name).display(),
-                path.display()
-            ));
+            return Err(SetError::Mismatch {
+                file: dir.join(name),
+                record: path,
+            });
         }
     }
     Ok(())
@@ -476,14 +503,14 @@ pub fn verify_set(dir: &Path, record: &str) -> Result<(), String> {
 /// run's, or one changed since).
 pub(crate) fn check_member(dir: &Path, record: &str, name: &str) -> Result<bool, String> {
     let path = dir.join(record);
-    let files = record_files(&path)?;
+    let files = record_files(&path).map_err(|e| e.to_string())?;
     let Some(entry) = files
         .iter()
         .find(|f| f.get("name").and_then(|n| n.as_str()) == Some(name))
     else {
         return Ok(false);
     };
-    let (_, same) = member_status(dir, entry)?;
+    let (_, same) = member_status(dir, entry).map_err(|e| e.to_string())?;
     if same {
         Ok(true)
     } else {
