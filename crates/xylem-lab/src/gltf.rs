@@ -213,7 +213,8 @@ fn read_glb(bytes: &[u8]) -> Result<GlbBoard, String> {
         let off = view.byte_offset.map_or(0, |o| o.0 as usize);
         let png = &bin[off..off + view.byte_length.0 as usize];
         let name = img.name.clone().unwrap_or_default();
-        let img = xylem::picture::png::decode_png_rgb8(std::path::Path::new(&name), png)?;
+        let img = xylem::picture::png::decode_png_rgb8(std::path::Path::new(&name), png)
+            .map_err(|e| e.to_string())?;
         images.push((name, img));
     }
     let pos = root.meshes[0].primitives[0]

@@ -392,8 +392,11 @@ pub(crate) fn read_png_rgb8_checked(path: &Path, size_ok: SizeCheck) -> Result<R
 
 /// A PNG held in memory (e.g. one a glTF binary embeds) as 8-bit RGB, as [`read_png_rgb8`]
 /// reads a file; `name` names it in errors.
-pub fn decode_png_rgb8(name: &Path, bytes: &[u8]) -> Result<Rgb8, String> {
-    decode_rgb8(name, bytes, &any_size)
+pub fn decode_png_rgb8(name: &Path, bytes: &[u8]) -> Result<Rgb8, ImageError> {
+    decode_rgb8(name, bytes, &any_size).map_err(|what| ImageError::Invalid {
+        path: name.display().to_string(),
+        what,
+    })
 }
 
 /// [`read_png_rgb8`] of any byte source.
