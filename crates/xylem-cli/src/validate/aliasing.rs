@@ -112,7 +112,44 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         rows.push(row.map_err(anyhow::Error::msg)?);
     }
     bar.finish();
-    let command = std::env::args().collect::<Vec<_>>().join(" ");
+    let command = report_command(std::env::args());
     let (md, checks) = report_md(&rows, &command);
     super::finish_report(&report, &md, &checks)
+}
+
+/// The command line as the report prints it: the program as `xylem` and the baseline binary as
+/// `BIN`, so a report names no path of the machine it ran on.
+fn report_command(args: impl Iterator<Item = String>) -> String {
+    let mut out = Vec::new();
+    let mut after_baseline = false;
+    for (i, a) in args.enumerate() {
+        out.push(match () {
+            _ if i == 0 => "xylem".to_string(),
+            _ if after_baseline => "BIN".to_string(),
+            _ if a.starts_with("--baseline=") => "--baseline=BIN".to_string(),
+            _ => a.clone(),
+        });
+        after_baseline = a == "--baseline";
+    }
+    out.join(" ")
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn the_report_names_no_machine_path() {
+        let args = [
+            "/opt/x/xylem",
+            "validate",
+            "aliasing",
+            "--baseline",
+            "/opt/base",
+            "--div",
+            "4",
+        ];
+        let line = super::report_command(args.iter().map(|s| s.to_string()));
+        assert_eq!(line, "xylem validate aliasing --baseline BIN --div 4");
+        let eq = super::report_command(["a", "--baseline=/x/y"].iter().map(|s| s.to_string()));
+        assert_eq!(eq, "xylem --baseline=BIN");
+    }
 }

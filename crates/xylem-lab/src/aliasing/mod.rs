@@ -461,12 +461,12 @@ pub fn report_md(rows: &[Row], command: &str) -> (String, Vec<Check>) {
     let design = rows.first().map(|r| r.design);
     let mut md = String::from(
         "# Aliasing energy: today's default against point sampling and the issue-time default (issue 28)\n\n\
-         Written by `xylem validate aliasing` (crates/xylem-lab/src/aliasing.rs; derivation in \
+         Written by `xylem validate aliasing` (crates/xylem-lab/src/aliasing/; derivation in \
          notes/render.md, \"The aliasing estimator\"). Each wood scene is rendered K times with \
          seeds of their own under each setting — today's default (wood band-limited by the pixel \
          footprint, Sobol-stratified samples), today's samples with the wood point-sampled, and, \
          with `--baseline BIN`, the default issue 28 was filed against rendered by that binary \
-         (independent samples, point-sampled wood) — against a converged point-sampled reference \
+         (`xylem` built from 5a8ffa9^ = 2934293: independent samples, point-sampled wood) — against a converged point-sampled reference \
          of R independent parts. **Energy**: the power of the 3 × 3 high-pass of a render's \
          luminance difference to the converged image over the wood, over the reference's wood \
          luminance power: *total* (one render's, the issue's aliasing energy, the reference's \
