@@ -18,6 +18,7 @@ use crate::tradeoff::{apply, Knobs};
 use glam::Vec3;
 use std::path::Path;
 use xylem::math::luminance;
+use xylem::picture::exr::read_exr_channels;
 use xylem::render::{render, RunOptions};
 use xylem::scene::LoadedScene;
 
@@ -104,24 +105,14 @@ pub struct Frame {
     pub cpu: f64,
 }
 
-/// The RGB layer `layer` (channels `layer.R`, `.G`, `.B`, whether stored as a part of that
-/// name or as prefixed channels) of an EXR that `xylem render` wrote.
+/// The RGB layer `layer` (channels `layer.R`, `.G`, `.B`) of an EXR that `xylem render` wrote
+/// (read by `picture::exr::read_exr_channels`).
 fn read_exr_rgb_layer(path: &Path, layer: &str) -> Result<Vec<Vec3>, String> {
-    let image = exr::prelude::read_all_flat_layers_from_file(path)
-        .map_err(|e| format!("{}: {e}", path.display()))?;
-    let channel = |name: &str| -> Result<Vec<f32>, String> {
+    let channels = read_exr_channels(path).map_err(|e| e.to_string())?;
+    let channel = |name: &str| {
         let want = format!("{layer}.{name}");
-        (image.layer_data.iter())
-            .flat_map(|l| {
-                let prefix =
-                    (l.attributes.layer_name.as_ref()).map_or(String::new(), |n| format!("{n}."));
-                l.channel_data
-                    .list
-                    .iter()
-                    .map(move |c| (format!("{prefix}{}", c.name), c))
-            })
-            .find(|(full, _)| *full == want)
-            .map(|(_, c)| c.sample_data.values_as_f32().collect())
+        (channels.iter().find(|(n, _)| *n == want))
+            .map(|(_, v)| v)
             .ok_or_else(|| format!("{}: no channel {want}", path.display()))
     };
     let (r, g, b) = (channel("R")?, channel("G")?, channel("B")?);
