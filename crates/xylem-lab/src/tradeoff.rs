@@ -3,7 +3,7 @@
 //! against a high-quality reference (relative MSE and SSIM). The named `--quality` presets are
 //! chosen from these measurements (validation/TRADEOFF.md).
 
-pub use crate::bench::clock::process_cpu_seconds;
+use crate::bench::clock::CpuTimer;
 use serde::Serialize;
 use xylem::bsdf::FinishModel;
 use xylem::material::BakedFibers;
@@ -254,7 +254,7 @@ pub struct Rendered {
     pub wood: Vec<bool>,
     /// Render time, wall clock.
     pub seconds: f64,
-    /// Render time in CPU seconds of the process ([`process_cpu_seconds`]; the wall clock where
+    /// Render time in CPU seconds of the process ([`CpuTimer::process`]; the wall clock where
     /// that is unavailable).
     pub cpu_seconds: f64,
     /// Wall-clock time spent applying the knobs.
@@ -271,13 +271,9 @@ pub fn render_with(
     let prep = std::time::Instant::now();
     apply(&mut loaded, knobs).map_err(|e| e.to_string())?;
     let prep = prep.elapsed().as_secs_f64();
-    let cpu0 = process_cpu_seconds();
+    let timer = CpuTimer::process();
     let out = render(&loaded.scene, &loaded.settings, run).map_err(|e| e.to_string())?;
-    let seconds = out.elapsed.as_secs_f64();
-    let cpu_seconds = match (cpu0, process_cpu_seconds()) {
-        (Some(a), Some(b)) => b - a,
-        _ => seconds,
-    };
+    let (seconds, cpu_seconds) = (out.elapsed.as_secs_f64(), timer.seconds());
     Ok(Rendered {
         wood: (out.image.aov.iter())
             .map(|a| a.fiber != glam::Vec3::ZERO)

@@ -3,9 +3,8 @@
 
 use glam::Vec3;
 use std::process::ExitCode;
-use std::time::Instant;
 use xylem::wood::{self, Needs, WoodVolume};
-use xylem_lab::bench::clock::thread_cpu_seconds;
+use xylem_lab::bench::clock::CpuTimer;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -34,7 +33,7 @@ pub struct Args {
 /// is unavailable), evaluated by `eval_many` when `batch`, else point by point with `eval`.
 /// Repeats the pass until at least a second of CPU time has been spent.
 pub fn texels_per_second(volume: &WoodVolume, points: &[Vec3], needs: Needs, batch: bool) -> f64 {
-    let (wall, cpu0) = (Instant::now(), thread_cpu_seconds());
+    let timer = CpuTimer::thread();
     let mut sink = 0.0f32;
     let mut done = 0usize;
     let mut out = vec![wood::WoodTexel::default(); points.len()];
@@ -50,10 +49,7 @@ pub fn texels_per_second(volume: &WoodVolume, points: &[Vec3], needs: Needs, bat
             sink += t.diffuse.x + t.fiber_dir.z + t.bump;
         }
         done += points.len();
-        let spent = match (cpu0, thread_cpu_seconds()) {
-            (Some(a), Some(b)) => b - a,
-            _ => wall.elapsed().as_secs_f64(),
-        };
+        let spent = timer.seconds();
         if spent >= 1.0 {
             std::hint::black_box(sink);
             return done as f64 / spent;

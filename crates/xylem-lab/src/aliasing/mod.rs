@@ -12,7 +12,7 @@
 //! jackknife standard error ([`energies`]), and ratios between settings with Fieller's interval
 //! ([`ratio_interval`]). Derivation: notes/render.md, "The aliasing estimator".
 
-use crate::bench::clock::{children_cpu_seconds, process_cpu_seconds};
+use crate::bench::clock::{children_cpu_seconds, CpuTimer};
 use crate::report::{checks_table, Check};
 use crate::tradeoff::{apply, Knobs};
 use glam::Vec3;
@@ -187,12 +187,9 @@ fn render_seeded(
     let mut loaded = base()?;
     loaded.settings.seed = seed;
     apply(&mut loaded, knobs).map_err(|e| e.to_string())?;
-    let cpu0 = process_cpu_seconds();
+    let timer = CpuTimer::process();
     let out = render(&loaded.scene, &loaded.settings, run).map_err(|e| e.to_string())?;
-    let cpu = match (cpu0, process_cpu_seconds()) {
-        (Some(a), Some(b)) => b - a,
-        _ => out.elapsed.as_secs_f64(),
-    };
+    let cpu = timer.seconds();
     let aov = &out.image.aov;
     Ok(Frame {
         wood: aov.iter().map(|a| a.fiber != Vec3::ZERO).collect(),

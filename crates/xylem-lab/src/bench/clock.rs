@@ -53,30 +53,46 @@ pub fn children_cpu_seconds() -> Option<f64> {
     None
 }
 
-/// A stopwatch over the calling thread's CPU time ([`thread_cpu_seconds`]; wall time where
-/// there is none): the time the thread waits descheduled is not counted, for xylem and a peer
-/// alike.
+/// A stopwatch over a CPU clock — the calling thread's ([`CpuTimer::thread`]) or the process's
+/// ([`CpuTimer::process`]) — reading wall time where the clock is unavailable: the time spent
+/// descheduled is not counted, for xylem and a peer alike.
 #[derive(Clone, Copy)]
-pub struct ThreadTimer {
+pub struct CpuTimer {
+    clock: fn() -> Option<f64>,
     cpu: Option<f64>,
     wall: Instant,
 }
 
-impl ThreadTimer {
-    /// Starts the stopwatch.
-    pub fn start() -> Self {
-        ThreadTimer {
-            cpu: thread_cpu_seconds(),
+impl CpuTimer {
+    /// Starts a stopwatch over the calling thread's CPU time.
+    pub fn thread() -> Self {
+        Self::over(thread_cpu_seconds)
+    }
+
+    /// Starts a stopwatch over the process's CPU time (all threads).
+    pub fn process() -> Self {
+        Self::over(process_cpu_seconds)
+    }
+
+    fn over(clock: fn() -> Option<f64>) -> Self {
+        CpuTimer {
+            clock,
+            cpu: clock(),
             wall: Instant::now(),
         }
     }
 
-    /// CPU time of the calling thread since [`ThreadTimer::start`].
-    pub fn elapsed(&self) -> Duration {
-        match (self.cpu, thread_cpu_seconds()) {
-            (Some(a), Some(b)) => Duration::from_secs_f64((b - a).max(0.0)),
-            _ => self.wall.elapsed(),
+    /// CPU seconds since the start (wall seconds where the clock is unavailable).
+    pub fn seconds(&self) -> f64 {
+        match (self.cpu, (self.clock)()) {
+            (Some(a), Some(b)) => (b - a).max(0.0),
+            _ => self.wall.elapsed().as_secs_f64(),
         }
+    }
+
+    /// [`CpuTimer::seconds`] as a duration.
+    pub fn elapsed(&self) -> Duration {
+        Duration::from_secs_f64(self.seconds())
     }
 }
 
@@ -88,13 +104,13 @@ mod tests {
     /// moves while the wall clock does (the control: wall time would count the sleep).
     #[test]
     fn cpu_clocks_count_work_not_sleep() {
-        let (t, p) = (ThreadTimer::start(), process_cpu_seconds().unwrap());
+        let (t, p) = (CpuTimer::thread(), CpuTimer::process());
         let mut x = 0u64;
         while t.elapsed() < Duration::from_millis(50) {
             x = x.wrapping_add(std::hint::black_box(1));
         }
-        assert!(x > 0 && process_cpu_seconds().unwrap() >= p + 0.05);
-        let (t, wall) = (ThreadTimer::start(), Instant::now());
+        assert!(x > 0 && p.seconds() >= 0.05);
+        let (t, wall) = (CpuTimer::thread(), Instant::now());
         std::thread::sleep(Duration::from_millis(100));
         assert!(wall.elapsed() >= Duration::from_millis(100));
         assert!(t.elapsed() < Duration::from_millis(20), "{:?}", t.elapsed());

@@ -199,13 +199,13 @@ impl Drop for EmbreeScene {
 
 /// Times Embree on the same rays as [`super::trace::time_rays`].
 pub fn time_rays(scene: &EmbreeScene, rays: &[Ray], coherent: bool) -> super::trace::TraceFigures {
-    let t0 = super::trace::ThreadTimer::start();
+    let t0 = super::clock::CpuTimer::thread();
     let hits = rays
         .iter()
         .filter(|r| scene.intersect(r, coherent).is_some())
         .count();
     let closest = t0.elapsed();
-    let t1 = super::trace::ThreadTimer::start();
+    let t1 = super::clock::CpuTimer::thread();
     let free = rays
         .iter()
         .filter(|r| scene.unoccluded(r, f32::INFINITY, coherent))

@@ -3,7 +3,7 @@
 //! time and closest-hit / any-hit rays per second on one core, for xylem's wide BVH and, on the
 //! same mesh and rays, obvhs's CWBVH traversal (and Embree 3 with the feature `embree-anchor`).
 
-pub(crate) use super::clock::ThreadTimer;
+use super::clock::CpuTimer;
 use glam::{Vec2, Vec3};
 use obvhs::cwbvh::{builder::build_cwbvh_from_tris, CwBvh};
 use obvhs::ray::{Ray as BvhRay, RayHit};
@@ -165,7 +165,7 @@ impl ObvhsCwBvh {
         // +0.0 turns −0.0 direction components into +0.0 (obvhs mishandles −0.0).
         let ray = |r: &Ray| BvhRay::new(r.o.into(), (r.d + Vec3::ZERO).into(), 0.0, f32::INFINITY);
         let tris = &self.tris;
-        let t0 = ThreadTimer::start();
+        let t0 = CpuTimer::thread();
         let mut hits = 0usize;
         for r in rays {
             let mut hit = RayHit::none();
@@ -173,7 +173,7 @@ impl ObvhsCwBvh {
                 (self.bvh).ray_traverse(ray(r), &mut hit, |r, id| tris[id].intersect(r)) as usize;
         }
         let closest = t0.elapsed();
-        let t1 = ThreadTimer::start();
+        let t1 = CpuTimer::thread();
         for r in rays {
             std::hint::black_box(
                 self.bvh
@@ -212,7 +212,7 @@ pub struct EmbreeFigures {
 
 /// Traces `rays` closest-hit and any-hit on the calling thread and times both.
 pub fn time_rays(accel: &Accel, rays: &[Ray]) -> TraceFigures {
-    let t0 = ThreadTimer::start();
+    let t0 = CpuTimer::thread();
     let mut hits = 0usize;
     for r in rays {
         if accel.intersect(r, f32::INFINITY).is_some() {
@@ -220,7 +220,7 @@ pub fn time_rays(accel: &Accel, rays: &[Ray]) -> TraceFigures {
         }
     }
     let closest = t0.elapsed();
-    let t1 = ThreadTimer::start();
+    let t1 = CpuTimer::thread();
     let mut free = 0usize;
     for r in rays {
         if accel.unoccluded(r, f32::INFINITY) {
