@@ -1,5 +1,5 @@
 //! The lab's CPU clocks, one of each kind, for every benchmark and study: the calling thread's
-//! CPU time ([`ThreadTimer`], the tracing and wood benchmarks), this process's
+//! CPU time ([`CpuTimer::thread`], the tracing and wood benchmarks), this process's
 //! ([`process_cpu_seconds`], `tradeoff` and `validate aliasing`) and its waited-for children's
 //! ([`children_cpu_seconds`], a render by another binary). On a shared machine CPU time leaves
 //! out the time other jobs hold the cores (cache and SMT contention still show). POSIX clocks
