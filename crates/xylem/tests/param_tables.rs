@@ -1,7 +1,7 @@
-//! The wood BSDF's parameter table (`bsdf::WOOD_BSDF_PARAMS`) is the one list its checks, the
-//! scene format and the documentation follow: `WoodBsdf::new` accepts each scalar field at its
-//! bounds and refuses it just beyond (naming the field), and scenes/README.md's `fiber` row names
-//! every field with the table's range.
+//! The wood BSDF's parameter table (`bsdf::WOOD_BSDF_PARAMS`) is the one list its checks follow:
+//! `WoodBsdf::new` accepts each scalar field at its bounds and refuses it just beyond (naming the
+//! field). The scene's `fiber` fields take their ranges from it (`scene::fields`, tested in
+//! scene_fields.rs).
 
 use glam::Vec3;
 use xylem::bsdf::{ParamKind, WoodBsdf, WoodBsdfParams, WOOD_BSDF_PARAMS};
@@ -58,32 +58,4 @@ fn each_scalar_is_accepted_at_its_bounds_and_refused_beyond() {
     };
     let e = WoodBsdf::new(bright).unwrap_err().to_string();
     assert!(e.contains("diffuse"), "{e}");
-}
-
-#[test]
-fn the_scene_documentation_lists_every_field_with_its_range() {
-    let readme = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../scenes/README.md"
-    ))
-    .unwrap();
-    let row = readme
-        .lines()
-        .find(|l| l.starts_with("| `fiber` |"))
-        .expect("scenes/README.md has a `fiber` material row");
-    for spec in WOOD_BSDF_PARAMS {
-        // Scene files give the highlight width in degrees.
-        let name = match spec.name {
-            "highlight_width" => "highlight_width_deg",
-            n => n,
-        };
-        assert!(
-            row.contains(&format!("`{name}`")),
-            "`{name}` missing: {row}"
-        );
-        if let (ParamKind::Scalar { min, max }, false) = (spec.kind, name.ends_with("_deg")) {
-            let range = format!("{} {min}–{max}", spec.name);
-            assert!(row.contains(&range), "{range:?} missing: {row}");
-        }
-    }
 }

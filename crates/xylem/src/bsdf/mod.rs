@@ -192,7 +192,7 @@ const UNIT: ParamKind = ParamKind::Scalar { min: 0.0, max: 1.0 };
 
 /// The fields of [`WoodBsdfParams`] in declaration order, with their checks: the one list that
 /// [`WoodBsdf::new`] validates against, Python's `WoodBsdf` takes as keyword arguments (its
-/// `FIELDS`) and scenes/README.md documents for the `fiber` material (tested there).
+/// `FIELDS`) and the scene fields of the finishes take their ranges from (`scene::fields`).
 pub const WOOD_BSDF_PARAMS: [ParamSpec; 8] = [
     ParamSpec {
         name: "diffuse",

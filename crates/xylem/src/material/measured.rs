@@ -353,7 +353,10 @@ pub enum BoardFace {
 }
 
 impl BoardFace {
-    /// The face named "+z", "-z", "+x", "-x", "+y" or "-y".
+    /// The faces' names, as scenes give them.
+    pub const NAMES: [&'static str; 6] = ["+z", "-z", "+x", "-x", "+y", "-y"];
+
+    /// The face named by one of [`NAMES`](Self::NAMES).
     pub(crate) fn from_name(name: &str) -> Option<BoardFace> {
         Some(match name {
             "+z" => BoardFace::PosZ,

@@ -197,11 +197,9 @@ fn default_up() -> [f32; 3] {
 fn one() -> f32 {
     1.0
 }
-fn white() -> [f32; 3] {
-    [1.0, 1.0, 1.0]
-}
 
-/// `[[lights]]`, one table per light, chosen by `type`.
+/// `[[lights]]`, one table per light, chosen by `type`; ranges and defaults in
+/// [`fields::LIGHTS`](super::fields::LIGHTS).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum LightTable {
@@ -212,10 +210,10 @@ pub enum LightTable {
         /// Position (mm).
         #[serde(deserialize_with = "exact")]
         position: [f32; 3],
-        /// Radiant intensity (W/sr, 0–1e12).
+        /// Radiant intensity (W/sr).
         intensity: f32,
-        /// Multiplies the strength ([r, g, b], each 0–1000, default [1, 1, 1]).
-        #[serde(default = "white")]
+        /// Multiplies the strength.
+        #[serde(default = "defaults::light_color")]
         #[serde(deserialize_with = "exact")]
         color: [f32; 3],
     },
@@ -229,15 +227,15 @@ pub enum LightTable {
         /// The point the cone's axis passes through (mm).
         #[serde(deserialize_with = "exact")]
         target: [f32; 3],
-        /// Radiant intensity on the axis (W/sr, 0–1e12).
+        /// Radiant intensity on the axis (W/sr).
         intensity: f32,
-        /// Multiplies the strength ([r, g, b], each 0–1000, default [1, 1, 1]).
-        #[serde(default = "white")]
+        /// Multiplies the strength.
+        #[serde(default = "defaults::light_color")]
         #[serde(deserialize_with = "exact")]
         color: [f32; 3],
-        /// Half-angle of the cone (degrees, 0.01–180).
+        /// Half-angle of the cone (degrees).
         cone_deg: f32,
-        /// Width of the smooth edge inside the cone (degrees, 0–`cone_deg`, default 0).
+        /// Width of the smooth edge inside the cone (degrees, at most `cone_deg`).
         #[serde(default)]
         falloff_deg: f32,
     },
@@ -248,10 +246,10 @@ pub enum LightTable {
         /// Direction towards the light.
         #[serde(deserialize_with = "exact")]
         direction: [f32; 3],
-        /// Irradiance on a surface facing the light (W/mm², 0–1e12).
+        /// Irradiance on a surface facing the light (W/mm²).
         irradiance: f32,
-        /// Multiplies the strength ([r, g, b], each 0–1000, default [1, 1, 1]).
-        #[serde(default = "white")]
+        /// Multiplies the strength.
+        #[serde(default = "defaults::light_color")]
         #[serde(deserialize_with = "exact")]
         color: [f32; 3],
     },
@@ -270,8 +268,8 @@ pub enum LightTable {
         edge_v: [f32; 3],
         /// Emitted radiance (W/(sr·mm²)).
         radiance: f32,
-        /// Multiplies the strength ([r, g, b], each 0–1000, default [1, 1, 1]).
-        #[serde(default = "white")]
+        /// Multiplies the strength.
+        #[serde(default = "defaults::light_color")]
         #[serde(deserialize_with = "exact")]
         color: [f32; 3],
     },
@@ -282,12 +280,12 @@ pub enum LightTable {
         /// Centre (mm).
         #[serde(deserialize_with = "exact")]
         center: [f32; 3],
-        /// Radius (mm, 1e-4–1e9).
+        /// Radius (mm).
         radius: f32,
         /// Emitted radiance (W/(sr·mm²)).
         radiance: f32,
-        /// Multiplies the strength ([r, g, b], each 0–1000, default [1, 1, 1]).
-        #[serde(default = "white")]
+        /// Multiplies the strength.
+        #[serde(default = "defaults::light_color")]
         #[serde(deserialize_with = "exact")]
         color: [f32; 3],
     },
@@ -295,17 +293,17 @@ pub enum LightTable {
     Environment {
         /// Unique name.
         name: Option<String>,
-        /// Radiance scale (default 1).
-        #[serde(default = "one")]
+        /// Radiance scale.
+        #[serde(default = "defaults::env_radiance")]
         radiance: f32,
-        /// Multiplies the strength ([r, g, b], each 0–1000, default [1, 1, 1]).
-        #[serde(default = "white")]
+        /// Multiplies the strength.
+        #[serde(default = "defaults::light_color")]
         #[serde(deserialize_with = "exact")]
         color: [f32; 3],
         /// Optional lat-long EXR map (z up, u = φ/2π from +x, v = θ/π from +z); path relative
         /// to the scene file.
         map: Option<String>,
-        /// Turn of the map about z (degrees, −360–360, default 0).
+        /// Turn of the map about z (degrees).
         #[serde(default)]
         rotate_deg: f32,
     },
@@ -325,41 +323,42 @@ impl LightTable {
     }
 }
 
-/// `[materials.NAME]`, chosen by `type`.
+/// `[materials.NAME]`, chosen by `type`; ranges and defaults in
+/// [`fields::MATERIALS`](super::fields::MATERIALS).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
 pub enum MaterialTable {
     /// Lambertian diffuse surface.
     Lambertian {
-        /// Reflectance ([r, g, b], each 0–1).
+        /// Reflectance.
         #[serde(deserialize_with = "exact")]
         albedo: [f32; 3],
     },
     /// The finished-wood BSDF with constant parameters; directions in object space.
     Fiber {
-        /// Diffuse colour ([r, g, b], each 0–1).
+        /// Diffuse colour.
         #[serde(deserialize_with = "exact")]
         diffuse: [f32; 3],
-        /// Fibre highlight colour ([r, g, b], each 0–1).
+        /// Fibre highlight colour.
         #[serde(deserialize_with = "exact")]
         fiber_color: [f32; 3],
         /// Fibre direction (object space).
         #[serde(deserialize_with = "exact")]
         fiber_dir: [f32; 3],
-        /// Ray-cell direction (object space, default [0, 0, 1]).
-        #[serde(default = "default_ray_dir")]
+        /// Ray-cell direction (object space).
+        #[serde(default = "defaults::ray_dir")]
         #[serde(deserialize_with = "exact")]
         ray_dir: [f32; 3],
-        /// How much of the surface is ray cells (0–1, default 0).
+        /// How much of the surface is ray cells.
         #[serde(default)]
         ray_mask: f32,
-        /// Fibre highlight width β (degrees, 0.06–90, default 8).
-        #[serde(default = "default_highlight")]
+        /// Fibre highlight width β (degrees).
+        #[serde(default = "defaults::fiber_width")]
         highlight_width_deg: f32,
-        /// Refractive index of the finish (1–4, default 1.5).
-        #[serde(default = "default_eta")]
+        /// Refractive index of the finish.
+        #[serde(default = "defaults::eta")]
         eta: f32,
-        /// GGX roughness of the finish (0–1, default 0 = smooth).
+        /// GGX roughness of the finish.
         #[serde(default)]
         roughness: f32,
     },
@@ -372,10 +371,10 @@ pub enum MaterialTable {
         /// Selects the tree.
         #[serde(default)]
         seed: u64,
-        /// Refractive index of the finish (1–4, default 1.5).
-        #[serde(default = "default_eta")]
+        /// Refractive index of the finish.
+        #[serde(default = "defaults::eta")]
         eta: f32,
-        /// GGX roughness of the finish (0–1, default 0 = smooth).
+        /// GGX roughness of the finish.
         #[serde(default)]
         roughness: f32,
         /// Pore bump strength (0 = off, 1 = the preset's pore depth); absent: the preset's
@@ -394,10 +393,10 @@ pub enum MaterialTable {
         fiber_axis: String,
         /// Optional β map (β = 90° · v/255); else `highlight_width_deg` everywhere.
         highlight_width: Option<String>,
-        /// Highlight width β everywhere (degrees, 0.06–90, default 10) when there is no β map.
+        /// Highlight width β everywhere (degrees) when there is no β map.
         highlight_width_deg: Option<f32>,
         /// The published lobe's k_f per stored unit (notes/measured.md).
-        #[serde(default = "default_fiber_color_scale")]
+        #[serde(default = "defaults::fiber_color_scale")]
         fiber_color_scale: f32,
         /// "linear" (default) or "srgb".
         color_space: Option<String>,
@@ -406,10 +405,10 @@ pub enum MaterialTable {
         size_mm: [f32; 2],
         /// "+z" (default), "-z", "+x", "-x", "+y" or "-y".
         face: Option<String>,
-        /// Refractive index of the finish (1–4, default 1.5).
-        #[serde(default = "default_eta")]
+        /// Refractive index of the finish.
+        #[serde(default = "defaults::eta")]
         eta: f32,
-        /// GGX roughness of the finish (0–1, default 0 = smooth).
+        /// GGX roughness of the finish.
         #[serde(default)]
         roughness: f32,
     },
@@ -424,37 +423,53 @@ pub enum MaterialTable {
     },
     /// Perfect mirror.
     Mirror {
-        /// Reflectance ([r, g, b], each 0–1, default 0.95).
-        #[serde(default = "default_reflectance")]
+        /// Reflectance.
+        #[serde(default = "defaults::mirror_reflectance")]
         #[serde(deserialize_with = "exact")]
         reflectance: [f32; 3],
     },
     /// Smooth dielectric (refracting) surface.
     Glass {
-        /// Refractive index (1–4, default 1.5).
-        #[serde(default = "default_eta")]
+        /// Refractive index.
+        #[serde(default = "defaults::glass_eta")]
         eta: f32,
-        /// Transmission tint ([r, g, b], each 0–1, default 1).
-        #[serde(default = "white")]
+        /// Transmission tint.
+        #[serde(default = "defaults::glass_tint")]
         #[serde(deserialize_with = "exact")]
         tint: [f32; 3],
     },
 }
 
-fn default_ray_dir() -> [f32; 3] {
-    [0.0, 0.0, 1.0]
-}
-fn default_highlight() -> f32 {
-    8.0
-}
-fn default_fiber_color_scale() -> f32 {
-    crate::material::DEFAULT_FIBER_COLOR_SCALE
-}
-fn default_eta() -> f32 {
-    1.5
-}
-fn default_reflectance() -> [f32; 3] {
-    [0.95, 0.95, 0.95]
+/// The serde defaults of the light and material tables, read from [`fields`](super::fields).
+mod defaults {
+    use crate::scene::fields::*;
+    pub fn light_color() -> [f32; 3] {
+        LIGHT_COLOR.default_triple()
+    }
+    pub fn env_radiance() -> f32 {
+        ENV_RADIANCE.default_number()
+    }
+    pub fn ray_dir() -> [f32; 3] {
+        RAY_DIR.default_triple()
+    }
+    pub fn fiber_width() -> f32 {
+        FIBER_WIDTH.default_number()
+    }
+    pub fn eta() -> f32 {
+        ETA.default_number()
+    }
+    pub fn fiber_color_scale() -> f32 {
+        FIBER_COLOR_SCALE.default_number()
+    }
+    pub fn mirror_reflectance() -> [f32; 3] {
+        MIRROR_REFLECTANCE.default_triple()
+    }
+    pub fn glass_eta() -> f32 {
+        GLASS_ETA.default_number()
+    }
+    pub fn glass_tint() -> [f32; 3] {
+        GLASS_TINT.default_triple()
+    }
 }
 
 /// A uniform or per-axis scale.
@@ -667,7 +682,7 @@ pub struct SweepBoard {
     #[serde(deserialize_with = "exact")]
     pub size_mm: [f32; 2],
     /// Refractive index of the finish (1–4, default 1.5); must match the board's material.
-    #[serde(default = "default_eta")]
+    #[serde(default = "defaults::eta")]
     pub eta: f32,
 }
 

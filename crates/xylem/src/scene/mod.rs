@@ -4,6 +4,7 @@
 //! its render settings. Every error names the file, the field and what is allowed.
 
 mod build;
+pub mod fields;
 pub mod format;
 pub mod mesh_io;
 pub mod overrides;
@@ -324,9 +325,20 @@ impl Builder<'_> {
         }
     }
 
-    fn color(&self, field: &str, a: [f32; 3], hi: f32) -> Result<Vec3, SceneError> {
+    /// Number `x` of field `spec` (its range from [`fields`]), reported as `at.<name>`.
+    fn number(&self, at: &str, spec: &fields::Field, x: f32) -> Result<f32, SceneError> {
+        let (lo, hi) = spec.bounds();
+        self.range(&format!("{at}.{}", spec.name), x, lo, hi)
+    }
+
+    /// Colour `a` of field `spec` (its range from [`fields`]), reported as `at.<name>`.
+    fn color(&self, at: &str, spec: &fields::Field, a: [f32; 3]) -> Result<Vec3, SceneError> {
+        let fields::Value::Colour { max } = spec.value else {
+            unreachable!("`{}` is a colour field", spec.name)
+        };
+        let field = format!("{at}.{}", spec.name);
         for x in a {
-            self.range(field, x, 0.0, hi)?;
+            self.range(&field, x, 0.0, max)?;
         }
         Ok(v3(a))
     }

@@ -17,7 +17,7 @@ impl Builder<'_> {
                     .any(|o: &Option<String>| o.as_deref() == Some(n))
                 {
                     return Err(self.invalid(
-                        format!("lights[{i}].name"),
+                        format!("lights[{i}].{}", crate::scene::fields::LIGHT_NAME.name),
                         format!("light name `{n}` is used twice"),
                     ));
                 }
@@ -28,15 +28,15 @@ impl Builder<'_> {
         Ok((lights, names))
     }
 
-    /// The light of table `lights[i]`.
+    /// The light of table `lights[i]`; ranges and names from [`fields`](crate::scene::fields).
     fn light(&self, t: &LightTable, i: usize) -> Result<Light, SceneError> {
-        let f = |s: &str| format!("lights[{i}].{s}");
+        use crate::scene::fields::*;
+        let at = format!("lights[{i}]");
+        let f = |spec: &Field| format!("{at}.{}", spec.name);
         // Colour times strength, the form every light's power takes.
-        let power =
-            |strength: &str, value: f32, color: [f32; 3]| -> Result<Vec3, SceneError> {
-                Ok(self.color(&f("color"), color, 1e3)?
-                    * self.range(&f(strength), value, 0.0, 1e12)?)
-            };
+        let power = |strength: &Field, value: f32, color: [f32; 3]| -> Result<Vec3, SceneError> {
+            Ok(self.color(&at, &LIGHT_COLOR, color)? * self.number(&at, strength, value)?)
+        };
         Ok(match t {
             LightTable::Point {
                 position,
@@ -44,8 +44,8 @@ impl Builder<'_> {
                 color,
                 ..
             } => Light::Point(PointLight {
-                position: self.finite3(&f("position"), *position)?,
-                intensity: power("intensity", *intensity, *color)?,
+                position: self.finite3(&f(&POSITION), *position)?,
+                intensity: power(&INTENSITY, *intensity, *color)?,
             }),
             LightTable::Spot {
                 position,
@@ -56,17 +56,17 @@ impl Builder<'_> {
                 falloff_deg,
                 ..
             } => {
-                let p = self.finite3(&f("position"), *position)?;
-                let d = self.finite3(&f("target"), *target)? - p;
+                let p = self.finite3(&f(&POSITION), *position)?;
+                let d = self.finite3(&f(&SPOT_TARGET), *target)? - p;
                 if d.length_squared() < 1e-12 {
-                    return Err(self.invalid(f("target"), "must differ from position"));
+                    return Err(self.invalid(f(&SPOT_TARGET), "must differ from position"));
                 }
-                let outer = self.range(&f("cone_deg"), *cone_deg, 0.01, 180.0)?;
-                let falloff = self.range(&f("falloff_deg"), *falloff_deg, 0.0, outer)?;
+                let outer = self.number(&at, &CONE, *cone_deg)?;
+                let falloff = self.range(&f(&FALLOFF), *falloff_deg, 0.0, outer)?;
                 Light::Spot(SpotLight {
                     position: p,
                     direction: d.normalize(),
-                    intensity: power("intensity", *intensity, *color)?,
+                    intensity: power(&INTENSITY, *intensity, *color)?,
                     cos_inner: (outer - falloff).to_radians().cos(),
                     cos_outer: outer.to_radians().cos(),
                 })
@@ -77,8 +77,8 @@ impl Builder<'_> {
                 color,
                 ..
             } => Light::Distant(DistantLight {
-                direction: self.unit3(&f("direction"), *direction)?,
-                irradiance: power("irradiance", *irradiance, *color)?,
+                direction: self.unit3(&f(&DISTANT_DIRECTION), *direction)?,
+                irradiance: power(&IRRADIANCE, *irradiance, *color)?,
             }),
             LightTable::Rect {
                 corner,
@@ -89,17 +89,17 @@ impl Builder<'_> {
                 ..
             } => {
                 let (u, v) = (
-                    self.finite3(&f("edge_u"), *edge_u)?,
-                    self.finite3(&f("edge_v"), *edge_v)?,
+                    self.finite3(&f(&EDGE_U), *edge_u)?,
+                    self.finite3(&f(&EDGE_V), *edge_v)?,
                 );
                 if u.cross(v).length_squared() < 1e-12 {
-                    return Err(self.invalid(f("edge_v"), "edges must span a non-zero area"));
+                    return Err(self.invalid(f(&EDGE_V), "edges must span a non-zero area"));
                 }
                 Light::Rect(RectLight::new(
-                    self.finite3(&f("corner"), *corner)?,
+                    self.finite3(&f(&CORNER), *corner)?,
                     u,
                     v,
-                    power("radiance", *radiance, *color)?,
+                    power(&RADIANCE, *radiance, *color)?,
                 ))
             }
             LightTable::Sphere {
@@ -109,9 +109,9 @@ impl Builder<'_> {
                 color,
                 ..
             } => Light::Sphere(SphereLight {
-                center: self.finite3(&f("center"), *center)?,
-                radius: self.range(&f("radius"), *radius, 1e-4, 1e9)?,
-                radiance: power("radiance", *radiance, *color)?,
+                center: self.finite3(&f(&CENTER), *center)?,
+                radius: self.number(&at, &SPHERE_RADIUS, *radius)?,
+                radiance: power(&RADIANCE, *radiance, *color)?,
             }),
             LightTable::Environment {
                 radiance,
@@ -120,9 +120,9 @@ impl Builder<'_> {
                 rotate_deg,
                 ..
             } => {
-                let scale = power("radiance", *radiance, *color)?;
-                let rot = self.range(&f("rotate_deg"), *rotate_deg, -360.0, 360.0)?;
-                let map = map.as_ref().map(|m| self.env_map(&f("map"), m, rot));
+                let scale = power(&ENV_RADIANCE, *radiance, *color)?;
+                let rot = self.number(&at, &ENV_ROTATE, *rotate_deg)?;
+                let map = map.as_ref().map(|m| self.env_map(&f(&ENV_MAP), m, rot));
                 let map = map.transpose()?.map(Arc::new);
                 Light::Environment(Environment { scale, map })
             }

@@ -1,17 +1,9 @@
 //! The `[materials]` tables of a scene file, checked and built (measured maps read here).
 
+use crate::scene::fields::*;
 use crate::scene::*;
 
 impl Builder<'_> {
-    /// `x` checked against the range of the wood BSDF's scalar field `name`
-    /// ([`WOOD_BSDF_PARAMS`](crate::bsdf::WOOD_BSDF_PARAMS)), reported as the scene's `field`.
-    pub(crate) fn bsdf_range(&self, field: &str, x: f32, name: &str) -> Result<f32, SceneError> {
-        match WoodBsdfParams::spec(name).map(|p| p.kind) {
-            Some(crate::bsdf::ParamKind::Scalar { min, max }) => self.range(field, x, min, max),
-            _ => unreachable!("`{name}` is a scalar field of WOOD_BSDF_PARAMS"),
-        }
-    }
-
     pub(in crate::scene) fn materials(
         &mut self,
         tables: &BTreeMap<String, MaterialTable>,
@@ -19,10 +11,11 @@ impl Builder<'_> {
         let mut out = Vec::new();
         let mut index = HashMap::new();
         for (name, t) in tables {
-            let f = |s: &str| format!("materials.{name}.{s}");
+            let at = format!("materials.{name}");
+            let f = |spec: &Field| format!("{at}.{}", spec.name);
             let m = match t {
                 MaterialTable::Lambertian { albedo } => Material::Lambertian {
-                    albedo: self.color(&f("albedo"), *albedo, 1.0)?,
+                    albedo: self.color(&at, &ALBEDO, *albedo)?,
                 },
                 MaterialTable::Fiber {
                     diffuse,
@@ -35,19 +28,20 @@ impl Builder<'_> {
                     roughness,
                 } => {
                     let params = WoodBsdfParams {
-                        diffuse: self.color(&f("diffuse"), *diffuse, 1.0)?,
-                        fiber_color: self.color(&f("fiber_color"), *fiber_color, 1.0)?,
-                        fiber_dir: self.unit3(&f("fiber_dir"), *fiber_dir)?,
-                        ray_dir: self.unit3(&f("ray_dir"), *ray_dir)?,
-                        ray_mask: self.bsdf_range(&f("ray_mask"), *ray_mask, "ray_mask")?,
+                        diffuse: self.color(&at, &FIBER_DIFFUSE, *diffuse)?,
+                        fiber_color: self.color(&at, &FIBER_COLOR, *fiber_color)?,
+                        fiber_dir: self.unit3(&f(&FIBER_DIR), *fiber_dir)?,
+                        ray_dir: self.unit3(&f(&RAY_DIR), *ray_dir)?,
+                        ray_mask: self.number(&at, &RAY_MASK, *ray_mask)?,
                         highlight_width: self
-                            .range(&f("highlight_width_deg"), *highlight_width_deg, 0.06, 90.0)?
+                            .number(&at, &FIBER_WIDTH, *highlight_width_deg)?
                             .to_radians(),
-                        eta: self.bsdf_range(&f("eta"), *eta, "eta")?,
-                        roughness: self.bsdf_range(&f("roughness"), *roughness, "roughness")?,
+                        eta: self.number(&at, &ETA, *eta)?,
+                        roughness: self.number(&at, &ROUGHNESS, *roughness)?,
                     };
                     // Let the BSDF itself check the combination once, here, with a clear message.
-                    WoodBsdf::new(params).map_err(|e| self.invalid(f("type"), e.to_string()))?;
+                    WoodBsdf::new(params)
+                        .map_err(|e| self.invalid(format!("{at}.type"), e.to_string()))?;
                     Material::Fiber { params }
                 }
                 MaterialTable::Wood {
@@ -60,12 +54,12 @@ impl Builder<'_> {
                 } => {
                     let params = match (preset, preset_file) {
                         (Some(name), None) => crate::wood::preset(name)
-                            .map_err(|e| self.invalid(f("preset"), e.to_string()))?,
+                            .map_err(|e| self.invalid(f(&PRESET), e.to_string()))?,
                         (None, Some(file)) => read_preset_file(&self.base.join(file))
-                            .map_err(|e| self.invalid(f("preset_file"), e.to_string()))?,
+                            .map_err(|e| self.invalid(f(&PRESET_FILE), e.to_string()))?,
                         _ => {
                             return Err(self.invalid(
-                                f("preset"),
+                                f(&PRESET),
                                 format!(
                                     "give exactly one of `preset` (one of: {}) or `preset_file`",
                                     crate::wood::PRESET_NAMES.join(", ")
@@ -74,15 +68,15 @@ impl Builder<'_> {
                         }
                     };
                     let bump = match bump {
-                        Some(b) => self.range(&f("bump"), *b, 0.0, 100.0)?,
+                        Some(b) => self.number(&at, &BUMP, *b)?,
                         None => params.default_bump(),
                     };
                     let volume = crate::wood::WoodVolume::new(params, *seed)
-                        .map_err(|e| self.invalid(f("preset"), e.to_string()))?;
+                        .map_err(|e| self.invalid(f(&PRESET), e.to_string()))?;
                     Material::Wood(Box::new(WoodMaterial {
                         volume: Arc::new(volume),
-                        eta: self.bsdf_range(&f("eta"), *eta, "eta")?,
-                        roughness: self.bsdf_range(&f("roughness"), *roughness, "roughness")?,
+                        eta: self.number(&at, &ETA, *eta)?,
+                        roughness: self.number(&at, &ROUGHNESS, *roughness)?,
                         bump,
                         switches: Default::default(),
                     }))
@@ -90,18 +84,18 @@ impl Builder<'_> {
                 MaterialTable::Measured { .. } => self.measured(t, name)?,
                 MaterialTable::Texture { texture, params } => {
                     let t = crate::texture::by_name(texture, params)
-                        .map_err(|e| self.invalid(f("texture"), e.to_string()))?;
+                        .map_err(|e| self.invalid(f(&TEXTURE), e.to_string()))?;
                     Material::Texture(TextureMaterial {
                         name: texture.clone(),
                         texture: Arc::from(t),
                     })
                 }
                 MaterialTable::Mirror { reflectance } => Material::Mirror {
-                    reflectance: self.color(&f("reflectance"), *reflectance, 1.0)?,
+                    reflectance: self.color(&at, &MIRROR_REFLECTANCE, *reflectance)?,
                 },
                 MaterialTable::Glass { eta, tint } => Material::Glass {
-                    eta: self.range(&f("eta"), *eta, 1.0, 4.0)?,
-                    tint: self.color(&f("tint"), *tint, 1.0)?,
+                    eta: self.number(&at, &GLASS_ETA, *eta)?,
+                    tint: self.color(&at, &GLASS_TINT, *tint)?,
                 },
             };
             index.insert(name.clone(), out.len() as u32);
@@ -129,43 +123,38 @@ impl Builder<'_> {
         else {
             unreachable!("called for measured materials only")
         };
-        let f = |s: &str| format!("materials.{name}.{s}");
+        let at = format!("materials.{name}");
+        let f = |spec: &Field| format!("{at}.{}", spec.name);
         if highlight_width.is_some() && highlight_width_deg.is_some() {
             return Err(self.invalid(
-                f("highlight_width_deg"),
+                f(&MEASURED_WIDTH),
                 "give either a β map `highlight_width` or a constant `highlight_width_deg`, not both",
             ));
         }
-        let beta = self.range(
-            &f("highlight_width_deg"),
-            highlight_width_deg.unwrap_or(crate::material::DEFAULT_HIGHLIGHT_WIDTH_DEG),
-            0.06,
-            90.0,
+        let beta = self.number(
+            &at,
+            &MEASURED_WIDTH,
+            highlight_width_deg.unwrap_or(MEASURED_WIDTH.default_number()),
         )?;
-        let scale = self.range(&f("fiber_color_scale"), *fiber_color_scale, 0.0, 1000.0)?;
+        let scale = self.number(&at, &FIBER_COLOR_SCALE, *fiber_color_scale)?;
         let size = Vec2::new(
-            self.range(&f("size_mm"), size_mm[0], 1e-3, 1e6)?,
-            self.range(&f("size_mm"), size_mm[1], 1e-3, 1e6)?,
+            self.number(&at, &SIZE_MM, size_mm[0])?,
+            self.number(&at, &SIZE_MM, size_mm[1])?,
         );
         let face = match face
             .as_deref()
             .map_or(Some(BoardFace::PosZ), BoardFace::from_name)
         {
             Some(face) => face,
-            None => {
-                return Err(self.invalid(
-                    f("face"),
-                    "allowed \"+z\", \"-z\", \"+x\", \"-x\", \"+y\", \"-y\"",
-                ))
-            }
+            None => return Err(self.invalid(f(&FACE), format!("allowed {}", FACE.value.range()))),
         };
         let colors = match color_space.as_deref() {
             None | Some("linear") => ColorSpace::Linear,
             Some("srgb") => ColorSpace::Srgb,
             Some(other) => {
                 return Err(self.invalid(
-                    f("color_space"),
-                    format!("`{other}` (allowed \"linear\" or \"srgb\")"),
+                    f(&COLOR_SPACE),
+                    format!("`{other}` (allowed {})", COLOR_SPACE.value.range()),
                 ))
             }
         };
@@ -176,20 +165,20 @@ impl Builder<'_> {
             highlight_width: highlight_width.as_ref().map(|p| self.base.join(p)),
         };
         let board = MeasuredBoard::from_files(&files, colors)
-            .map_err(|e| self.invalid(f(e.field()), e.to_string()))?;
+            .map_err(|e| self.invalid(format!("{at}.{}", e.field()), e.to_string()))?;
         let m = MeasuredMaterial::new(
             Arc::new(board),
             face.rect(size),
             scale,
             beta.to_radians(),
-            self.bsdf_range(&f("eta"), *eta, "eta")?,
-            self.bsdf_range(&f("roughness"), *roughness, "roughness")?,
+            self.number(&at, &ETA, *eta)?,
+            self.number(&at, &ROUGHNESS, *roughness)?,
         );
         if m.clamped > 0 {
             self.warnings.push(format!(
                 "{}: {}: {} of {} texels have 2π · fiber_color_scale · fiber_color above 1 and were scaled down to 1 (hue kept)",
                 self.path,
-                f("fiber_color_scale"),
+                f(&FIBER_COLOR_SCALE),
                 m.clamped,
                 m.board.fiber_color.len()
             ));

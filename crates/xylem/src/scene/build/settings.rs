@@ -154,7 +154,7 @@ impl Builder<'_> {
             for v in b.size_mm {
                 self.range("sweep.board.size_mm", v, 1e-3, 1e6)?;
             }
-            self.bsdf_range("sweep.board.eta", b.eta, "eta")?;
+            self.number("sweep.board", &crate::scene::fields::ETA, b.eta)?;
         }
         if !names.iter().any(|n| n.as_deref() == Some(s.light.as_str())) {
             let known: Vec<&str> = names.iter().flatten().map(String::as_str).collect();
