@@ -30,8 +30,9 @@ const MIN_COS_PSI: f32 = 1e-5;
 /// on a sliver where f·cos vanishes anyway.
 const MIN_ARC: f32 = PI / 8.0;
 
-/// ψr = asin(ωo·u) and cos ψr of one outgoing direction, for [`FiberAxis::eval_pdf_at`].
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// ψr = asin(ωo·u) and cos ψr of one outgoing direction, for [`FiberAxis::eval_pdf_at`]
+/// (the default: a lobe that is not used).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FiberAtWo {
     psi_r: f32,
     cos_psi_r: f32,
@@ -195,9 +196,24 @@ impl FiberAxis {
 
     /// The lobe without its colour k_f, for interior directions `wo`, `wi`.
     pub fn eval(&self, wo: Vec3, wi: Vec3, beta: f32, norm: FiberNormalization) -> f32 {
-        let (at, psi_i) = (self.at_wo(wo), self.psi(wi));
+        self.lobe_at(&self.at_wo(wo), wi.dot(self.frame.n), beta, norm)
+            .0
+    }
+
+    /// The lobe without k_f at sin ψi = `sin_psi` for the `wo` of `at`, and its Gaussian
+    /// g(β, ψi + ψr) (Marschner et al. 2005 eq. 3, normalised by `norm`): the one scalar form,
+    /// of [`FiberAxis::eval`] and [`FiberAxis::eval_pdf_at`].
+    #[inline(always)]
+    fn lobe_at(
+        &self,
+        at: &FiberAtWo,
+        sin_psi: f32,
+        beta: f32,
+        norm: FiberNormalization,
+    ) -> (f32, f32) {
+        let psi_i = asin(sin_psi);
         let g = gaussian(beta, psi_i + at.psi_r);
-        lobe_value(norm, g, lobe_cos(norm, psi_i, &at), &at)
+        (lobe_value(norm, g, lobe_cos(norm, psi_i, at), at), g)
     }
 
     /// How this fibre sees the light a rough finish transmits from the exterior direction `w`
@@ -273,9 +289,7 @@ impl FiberAxis {
         z_min: f32,
     ) -> (f32, f32) {
         let sin_psi = wi.dot(self.frame.n);
-        let psi_i = asin(sin_psi);
-        let g = gaussian_scale(beta, exp(gaussian_exponent(beta, psi_i + at.psi_r)));
-        let f = lobe_value(norm, g, lobe_cos(norm, psi_i, at), at);
+        let (f, g) = self.lobe_at(at, sin_psi, beta, norm);
         // As in `pdf`: sin ψi clamped, ψi = asin of it (= `psi(wi)`), so g is the same; the arc
         // (an acos) only where `pdf_value` needs it.
         let (cos_psi, t) = self.arc_argument(sin_psi, z_min);

@@ -134,14 +134,6 @@ struct RoughView {
     sample_ray: (f32, f32),
 }
 
-/// What the fibre lobes' samples are drawn about: ωo refracted into a smooth finish, or the
-/// angles of a rough finish's [`RoughView`].
-#[derive(Clone, Copy, Debug)]
-enum About<'a> {
-    Refracted(Vec3),
-    Rough(&'a RoughView),
-}
-
 /// (ψ, β) to draw a fibre lobe's samples with, from ωo's spreads (see [`RoughView`]).
 fn sampling_about(spread: &[PsiSpread; 2], beta: f32) -> (f32, f32) {
     let var: f32 = spread.iter().map(|p| p.share * p.var).sum();
@@ -264,25 +256,6 @@ impl WoodBsdf {
         1.0 - fresnel_dielectric(cos, self.params.eta)
     }
 
-    /// The substrate BSDF for interior directions (no cosine): diffuse with its internal
-    /// reflections, plus k_f times the ray-mask blend of the two fibre lobes.
-    #[inline]
-    fn substrate(&self, wo: Vec3, wi: Vec3) -> Vec3 {
-        let p = &self.params;
-        let beta = p.highlight_width;
-        let f_fib = if p.ray_mask < 1.0 {
-            self.fiber.eval(wo, wi, beta, self.norm)
-        } else {
-            0.0
-        };
-        let f_ray = if p.ray_mask > 0.0 {
-            self.ray.eval(wo, wi, beta, self.norm)
-        } else {
-            0.0
-        };
-        self.blend(f_fib, f_ray)
-    }
-
     /// [`RoughView`] of `wo`, or `None` for a smooth finish.
     fn rough_view(&self, wo: Vec3) -> Option<RoughView> {
         let parts = self.transmission?.parts(wo.z);
@@ -345,23 +318,19 @@ impl WoodBsdf {
     }
 
     /// The interior density of the fibre and ray lobes' samples for `wi_in` (0 for a lobe never
-    /// picked), drawn about ωo's refraction (smooth finish) or about its rough view's angles.
-    fn lobe_densities(&self, probs: &LobeProbs, about: About, wi_in: Vec3) -> (f32, f32) {
-        let (beta, z) = (self.params.highlight_width, self.z_crit);
-        let density = |axis: &FiberAxis, pick: fn(&RoughView) -> (f32, f32)| match about {
-            About::Refracted(wo_in) => axis.pdf(wo_in, wi_in, beta, z),
-            About::Rough(v) => {
-                let (psi, width) = pick(v);
-                axis.pdf_about(psi, wi_in, width, z)
-            }
-        };
+    /// picked) under a rough finish, drawn about its view's angles (a smooth finish's come with
+    /// the lobes' values, [`FiberAxis::eval_pdf_at`]).
+    fn rough_lobe_densities(&self, probs: &LobeProbs, view: &RoughView, wi_in: Vec3) -> (f32, f32) {
+        let z = self.z_crit;
+        let density =
+            |axis: &FiberAxis, (psi, width): (f32, f32)| axis.pdf_about(psi, wi_in, width, z);
         let p_fib = if probs.fiber > 0.0 {
-            density(&self.fiber, |v| v.sample_fiber)
+            density(&self.fiber, view.sample_fiber)
         } else {
             0.0
         };
         let p_ray = if probs.ray > 0.0 {
-            density(&self.ray, |v| v.sample_ray)
+            density(&self.ray, view.sample_ray)
         } else {
             0.0
         };
@@ -425,24 +394,6 @@ impl WoodBsdf {
             }
         }
         last
-    }
-
-    fn pdf_with(&self, probs: &LobeProbs, view: Option<&RoughView>, wo: Vec3, wi: Vec3) -> f32 {
-        if !(wo.z > 0.0 && wi.z > 0.0) {
-            return 0.0;
-        }
-        let eta = self.params.eta;
-        let wi_in = refract_in(wi, eta);
-        let (p_fib, p_ray) = if probs.fiber > 0.0 || probs.ray > 0.0 {
-            let about = match view {
-                Some(v) => About::Rough(v),
-                None => About::Refracted(refract_in(wo, eta)),
-            };
-            self.lobe_densities(probs, about, wi_in)
-        } else {
-            (0.0, 0.0)
-        };
-        self.density(probs, wo, wi, wi_in, p_fib, p_ray)
     }
 
     /// The density of [`Bsdf::sample`] from the lobe probabilities and the fibre and ray lobes'
@@ -537,37 +488,20 @@ impl Bsdf for WoodBsdf {
     /// f(ωo, ωi) = T(θo) T(θi) f_s(ωo', ωi') / η² (+ the rough reflection), ω' refracted into
     /// the finish (notes/bsdf.md eq. 1.4).
     fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
-        if !(wo.z > 0.0 && wi.z > 0.0) {
-            return Vec3::ZERO;
-        }
-        let eta = self.params.eta;
-        let (wo_in, wi_in) = (refract_in(wo, eta), refract_in(wi, eta));
-        let t = self.transmittance(wo.z) * self.transmittance(wi.z) * self.inv_eta2;
-        let substrate = match self.rough_view(wo) {
-            Some(view) => {
-                let (f_fib, f_ray) = self.rough_lobes(&view, wi);
-                self.blend(f_fib, f_ray)
-            }
-            None => self.substrate(wo_in, wi_in),
-        };
-        self.value(wo, wi, substrate, t)
+        self.at_wo(wo).eval_pdf(wi, false).0
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if !(wo.z > 0.0 && wi.z > 0.0) {
-            return 0.0;
-        }
-        self.pdf_with(&self.lobe_probs(wo), self.rough_view(wo).as_ref(), wo, wi)
+        self.at_wo(wo).eval_pdf(wi, true).1
     }
 
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
         if !(wo.z > 0.0) {
             return None;
         }
-        let probs = self.lobe_probs(wo);
-        let view = self.rough_view(wo);
-        let view = view.as_ref();
-        let lobe = Self::pick(&probs, uc);
+        let at = self.at_wo(wo);
+        let (probs, view) = (&at.probs, at.rough.as_ref());
+        let lobe = Self::pick(probs, uc);
         let eta = self.params.eta;
         let beta = self.params.highlight_width;
         let wi = match lobe {
@@ -611,13 +545,13 @@ impl Bsdf for WoodBsdf {
         if !(wi.z > 0.0) {
             return None;
         }
-        let pdf = self.pdf_with(&probs, view, wo, wi);
+        let (f, pdf) = at.eval_pdf(wi, true);
         if !(pdf > 0.0) {
             return None;
         }
         Some(BsdfSample {
             wi,
-            f: self.eval(wo, wi),
+            f,
             pdf,
             is_delta: false,
             eta: 1.0,

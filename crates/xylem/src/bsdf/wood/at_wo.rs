@@ -4,7 +4,7 @@
 
 use super::super::fiber::{FiberAtWo, FiberAxis, BATCH};
 use super::super::fresnel::refract_in;
-use super::{finite_nonnegative, finite_or_zero, About, LobeProbs, RoughView, WoodBsdf};
+use super::{finite_nonnegative, finite_or_zero, LobeProbs, RoughView, WoodBsdf};
 use glam::Vec3;
 
 /// [`WoodBsdf`]'s `eval` and `pdf` for one fixed `wo`, with what depends on `wo` alone — its
@@ -17,23 +17,31 @@ pub struct WoodAtWo<'a> {
     bsdf: &'a WoodBsdf,
     wo: Vec3,
     t_o: f32,
-    probs: LobeProbs,
+    pub(super) probs: LobeProbs,
     fiber: FiberAtWo,
     ray: FiberAtWo,
-    rough: Option<RoughView>,
+    pub(super) rough: Option<RoughView>,
 }
 
 impl WoodBsdf {
     /// This BSDF with `wo` fixed.
     pub fn at_wo(&self, wo: Vec3) -> WoodAtWo<'_> {
         let wo_in = refract_in(wo, self.params.eta);
+        let prepare = |axis: &FiberAxis, used: bool| {
+            if used {
+                axis.at_wo(wo_in)
+            } else {
+                FiberAtWo::default()
+            }
+        };
         WoodAtWo {
             bsdf: self,
             wo,
             t_o: self.transmittance(wo.z),
             probs: self.lobe_probs(wo),
-            fiber: self.fiber.at_wo(wo_in),
-            ray: self.ray.at_wo(wo_in),
+            // A lobe the ray mask leaves out is neither evaluated nor sampled.
+            fiber: prepare(&self.fiber, self.params.ray_mask < 1.0),
+            ray: prepare(&self.ray, self.params.ray_mask > 0.0),
             rough: self.rough_view(wo),
         }
     }
@@ -54,7 +62,7 @@ impl WoodAtWo<'_> {
             if !with_pdf {
                 return (f, 0.0);
             }
-            let (p_fib, p_ray) = b.lobe_densities(probs, About::Rough(view), wi_in);
+            let (p_fib, p_ray) = b.rough_lobe_densities(probs, view, wi_in);
             return (f, self.density(wi, wi_in, p_fib, p_ray));
         }
         let lobe = |axis: &FiberAxis, at: &FiberAtWo, in_f: bool, in_pdf: bool| {
