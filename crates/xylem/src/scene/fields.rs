@@ -183,7 +183,7 @@ const fn field(
 const STRENGTH: (f32, f32) = (0.0, 1e12);
 
 /// `name` of any light.
-pub const LIGHT_NAME: Field = field(
+pub(crate) const LIGHT_NAME: Field = field(
     "name",
     Value::Text {
         allowed: "unique among the lights",
@@ -192,16 +192,16 @@ pub const LIGHT_NAME: Field = field(
     "the sweep moves a light by name",
 );
 /// `color` of any light.
-pub const LIGHT_COLOR: Field = field(
+pub(crate) const LIGHT_COLOR: Field = field(
     "color",
     Value::Colour { max: 1e3 },
     FieldDefault::Triple([1.0; 3]),
     "multiplies the strength",
 );
 /// `position` of a point or spot light.
-pub const POSITION: Field = field("position", Value::Point, FieldDefault::Required, "");
+pub(crate) const POSITION: Field = field("position", Value::Point, FieldDefault::Required, "");
 /// `intensity` of a point or spot light.
-pub const INTENSITY: Field = number(
+pub(crate) const INTENSITY: Field = number(
     "intensity",
     "W/sr",
     STRENGTH,
@@ -209,14 +209,14 @@ pub const INTENSITY: Field = number(
     "radiant intensity (a spot's on its axis)",
 );
 /// `target` of a spot light.
-pub const SPOT_TARGET: Field = field(
+pub(crate) const SPOT_TARGET: Field = field(
     "target",
     Value::Point,
     FieldDefault::Required,
     "the point the cone's axis passes through; must differ from `position`",
 );
 /// `cone_deg` of a spot light.
-pub const CONE: Field = number(
+pub(crate) const CONE: Field = number(
     "cone_deg",
     "degrees",
     (0.01, 180.0),
@@ -224,7 +224,7 @@ pub const CONE: Field = number(
     "half-angle of the cone",
 );
 /// `falloff_deg` of a spot light.
-pub const FALLOFF: Field = number(
+pub(crate) const FALLOFF: Field = number(
     "falloff_deg",
     "degrees",
     (0.0, 180.0),
@@ -232,14 +232,14 @@ pub const FALLOFF: Field = number(
     "width of the smooth edge inside the cone; at most `cone_deg`",
 );
 /// `direction` of a distant light.
-pub const DISTANT_DIRECTION: Field = field(
+pub(crate) const DISTANT_DIRECTION: Field = field(
     "direction",
     Value::Direction,
     FieldDefault::Required,
     "towards the light",
 );
 /// `irradiance` of a distant light.
-pub const IRRADIANCE: Field = number(
+pub(crate) const IRRADIANCE: Field = number(
     "irradiance",
     "W/mm²",
     STRENGTH,
@@ -247,23 +247,23 @@ pub const IRRADIANCE: Field = number(
     "on a surface facing the light",
 );
 /// `corner` of a rect light.
-pub const CORNER: Field = field("corner", Value::Point, FieldDefault::Required, "one corner");
+pub(crate) const CORNER: Field = field("corner", Value::Point, FieldDefault::Required, "one corner");
 /// `edge_u` of a rect light.
-pub const EDGE_U: Field = field(
+pub(crate) const EDGE_U: Field = field(
     "edge_u",
     Value::Vector,
     FieldDefault::Required,
     "first edge from `corner`; the light emits to the side of `edge_u × edge_v`",
 );
 /// `edge_v` of a rect light.
-pub const EDGE_V: Field = field(
+pub(crate) const EDGE_V: Field = field(
     "edge_v",
     Value::Vector,
     FieldDefault::Required,
     "second edge from `corner`; the edges must span a non-zero area",
 );
 /// `radiance` of a rect or sphere light.
-pub const RADIANCE: Field = number(
+pub(crate) const RADIANCE: Field = number(
     "radiance",
     "W/(sr·mm²)",
     STRENGTH,
@@ -271,11 +271,11 @@ pub const RADIANCE: Field = number(
     "emitted radiance",
 );
 /// `center` of a sphere light.
-pub const CENTER: Field = field("center", Value::Point, FieldDefault::Required, "");
+pub(crate) const CENTER: Field = field("center", Value::Point, FieldDefault::Required, "");
 /// `radius` of a sphere light.
-pub const SPHERE_RADIUS: Field = number("radius", "mm", (1e-4, 1e9), FieldDefault::Required, "");
+pub(crate) const SPHERE_RADIUS: Field = number("radius", "mm", (1e-4, 1e9), FieldDefault::Required, "");
 /// `radiance` of the environment.
-pub const ENV_RADIANCE: Field = number(
+pub(crate) const ENV_RADIANCE: Field = number(
     "radiance",
     "W/(sr·mm²)",
     STRENGTH,
@@ -283,7 +283,7 @@ pub const ENV_RADIANCE: Field = number(
     "scales the map (or the constant sky)",
 );
 /// `map` of the environment.
-pub const ENV_MAP: Field = field(
+pub(crate) const ENV_MAP: Field = field(
     "map",
     Value::Text {
         allowed: "an EXR path; texels finite, ≥ 0",
@@ -292,7 +292,7 @@ pub const ENV_MAP: Field = field(
     "lat-long map, z up, u = φ/2π from +x, v = θ/π from +z; absent: constant",
 );
 /// `rotate_deg` of the environment.
-pub const ENV_ROTATE: Field = number(
+pub(crate) const ENV_ROTATE: Field = number(
     "rotate_deg",
     "degrees",
     (-360.0, 360.0),
@@ -346,39 +346,39 @@ pub const LIGHTS: [TypeFields; 6] = [
 const REFLECTANCE: Value = Value::Colour { max: 1.0 };
 
 /// `albedo` of a Lambertian material.
-pub const ALBEDO: Field = field("albedo", REFLECTANCE, FieldDefault::Required, "reflectance");
+pub(crate) const ALBEDO: Field = field("albedo", REFLECTANCE, FieldDefault::Required, "reflectance");
 /// `diffuse` of a fibre material.
-pub const FIBER_DIFFUSE: Field = field(
+pub(crate) const FIBER_DIFFUSE: Field = field(
     "diffuse",
     REFLECTANCE,
     FieldDefault::Required,
     "diffuse colour",
 );
 /// `fiber_color` of a fibre material.
-pub const FIBER_COLOR: Field = field(
+pub(crate) const FIBER_COLOR: Field = field(
     "fiber_color",
     REFLECTANCE,
     FieldDefault::Required,
     "fibre highlight colour",
 );
 /// `fiber_dir` of a fibre material.
-pub const FIBER_DIR: Field = field(
+pub(crate) const FIBER_DIR: Field = field(
     "fiber_dir",
     Value::Direction,
     FieldDefault::Required,
     "fibre direction (object space)",
 );
 /// `ray_dir` of a fibre material.
-pub const RAY_DIR: Field = field(
+pub(crate) const RAY_DIR: Field = field(
     "ray_dir",
     Value::Direction,
     FieldDefault::Triple([0.0, 0.0, 1.0]),
     "ray-cell direction (object space)",
 );
 /// `ray_mask` of a fibre material.
-pub const RAY_MASK: Field = bsdf_number("ray_mask", 0.0, "how much of the surface is ray cells");
+pub(crate) const RAY_MASK: Field = bsdf_number("ray_mask", 0.0, "how much of the surface is ray cells");
 /// `highlight_width_deg` of a fibre material.
-pub const FIBER_WIDTH: Field = number(
+pub(crate) const FIBER_WIDTH: Field = number(
     "highlight_width_deg",
     "degrees",
     (0.06, 90.0),
@@ -386,19 +386,19 @@ pub const FIBER_WIDTH: Field = number(
     "fibre highlight width β",
 );
 /// `eta` of any finished material.
-pub const ETA: Field = bsdf_number("eta", 1.5, "refractive index of the finish");
+pub(crate) const ETA: Field = bsdf_number("eta", 1.5, "refractive index of the finish");
 /// `roughness` of any finished material.
-pub const ROUGHNESS: Field =
+pub(crate) const ROUGHNESS: Field =
     bsdf_number("roughness", 0.0, "GGX roughness of the finish (0 = smooth)");
 /// `preset` of a wood material.
-pub const PRESET: Field = field(
+pub(crate) const PRESET: Field = field(
     "preset",
     Value::OneOf(&crate::wood::PRESET_NAMES),
     FieldDefault::Optional,
     "give exactly one of `preset` and `preset_file`",
 );
 /// `preset_file` of a wood material.
-pub const PRESET_FILE: Field = field(
+pub(crate) const PRESET_FILE: Field = field(
     "preset_file",
     Value::Text {
         allowed: "a preset TOML path",
@@ -407,14 +407,14 @@ pub const PRESET_FILE: Field = field(
     "a preset of one's own instead of a built-in",
 );
 /// `seed` of a wood material.
-pub const WOOD_SEED: Field = field(
+pub(crate) const WOOD_SEED: Field = field(
     "seed",
     Value::Integer,
     FieldDefault::Number(0.0),
     "selects the tree",
 );
 /// `bump` of a wood material.
-pub const BUMP: Field = number(
+pub(crate) const BUMP: Field = number(
     "bump",
     "",
     (0.0, 100.0),
@@ -422,7 +422,7 @@ pub const BUMP: Field = number(
     "pore bump strength; 1 = the preset's pores at their anatomical depth; 0 skips the bump",
 );
 /// `diffuse` map of a measured material.
-pub const MEASURED_DIFFUSE: Field = field(
+pub(crate) const MEASURED_DIFFUSE: Field = field(
     "diffuse",
     Value::Text {
         allowed: "an 8-bit PNG path",
@@ -431,7 +431,7 @@ pub const MEASURED_DIFFUSE: Field = field(
     "diffuse colour map",
 );
 /// `fiber_color` map of a measured material.
-pub const MEASURED_FIBER_COLOR: Field = field(
+pub(crate) const MEASURED_FIBER_COLOR: Field = field(
     "fiber_color",
     Value::Text {
         allowed: "an 8-bit PNG path, the size of `diffuse`",
@@ -440,7 +440,7 @@ pub const MEASURED_FIBER_COLOR: Field = field(
     "fibre colour map",
 );
 /// `fiber_axis` map of a measured material.
-pub const MEASURED_FIBER_AXIS: Field = field(
+pub(crate) const MEASURED_FIBER_AXIS: Field = field(
     "fiber_axis",
     Value::Text {
         allowed: "an 8-bit PNG path, the size of `diffuse`; axis length 0.95–1.05",
@@ -449,7 +449,7 @@ pub const MEASURED_FIBER_AXIS: Field = field(
     "fibre axis map: axis = 2v/255 − 1 in the frame x = columns, y = towards the top row, z = the normal",
 );
 /// `highlight_width` map of a measured material.
-pub const MEASURED_WIDTH_MAP: Field = field(
+pub(crate) const MEASURED_WIDTH_MAP: Field = field(
     "highlight_width",
     Value::Text {
         allowed: "an 8-bit PNG path, the size of `diffuse`",
@@ -458,7 +458,7 @@ pub const MEASURED_WIDTH_MAP: Field = field(
     "β map, β = 90° · v/255; give this or `highlight_width_deg`",
 );
 /// `highlight_width_deg` of a measured material.
-pub const MEASURED_WIDTH: Field = number(
+pub(crate) const MEASURED_WIDTH: Field = number(
     "highlight_width_deg",
     "degrees",
     (0.06, 90.0),
@@ -466,7 +466,7 @@ pub const MEASURED_WIDTH: Field = number(
     "β everywhere, when there is no β map",
 );
 /// `fiber_color_scale` of a measured material.
-pub const FIBER_COLOR_SCALE: Field = number(
+pub(crate) const FIBER_COLOR_SCALE: Field = number(
     "fiber_color_scale",
     "",
     (0.0, 1000.0),
@@ -474,14 +474,14 @@ pub const FIBER_COLOR_SCALE: Field = number(
     "the published lobe's k_f per stored unit (notes/measured.md); converted to xylem's lobe as 2π ×, texels above 1 scaled down to 1 keeping hue, with a warning",
 );
 /// `color_space` of a measured material.
-pub const COLOR_SPACE: Field = field(
+pub(crate) const COLOR_SPACE: Field = field(
     "color_space",
     Value::OneOf(&["linear", "srgb"]),
     FieldDefault::Words("\"linear\""),
     "encoding of the colour maps",
 );
 /// `size_mm` of a measured material.
-pub const SIZE_MM: Field = field(
+pub(crate) const SIZE_MM: Field = field(
     "size_mm",
     Value::Size {
         min: 1e-3,
@@ -491,35 +491,35 @@ pub const SIZE_MM: Field = field(
     "the image's [width, height] on the face (object space), centred on the object's origin",
 );
 /// `face` of a measured material.
-pub const FACE: Field = field(
+pub(crate) const FACE: Field = field(
     "face",
     Value::OneOf(&crate::material::BoardFace::NAMES),
     FieldDefault::Words("\"+z\""),
     "the face of the object the maps lie on",
 );
 /// `texture` of a texture material.
-pub const TEXTURE: Field = field(
+pub(crate) const TEXTURE: Field = field(
     "texture",
     Value::OneOf(&crate::texture::NAMES),
     FieldDefault::Required,
     "a classic solid texture (`xylem texture --help`) as a Lambertian albedo clamped to 0–1, looked up at the object's `tree` placement point (mm); clouds and rust take a `time` in seconds",
 );
 /// `params` of a texture material.
-pub const TEXTURE_PARAMS: Field = field(
+pub(crate) const TEXTURE_PARAMS: Field = field(
     "params",
     Value::Table,
     FieldDefault::Words("the texture's defaults"),
     "the texture's parameters, `{ name = value, … }`",
 );
 /// `reflectance` of a mirror.
-pub const MIRROR_REFLECTANCE: Field = field(
+pub(crate) const MIRROR_REFLECTANCE: Field = field(
     "reflectance",
     REFLECTANCE,
     FieldDefault::Triple([0.95; 3]),
     "",
 );
 /// `eta` of glass.
-pub const GLASS_ETA: Field = number(
+pub(crate) const GLASS_ETA: Field = number(
     "eta",
     "",
     (1.0, 4.0),
@@ -527,7 +527,7 @@ pub const GLASS_ETA: Field = number(
     "refractive index",
 );
 /// `tint` of glass.
-pub const GLASS_TINT: Field = field(
+pub(crate) const GLASS_TINT: Field = field(
     "tint",
     REFLECTANCE,
     FieldDefault::Triple([1.0; 3]),
