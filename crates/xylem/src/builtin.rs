@@ -99,7 +99,7 @@ pub fn lookup(path: &Path) -> Option<&'static [u8]> {
 
 /// The embedded file that stands in for `path` — (repository path, contents) — where `path`
 /// does not exist on disk; None where the disk has it or nothing is embedded under that name.
-pub fn stand_in(path: &Path) -> Option<(&'static str, &'static [u8])> {
+pub(crate) fn stand_in(path: &Path) -> Option<(&'static str, &'static [u8])> {
     entry(path).filter(|_| !path.exists())
 }
 

@@ -12,7 +12,7 @@ enum Open {
 
 /// The path (`frames[3].intensity`) of the value at 1-based `line` and `column` of `text`
 /// (columns count bytes, as serde_json's do); empty at the top level.
-pub fn path_at(text: &str, line: usize, column: usize) -> String {
+pub(crate) fn path_at(text: &str, line: usize, column: usize) -> String {
     let mut stack: Vec<Open> = Vec::new();
     let mut expect_key = false;
     let (mut l, mut c) = (1usize, 0usize);

@@ -266,28 +266,28 @@ pub fn read_text_bounded(path: &Path, max: u64, what: &str) -> Result<String, Re
 }
 
 /// The largest side of an image read (pixels): twice `--res`'s 16384.
-pub const MAX_IMAGE_SIDE: u64 = 32768;
+pub(crate) const MAX_IMAGE_SIDE: u64 = 32768;
 /// The most pixels an image read may declare: 2²⁸ = 16384², the largest render.
-pub const MAX_IMAGE_PIXELS: u64 = 1 << 28;
+pub(crate) const MAX_IMAGE_PIXELS: u64 = 1 << 28;
 /// The largest image file read (EXR or PNG): a 16384² render's uncompressed 17-channel float
 /// EXR is 17 GiB.
-pub const MAX_IMAGE_BYTES: u64 = 20 << 30;
+pub(crate) const MAX_IMAGE_BYTES: u64 = 20 << 30;
 
 /// A check of an image's declared size (width, height) made on its header alone, before a pixel
 /// is decoded or its buffer allocated: a fit's frame must be the manifest's camera size, a
 /// measured map the diffuse map's, a sweep frame its record's. `Err` says why, naming the
 /// declared size; the caller names the file.
-pub type SizeCheck<'a> = &'a dyn Fn(u32, u32) -> Result<(), String>;
+pub(crate) type SizeCheck<'a> = &'a dyn Fn(u32, u32) -> Result<(), String>;
 
 /// A [`SizeCheck`] that takes any size ([`check_image`] still bounds it).
-pub fn any_size(_: u32, _: u32) -> Result<(), String> {
+pub(crate) fn any_size(_: u32, _: u32) -> Result<(), String> {
     Ok(())
 }
 
 /// Checks an image's declared size before it is decoded: each side 1 to [`MAX_IMAGE_SIDE`],
 /// at most [`MAX_IMAGE_PIXELS`] pixels, and `bytes_per_pixel` × pixels (what the decoder and
 /// the caller allocate for it) within the available memory.
-pub fn check_image(
+pub(crate) fn check_image(
     path: &Path,
     width: u64,
     height: u64,

@@ -136,7 +136,7 @@ impl Simd {
     }
 
     /// A forced level capped at the `available` one, with a message when it had to be capped.
-    pub fn choose(forced: Option<Simd>, available: Simd) -> (Simd, Option<String>) {
+    pub(crate) fn choose(forced: Option<Simd>, available: Simd) -> (Simd, Option<String>) {
         match forced {
             Some(f) if f > available => (
                 available,

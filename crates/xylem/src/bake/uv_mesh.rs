@@ -167,7 +167,7 @@ impl UvMesh {
 
     /// Per-vertex tangents (xyz unit, ⟂ the normal; w = ±1 with bitangent w (n × t) along
     /// −∂p/∂v), as glTF's TANGENT attribute.
-    pub fn tangents(&self) -> Vec<Vec4> {
+    pub(crate) fn tangents(&self) -> Vec<Vec4> {
         let mut tu = vec![Vec3::ZERO; self.positions.len()];
         let mut tv = vec![Vec3::ZERO; self.positions.len()];
         for t in &self.indices {

@@ -69,7 +69,7 @@ pub fn gaussian(beta: f32, x: f32) -> f32 {
 }
 
 /// Directions per call of [`FiberAxis::eval_pdf_many_at`] (its columns live on the stack).
-pub const BATCH: usize = 16;
+pub(crate) const BATCH: usize = 16;
 
 /// −x²/2β², the exponent of [`gaussian`].
 #[inline(always)]

@@ -38,7 +38,7 @@ impl Ggx {
 
     /// G1(ω) = 1 / (1 + Λ(ω)).
     #[inline]
-    pub fn g1(&self, w: Vec3) -> f32 {
+    pub(crate) fn g1(&self, w: Vec3) -> f32 {
         1.0 / (1.0 + self.lambda(w))
     }
 

@@ -49,7 +49,7 @@ impl SurfaceBsdf {
     /// copied the whole enum, 480 bytes by `memcpy`, for every variant: 2.6 % of a Cornell-box
     /// render's instructions.)
     #[inline(always)]
-    pub fn copy_to(&self, out: &mut Self) {
+    pub(crate) fn copy_to(&self, out: &mut Self) {
         match (self, &mut *out) {
             (SurfaceBsdf::Lambertian(b), SurfaceBsdf::Lambertian(o)) => *o = *b,
             (SurfaceBsdf::Wood(b), SurfaceBsdf::Wood(o)) => *o = *b,

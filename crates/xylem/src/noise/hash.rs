@@ -43,7 +43,7 @@ pub fn mix32(mut x: u32) -> u32 {
 /// Hash of an integer cell `(ix, iy, iz)` and a seed: [`pcg3d`] of the cell translated by a
 /// seed-dependent offset, so different seeds see unrelated hash values.
 #[inline(always)]
-pub fn cell3(ix: i32, iy: i32, iz: i32, seed: u32) -> [u32; 3] {
+pub(crate) fn cell3(ix: i32, iy: i32, iz: i32, seed: u32) -> [u32; 3] {
     cell3_offset(ix, iy, iz, &seed_offsets(seed))
 }
 
@@ -59,7 +59,7 @@ pub(crate) fn cell3_offset(ix: i32, iy: i32, iz: i32, s: &[u32; 3]) -> [u32; 3] 
 
 /// Three large pseudo-random lattice translations derived from a seed (see [`cell3`]).
 #[inline(always)]
-pub fn seed_offsets(seed: u32) -> [u32; 3] {
+pub(crate) fn seed_offsets(seed: u32) -> [u32; 3] {
     let a = mix32(seed ^ 0x9e37_79b9);
     [a, mix32(a ^ 0x85eb_ca6b), mix32(a ^ 0xc2b2_ae35)]
 }
@@ -97,7 +97,7 @@ pub(crate) fn signed_f32(h: u32) -> f32 {
 /// `x as i32` (truncation, saturating, NaN → 0) from an unchecked conversion and selects: the
 /// same values, but a loop over many x vectorises (a plain `as` compiles to scalar code there).
 #[inline(always)]
-pub fn saturating_i32(x: f32) -> i32 {
+pub(crate) fn saturating_i32(x: f32) -> i32 {
     const LIMIT: f32 = 2_147_483_648.0; // 2³¹
     let inside = x.abs() < LIMIT;
     // SAFETY: the argument is finite and below 2³¹ in magnitude.

@@ -168,7 +168,7 @@ impl Rgb8 {
 
     /// The image shrunk by the smallest whole factor that makes it at most `max_width` wide,
     /// averaging each factor × factor block in linear light (averaging sRGB codes would darken edges).
-    pub fn shrink_to_width(&self, max_width: u32) -> Rgb8 {
+    pub(crate) fn shrink_to_width(&self, max_width: u32) -> Rgb8 {
         let f = shrink_factor(self.width, max_width);
         if f == 1 {
             return self.clone();

@@ -209,7 +209,7 @@ fn stream_chunk() -> usize {
 
 /// [`write_apng`] of `count` frames of `width × height` made one chunk at a time by `frame(k)`
 /// (in parallel within a chunk), so a long sequence is never held whole.
-pub fn write_apng_streamed(
+pub(crate) fn write_apng_streamed(
     path: &Path,
     (width, height): (u32, u32),
     count: usize,

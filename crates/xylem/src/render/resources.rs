@@ -24,7 +24,7 @@ pub struct Resources {
 /// The remedy of an image's estimate: its size and, for a sweep, its length.
 const LOWER_RESOLUTION: &str = "lower the resolution or the frame count";
 /// The remedy of a geometry estimate: the triangles it builds.
-pub const LOWER_TRIANGLES: &str =
+pub(crate) const LOWER_TRIANGLES: &str =
     "use fewer triangles (a shape's `segments`, a lighter or decimated mesh)";
 
 /// Peak bytes per stored triangle while its BVH is built: the triangle copies, obvhs's BVH2 and

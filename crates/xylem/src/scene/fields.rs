@@ -247,7 +247,8 @@ pub(crate) const IRRADIANCE: Field = number(
     "on a surface facing the light",
 );
 /// `corner` of a rect light.
-pub(crate) const CORNER: Field = field("corner", Value::Point, FieldDefault::Required, "one corner");
+pub(crate) const CORNER: Field =
+    field("corner", Value::Point, FieldDefault::Required, "one corner");
 /// `edge_u` of a rect light.
 pub(crate) const EDGE_U: Field = field(
     "edge_u",
@@ -273,7 +274,8 @@ pub(crate) const RADIANCE: Field = number(
 /// `center` of a sphere light.
 pub(crate) const CENTER: Field = field("center", Value::Point, FieldDefault::Required, "");
 /// `radius` of a sphere light.
-pub(crate) const SPHERE_RADIUS: Field = number("radius", "mm", (1e-4, 1e9), FieldDefault::Required, "");
+pub(crate) const SPHERE_RADIUS: Field =
+    number("radius", "mm", (1e-4, 1e9), FieldDefault::Required, "");
 /// `radiance` of the environment.
 pub(crate) const ENV_RADIANCE: Field = number(
     "radiance",
@@ -346,7 +348,8 @@ pub const LIGHTS: [TypeFields; 6] = [
 const REFLECTANCE: Value = Value::Colour { max: 1.0 };
 
 /// `albedo` of a Lambertian material.
-pub(crate) const ALBEDO: Field = field("albedo", REFLECTANCE, FieldDefault::Required, "reflectance");
+pub(crate) const ALBEDO: Field =
+    field("albedo", REFLECTANCE, FieldDefault::Required, "reflectance");
 /// `diffuse` of a fibre material.
 pub(crate) const FIBER_DIFFUSE: Field = field(
     "diffuse",
@@ -376,7 +379,8 @@ pub(crate) const RAY_DIR: Field = field(
     "ray-cell direction (object space)",
 );
 /// `ray_mask` of a fibre material.
-pub(crate) const RAY_MASK: Field = bsdf_number("ray_mask", 0.0, "how much of the surface is ray cells");
+pub(crate) const RAY_MASK: Field =
+    bsdf_number("ray_mask", 0.0, "how much of the surface is ray cells");
 /// `highlight_width_deg` of a fibre material.
 pub(crate) const FIBER_WIDTH: Field = number(
     "highlight_width_deg",

@@ -51,7 +51,7 @@ const TUBES: [(Curve, Curve, [f32; 4]); 4] = [
 ];
 
 /// The 32 control-point patches.
-pub fn patches() -> Vec<Patch> {
+pub(crate) fn patches() -> Vec<Patch> {
     let mut out = Vec::with_capacity(32);
     for (profile, ccw) in REVOLVED {
         for quarter in 0..4 {

@@ -238,7 +238,7 @@ pub(crate) fn write_frames(
 /// What every frame of a sweep shares, for its EXR header: the moving light (its name and
 /// kind, the arc's pivot and radius), spp, seed, integrator and the camera (as
 /// [`RenderSettings::exr_meta`](crate::render::RenderSettings::exr_meta) words it).
-pub fn frame_header(loaded: &LoadedScene, path: &SweepPath, moving: usize) -> String {
+pub(crate) fn frame_header(loaded: &LoadedScene, path: &SweepPath, moving: usize) -> String {
     let light = loaded
         .light_names
         .get(moving)

@@ -32,7 +32,7 @@ pub(crate) const CLOUD_PARAMS: &[ParamSpec] = &[
     p("seed", 1.0, 0.0, 1e9, "noise seed"),
 ];
 
-pub struct Clouds {
+pub(crate) struct Clouds {
     scale: f32,
     warp: Warp,
     cover: f32,

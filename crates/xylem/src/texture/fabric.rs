@@ -32,7 +32,7 @@ pub(crate) const FABRIC_PARAMS: &[ParamSpec] = &[
 pub(crate) const WARP: Vec3 = Vec3::new(0.45, 0.06, 0.05);
 pub(crate) const WEFT: Vec3 = Vec3::new(0.7, 0.62, 0.45);
 
-pub struct Fabric {
+pub(crate) struct Fabric {
     thread: f32,
     fuzz: f32,
     seed: u32,

@@ -49,7 +49,7 @@ pub(crate) const MARBLE_PARAMS: &[ParamSpec] = &[
 ];
 
 /// Sine-band marble.
-pub struct Marble {
+pub(crate) struct Marble {
     scale: f32,
     frequency: f32,
     distortion: f32,

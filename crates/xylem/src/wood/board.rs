@@ -127,7 +127,7 @@ pub(crate) fn board_at(layout: &BoardLayout, uv: Vec2) -> BoardPoint {
 
 /// Where board `index` sits in the tree: the index is hashed into `region` (§7.2). Returns the
 /// tree-space point of board coordinates (along the grain, across it, depth below the face).
-pub fn board_to_tree(
+pub(crate) fn board_to_tree(
     index: [i32; 3],
     along: f32,
     across: f32,

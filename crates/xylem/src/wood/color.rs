@@ -34,7 +34,7 @@ impl BeerColor {
     /// Absorbance σℓ for ring value g, pore mask p, ray mask `ray` and extra path `extra`
     /// (latewood units, e.g. knot wood).
     #[inline(always)]
-    pub fn absorbance(&self, g: f32, pore: f32, ray: f32, extra: f32) -> Vec3 {
+    pub(crate) fn absorbance(&self, g: f32, pore: f32, ray: f32, extra: f32) -> Vec3 {
         let channel = |ch| self.channel_absorbance(ch, g, pore, ray, extra);
         Vec3::new(channel(0), channel(1), channel(2))
     }
@@ -42,7 +42,7 @@ impl BeerColor {
     /// (diffuse, fibre) colours of an absorbance; the fibre colour uses the absorbance scaled per
     /// channel by the fibre saturation (App. A.3; below 1: less saturated than the diffuse). Clamped to [0, 1] (a negative path may lighten).
     #[inline(always)]
-    pub fn colors(&self, absorbance: Vec3) -> (Vec3, Vec3) {
+    pub(crate) fn colors(&self, absorbance: Vec3) -> (Vec3, Vec3) {
         let (r, g, b) = (
             self.channel_colors(0, absorbance.x),
             self.channel_colors(1, absorbance.y),
@@ -53,7 +53,7 @@ impl BeerColor {
 
     /// The absorbance per unit ring value g, k = σℓ_g, of the diffuse and of the fibre colour
     /// (× the fibre saturation).
-    pub fn ring_scales(&self) -> [Vec3; 2] {
+    pub(crate) fn ring_scales(&self) -> [Vec3; 2] {
         [self.ring, self.ring * self.fiber_saturation]
     }
 

@@ -107,7 +107,7 @@ impl DistortionNoise {
 /// the kernel over its unit ball. With unit weights and on average `density` kernels overlapping
 /// a point (λ V = density), the mean of the summed mask is density × this (Campbell's theorem,
 /// notes/sweep.md "Footprint"). 512-point midpoint rule.
-pub fn bump_kernel_mean(sharpness: f32) -> f32 {
+pub(crate) fn bump_kernel_mean(sharpness: f32) -> f32 {
     let n = 512;
     let mut sum = 0.0f64;
     for i in 0..n {
@@ -314,7 +314,7 @@ impl Rays {
 /// oriented by the cylindrical frame at the query, scaled so that each angle has the standard
 /// deviation asked for (Campbell's theorem: variance = density · 1024/45045 · magnitude²).
 #[derive(Clone, Debug)]
-pub struct FibreWander {
+pub(crate) struct FibreWander {
     /// Per scale, tilt towards r̂ and towards θ̂ (None: that angle is zero at that scale).
     angles: Vec<[Option<SeededSparse>; 2]>,
     /// Per scale, the two angles' variances (rad²) and correlation lengths (mm, 1/e lag):
@@ -328,11 +328,11 @@ impl FibreWander {
     /// Variance of one band of signed-weight Wyvill sparse convolution noise of magnitude 1 per
     /// unit density: E[w²] · ∫K² dV / V = (1/3) · (4π · 1024/45045) / (4π/3) = 1024/45045
     /// (weights uniform in [−1, 1), ∫₀¹ r² (1 − r²)⁶ dr = 1024/45045; notes/wood.md §9a).
-    pub const VARIANCE_PER_DENSITY: f32 = 1024.0 / 45045.0;
+    pub(crate) const VARIANCE_PER_DENSITY: f32 = 1024.0 / 45045.0;
     /// Lag, in kernel semi-axes, at which that noise's autocorrelation along an axis falls to
     /// 1/e (numerical integration of the kernel's autocorrelation, notes/wood.md §9a; ½ at 0.549,
     /// 0 at 2).
-    pub const CORRELATION_LAG: f32 = 0.656;
+    pub(crate) const CORRELATION_LAG: f32 = 0.656;
 
     /// The wander of `p`; `seeds` gives each noise field its own (coarse r, coarse θ, fine r,
     /// fine θ).
@@ -384,7 +384,7 @@ impl FibreWander {
     /// the highlight instead of aliasing it (notes/wood.md §9e). An angle with C² below
     /// [`FibreWander::NEGLIGIBLE_SHARE`] is not evaluated.
     #[inline]
-    pub fn band_limited(
+    pub(crate) fn band_limited(
         &self,
         q: Vec3,
         fiber: &Frame,
@@ -432,7 +432,7 @@ impl FibreWander {
 
     /// The share C² of an angle's variance below which its estimate is left out (its standard
     /// deviation an eighth of the angle's).
-    pub const NEGLIGIBLE_SHARE: f32 = 1.0 / 64.0;
+    pub(crate) const NEGLIGIBLE_SHARE: f32 = 1.0 / 64.0;
 
     /// The narrowest footprint (mm) under which every angle of the wander falls below
     /// [`FibreWander::NEGLIGIBLE_SHARE`] and is no longer evaluated, for the scale `p`.

@@ -56,14 +56,14 @@ impl SmoothTriangleWave {
 
     /// Whether [`SmoothTriangleWave::eval_unchecked`] holds at `x`: |x| below 2²¹ periods.
     #[inline]
-    pub fn in_fast_range(&self, x: f32) -> bool {
+    pub(crate) fn in_fast_range(&self, x: f32) -> bool {
         x.abs() < 2_097_152.0 * self.period
     }
 
     /// [`SmoothTriangleWave::eval`] where [`SmoothTriangleWave::in_fast_range`] holds (same bits),
     /// without the remainder's fallback call: a loop over many points vectorises.
     #[inline]
-    pub fn eval_unchecked(&self, x: f32) -> (f32, f32) {
+    pub(crate) fn eval_unchecked(&self, x: f32) -> (f32, f32) {
         self.eval_with::<false>(x)
     }
 
@@ -232,7 +232,7 @@ impl SmoothRectangleWave {
     /// quintic transition's ∫ exp(−k P(y)) dy has none and comes from the table
     /// ([`RingExpTable`], built once per k). Below [`SmoothRectangleWave::min_box`] the point
     /// value exp(−k s(t)).
-    pub fn box_exp_mean(&self, lo: f32, hi: f32, table: &RingExpTable) -> Vec3 {
+    pub(crate) fn box_exp_mean(&self, lo: f32, hi: f32, table: &RingExpTable) -> Vec3 {
         let w = hi - lo;
         if !(w >= self.min_box()) {
             return (-table.k * self.normalized(0.5 * (lo + hi))).exp();

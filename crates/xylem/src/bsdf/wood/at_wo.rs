@@ -83,7 +83,13 @@ impl WoodAtWo<'_> {
 
     /// [`WoodAtWo::eval_pdf`] of every `wi[k]` into `f[k]`, `pdf[k]` (`f`, `pdf` as long as
     /// `wi`): [`WoodAtWo::eval_pdf_lanes`] on columns copied `BATCH` directions at a time.
-    pub fn eval_pdf_many(&self, wi: &[Vec3], with_pdf: bool, f: &mut [Vec3], pdf: &mut [f32]) {
+    pub(crate) fn eval_pdf_many(
+        &self,
+        wi: &[Vec3],
+        with_pdf: bool,
+        f: &mut [Vec3],
+        pdf: &mut [f32],
+    ) {
         assert!(f.len() == wi.len() && pdf.len() == wi.len());
         for ((wi, f), pdf) in wi
             .chunks(BATCH)
@@ -115,7 +121,7 @@ impl WoodAtWo<'_> {
     /// that the same values come out (tested) with the arithmetic in SIMD lanes. Under a rough
     /// finish every direction has its own spreads, and they are taken one at a time.
     #[inline(always)]
-    pub fn eval_pdf_lanes(
+    pub(crate) fn eval_pdf_lanes(
         &self,
         wi: [&[f32]; 3],
         with_pdf: bool,

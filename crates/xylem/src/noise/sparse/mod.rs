@@ -334,7 +334,7 @@ impl SeededSparse {
     /// features whose size varies with the point such as ring-porous pores (Liu et al. 2016
     /// §6.1.6). A scale of 1 gives exactly the unscaled noise.
     #[inline]
-    pub fn eval_oriented_with<const GRAD: bool>(
+    pub(crate) fn eval_oriented_with<const GRAD: bool>(
         &self,
         p: Vec3,
         frame: &Frame,
@@ -350,7 +350,7 @@ impl SeededSparse {
     /// scale: every band's query set-up (eq. 9–12) in SIMD lanes, the cell search point by
     /// point. The same values, bit for bit (tests).
     #[inline(always)]
-    pub fn eval_oriented_many<const N: usize>(
+    pub(crate) fn eval_oriented_many<const N: usize>(
         &self,
         p: &[Vec3; N],
         frames: &[Frame; N],

@@ -50,7 +50,7 @@ impl TriMesh {
     }
 
     /// Appends `other` (re-indexing its triangles); normals are kept only if both have them.
-    pub fn append(&mut self, other: &TriMesh) {
+    pub(crate) fn append(&mut self, other: &TriMesh) {
         let base = self.positions.len() as u32;
         let keep_normals =
             (self.normals.is_some() || self.positions.is_empty()) && other.normals.is_some();
