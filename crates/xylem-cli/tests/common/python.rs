@@ -24,22 +24,26 @@ pub fn run(cmd: &mut Command, what: &str, hint: &str) {
 }
 
 /// The virtual environment with the pinned test requirements, made once and reused while the
-/// requirements file is unchanged.
+/// requirements file is unchanged. Test threads and processes take turns through a lock file,
+/// and a venv without the stamp of the wanted requirements (new, changed, or left half-made by a
+/// killed run) is made afresh (`venv --clear`) before pip installs into it.
 pub fn venv() -> PathBuf {
     let venv = root().join("target/python-venv");
     let python = venv.join("bin/python");
-    if !python.exists() {
-        let base = std::env::var("XYLEM_PYTHON").unwrap_or_else(|_| "python3".into());
-        run(
-            Command::new(&base).args(["-m", "venv"]).arg(&venv),
-            "creating target/python-venv",
-            "Python 3.11+ with venv is needed (Debian: apt-get install python3 python3-venv; or set XYLEM_PYTHON)",
-        );
-    }
+    std::fs::create_dir_all(root().join("target")).expect("target/");
+    let lock = std::fs::File::create(root().join("target/python-venv.lock"))
+        .expect("target/python-venv.lock");
+    lock.lock().expect("locking target/python-venv.lock");
     let req = root().join("python/requirements-test.txt");
     let wanted = std::fs::read_to_string(&req).expect("python/requirements-test.txt");
     let stamp = venv.join("xylem-requirements.txt");
     if std::fs::read_to_string(&stamp).ok().as_deref() != Some(wanted.as_str()) {
+        let base = std::env::var("XYLEM_PYTHON").unwrap_or_else(|_| "python3".into());
+        run(
+            Command::new(&base).args(["-m", "venv", "--clear"]).arg(&venv),
+            "creating target/python-venv",
+            "Python 3.11+ with venv is needed (Debian: apt-get install python3 python3-venv; or set XYLEM_PYTHON)",
+        );
         run(
             Command::new(&python)
                 .args([
