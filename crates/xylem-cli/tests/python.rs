@@ -405,3 +405,96 @@ for name, call in [("render", lambda: xylem.render("sweep_board", spp=1024, res=
     );
     assert!(said.contains("render stopped") && said.contains("sweep stopped"));
 }
+
+/// The distribution as users get it: `maturin build` (pinned in python/requirements-test.txt,
+/// reusing this `cargo test --release`'s compiled engine through the shared target folder)
+/// makes the `xylem-wood` wheel — abi3, manylinux, stripped, carrying the sources, stubs and
+/// `py.typed` — and the wheel installed alone into an empty folder imports, reports the
+/// workspace's version and evaluates the BSDF as the Rust library does.
+#[test]
+fn wheel_builds_installs_and_imports() {
+    let venv = venv();
+    let dir = root().join("target/python-wheel");
+    let _ = std::fs::remove_dir_all(&dir);
+    let wheels = dir.join("wheels");
+    common::python::run(
+        Command::new(venv.join("bin/maturin"))
+            .args(["build", "--quiet", "--profile", "release", "-m"])
+            .arg(root().join("python/Cargo.toml"))
+            .arg("--target-dir")
+            .arg(root().join("target"))
+            .arg("--out")
+            .arg(&wheels),
+        "maturin build",
+        "maturin comes with python/requirements-test.txt",
+    );
+    let names: Vec<String> = std::fs::read_dir(&wheels)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    let version = env!("CARGO_PKG_VERSION");
+    let expected = format!("xylem_wood-{version}-cp38-abi3-manylinux_2_34_x86_64.whl");
+    assert_eq!(names, std::slice::from_ref(&expected), "the one wheel");
+    let wheel = wheels.join(&expected);
+    let site = dir.join("site");
+    common::python::run(
+        Command::new(venv.join("bin/python"))
+            .args([
+                "-m",
+                "pip",
+                "install",
+                "--quiet",
+                "--no-deps",
+                "--disable-pip-version-check",
+            ])
+            .arg("--target")
+            .arg(&site)
+            .arg(&wheel),
+        "pip install of the wheel",
+        "",
+    );
+    for f in [
+        "__init__.py",
+        "mitsuba.py",
+        "_xylem.pyi",
+        "py.typed",
+        "_xylem.abi3.so",
+    ] {
+        assert!(
+            site.join("xylem").join(f).exists(),
+            "the wheel lacks xylem/{f}"
+        );
+    }
+    // Stripped: no debug sections, and small (the module with debug info was 57.7 MB).
+    let so = site.join("xylem/_xylem.abi3.so");
+    let size = std::fs::metadata(&so).unwrap().len();
+    assert!(size < 20 << 20, "{} bytes", size);
+    let bytes = std::fs::read(&so).unwrap();
+    assert!(
+        !bytes.windows(12).any(|w| w == b".debug_info\0"),
+        "the module carries debug info"
+    );
+    let b = WoodBsdf::new(WoodBsdfParams::default()).unwrap();
+    let (wo, wi) = (
+        Vec3::new(0.3, 0.1, 0.9).normalize(),
+        Vec3::new(-0.4, 0.2, 0.8).normalize(),
+    );
+    let f = b.eval(wo, wi);
+    let script = format!(
+        "import sys; sys.path.insert(0, {site:?})\n\
+         import numpy as np, xylem\n\
+         assert xylem.__file__.startswith({site:?}), xylem.__file__\n\
+         assert xylem.__version__ == {version:?}, xylem.__version__\n\
+         f = xylem.WoodBsdf().eval(np.array({wo:?}), np.array({wi:?}))\n\
+         assert np.allclose(f, {f:?}, rtol=1e-6, atol=0), f\n",
+        site = site.display().to_string(),
+        wo = wo.to_array(),
+        wi = wi.to_array(),
+        f = f.to_array(),
+    );
+    common::python::run(
+        Command::new(venv.join("bin/python")).args(["-c", &script]),
+        "importing the installed wheel",
+        "",
+    );
+}
