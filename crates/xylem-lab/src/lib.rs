@@ -18,7 +18,8 @@
 //! - [`tradeoff`]: error and time of every quality knob (validation/TRADEOFF.md);
 //! - [`aliasing`]: aliasing energy and error at equal time with and without the footprint
 //!   filter (validation/ALIASING.md);
-//! - [`mod@bench`]: the tracing benchmark against obvhs's own traversal and Embree 3.
+//! - [`mod@bench`]: the tracing benchmark against obvhs's own traversal and Embree 3;
+//! - [`tables`]: the engine's generated BSDF tables, written by the binary `xylem-tables`.
 
 pub mod aliasing;
 pub mod appearance;
@@ -34,6 +35,7 @@ pub mod rough_finish;
 pub mod scene_template;
 pub mod scenes;
 pub mod sweep;
+pub mod tables;
 pub mod tradeoff;
 
 pub use report::update_report_section;

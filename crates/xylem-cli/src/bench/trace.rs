@@ -1,10 +1,11 @@
 //! `xylem bench trace`: BVH build time and closest-hit / any-hit rays per second per core on a
-//! ~1M-triangle mesh, for coherent (camera) and incoherent (random) rays.
+//! ~1M-triangle mesh, for coherent (camera) and incoherent (random) rays
+//! ([`xylem_lab::bench::trace`]).
 
-use anyhow::{bail, Context};
+use anyhow::Context;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use xylem_lab::bench::trace::{build_params, run_trace_benchmark, TraceFigures, BUILD_PRESETS};
+use xylem_lab::bench::trace::{run_presets, TraceFigures, TraceReport};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -23,56 +24,7 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    if !(1..=50_000_000).contains(&args.triangles) {
-        bail!("--triangles {}: allowed 1 to 50000000", args.triangles);
-    }
-    if !(1..=100_000_000).contains(&args.rays) {
-        bail!("--rays {}: allowed 1 to 100000000", args.rays);
-    }
-    let mut reports = Vec::new();
-    for name in args.build.split(',').map(str::trim) {
-        let Some(params) = build_params(name) else {
-            bail!(
-                "--build {name}: unknown preset (allowed: {})",
-                BUILD_PRESETS.join(", ")
-            );
-        };
-        let r = run_trace_benchmark(args.triangles, args.rays, params, name);
-        let row = |label: &str, f: &TraceFigures| {
-            println!(
-                "  {label:<10} {:>9} rays  closest-hit {:>7.2} Mrays/s  any-hit {:>7.2} Mrays/s  ({} hits)",
-                f.rays, f.closest_mrays_per_s, f.any_hit_mrays_per_s, f.closest_hits
-            )
-        };
-        println!(
-            "xylem wide BVH (obvhs BVH2 build `{name}`): {} triangles, build {:.3} s core / {:.3} s total (all cores); tracing on 1 core:",
-            r.triangles, r.build_core_s, r.build_total_s
-        );
-        row("coherent", &r.coherent);
-        row("incoherent", &r.incoherent);
-        println!(
-            "obvhs CWBVH traversal (same build preset, build {:.3} s core); tracing on 1 core:",
-            r.obvhs_cwbvh.build_core_s
-        );
-        row("coherent", &r.obvhs_cwbvh.coherent);
-        row("incoherent", &r.obvhs_cwbvh.incoherent);
-        match &r.embree {
-            Some(e) => {
-                println!(
-                    "Embree 3 (high-quality build {:.3} s, all cores); tracing on 1 core:",
-                    e.build_s
-                );
-                row("coherent", &e.coherent);
-                row("incoherent", &e.incoherent);
-                println!(
-                    "  xylem / Embree closest-hit: coherent {:.2}x, incoherent {:.2}x",
-                    e.closest_ratio_coherent, e.closest_ratio_incoherent
-                );
-            }
-            None => println!("  (Embree comparison: build with --features embree-anchor)"),
-        }
-        reports.push(r);
-    }
+    let reports = run_presets(args.triangles, args.rays, &args.build, print)?;
     if let Some(path) = &args.json {
         let text = serde_json::to_string_pretty(&reports)?;
         xylem::output::write_atomic(path, text.as_bytes())
@@ -80,4 +32,41 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         println!("wrote {}", path.display());
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// One preset's figures.
+fn print(r: &TraceReport) {
+    let row = |label: &str, f: &TraceFigures| {
+        println!(
+            "  {label:<10} {:>9} rays  closest-hit {:>7.2} Mrays/s  any-hit {:>7.2} Mrays/s  ({} hits)",
+            f.rays, f.closest_mrays_per_s, f.any_hit_mrays_per_s, f.closest_hits
+        )
+    };
+    println!(
+        "xylem wide BVH (obvhs BVH2 build `{}`): {} triangles, build {:.3} s core / {:.3} s total (all cores); tracing on 1 core:",
+        r.build_params, r.triangles, r.build_core_s, r.build_total_s
+    );
+    row("coherent", &r.coherent);
+    row("incoherent", &r.incoherent);
+    println!(
+        "obvhs CWBVH traversal (same build preset, build {:.3} s core); tracing on 1 core:",
+        r.obvhs_cwbvh.build_core_s
+    );
+    row("coherent", &r.obvhs_cwbvh.coherent);
+    row("incoherent", &r.obvhs_cwbvh.incoherent);
+    match &r.embree {
+        Some(e) => {
+            println!(
+                "Embree 3 (high-quality build {:.3} s, all cores); tracing on 1 core:",
+                e.build_s
+            );
+            row("coherent", &e.coherent);
+            row("incoherent", &e.incoherent);
+            println!(
+                "  xylem / Embree closest-hit: coherent {:.2}x, incoherent {:.2}x",
+                e.closest_ratio_coherent, e.closest_ratio_incoherent
+            );
+        }
+        None => println!("  (Embree comparison: build with --features embree-anchor)"),
+    }
 }

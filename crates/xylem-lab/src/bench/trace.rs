@@ -344,6 +344,46 @@ pub const BUILD_PRESETS: [&str; 6] = [
     "very_slow",
 ];
 
+/// An argument of [`run_presets`] out of range or an unknown preset, as `xylem bench trace`
+/// spells it.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct TraceArgError(pub String);
+
+/// [`run_trace_benchmark`] for each preset of the comma-separated `build` ([`BUILD_PRESETS`]),
+/// in order, each report handed to `each` as soon as it is measured; refuses `triangles` outside
+/// 1 to 50 000 000, `rays` outside 1 to 100 000 000 and (when reached) an unknown preset.
+pub fn run_presets(
+    triangles: usize,
+    rays: usize,
+    build: &str,
+    mut each: impl FnMut(&TraceReport),
+) -> Result<Vec<TraceReport>, TraceArgError> {
+    if !(1..=50_000_000).contains(&triangles) {
+        return Err(TraceArgError(format!(
+            "--triangles {triangles}: allowed 1 to 50000000"
+        )));
+    }
+    if !(1..=100_000_000).contains(&rays) {
+        return Err(TraceArgError(format!(
+            "--rays {rays}: allowed 1 to 100000000"
+        )));
+    }
+    let mut reports = Vec::new();
+    for name in build.split(',').map(str::trim) {
+        let Some(params) = build_params(name) else {
+            return Err(TraceArgError(format!(
+                "--build {name}: unknown preset (allowed: {})",
+                BUILD_PRESETS.join(", ")
+            )));
+        };
+        let r = run_trace_benchmark(triangles, rays, params, name);
+        each(&r);
+        reports.push(r);
+    }
+    Ok(reports)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

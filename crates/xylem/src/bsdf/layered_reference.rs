@@ -11,7 +11,7 @@
 //! shared, as the substrate being layered.
 //!
 //! It lives in the engine, not the lab, because the rough-finish and rough-transmission tables are
-//! generated from it (their ignored `regenerate_table` tests); the lab's rough-finish suite
+//! generated from it (by the lab's binary `xylem-tables`); the lab's rough-finish suite
 //! measures the analytic model against it (`xylem_lab::layered_reference`).
 
 use super::{FiberAxis, FiberNormalization};

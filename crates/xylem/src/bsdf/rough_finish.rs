@@ -9,11 +9,12 @@
 
 use super::fresnel::fresnel_dielectric;
 use super::ggx::Ggx;
+use super::layered_reference::{LayeredReference, Substrate};
 use super::rough_finish_table::{
     ALPHA_NODES, ETA_NODES, MULTIPLE_REFLECTANCE, MU_NODES, MU_WEIGHTS, SINGLE_REFLECTANCE,
 };
 use super::rough_transmission::{RoughTransmission, PER_NODE};
-use crate::math::INV_PI;
+use crate::math::{Pcg32, INV_PI};
 use glam::{Vec2, Vec3};
 
 /// μ node i is (i/(N−1))² (dense at grazing, where the albedos change fastest).
@@ -209,40 +210,109 @@ pub fn finish_nodes(alpha: f32, eta: f32) -> FinishNodes {
     }
 }
 
+/// η of every table node, in order.
+fn etas() -> Vec<f32> {
+    (0..ETA_NODES).map(eta_node).collect()
+}
+
+/// Visible-normal quadrature points per side for the tabulated R_ss.
+const QUAD_N: usize = 256;
+/// Microsurface walks per node for the tabulated R_ms.
+const WALKS: u32 = 30_000;
+
+/// R_ms(μ, α, η): the fraction of `WALKS` microsurface random walks (Heitz et al. 2016, as in
+/// [`super::layered_reference`]) from a view of cosine `mu` that leave upward after two or
+/// more events. Binomial standard error ≤ √(0.25/WALKS) ≈ 3·10⁻³, ≈ 10⁻³ where R_ms ≤ 0.03.
+fn multiple_scattering_reflectance(mu: f32, alpha: f32, eta: f32, seed: u64) -> f64 {
+    let mu = mu.clamp(MU_FLOOR, 1.0) as f64;
+    let walk = LayeredReference {
+        alpha: alpha as f64,
+        eta: eta as f64,
+        substrate: Substrate::Lambertian(0.0),
+    };
+    let d = glam::DVec3::new(-(1.0 - mu * mu).max(0.0).sqrt(), 0.0, -mu);
+    let mut rng = Pcg32::new(0x12, seed);
+    let up = (0..WALKS)
+        .filter(|_| matches!(walk.interface(d, true, &mut rng), Some((_, true, n)) if n >= 2))
+        .count();
+    up as f64 / WALKS as f64
+}
+
+/// The walk seed of node (μ_i, α_j, η_k): every node its own stream, the same in every run.
+fn node_seed(i: usize, j: usize, k: usize) -> u64 {
+    ((j * ETA_NODES + k) * MU_NODES + i) as u64
+}
+
+/// 4∫φᵢ(s) s³ ds for the hat functions φᵢ on the s = √μ nodes (3-point Gauss–Legendre per
+/// interval, exact for the quartic integrand): the weights of 2∫f(μ) μ dμ.
+fn mu_weights() -> Vec<f64> {
+    let n = MU_NODES;
+    let h = 1.0 / (n - 1) as f64;
+    let (x, w) = (
+        [-(0.6f64).sqrt(), 0.0, (0.6f64).sqrt()],
+        [5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0],
+    );
+    let mut out = vec![0.0; n];
+    for seg in 0..n - 1 {
+        for q in 0..3 {
+            let t = 0.5 * (x[q] + 1.0);
+            let s = (seg as f64 + t) * h;
+            let g = 4.0 * s * s * s * 0.5 * h * w[q];
+            out[seg] += g * (1.0 - t);
+            out[seg + 1] += g * t;
+        }
+    }
+    out
+}
+
+/// The values of rough_finish_table.rs, computed afresh (for its generator, the lab's
+/// `xylem-tables rough-finish`): slabs are indexed `[k][i]` (η, μ) per α row j.
+#[derive(Clone, Debug)]
+pub struct ReflectanceTable {
+    /// Weights of 2∫f(μ)μ dμ for f linear in √μ between the μ nodes (one per μ node).
+    pub mu_weights: Vec<f64>,
+    /// R_ss(μ_i, α_j, η_k) by quadrature over `QUAD_N`² visible normals: `[j][k][i]`.
+    pub single: Vec<Vec<Vec<f64>>>,
+    /// R_ms(μ_i, α_j, η_k) by `WALKS` microsurface walks seeded per node: `[j][k][i]`.
+    pub multiple: Vec<Vec<Vec<f64>>>,
+}
+
+/// [`ReflectanceTable`] of every node, α rows on all cores (each node seeded on its own, so
+/// the result does not depend on the number of threads).
+pub fn reflectance_table() -> ReflectanceTable {
+    use rayon::prelude::*;
+    type Slab = Vec<Vec<f64>>;
+    let rows: Vec<(Slab, Slab)> = (0..ALPHA_NODES)
+        .into_par_iter()
+        .map(|j| {
+            let mut r = vec![vec![0.0; MU_NODES]; ETA_NODES];
+            let mut m = vec![vec![0.0; MU_NODES]; ETA_NODES];
+            for i in 0..MU_NODES {
+                let ri = single_scattering_reflectance(mu_node(i), alpha_node(j), &etas(), QUAD_N);
+                for k in 0..ETA_NODES {
+                    r[k][i] = ri[k];
+                    m[k][i] = multiple_scattering_reflectance(
+                        mu_node(i),
+                        alpha_node(j),
+                        eta_node(k),
+                        node_seed(i, j, k),
+                    );
+                }
+            }
+            (r, m)
+        })
+        .collect();
+    let (single, multiple) = rows.into_iter().unzip();
+    ReflectanceTable {
+        mu_weights: mu_weights(),
+        single,
+        multiple,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bsdf::layered_reference::{LayeredReference, Substrate};
-    use crate::math::Pcg32;
-
-    fn etas() -> Vec<f32> {
-        (0..ETA_NODES).map(eta_node).collect()
-    }
-
-    const QUAD_N: usize = 256;
-    const WALKS: u32 = 30_000;
-
-    /// R_ms(μ, α, η): the fraction of `WALKS` microsurface random walks (Heitz et al. 2016, as in
-    /// `validate::layered_reference`) from a view of cosine `mu` that leave upward after two or
-    /// more events. Binomial standard error ≤ √(0.25/WALKS) ≈ 3·10⁻³, ≈ 10⁻³ where R_ms ≤ 0.03.
-    fn multiple_scattering_reflectance(mu: f32, alpha: f32, eta: f32, seed: u64) -> f64 {
-        let mu = mu.clamp(MU_FLOOR, 1.0) as f64;
-        let walk = LayeredReference {
-            alpha: alpha as f64,
-            eta: eta as f64,
-            substrate: Substrate::Lambertian(0.0),
-        };
-        let d = glam::DVec3::new(-(1.0 - mu * mu).max(0.0).sqrt(), 0.0, -mu);
-        let mut rng = Pcg32::new(0x12, seed);
-        let up = (0..WALKS)
-            .filter(|_| matches!(walk.interface(d, true, &mut rng), Some((_, true, n)) if n >= 2))
-            .count();
-        up as f64 / WALKS as f64
-    }
-
-    fn node_seed(i: usize, j: usize, k: usize) -> u64 {
-        ((j * ETA_NODES + k) * MU_NODES + i) as u64
-    }
 
     /// 12 random nodes: R_ss equals a fresh quadrature within 2·10⁻⁵ (the f32 rounding), R_ms a
     /// fresh walk of another seed within 5σ of their difference (σ from the binomial).
@@ -298,102 +368,5 @@ mod tests {
             (one - 1.0).abs() < 1e-5 && (mu - 2.0 / 3.0).abs() < 1e-3,
             "{one} {mu}"
         );
-    }
-
-    /// 4∫φᵢ(s) s³ ds for the hat functions φᵢ on the s = √μ nodes (3-point Gauss–Legendre per
-    /// interval, exact for the quartic integrand): the weights of 2∫f(μ) μ dμ.
-    fn mu_weights() -> Vec<f64> {
-        let n = MU_NODES;
-        let h = 1.0 / (n - 1) as f64;
-        let (x, w) = (
-            [-(0.6f64).sqrt(), 0.0, (0.6f64).sqrt()],
-            [5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0],
-        );
-        let mut out = vec![0.0; n];
-        for seg in 0..n - 1 {
-            for q in 0..3 {
-                let t = 0.5 * (x[q] + 1.0);
-                let s = (seg as f64 + t) * h;
-                let g = 4.0 * s * s * s * 0.5 * h * w[q];
-                out[seg] += g * (1.0 - t);
-                out[seg + 1] += g * t;
-            }
-        }
-        out
-    }
-
-    /// Writes crates/xylem/src/bsdf/rough_finish_table.rs:
-    /// `cargo test --release --lib rough_finish::tests::regenerate_table -- --ignored` (~15 min on the loaded 2-core VM).
-    #[test]
-    #[ignore]
-    fn regenerate_table() {
-        use rayon::prelude::*;
-        type Slab = Vec<Vec<f64>>;
-        let rows: Vec<(Slab, Slab)> = (0..ALPHA_NODES)
-            .into_par_iter()
-            .map(|j| {
-                let mut r = vec![vec![0.0; MU_NODES]; ETA_NODES];
-                let mut m = vec![vec![0.0; MU_NODES]; ETA_NODES];
-                for i in 0..MU_NODES {
-                    let ri =
-                        single_scattering_reflectance(mu_node(i), alpha_node(j), &etas(), QUAD_N);
-                    for k in 0..ETA_NODES {
-                        r[k][i] = ri[k];
-                        m[k][i] = multiple_scattering_reflectance(
-                            mu_node(i),
-                            alpha_node(j),
-                            eta_node(k),
-                            node_seed(i, j, k),
-                        );
-                    }
-                }
-                (r, m)
-            })
-            .collect();
-        let row = |v: &[f64]| {
-            let s: Vec<String> = v.iter().map(|x| format!("{x:.7}")).collect();
-            format!("[{}]", s.join(", "))
-        };
-        let mut s = String::from(
-            "//! Generated by `cargo test --release --lib rough_finish::tests::regenerate_table --\n\
-             //! --ignored`: R_ss by `single_scattering_reflectance` (256² visible normals per node),\n\
-             //! R_ms by 30 000 microsurface walks per node (seeded per node). μ_i = (i/(N−1))²,\n\
-             //! α_j = (j/(N−1))² (α_0 = 10⁻³), η_k = 1 + 3 (k/(N−1))². Do not edit.\n\n",
-        );
-        s += &format!(
-            "pub const MU_NODES: usize = {MU_NODES};\npub const ALPHA_NODES: usize = {ALPHA_NODES};\n\
-             pub(crate) const ETA_NODES: usize = {ETA_NODES};\n\n"
-        );
-        s += "/// Weights of 2∫f(μ)μ dμ for f linear in √μ between the nodes.\n#[rustfmt::skip]\n";
-        s += &format!(
-            "pub static MU_WEIGHTS: [f32; MU_NODES] = {};\n",
-            row(&mu_weights())
-        );
-        for (name, doc, pick) in [
-            (
-                "SINGLE_REFLECTANCE",
-                "R_ss(μ_i, α_j, η_k), single scattering",
-                0,
-            ),
-            ("MULTIPLE_REFLECTANCE", "R_ms(μ_i, α_j, η_k), orders ≥ 2", 1),
-        ] {
-            s += &format!(
-                "\n/// {doc}: [j][k][i].\n#[rustfmt::skip]\n\
-                 pub static {name}: [[[f32; MU_NODES]; ETA_NODES]; ALPHA_NODES] = [\n"
-            );
-            for (r, m) in &rows {
-                s += "    [\n";
-                for v in if pick == 0 { r } else { m } {
-                    s += &format!("        {},\n", row(v));
-                }
-                s += "    ],\n";
-            }
-            s += "];\n";
-        }
-        let path = concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/src/bsdf/rough_finish_table.rs"
-        );
-        std::fs::write(path, s).unwrap();
     }
 }

@@ -1,8 +1,14 @@
 //! Measuring the speed/accuracy trade (`xylem tradeoff`): render one frame of a scene with each
 //! setting of each knob the renderer and the wood model expose, time it, and measure its error
 //! against a high-quality reference (relative MSE and SSIM). The named `--quality` presets are
-//! chosen from these measurements (validation/TRADEOFF.md).
+//! chosen from these measurements (validation/TRADEOFF.md): the measures here, the study in
+//! [`study`], the report in [`report`].
 
+pub mod report;
+pub mod study;
+
+pub use self::report::write_report;
+pub use self::study::{check_options, run_study, StudyError, StudyOptions, StudyResult};
 use crate::bench::clock::CpuTimer;
 use serde::Serialize;
 use xylem::bsdf::FinishModel;
