@@ -6,32 +6,12 @@
 use xylem::math::{Pcg32, Vec3};
 #[path = "common/bare.rs"]
 mod bare;
+#[path = "common/supersample.rs"]
+mod supersample;
 
 use bare::rings_only;
+use supersample::{supersampled, COLOR};
 use xylem::wood::{preset, Footprint, Needs, WoodVolume};
-
-const COLOR: Needs = Needs {
-    color: true,
-    fibers: false,
-    bump: false,
-};
-
-/// The unfiltered colour averaged over a `w` × `w` square spanned by the unit vectors `u`, `v`
-/// around `c` (32 × 32 midpoints): the supersampled reference.
-fn supersampled(vol: &WoodVolume, c: Vec3, u: Vec3, v: Vec3, w: f32) -> Vec3 {
-    let n = 32;
-    let mut sum = Vec3::ZERO;
-    for i in 0..n {
-        for j in 0..n {
-            let (a, b) = (
-                ((i as f32 + 0.5) / n as f32 - 0.5) * w,
-                ((j as f32 + 0.5) / n as f32 - 0.5) * w,
-            );
-            sum += vol.eval(c + a * u + b * v, COLOR).diffuse;
-        }
-    }
-    sum / (n * n) as f32
-}
 
 /// Root-mean-square colour error of the filtered and of the point-sampled colour against the
 /// supersampled footprint, over random points, surface orientations and footprints of 0.3–4
@@ -61,7 +41,7 @@ fn errors(name: &str, seed: u64) -> (f64, f64) {
         let u = in_plane.normalize();
         let v = normal.cross(u);
         let w = ring * 0.3 * (4.0f32 / 0.3).powf(rng.next_f32());
-        let want = supersampled(&vol, c, u, v, w);
+        let want = supersampled(&vol, c, (u, v), w, 32);
         let fp = Footprint { width: w, normal };
         let filtered = vol.eval_footprint(c, COLOR, fp).diffuse;
         let point = vol.eval(c, COLOR).diffuse;

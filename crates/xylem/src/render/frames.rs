@@ -127,9 +127,9 @@ impl LightFrames {
     }
 
     /// Calls `f(k, hit)` for every frame k where `nearest_light(frame k's lights, ray, t_max)`
-    /// is `Some(hit)` (frames whose ray meets no light are skipped). When the ray surely misses
-    /// the moving light's box (or nothing moves), the answer is that of the fixed lights alone,
-    /// found once.
+    /// is `Some(hit)` (frames whose ray meets no light are skipped; the index is the light's
+    /// place in the frame's lights). When the ray surely misses the moving light's box (or
+    /// nothing moves), the answer is that of the fixed lights alone, found once.
     #[inline(always)]
     pub(crate) fn nearest_per_frame(
         &self,
@@ -142,8 +142,20 @@ impl LightFrames {
                 let inv = Vec3A::ONE / Vec3A::from(ray.d);
                 segment_misses_box(ray.o.into(), inv, f32::INFINITY, lo, hi)
             });
+        // An index among the fixed lights as one among the frame's lights.
+        let moving = self.moving;
+        let fixed_place = move |(i, hit): (usize, LightHit)| {
+            (
+                if moving.is_some_and(|m| i >= m) {
+                    i + 1
+                } else {
+                    i
+                },
+                hit,
+            )
+        };
         if misses {
-            if let Some(hit) = nearest_light(&self.fixed, ray, t_max) {
+            if let Some(hit) = nearest_light(&self.fixed, ray, t_max).map(fixed_place) {
                 for k in 0..self.frames.len() {
                     f(k, hit);
                 }
@@ -153,7 +165,7 @@ impl LightFrames {
             // `intersect_sphere` starts with) has the fixed lights' answer; only the others are
             // asked in full. The misses are found a block of frames at a time in SIMD lanes.
             const BLOCK: usize = 16;
-            let fixed = nearest_light(&self.fixed, ray, t_max);
+            let fixed = nearest_light(&self.fixed, ray, t_max).map(fixed_place);
             let [cx, cy, cz] = &s.centers;
             for start in (0..self.frames.len()).step_by(BLOCK) {
                 let n = BLOCK.min(self.frames.len() - start);

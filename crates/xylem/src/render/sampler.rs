@@ -48,12 +48,24 @@ impl PathNumbers {
     /// The point of role `role` (a small integer, unique per role) at vertex `depth`.
     #[inline]
     fn point(&self, depth: u32, role: u64) -> [f32; 4] {
+        self.point_at(depth, role, self.index)
+    }
+
+    /// [`PathNumbers::point`] at sequence index `index` (a split role's points sit at
+    /// consecutive indices, [`PathNumbers::light_split`]). The Sobol points take indices below
+    /// 2^16; each further block of 2^16 is scrambled on its own, as the samples' blocks are.
+    #[inline]
+    fn point_at(&self, depth: u32, role: u64, index: u32) -> [f32; 4] {
         let role = (u64::from(depth) << 33) | role;
-        let scramble = splitmix64(self.key ^ splitmix64(role));
+        let mut scramble = splitmix64(self.key ^ splitmix64(role));
         if depth < STRATIFIED_DEPTH {
-            return sobol_burley::sample_4d(self.index, 0, scramble as u32);
+            let block = index >> 16;
+            if block != 0 {
+                scramble = splitmix64(scramble ^ u64::from(block));
+            }
+            return sobol_burley::sample_4d(index & 0xFFFF, 0, scramble as u32);
         }
-        let a = splitmix64(scramble ^ u64::from(self.index));
+        let a = splitmix64(scramble ^ u64::from(index));
         let b = splitmix64(a);
         // The top 24 bits of each 32-bit half: uniform on [0, 1) in steps of 2^−24.
         let u = |x: u64| (x >> 40) as f32 * (1.0 / (1u64 << 24) as f32);
@@ -64,6 +76,16 @@ impl PathNumbers {
     #[inline]
     pub(crate) fn light(&self, depth: u32, light: usize) -> [f32; 2] {
         let p = self.point(depth, (light as u64) << 1);
+        [p[0], p[1]]
+    }
+
+    /// The two numbers of the `k`-th of `n` samples of light `light` at vertex `depth`: the
+    /// sequence's points n·i + k for pixel sample i, so a pixel's n · spp samples of the light
+    /// are one Owen-scrambled Sobol sequence (each sample's n a stratified block of it, the
+    /// whole a (0, m, 2)-net where n · spp = 2^m). With n = 1, [`PathNumbers::light`].
+    #[inline]
+    pub(crate) fn light_split(&self, depth: u32, light: usize, k: u32, n: u32) -> [f32; 2] {
+        let p = self.point_at(depth, (light as u64) << 1, self.index * n + k);
         [p[0], p[1]]
     }
 
@@ -219,5 +241,37 @@ mod tests {
         assert_ne!(a, pixel_sample(7, 4, 0));
         assert_ne!(a, pixel_sample(8, 3, 0));
         assert_ne!(pixel_sample(7, 3, 5), pixel_sample(7, 3, 5 + (1 << 16)));
+    }
+
+    /// A light's split samples (`light_split`): with n = 1 the unsplit numbers bit for bit; with
+    /// n = 4 a pixel's 4 × 16 samples fill every cell of an 8 × 8 grid, and each pixel sample's
+    /// 4 one cell of a 2 × 2 grid each. Control: 4 samples drawn as the unsplit numbers of
+    /// other lights (independent scrambles) fill the 8 × 8 grid in almost no pixel.
+    #[test]
+    fn split_light_numbers_are_one_stratified_sequence() {
+        let mut controls = 0;
+        for pixel in 0..50u64 {
+            let (mut seen, mut control) = ([false; 64], [false; 64]);
+            for s in 0..16u32 {
+                let n = PathNumbers::new(7, pixel, s);
+                assert_eq!(n.light_split(0, 2, 0, 1), n.light(0, 2));
+                assert_eq!(n.light_split(2, 2, 0, 1), n.light(2, 2));
+                let mut quads = [false; 4];
+                for k in 0..4 {
+                    let u = n.light_split(0, 2, k, 4);
+                    seen[cell(u[0], u[1], 8)] = true;
+                    quads[cell(u[0], u[1], 2)] = true;
+                    let c = n.light(0, 2 + 8 * k as usize);
+                    control[cell(c[0], c[1], 8)] = true;
+                }
+                assert!(quads.iter().all(|&q| q), "pixel {pixel}, sample {s}");
+            }
+            assert!(seen.iter().all(|&c| c), "pixel {pixel}");
+            controls += control.iter().all(|&c| c) as usize;
+        }
+        assert!(
+            controls <= 1,
+            "independent lights filled the grid in {controls} of 50 pixels"
+        );
     }
 }

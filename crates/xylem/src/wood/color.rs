@@ -57,6 +57,22 @@ impl BeerColor {
         [self.ring, self.ring * self.fiber_saturation]
     }
 
+    /// The absorbance of a full pore mask and of a full ray mask (mask 1), each for the diffuse
+    /// and the fibre colour: `[pore, ray]`, each `[diffuse, fibre]` (eq. 25's σℓ_p, σℓ_r; the
+    /// fibre's × the fibre saturation).
+    pub(crate) fn mask_scales(&self) -> [[Vec3; 2]; 2] {
+        let [p, r] = [self.pore_path, self.ray_path].map(|l| self.late * l);
+        [
+            [p, p * self.fiber_saturation],
+            [r, r * self.fiber_saturation],
+        ]
+    }
+
+    /// The fibre saturation per channel (App. A.3).
+    pub(crate) fn fiber_saturation(&self) -> Vec3 {
+        self.fiber_saturation
+    }
+
     /// (diffuse, fibre) colours averaged over a window of the ring wave: with the pore, ray and
     /// extra paths held, the absorbance is a₀ + k g (k of [`BeerColor::ring_scales`]), so Beer's
     /// law averages to exp(−a₀) · E[exp(−k g)], which `mean_exp(i)` gives for `ring_scales()[i]`.

@@ -46,6 +46,90 @@ where
     sum * (1.0 / RING_PIECES as f32)
 }
 
+/// Beer's law averaged over the pore and ray masks a footprint cannot resolve (notes/wood.md
+/// §3b): the colour is exp(−a − c_p m_p − c_r m_r) with the masks' fields independent of each
+/// other and of the rings at a given ring value, so its mean over the masks is exp(−a) times
+/// E[exp(−c_p m_p)] times E[exp(−c_r m_r)] ([`clamped_shot_noise_exp_means`]), not the colour
+/// of the mean masks (exp is convex: red oak's earlywood pores 7 % too dark in green).
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct MaskColorMeans {
+    /// Per colour (diffuse, fibre), E[exp(−c_p m_p)] as a cubic in the ring value s, the
+    /// coefficients of 1, s, s², s³: ring porosity scales the pores' overlap by
+    /// (1 − ρ s)³, the cubic interpolates the exact means at s = 0, ⅓, ⅔, 1 (Newton's forward
+    /// differences), so a footprint's mean over its ring values follows from the moments
+    /// E[s], E[s²], E[s³] as the mean mask does ([`Pores::mean_mask_over`]).
+    pore: [[Vec3; 4]; 2],
+    /// Per colour, E[exp(−c_r m_r)] (the rays do not depend on the ring value).
+    ray: [Vec3; 2],
+    /// Per colour, c_p and c_r: the absorbance of a full mask ([`BeerColor::mask_scales`]).
+    scales: [[Vec3; 2]; 2],
+}
+
+impl MaskColorMeans {
+    /// The means for `params`' pores and rays under `color`.
+    pub(crate) fn new(params: &WoodParams, color: &BeerColor) -> Self {
+        let scales = color.mask_scales();
+        let mut pore = [[Vec3::ONE, Vec3::ZERO, Vec3::ZERO, Vec3::ZERO]; 2];
+        if let Some(p) = &params.pores {
+            let at = |s: f32| {
+                let size = (1.0 - p.ring_porosity * s).clamp(0.0, 1.0);
+                let overlap = if size <= 1e-3 {
+                    0.0
+                } else {
+                    p.density * size.powi(3)
+                };
+                clamped_shot_noise_exp_means(p.sharpness, overlap, &scales[0])
+            };
+            let h: Vec<Vec<Vec3>> = [0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0].map(at).to_vec();
+            for (k, coeffs) in pore.iter_mut().enumerate() {
+                let (h0, h1, h2, h3) = (h[0][k], h[1][k], h[2][k], h[3][k]);
+                // Newton's forward form in x = 3 s: h0 + Δ₁x + Δ₂ x(x − 1)/2 + Δ₃ x(x − 1)(x − 2)/6.
+                let d1 = h1 - h0;
+                let d2 = h2 - 2.0 * h1 + h0;
+                let d3 = h3 - 3.0 * h2 + 3.0 * h1 - h0;
+                *coeffs = [
+                    h0,
+                    3.0 * (d1 - 0.5 * d2 + d3 / 3.0),
+                    9.0 * (0.5 * d2 - 0.5 * d3),
+                    27.0 * (d3 / 6.0),
+                ];
+            }
+        }
+        let mut ray = [Vec3::ONE; 2];
+        if let Some(r) = params.rays.as_ref().filter(|r| r.strength > 0.0) {
+            let c = scales[1].map(|c| c * r.strength);
+            let m = clamped_shot_noise_exp_means(r.sharpness, r.density, &c);
+            ray = [m[0], m[1]];
+        }
+        MaskColorMeans { pore, ray, scales }
+    }
+
+    /// The most a pore and a ray together can lower the diffuse absorbance (≥ 0 per channel):
+    /// a negative path (rays lighter than the fibres) lightens.
+    fn lightening(&self) -> Vec3 {
+        -(self.scales[0][0].min(Vec3::ZERO) + self.scales[1][0].min(Vec3::ZERO))
+    }
+
+    /// E[exp(−c_p m_p)] for colour `k` over ring values with moments (E[s], E[s²], E[s³]).
+    #[inline]
+    fn pore_mean(&self, k: usize, moments: Vec3) -> Vec3 {
+        let [a, b, c, d] = self.pore[k];
+        a + b * moments.x + c * moments.y + d * moments.z
+    }
+}
+
+/// A mask faded by the footprint: its weight w ([`footprint_weight`]) and its value at the point
+/// (the faded mask is w · point + (1 − w) · mean).
+#[derive(Clone, Copy, Debug)]
+struct Fade {
+    w: f32,
+    point: f32,
+}
+
+impl Fade {
+    const NONE: Fade = Fade { w: 1.0, point: 0.0 };
+}
+
 impl WoodVolume {
     /// [`WoodVolume::eval_filtered`] over a footprint whose surface normal may be known. The
     /// growth rings, their colour and the highlight width they drive are box-filtered in closed
@@ -80,14 +164,18 @@ impl WoodVolume {
                 n: Vec3::Z,
             }
         };
+        let (mut pore_fade, mut ray_fade) = (Fade::NONE, Fade::NONE);
         if want_pores {
-            self.pores_into(&mut texel, &c, &frame, needs, fp.width, g_point, moments);
+            pore_fade = self.pores_into(&mut texel, &c, &frame, needs, fp.width, g_point, moments);
         }
         if want_rays {
-            texel.ray_mask = self.ray_mask(q, fp);
+            let faded;
+            (faded, ray_fade) = self.ray_mask(q, fp);
+            texel.ray_mask = faded;
         }
         if needs.color {
-            self.colors_into(&mut texel, &c, ring_window, g, fp.width);
+            let fades = [pore_fade, ray_fade];
+            self.colors_into(&mut texel, &c, ring_window, moments, fp.width, fades);
         }
         if needs.fibers {
             self.fibers_into(&mut texel, &c, &frame, fp, g, g_point);
@@ -207,7 +295,7 @@ impl WoodVolume {
     }
 
     /// The pore mask of `texel` (and its bump where `needs` asks), faded to the mean over the
-    /// footprint's ring `moments` as the footprint outgrows the pores.
+    /// footprint's ring `moments` as the footprint outgrows the pores; returns the fade.
     #[allow(clippy::too_many_arguments)]
     fn pores_into(
         &self,
@@ -218,7 +306,7 @@ impl WoodVolume {
         footprint: f32,
         g_point: f32,
         moments: Vec3,
-    ) {
+    ) -> Fade {
         let q = c.dist.point;
         let pores = self.pores.as_ref().expect("checked");
         let w = footprint_weight(pores.diameter, footprint);
@@ -229,6 +317,7 @@ impl WoodVolume {
         } else {
             pores.mask::<false>(q, frame, g_point)
         };
+        let fade = Fade { w, point: mask };
         if w < 1.0 {
             // Linear filtering: the pore detail fades to its mean (which has no gradient).
             mask = w * mask + (1.0 - w) * pores.mean_mask_over(moments);
@@ -240,10 +329,12 @@ impl WoodVolume {
             texel.bump = -pores.depth * mask;
             texel.bump_grad = c.dist.gradient(grad * -pores.depth);
         }
+        fade
     }
 
-    /// The ray mask at `q`, faded to its mean as the footprint outgrows the trace the face cuts.
-    fn ray_mask(&self, q: Vec3, fp: Footprint) -> f32 {
+    /// The ray mask at `q`, faded to its mean as the footprint outgrows the trace the face cuts,
+    /// and the fade.
+    fn ray_mask(&self, q: Vec3, fp: Footprint) -> (f32, Fade) {
         let footprint = fp.width;
         let rays = self.rays.as_ref().expect("checked");
         // A ray is a sheet `width` thick with normal θ̂: a face with normal n cuts it in a
@@ -261,24 +352,30 @@ impl WoodVolume {
         };
         let w = footprint_weight(trace, footprint);
         if w >= 1.0 {
-            rays.mask(q)
+            let m = rays.mask(q);
+            (m, Fade { w, point: m })
         } else if w <= 0.0 {
-            rays.mean_mask
+            (rays.mean_mask, Fade { w, point: 0.0 })
         } else {
-            w * rays.mask(q) + (1.0 - w) * rays.mean_mask
+            let m = rays.mask(q);
+            (w * m + (1.0 - w) * rays.mean_mask, Fade { w, point: m })
         }
     }
 
-    /// The diffuse and fibre colours of `texel` (Beer's law over the ring value `g`, or over
-    /// the footprint's ring window in closed form), its pore and ray masks already set.
+    /// The diffuse and fibre colours of `texel` (Beer's law over the ring moments' value, or over
+    /// the footprint's ring window in closed form), its pore and ray masks already set. Where
+    /// the footprint fades the pores or rays (`fades`), the colour fades to the mean colour over
+    /// the masks ([`MaskColorMeans`]), not to the colour of the mean masks.
     fn colors_into(
         &self,
         texel: &mut WoodTexel,
         c: &Core,
         ring_window: Option<[f32; RING_PIECES + 1]>,
-        g: f32,
+        moments: Vec3,
         footprint: f32,
+        fades: [Fade; 2],
     ) {
+        let g = moments.x;
         let q = c.dist.point;
         let mut extra = match (&c.knot, &self.knots) {
             (Some(k), Some(kn)) => kn.darkening * (k.inside + 3.0 * k.bark),
@@ -289,6 +386,12 @@ impl WoodVolume {
         }
         if let Some(t) = &self.texture {
             extra += t.path(q, footprint);
+        }
+        if fades.iter().any(|f| f.w < 1.0) {
+            if let Some(colors) = self.faded_colors(ring_window, moments, extra, fades) {
+                (texel.diffuse, texel.fiber_color) = colors;
+                return;
+            }
         }
         let filtered = ring_window.and_then(|ends| {
             self.color
@@ -305,5 +408,57 @@ impl WoodVolume {
         });
         texel.diffuse = diffuse;
         texel.fiber_color = fiber;
+    }
+
+    /// (diffuse, fibre) colours with the pores and rays faded as `fades` says: per colour,
+    /// exp(−a) · F_p · F_r with F = w · exp(−c · point) + (1 − w) · E[exp(−c m)] for each mask
+    /// (the linear fade of the colour, whose w = 0 end is the footprint's mean colour), a the
+    /// absorbance of the rings and `extra`. Over a ring window the pores' mean goes with each
+    /// piece's ring values (exp(−k s) and the pores' size both follow s): the mean over the
+    /// pieces of E[exp(−k s)] · E[F_p] per piece, exact where a piece lies on a plateau.
+    /// `None` where the clamp at zero absorbance could act (a negative pore or ray path where
+    /// the wood is light): Beer's law is then not the product of the masks' factors.
+    fn faded_colors(
+        &self,
+        ring_window: Option<[f32; RING_PIECES + 1]>,
+        moments: Vec3,
+        extra: f32,
+        [pore, ray]: [Fade; 2],
+    ) -> Option<(Vec3, Vec3)> {
+        let means = &self.mask_means;
+        let mut out = [Vec3::ZERO; 2];
+        let a0 = self.color.absorbance(0.0, 0.0, 0.0, extra);
+        let ring = self.color.ring_scales();
+        let least = a0 - means.lightening();
+        if least.min_element() < 0.0 || (least + ring[0]).min_element() < 0.0 {
+            return None;
+        }
+        let saturation = [Vec3::ONE, self.color.fiber_saturation()];
+        for (k, out) in out.iter_mut().enumerate() {
+            let [c_p, c_r] = [means.scales[0][k], means.scales[1][k]];
+            let f_r = ray.w * (-c_r * ray.point).exp() + (1.0 - ray.w) * means.ray[k];
+            let point = (-c_p * pore.point).exp();
+            let rings_and_pores = match ring_window {
+                Some(ends) => {
+                    let table = &self.ring_tables[k];
+                    let (mut at_point, mut mean) = (Vec3::ZERO, Vec3::ZERO);
+                    for w in ends.windows(2) {
+                        let e = self.rings.box_exp_mean(w[0], w[1], table);
+                        at_point += e;
+                        if pore.w < 1.0 {
+                            mean += e * means.pore_mean(k, self.rings.box_moments(w[0], w[1]));
+                        }
+                    }
+                    let n = 1.0 / RING_PIECES as f32;
+                    pore.w * point * at_point * n + (1.0 - pore.w) * mean * n
+                }
+                None => {
+                    let e = (-ring[k] * moments.x).exp();
+                    e * (pore.w * point + (1.0 - pore.w) * means.pore_mean(k, moments))
+                }
+            };
+            *out = (-a0 * saturation[k]).exp() * f_r * rings_and_pores;
+        }
+        Some((out[0], out[1]))
     }
 }

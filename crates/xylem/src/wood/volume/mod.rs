@@ -5,7 +5,8 @@ use super::color::BeerColor;
 use super::error::WoodError;
 use super::eyes::Eyes;
 use super::features::{
-    footprint_weight, sub_seed, CellTexture, DistortionNoise, FibreWander, Noise1, Pores, Rays,
+    clamped_shot_noise_exp_means, footprint_weight, sub_seed, CellTexture, DistortionNoise,
+    FibreWander, Noise1, Pores, Rays,
 };
 use super::growth::{RingExpTable, SmoothRectangleWave, SmoothTriangleWave};
 use super::knots::{KnotSample, Knots};
@@ -56,6 +57,8 @@ pub struct WoodVolume {
     /// Beer's law over the ring wave for the diffuse and the fibre colour (footprint filter).
     ring_tables: Arc<[RingExpTable; 2]>,
     color: BeerColor,
+    /// Beer's law averaged over the pore and ray masks (footprint filter).
+    mask_means: MaskColorMeans,
     pores: Option<Pores>,
     rays: Option<Rays>,
     knots: Option<Knots>,
@@ -72,6 +75,7 @@ mod batch;
 mod footprint;
 
 pub use footprint::Footprint;
+use footprint::MaskColorMeans;
 
 /// Salts of the independent noise fields, so each feature has its own seed.
 mod salt {
@@ -158,6 +162,7 @@ impl WoodVolume {
                     .map(|k| rings.exp_table(k)),
             ),
             color: BeerColor::new(&p.color),
+            mask_means: MaskColorMeans::new(p, &BeerColor::new(&p.color)),
             pores,
             rays,
             knots,
