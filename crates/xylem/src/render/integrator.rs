@@ -21,7 +21,7 @@ use super::shading::{offset_origin, ShadingPoint};
 use super::shadow::{shadow_t_max, Segments, ShadowTest};
 use super::Scene;
 use crate::bsdf::Bsdf;
-use crate::material::{MaterialHit, SurfaceAtWo};
+use crate::material::{MaterialHit, SurfaceAtWo, SurfaceBsdf};
 use crate::math::{is_zero, power_heuristic, Frame};
 use glam::{Mat3, UVec2, Vec2, Vec3};
 
@@ -290,18 +290,26 @@ pub(crate) fn light_term(
     weighted_term(f, ls.li, wi.z, ls.pdf, bsdf_pdf, ls.is_delta)
 }
 
-/// How many next-event samples light `light` takes at vertex `depth`: its
-/// [`Light::nee_samples`] at the camera's first hit, where the wood's shading costs most and
-/// its direct lighting is seen directly, and one at later vertices, where splitting would cost
-/// a path tracer's every bounce (the Cornell box, Lambertian, 8 bounces: +67 % CPU split at
-/// every vertex).
+/// How many next-event samples light `light` takes at vertex `depth` of surface kind
+/// `on_wood`: its [`Light::nee_samples`] at the camera's first hit on wood, whose glossy fibre
+/// highlight and finish reflection one light sample resolves poorly (parquet floor, teapot:
+/// 2.3–2.7× less high-frequency noise, notes/render.md), and one elsewhere. At later vertices
+/// splitting would cost a path tracer's every bounce (the Cornell box, 8 bounces: +67 % CPU),
+/// and on Lambertian surfaces it bought nothing (Cornell box split at the first hit: relative
+/// MSE 0.998× for +27 % CPU).
 #[inline]
-fn splits_at(light: &Light, depth: u32) -> u32 {
-    if depth == 0 {
+fn splits_at(light: &Light, depth: u32, on_wood: bool) -> u32 {
+    if depth == 0 && on_wood {
         light.nee_samples()
     } else {
         1
     }
+}
+
+/// Whether `sp` is wood, where the first hit's rect-light samples are split ([`splits_at`]).
+#[inline(always)]
+fn on_wood(sp: &ShadingPoint) -> bool {
+    matches!(sp.bsdf, SurfaceBsdf::Wood(_))
 }
 
 /// The numbers of the `k`-th of `n` next-event samples of light `j` at vertex `depth`
@@ -330,7 +338,7 @@ fn split_light_term(
     (numbers, depth, j): (&PathNumbers, u32, usize),
     rays: &mut RayCount,
 ) -> Vec3 {
-    let n = splits_at(light, depth);
+    let n = splits_at(light, depth, on_wood(sp));
     let sample = |k| {
         let u = Vec2::from(split_numbers(numbers, depth, j, k, n));
         let ls = light.sample(sp.p, u);
@@ -519,6 +527,8 @@ struct PathState {
     eta_scale: f32,
     prev_pdf: f32,
     specular: bool,
+    /// Whether the vertex the ray left is wood ([`splits_at`]).
+    prev_wood: bool,
     ray: Ray,
     t_hit: f32,
 }
@@ -545,6 +555,7 @@ impl PathState {
         self.eta_scale *= bs.eta * bs.eta;
         self.specular = bs.is_delta;
         self.prev_pdf = bs.pdf;
+        self.prev_wood = on_wood(sp);
         if depth >= 3 {
             let q = survival(self.beta, self.eta_scale);
             if u_roulette >= q {
@@ -579,8 +590,8 @@ impl PathState {
             if alive[k] && (hit.distance < self.t_hit || !hit_surface) {
                 // Against the light's n next-event samples, as `split_light_term` weighs them.
                 // The ray left the vertex before this one (depth − 1; the camera ray,
-                // depth 0, is `specular`).
-                let splits = splits_at(&lights.first()[i], depth.saturating_sub(1));
+                // depth 0, is `specular`), on wood or not (`prev_wood`).
+                let splits = splits_at(&lights.first()[i], depth.saturating_sub(1), self.prev_wood);
                 let w = if self.specular {
                     1.0
                 } else if splits == 1 {
@@ -694,6 +705,7 @@ pub(crate) fn radiance_frames<const ONE: bool>(
         eta_scale: 1.0,
         prev_pdf: 0.0,
         specular: true,
+        prev_wood: false,
         ray: ps.ray,
         t_hit: ps.t_hit,
     };
@@ -803,7 +815,7 @@ fn next_event_frames<const ONE: bool>(
     };
     // The moving light's split samples as `split_light_term` takes them, in every frame:
     // the k-th sample's terms into `split_terms`, added to the first's in the same order.
-    let splits = splits_at(&lights.first()[m], depth);
+    let splits = splits_at(&lights.first()[m], depth, on_wood(sp));
     resize_columns(moving_terms, n);
     for k in 0..splits {
         let u = LightU::new(Vec2::from(split_numbers(numbers, depth, m, k, splits)));
