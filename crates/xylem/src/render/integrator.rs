@@ -290,26 +290,32 @@ pub(crate) fn light_term(
     weighted_term(f, ls.li, wi.z, ls.pdf, bsdf_pdf, ls.is_delta)
 }
 
-/// How many next-event samples light `light` takes at vertex `depth` of surface kind
-/// `on_wood`: its [`Light::nee_samples`] at the camera's first hit on wood, whose glossy fibre
-/// highlight and finish reflection one light sample resolves poorly (parquet floor, teapot:
-/// 2.3–2.7× less high-frequency noise, notes/render.md), and one elsewhere. At later vertices
-/// splitting would cost a path tracer's every bounce (the Cornell box, 8 bounces: +67 % CPU),
-/// and on Lambertian surfaces it bought nothing (Cornell box split at the first hit: relative
-/// MSE 0.998× for +27 % CPU).
+/// How many next-event samples light `light` takes at vertex `depth`, `glossy` saying whether
+/// the vertex is glossy wood ([`glossy_wood`]): its [`Light::nee_samples`] at the camera's first
+/// hit on glossy wood, whose sharp finish reflection and fibre highlight one light sample
+/// resolves poorly (parquet floor, roughness 0.08, and teapot, 0.05: 2.3–2.7× less
+/// high-frequency noise, notes/render.md), and one elsewhere. At later vertices splitting would
+/// cost a path tracer's every bounce (the Cornell box, 8 bounces: +67 % CPU); on Lambertian
+/// surfaces (the Cornell box: relative MSE 0.998× for +27 % CPU) and satin wood
+/// (cornell_wood_marble, roughness 0.5: 0.989× for +12 %) it bought nothing.
 #[inline]
-fn splits_at(light: &Light, depth: u32, on_wood: bool) -> u32 {
-    if depth == 0 && on_wood {
+fn splits_at(light: &Light, depth: u32, glossy: bool) -> u32 {
+    if depth == 0 && glossy {
         light.nee_samples()
     } else {
         1
     }
 }
 
-/// Whether `sp` is wood, where the first hit's rect-light samples are split ([`splits_at`]).
+/// Finish roughness below which wood counts as glossy for [`splits_at`]: between the measured
+/// scenes that gained (≤ 0.08) and the one that did not (0.5).
+const GLOSSY_ROUGHNESS: f32 = 0.25;
+
+/// Whether `sp` is wood under a glossy finish (roughness below [`GLOSSY_ROUGHNESS`]), where
+/// the first hit's rect-light samples are split ([`splits_at`]).
 #[inline(always)]
-fn on_wood(sp: &ShadingPoint) -> bool {
-    matches!(sp.bsdf, SurfaceBsdf::Wood(_))
+fn glossy_wood(sp: &ShadingPoint) -> bool {
+    matches!(&sp.bsdf, SurfaceBsdf::Wood(b) if b.params().roughness < GLOSSY_ROUGHNESS)
 }
 
 /// The numbers of the `k`-th of `n` next-event samples of light `j` at vertex `depth`
@@ -338,7 +344,7 @@ fn split_light_term(
     (numbers, depth, j): (&PathNumbers, u32, usize),
     rays: &mut RayCount,
 ) -> Vec3 {
-    let n = splits_at(light, depth, on_wood(sp));
+    let n = splits_at(light, depth, glossy_wood(sp));
     let sample = |k| {
         let u = Vec2::from(split_numbers(numbers, depth, j, k, n));
         let ls = light.sample(sp.p, u);
@@ -527,8 +533,8 @@ struct PathState {
     eta_scale: f32,
     prev_pdf: f32,
     specular: bool,
-    /// Whether the vertex the ray left is wood ([`splits_at`]).
-    prev_wood: bool,
+    /// Whether the vertex the ray left is glossy wood ([`splits_at`]).
+    prev_glossy: bool,
     ray: Ray,
     t_hit: f32,
 }
@@ -555,7 +561,7 @@ impl PathState {
         self.eta_scale *= bs.eta * bs.eta;
         self.specular = bs.is_delta;
         self.prev_pdf = bs.pdf;
-        self.prev_wood = on_wood(sp);
+        self.prev_glossy = glossy_wood(sp);
         if depth >= 3 {
             let q = survival(self.beta, self.eta_scale);
             if u_roulette >= q {
@@ -590,8 +596,12 @@ impl PathState {
             if alive[k] && (hit.distance < self.t_hit || !hit_surface) {
                 // Against the light's n next-event samples, as `split_light_term` weighs them.
                 // The ray left the vertex before this one (depth − 1; the camera ray,
-                // depth 0, is `specular`), on wood or not (`prev_wood`).
-                let splits = splits_at(&lights.first()[i], depth.saturating_sub(1), self.prev_wood);
+                // depth 0, is `specular`), glossy wood or not (`prev_glossy`).
+                let splits = splits_at(
+                    &lights.first()[i],
+                    depth.saturating_sub(1),
+                    self.prev_glossy,
+                );
                 let w = if self.specular {
                     1.0
                 } else if splits == 1 {
@@ -705,7 +715,7 @@ pub(crate) fn radiance_frames<const ONE: bool>(
         eta_scale: 1.0,
         prev_pdf: 0.0,
         specular: true,
-        prev_wood: false,
+        prev_glossy: false,
         ray: ps.ray,
         t_hit: ps.t_hit,
     };
@@ -815,7 +825,7 @@ fn next_event_frames<const ONE: bool>(
     };
     // The moving light's split samples as `split_light_term` takes them, in every frame:
     // the k-th sample's terms into `split_terms`, added to the first's in the same order.
-    let splits = splits_at(&lights.first()[m], depth, on_wood(sp));
+    let splits = splits_at(&lights.first()[m], depth, glossy_wood(sp));
     resize_columns(moving_terms, n);
     for k in 0..splits {
         let u = LightU::new(Vec2::from(split_numbers(numbers, depth, m, k, splits)));
