@@ -318,17 +318,6 @@ fn glossy_wood(sp: &ShadingPoint) -> bool {
     matches!(&sp.bsdf, SurfaceBsdf::Wood(b) if b.params().roughness < GLOSSY_ROUGHNESS)
 }
 
-/// The numbers of the `k`-th of `n` next-event samples of light `j` at vertex `depth`
-/// ([`PathNumbers::light`] when the light takes one).
-#[inline]
-fn split_numbers(numbers: &PathNumbers, depth: u32, j: usize, k: u32, n: u32) -> [f32; 2] {
-    if n == 1 {
-        numbers.light(depth, j)
-    } else {
-        numbers.light_split(depth, j, k, n)
-    }
-}
-
 /// The next-event term of light `light` (index `j` among the lights) at `sp`: the sum of
 /// [`light_term`] over its n = [`splits_at`] samples, each sample's density taken × n.
 /// That is Veach's multi-sample MIS with n light samples and one BSDF sample (Veach 1997
@@ -341,21 +330,17 @@ fn split_light_term(
     sp: &ShadingPoint,
     bsdf: &SurfaceAtWo,
     light: &Light,
-    (numbers, depth, j): (&PathNumbers, u32, usize),
+    (numbers, depth, j, glossy): (&PathNumbers, u32, usize, bool),
     rays: &mut RayCount,
 ) -> Vec3 {
-    let n = splits_at(light, depth, glossy_wood(sp));
+    let n = splits_at(light, depth, glossy);
+    // × n is exact for n = 1, and `light_split` with n = 1 is `light`: one sample unchanged.
     let sample = |k| {
-        let u = Vec2::from(split_numbers(numbers, depth, j, k, n));
-        let ls = light.sample(sp.p, u);
-        if n == 1 {
+        let u = Vec2::from(numbers.light_split(depth, j, k, n));
+        light.sample(sp.p, u).map(|mut ls| {
+            ls.pdf *= n as f32;
             ls
-        } else {
-            ls.map(|mut ls| {
-                ls.pdf *= n as f32;
-                ls
-            })
-        }
+        })
     };
     let mut sum = light_term(shadow, sp, bsdf, sample(0), rays);
     for k in 1..n {
@@ -604,8 +589,6 @@ impl PathState {
                 );
                 let w = if self.specular {
                     1.0
-                } else if splits == 1 {
-                    power_heuristic(self.prev_pdf, hit.pdf)
                 } else {
                     power_heuristic(self.prev_pdf, splits as f32 * hit.pdf)
                 };
@@ -806,13 +789,14 @@ fn next_event_frames<const ONE: bool>(
         term_scratch,
     } = scratch;
     let bsdf = sp.bsdf.at_wo(sp.wo);
+    let glossy = glossy_wood(sp);
     let moving = lights.moving_index();
     terms.clear();
     for (j, light) in lights.first().iter().enumerate() {
         terms.push(if Some(j) == moving {
             Vec3::ZERO
         } else {
-            split_light_term(shadow, sp, &bsdf, light, (numbers, depth, j), rays)
+            split_light_term(shadow, sp, &bsdf, light, (numbers, depth, j, glossy), rays)
         });
     }
     resize_columns(nee, n);
@@ -825,10 +809,10 @@ fn next_event_frames<const ONE: bool>(
     };
     // The moving light's split samples as `split_light_term` takes them, in every frame:
     // the k-th sample's terms into `split_terms`, added to the first's in the same order.
-    let splits = splits_at(&lights.first()[m], depth, glossy_wood(sp));
+    let splits = splits_at(&lights.first()[m], depth, glossy);
     resize_columns(moving_terms, n);
     for k in 0..splits {
-        let u = LightU::new(Vec2::from(split_numbers(numbers, depth, m, k, splits)));
+        let u = LightU::new(Vec2::from(numbers.light_split(depth, m, k, splits)));
         match lights.sphere() {
             Some(s) => samples.sample_sphere(sp.p, &s.centers, s.radius, s.radiance, &u),
             None => samples.sample_each(sp.p, lights.moving_places(m), &u),

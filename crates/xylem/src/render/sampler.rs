@@ -72,8 +72,10 @@ impl PathNumbers {
         [u(a), u(a << 32), u(b), u(b << 32)]
     }
 
-    /// The two numbers that sample light `light` for next-event estimation at vertex `depth`.
-    #[inline]
+    /// The two numbers that sample light `light` once at vertex `depth` (the renderer takes
+    /// them through [`PathNumbers::light_split`], which gives these with n = 1; the tests
+    /// compare against this form).
+    #[cfg(test)]
     pub(crate) fn light(&self, depth: u32, light: usize) -> [f32; 2] {
         let p = self.point(depth, (light as u64) << 1);
         [p[0], p[1]]

@@ -22,7 +22,8 @@ use super::geometry::Ray;
 use crate::math::PI;
 use glam::{Vec2, Vec3};
 
-/// Next-event samples of a rect light at the camera's first hit ([`Light::nee_samples`]).
+/// Next-event samples of a rect light at the camera's first hit on glossy wood
+/// ([`Light::nee_samples`]).
 pub const RECT_LIGHT_SAMPLES: u32 = 4;
 
 /// One light of the scene. Each kind is a struct of its own, and every `match` on lights names
@@ -69,7 +70,7 @@ impl Light {
     }
 
     /// How many samples next-event estimation takes of this light at the camera's first hit
-    /// (one at later vertices, `integrator::splits_at`): 4 for a rect light, 1 for every other
+    /// on glossy wood (one elsewhere, `integrator::splits_at`): 4 for a rect light, 1 for every other
     /// kind. Splitting a light's samples (pbrt-v3's per-light
     /// `nSamples` in `UniformSampleAllLights`, Pharr, Jakob, Humphreys 2016 §14.3.1; Mitsuba 3's
     /// `emitter_samples`) is unbiased. A large area light near glossy wood dominated the
