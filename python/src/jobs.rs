@@ -83,17 +83,18 @@ pub(crate) fn interruptible<T: Send>(
     })
 }
 
-/// `render(scene, spp=None, res=None, seed=None, threads=0, quality=None, footprint_filter=None)`:
+/// `render(scene, spp=None, res=None, seed=None, threads=0, quality=None, footprint_filter=None,
+/// sampling=None)`:
 /// renders a scene (a file path, a built-in scene name, a dict as `load_dict` takes, or a
 /// `Scene`) as `xylem render` does — `quality` is `--quality` (`draft`, `default`, `final`: spp
-/// and wood-model knobs, validation/TRADEOFF.md), `spp` and `footprint_filter` override it —
-/// and returns a dict of (H, W[, 3]) float32 arrays, top row first: `beauty`
+/// and wood-model knobs, validation/TRADEOFF.md), `spp` and `footprint_filter` override it;
+/// `sampling` is `--sampling` (`adaptive`, the default, or `uniform`) — and returns a dict of (H, W[, 3]) float32 arrays, top row first: `beauty`
 /// (linear RGB), `std_error` (of each pixel's luminance), and the first-hit AOVs `albedo`,
 /// `normal`, `depth`, `fiber`, `ray_mask`, `growth_time`; plus `nonfinite` (samples dropped) and
 /// `seconds`. The GIL is released while rendering; Ctrl-C stops it within a tile and raises
 /// KeyboardInterrupt.
 #[pyfunction]
-#[pyo3(signature = (scene, spp=None, res=None, seed=None, threads=0, quality=None, footprint_filter=None))]
+#[pyo3(signature = (scene, spp=None, res=None, seed=None, threads=0, quality=None, footprint_filter=None, sampling=None))]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn render<'py>(
     py: Python<'py>,
@@ -104,14 +105,19 @@ pub(crate) fn render<'py>(
     threads: usize,
     quality: Option<&str>,
     footprint_filter: Option<bool>,
+    sampling: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
     check_threads(threads)?;
+    let sampling = sampling
+        .map(|s| s.parse().map_err(|e| value_error(format!("sampling: {e}"))))
+        .transpose()?;
     let o = Overrides {
         quality: parse_quality(quality)?,
         spp,
         res,
         seed,
         footprint_filter,
+        sampling,
     };
     let out = with_scene(py, scene, &o, |loaded| {
         interruptible(py, |stop| {
@@ -170,6 +176,7 @@ pub(crate) fn sweep<'py>(
         res,
         seed,
         footprint_filter,
+        sampling: None,
     };
     let (r, deg) = with_scene(py, scene, &o, |loaded| {
         let (path, moving) =

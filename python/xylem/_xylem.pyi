@@ -111,6 +111,7 @@ def render(
     threads: int = 0,
     quality: str | None = None,
     footprint_filter: bool | None = None,
+    sampling: str | None = None,
 ) -> dict[str, Any]: ...
 def sweep(
     scene: _SceneLike,

@@ -33,6 +33,12 @@ pub struct Args {
     /// Random seed (overrides render.seed).
     #[arg(long)]
     seed: Option<u64>,
+    /// How the samples are spread over the pixels (overrides render.sampling, default
+    /// adaptive): `adaptive` takes a pilot of spp/4 in every pixel and gives the rest of the
+    /// W×H×spp samples to the pixels whose neighbours came out noisy; `uniform` takes spp in
+    /// every pixel.
+    #[arg(long, value_parser = crate::named::<xylem::render::Sampling>(&xylem::render::Sampling::NAMES))]
+    sampling: Option<xylem::render::Sampling>,
     /// Before rendering, print which wood features the scene skips and why: per wood material,
     /// the smallest pixel footprint its objects get from the camera and each fine feature (pores,
     /// rays, cell texture) kept, fading or skipped (faded to its mean in every pixel).
@@ -122,6 +128,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         res: args.res,
         seed: args.seed,
         footprint_filter: args.footprint_filter,
+        sampling: args.sampling,
     }
     .apply(&mut loaded)?;
     let bar = super::progress::Bar::new(!args.quiet);

@@ -5,7 +5,7 @@ use std::sync::Arc;
 use xylem::material::{Material, Placement};
 use xylem::render::{
     render, Accel, Camera, DistantLight, Environment, Filter, Instance, Integrator, Light,
-    PointLight, Projection, RenderSettings, RunOptions, Scene, Transform,
+    PointLight, Projection, RenderSettings, RunOptions, Sampling, Scene, Transform,
 };
 use xylem::scene::shapes;
 
@@ -51,6 +51,7 @@ fn lambertian_quad_under_point_light_matches_closed_form() {
         spp: 1,
         integrator: Integrator::Direct,
         seed: 3,
+        sampling: Sampling::default(),
     };
     let img = render(&scene, &settings, &RunOptions::default())
         .unwrap()
@@ -104,6 +105,7 @@ fn furnace(material: Material, spp: u32, max_depth: u32, seed: u64) -> Vec<(f32,
         spp,
         integrator: Integrator::Path { max_depth },
         seed,
+        sampling: Sampling::default(),
     };
     let img = render(&scene, &settings, &RunOptions::default())
         .unwrap()
@@ -234,6 +236,7 @@ fn constant_fibre_board_under_distant_light_matches_bsdf() {
         spp: 2,
         integrator: Integrator::Direct,
         seed: 5,
+        sampling: Sampling::default(),
     };
     let img = render(&scene, &settings, &RunOptions::default())
         .unwrap()

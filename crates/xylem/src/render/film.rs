@@ -160,9 +160,14 @@ impl RadianceSum {
     fn mean_and_error(&self) -> (Vec3, f32) {
         let n = self.count.max(1) as f64;
         let mean = self.sum / n as f32;
-        let m = crate::math::luminance(mean) as f64;
-        let var = ((self.sum_sq / n - m * m) * n / (n - 1.0).max(1.0)).max(0.0);
-        (mean, (var / n).sqrt() as f32)
+        (mean, (self.luminance_variance() / n).sqrt() as f32)
+    }
+
+    /// The sample variance of the samples' luminance (Bessel's correction; 0 below 2 samples).
+    pub(crate) fn luminance_variance(&self) -> f64 {
+        let n = self.count.max(1) as f64;
+        let m = crate::math::luminance(self.sum / n as f32) as f64;
+        ((self.sum_sq / n - m * m) * n / (n - 1.0).max(1.0)).max(0.0)
     }
 }
 
@@ -194,6 +199,11 @@ impl FrameSums {
             sum_sq: vec![0.0; n],
             nonfinite: vec![0; n],
         }
+    }
+
+    /// Frames summed.
+    pub fn frames(&self) -> usize {
+        self.frames
     }
 
     /// Adds one sample of pixel `i` in every frame, its radiance in frame k being

@@ -5,6 +5,7 @@
 //! random numbers from streams keyed by (seed, pixel, sample) only, so the image is bit-identical
 //! for any thread count.
 
+mod adaptive;
 pub mod camera;
 pub mod film;
 pub mod frames;
@@ -68,6 +69,49 @@ pub struct RenderSettings {
     pub integrator: Integrator,
     /// Random seed: the same seed gives the same image on any thread count.
     pub seed: u64,
+    /// How [`render`] spreads the image's W·H·spp samples over its pixels.
+    pub sampling: Sampling,
+}
+
+/// How [`render`] spreads an image's W·H·spp samples over its pixels (`[render] sampling`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Sampling {
+    /// spp samples in every pixel.
+    Uniform,
+    /// A pilot of spp/4 samples in every pixel, then the rest of the W·H·spp where the pilot
+    /// found the pixel's neighbours noisy, at most 16 spp a pixel (Neyman allocation,
+    /// unbiased: notes/render.md, "Adaptive sampling"). Uniform below 8 spp, and in
+    /// [`render_frames`] (a sweep's frames share their samples).
+    #[default]
+    Adaptive,
+}
+
+impl Sampling {
+    /// The names a scene file or a command line gives.
+    pub const NAMES: [&'static str; 2] = ["adaptive", "uniform"];
+}
+
+impl std::str::FromStr for Sampling {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "adaptive" => Ok(Sampling::Adaptive),
+            "uniform" => Ok(Sampling::Uniform),
+            _ => Err(format!(
+                "unknown sampling {s:?} (one of: adaptive, uniform)"
+            )),
+        }
+    }
+}
+
+impl std::fmt::Display for Sampling {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Sampling::Uniform => "uniform",
+            Sampling::Adaptive => "adaptive",
+        })
+    }
 }
 
 impl RenderSettings {
@@ -98,6 +142,7 @@ impl RenderSettings {
             ("scene", scene.to_string()),
             ("scene_file", file.to_string()),
             ("spp", self.spp.to_string()),
+            ("sampling", self.sampling.to_string()),
             ("seed", self.seed.to_string()),
             ("integrator", self.integrator.to_string()),
             (
@@ -203,7 +248,11 @@ pub fn render(
     settings: &RenderSettings,
     run: &RunOptions,
 ) -> Result<RenderOutput, RenderError> {
-    let mut frames = render_frames(scene, &LightFrames::fixed(&scene.lights), settings, run)?;
+    let lights = LightFrames::fixed(&scene.lights);
+    let mut frames = match (settings.sampling, adaptive::pilot_count(settings.spp)) {
+        (Sampling::Adaptive, Some(pilot)) => render_adaptive(scene, &lights, settings, run, pilot)?,
+        _ => render_frames(scene, &lights, settings, run)?,
+    };
     let frame = frames.frames.swap_remove(0);
     Ok(RenderOutput {
         image: RenderedImage {
@@ -315,65 +364,31 @@ pub fn render_frames_reusing(
     run: &RunOptions,
     primaries: Option<&mut Primaries>,
 ) -> Result<Frames, RenderError> {
-    let (w, h) = (scene.camera.width, scene.camera.height);
-    if w == 0 || h == 0 {
-        return Err(RenderError::EmptyImage {
-            width: w,
-            height: h,
-        });
-    }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(run.threads)
-        .build()
-        .map_err(|e| RenderError::Threads {
-            threads: run.threads,
-            message: e.to_string(),
-        })?;
-    let tiles = tile_origins(w, h);
+    let (w, h, tiles) = image_tiles(scene)?;
     let keep = primaries.as_ref().is_some_and(|p| p.is_empty());
     let reuse = primaries.as_deref().filter(|p| !p.is_empty());
     if let Some(p) = reuse {
         assert_eq!(p.tiles.len(), tiles.len(), "primaries of another render");
     }
     let shadow = ShadowTest::culled(&scene.accel);
-    let n_tiles = tiles.len() as u64;
-    run.progress.start(n_tiles, &progress_unit(lights.len()));
-    let tiles_done = AtomicU64::new(0);
-    let total_rays = AtomicU64::new(0);
     let start = Instant::now();
-    let stopped = std::sync::atomic::AtomicBool::new(false);
-    let results: Vec<Option<(UVec2, TileFrames)>> = pool.install(|| {
-        tiles
-            .par_iter()
-            .enumerate()
-            .map(|(t, &origin)| {
-                if stopped.load(Ordering::Relaxed) || run.progress.stop() {
-                    stopped.store(true, Ordering::Relaxed);
-                    return None;
-                }
-                let primary = match reuse {
-                    Some(p) => Primary::Reuse(&p.tiles[t]),
-                    None if keep => Primary::Keep,
-                    None => Primary::Compute,
-                };
-                let tile = render_tile(scene, lights, &shadow, settings, origin, primary);
-                let total = total_rays.fetch_add(tile.rays, Ordering::Relaxed) + tile.rays;
-                let secs = start.elapsed().as_secs_f64().max(1e-9);
-                let done = tiles_done.fetch_add(1, Ordering::Relaxed) + 1;
-                let rate = format!("{:.2} Mrays/s", total as f64 / secs / 1e6);
-                run.progress.update(done, n_tiles, &rate);
-                Some((origin, tile))
-            })
-            .collect()
-    });
-    run.progress.finish();
-    if stopped.into_inner() {
-        return Err(RenderError::Stopped {
-            done: tiles_done.into_inner(),
-            total: n_tiles,
-        });
-    }
-    let mut results: Vec<(UVec2, TileFrames)> = results.into_iter().flatten().collect();
+    let mut pass = TilePass::new(run, tiles.len() as u64, 1, &progress_unit(lights.len()))?;
+    let results = pass.run(&tiles, |t, origin| {
+        let primary = match reuse {
+            Some(p) => Primary::Reuse(&p.tiles[t]),
+            None if keep => Primary::Keep,
+            None => Primary::Compute,
+        };
+        let job = TileJob {
+            origin,
+            primary,
+            span: Span::All(settings.spp),
+            carry: None,
+        };
+        render_tile(scene, lights, &shadow, settings, job).finish()
+    })?;
+    let rays = pass.finish();
+    let mut results: Vec<(UVec2, TileFrames)> = tiles.into_iter().zip(results).collect();
     if keep {
         if let Some(p) = primaries {
             p.tiles = results
@@ -382,15 +397,185 @@ pub fn render_frames_reusing(
                 .collect();
         }
     }
-    let (aov, frames) = place_tiles(w, h, lights.len(), results);
-    Ok(Frames {
-        width: w,
-        height: h,
-        aov,
-        frames,
-        elapsed: start.elapsed(),
-        rays: total_rays.into_inner(),
-    })
+    Ok(place_tiles(w, h, lights.len(), results, start, rays))
+}
+
+/// [`render_frames`] of one frame with [`Sampling::Adaptive`]: every pixel's first `pilot`
+/// samples, then the rest of the image's W·H·spp samples spread by [`adaptive::allocate`]
+/// over the pilot's variances, each pixel continuing its own sample sequence where the pilot
+/// left it (so a pixel's samples are those of a uniform render with more spp, in order).
+fn render_adaptive(
+    scene: &Scene,
+    lights: &LightFrames,
+    settings: &RenderSettings,
+    run: &RunOptions,
+    pilot: u32,
+) -> Result<Frames, RenderError> {
+    let (w, h, tiles) = image_tiles(scene)?;
+    let shadow = ShadowTest::culled(&scene.accel);
+    let start = Instant::now();
+    let mut pass = TilePass::new(run, tiles.len() as u64, 2, "tiles (pilot, then the rest)")?;
+    let pilots = pass.run(&tiles, |_, origin| {
+        let job = TileJob {
+            origin,
+            primary: Primary::Compute,
+            span: Span::All(pilot),
+            carry: None,
+        };
+        render_tile(scene, lights, &shadow, settings, job)
+    })?;
+    let mut variance = vec![0.0f64; (w * h) as usize];
+    for (&origin, tile) in tiles.iter().zip(&pilots) {
+        for (i, sum) in tile.sums.frame(0).enumerate() {
+            variance[tile_pixel(w, origin, i)] = sum.luminance_variance();
+        }
+    }
+    let pixels = w as u64 * h as u64;
+    let budget = pixels * (settings.spp - pilot) as u64;
+    let cap = adaptive::MAX_FACTOR * settings.spp - pilot;
+    let extra = adaptive::allocate(w, h, &variance, budget, cap, settings.seed);
+    let mut carried: Vec<Option<TileSums>> = pilots.into_iter().map(Some).collect();
+    let carried = std::sync::Mutex::new(&mut carried);
+    let results = pass.run(&tiles, |t, origin| {
+        let carry = carried.lock().expect("no panic holds it")[t].take();
+        let tw = TILE.min(w - origin.x) as usize;
+        let th = TILE.min(h - origin.y) as usize;
+        let counts: Vec<u32> = (0..tw * th)
+            .map(|i| extra[tile_pixel(w, origin, i)])
+            .collect();
+        let job = TileJob {
+            origin,
+            primary: Primary::Compute,
+            span: Span::After {
+                first: pilot,
+                extra: &counts,
+            },
+            carry,
+        };
+        render_tile(scene, lights, &shadow, settings, job).finish()
+    })?;
+    let rays = pass.finish();
+    let results: Vec<(UVec2, TileFrames)> = tiles.into_iter().zip(results).collect();
+    Ok(place_tiles(w, h, lights.len(), results, start, rays))
+}
+
+/// The image index of pixel `i` (row-major within its tile) of the tile at `origin` in a
+/// `w`-wide image.
+fn tile_pixel(w: u32, origin: UVec2, i: usize) -> usize {
+    let tw = TILE.min(w - origin.x);
+    let (x, y) = (origin.x + i as u32 % tw, origin.y + i as u32 / tw);
+    (y * w + x) as usize
+}
+
+/// Passes over an image's tiles on a pool of `run.threads` threads, with progress over all
+/// the passes, the rays counted and a stop asked for by [`Progress::stop`] honoured.
+struct TilePass<'a> {
+    pool: rayon::ThreadPool,
+    run: &'a RunOptions<'a>,
+    total: u64,
+    done: AtomicU64,
+    rays: AtomicU64,
+    start: Instant,
+}
+
+impl<'a> TilePass<'a> {
+    fn new(
+        run: &'a RunOptions<'a>,
+        tiles: u64,
+        passes: u64,
+        unit: &str,
+    ) -> Result<Self, RenderError> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(run.threads)
+            .build()
+            .map_err(|e| RenderError::Threads {
+                threads: run.threads,
+                message: e.to_string(),
+            })?;
+        let total = tiles * passes;
+        run.progress.start(total, unit);
+        Ok(TilePass {
+            pool,
+            run,
+            total,
+            done: AtomicU64::new(0),
+            rays: AtomicU64::new(0),
+            start: Instant::now(),
+        })
+    }
+
+    /// `tile(index, origin)` for every tile, in tile order.
+    fn run<T: Send + Rayed>(
+        &mut self,
+        tiles: &[UVec2],
+        tile: impl Fn(usize, UVec2) -> T + Sync + Send,
+    ) -> Result<Vec<T>, RenderError> {
+        let stopped = std::sync::atomic::AtomicBool::new(false);
+        let this = &*self;
+        let results: Vec<Option<T>> = self.pool.install(|| {
+            tiles
+                .par_iter()
+                .enumerate()
+                .map(|(t, &origin)| {
+                    if stopped.load(Ordering::Relaxed) || this.run.progress.stop() {
+                        stopped.store(true, Ordering::Relaxed);
+                        return None;
+                    }
+                    let out = tile(t, origin);
+                    let rays = out.rays();
+                    let total = this.rays.fetch_add(rays, Ordering::Relaxed) + rays;
+                    let secs = this.start.elapsed().as_secs_f64().max(1e-9);
+                    let done = this.done.fetch_add(1, Ordering::Relaxed) + 1;
+                    let rate = format!("{:.2} Mrays/s", total as f64 / secs / 1e6);
+                    this.run.progress.update(done, this.total, &rate);
+                    Some(out)
+                })
+                .collect()
+        });
+        if stopped.into_inner() {
+            self.run.progress.finish();
+            return Err(RenderError::Stopped {
+                done: self.done.load(Ordering::Relaxed),
+                total: self.total,
+            });
+        }
+        Ok(results.into_iter().flatten().collect())
+    }
+
+    /// Ends the progress report; the rays traced over all passes.
+    fn finish(self) -> u64 {
+        self.run.progress.finish();
+        self.rays.into_inner()
+    }
+}
+
+/// What a tile pass counts its rays from.
+trait Rayed {
+    fn rays(&self) -> u64;
+}
+
+impl Rayed for TileFrames {
+    fn rays(&self) -> u64 {
+        self.rays
+    }
+}
+
+impl Rayed for TileSums {
+    fn rays(&self) -> u64 {
+        self.rays
+    }
+}
+
+/// The camera's image size and its tiles ([`tile_origins`]); an error for an empty image.
+fn image_tiles(scene: &Scene) -> Result<(u32, u32, Vec<UVec2>), RenderError> {
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    if w == 0 || h == 0 {
+        return Err(RenderError::EmptyImage {
+            width: w,
+            height: h,
+        });
+    }
+    Ok((w, h, tile_origins(w, h)))
 }
 
 /// The top-left corners of the `TILE × TILE` tiles covering a `w × h` image, row by row.
@@ -400,14 +585,16 @@ fn tile_origins(w: u32, h: u32) -> Vec<UVec2> {
         .collect()
 }
 
-/// The finished tiles put together into a `w × h` image: the AOVs and each of `n_frames`
-/// frames.
+/// The finished tiles put together into a `w × h` run of `n_frames` frames with their AOVs,
+/// timed from `start`, `rays` traced.
 fn place_tiles(
     w: u32,
     h: u32,
     n_frames: usize,
     results: Vec<(UVec2, TileFrames)>,
-) -> (Vec<Aov>, Vec<FrameImage>) {
+    start: Instant,
+    rays: u64,
+) -> Frames {
     let n = (w * h) as usize;
     let mut frames: Vec<FrameImage> = (0..n_frames)
         .map(|_| FrameImage {
@@ -418,11 +605,7 @@ fn place_tiles(
         .collect();
     let mut aov = vec![Aov::default(); n];
     for (origin, tile) in results {
-        let tw = TILE.min(w - origin.x);
-        let place = |i: usize| {
-            let (x, y) = (origin.x + i as u32 % tw, origin.y + i as u32 / tw);
-            (y * w + x) as usize
-        };
+        let place = |i: usize| tile_pixel(w, origin, i);
         for (i, a) in tile.aov.iter().enumerate() {
             aov[place(i)] = *a;
         }
@@ -434,7 +617,14 @@ fn place_tiles(
             f.nonfinite += img.nonfinite;
         }
     }
-    (aov, frames)
+    Frames {
+        width: w,
+        height: h,
+        aov,
+        frames,
+        elapsed: start.elapsed(),
+        rays,
+    }
 }
 
 /// What a render's progress counts: `tiles`, or `tiles × 48 frames` for a sweep.
@@ -455,6 +645,52 @@ struct TileFrames {
     kept: Vec<KeptSample>,
 }
 
+/// A tile's sums so far (its pixels' radiance in every frame and AOVs, pixel-major), the rays
+/// its pass traced and, when asked to keep them, its primary samples.
+struct TileSums {
+    width: u32,
+    height: u32,
+    sums: FrameSums,
+    aov_sums: Vec<PixelSum>,
+    rays: u64,
+    kept: Vec<KeptSample>,
+}
+
+impl TileSums {
+    /// The tile's averaged frames and AOVs.
+    fn finish(self) -> TileFrames {
+        let (tw, th) = (self.width, self.height);
+        let aov = RenderedImage::from_sums(tw, th, &self.aov_sums).aov;
+        let frames = (0..self.sums.frames())
+            .map(|k| RenderedImage::from_radiance(tw, th, self.sums.frame(k)))
+            .collect();
+        TileFrames {
+            aov,
+            frames,
+            rays: self.rays,
+            kept: self.kept,
+        }
+    }
+}
+
+/// One tile's work in a pass: where it is, where its primary samples come from, which samples
+/// it takes and the sums of an earlier pass it continues.
+struct TileJob<'a> {
+    origin: UVec2,
+    primary: Primary<'a>,
+    span: Span<'a>,
+    carry: Option<TileSums>,
+}
+
+/// Which samples of its pixels a tile pass takes.
+#[derive(Clone, Copy)]
+enum Span<'a> {
+    /// Samples 0..n of every pixel.
+    All(u32),
+    /// Samples first..first + extra[i] of the tile's pixel i.
+    After { first: u32, extra: &'a [u32] },
+}
+
 /// Where a tile's primary samples come from: computed, computed and kept, or read from an
 /// earlier pass (the tile's samples, pixel-major).
 #[derive(Clone, Copy)]
@@ -471,21 +707,16 @@ fn render_tile(
     lights: &LightFrames,
     shadow: &ShadowTest,
     settings: &RenderSettings,
-    origin: UVec2,
-    primary: Primary,
-) -> TileFrames {
+    job: TileJob,
+) -> TileSums {
     #[cfg(target_arch = "x86_64")]
     match Simd::best() {
         // SAFETY: `Simd::best` detected the level's features on this CPU.
-        Simd::Avx512 => {
-            return unsafe { render_tile_avx512(scene, lights, shadow, settings, origin, primary) }
-        }
-        Simd::Avx2 => {
-            return unsafe { render_tile_avx2(scene, lights, shadow, settings, origin, primary) }
-        }
+        Simd::Avx512 => return unsafe { render_tile_avx512(scene, lights, shadow, settings, job) },
+        Simd::Avx2 => return unsafe { render_tile_avx2(scene, lights, shadow, settings, job) },
         Simd::Sse2 | Simd::Scalar => {}
     }
-    render_tile_in(scene, lights, shadow, settings, origin, primary)
+    render_tile_in(scene, lights, shadow, settings, job)
 }
 
 simd_wide! {
@@ -494,10 +725,9 @@ simd_wide! {
         lights: &LightFrames,
         shadow: &ShadowTest,
         settings: &RenderSettings,
-        origin: UVec2,
-        primary: Primary,
-    ) -> TileFrames {
-        render_tile_in(scene, lights, shadow, settings, origin, primary)
+        job: TileJob,
+    ) -> TileSums {
+        render_tile_in(scene, lights, shadow, settings, job)
     }
 }
 
@@ -510,13 +740,12 @@ fn render_tile_in(
     lights: &LightFrames,
     shadow: &ShadowTest,
     settings: &RenderSettings,
-    origin: UVec2,
-    primary: Primary,
-) -> TileFrames {
+    job: TileJob,
+) -> TileSums {
     // One frame (a plain render): the frame loops of constant length (`radiance_frames`).
     match lights.len() {
-        1 => tile_frames::<true>(scene, lights, shadow, settings, origin, primary),
-        _ => tile_frames::<false>(scene, lights, shadow, settings, origin, primary),
+        1 => tile_frames::<true>(scene, lights, shadow, settings, job),
+        _ => tile_frames::<false>(scene, lights, shadow, settings, job),
     }
 }
 
@@ -527,9 +756,14 @@ fn tile_frames<const ONE: bool>(
     lights: &LightFrames,
     shadow: &ShadowTest,
     settings: &RenderSettings,
-    origin: UVec2,
-    primary: Primary,
-) -> TileFrames {
+    job: TileJob,
+) -> TileSums {
+    let TileJob {
+        origin,
+        primary,
+        span,
+        carry,
+    } = job;
     let (w, h) = (scene.camera.width, scene.camera.height);
     let (tw, th) = (TILE.min(w - origin.x), TILE.min(h - origin.y));
     let n = (tw * th) as usize;
@@ -537,8 +771,10 @@ fn tile_frames<const ONE: bool>(
     let max_depth = settings.integrator.max_depth();
     // Pixel-major (pixel i, frame k at i·frames + k): a pixel's samples update one contiguous
     // run of sums instead of one cache line in each of `frames` arrays.
-    let mut sums = FrameSums::new(n, frames);
-    let mut aov_sums = vec![PixelSum::default(); n];
+    let (mut sums, mut aov_sums) = match carry {
+        Some(c) => (c.sums, c.aov_sums),
+        None => (FrameSums::new(n, frames), vec![PixelSum::default(); n]),
+    };
     // Each frame's radiance of the sample at hand, by channel ([`integrator::Columns`]).
     let mut radiance = integrator::Columns::default();
     let mut scratch = FramesScratch::default();
@@ -559,7 +795,11 @@ fn tile_frames<const ONE: bool>(
         .flat_map(|y| (origin.x..origin.x + tw).map(move |x| UVec2::new(x, y)))
         .enumerate()
     {
-        for s in 0..settings.spp {
+        let samples = match span {
+            Span::All(n) => 0..n,
+            Span::After { first, extra } => first..first + extra[i],
+        };
+        for s in samples {
             let (ps, reused) = match primary {
                 Primary::Reuse(p) => {
                     let k = &p[i * spp + s as usize];
@@ -605,13 +845,11 @@ fn tile_frames<const ONE: bool>(
             aov_sums[i].add(Vec3::ZERO, &ps.aov);
         }
     }
-    let aov = RenderedImage::from_sums(tw, th, &aov_sums).aov;
-    let frames = (0..frames)
-        .map(|k| RenderedImage::from_radiance(tw, th, sums.frame(k)))
-        .collect();
-    TileFrames {
-        aov,
-        frames,
+    TileSums {
+        width: tw,
+        height: th,
+        sums,
+        aov_sums,
         rays: rays.0,
         kept,
     }

@@ -108,6 +108,9 @@ pub struct RenderTable {
     /// Band-limit wood by the pixel footprint (default true; false point-samples it, as
     /// before issue 28; `xylem render --footprint-filter` overrides).
     pub footprint_filter: bool,
+    /// `"adaptive"` (default: a pilot, then the rest of the samples where the pixels are
+    /// noisy) or `"uniform"` (spp in every pixel); `xylem render --sampling` overrides.
+    pub sampling: crate::render::Sampling,
 }
 
 impl Default for RenderTable {
@@ -123,6 +126,7 @@ impl Default for RenderTable {
             filter: FilterName::Gaussian,
             filter_radius: None,
             footprint_filter: true,
+            sampling: crate::render::Sampling::Adaptive,
         }
     }
 }

@@ -424,6 +424,7 @@ impl Builder<'_> {
                 spp: r.spp.unwrap_or(DEFAULT_SPP),
                 integrator,
                 seed: r.seed,
+                sampling: r.sampling,
             },
             exposure: r.exposure,
             light_names,

@@ -27,6 +27,8 @@ pub struct Overrides {
     pub seed: Option<u64>,
     /// Band-limit the wood by the pixel footprint (over the preset's).
     pub footprint_filter: Option<bool>,
+    /// How the render spreads its samples over the pixels.
+    pub sampling: Option<crate::render::Sampling>,
 }
 
 /// Why overrides could not be applied: the field and its allowed range, or the preset's error.
@@ -84,6 +86,9 @@ impl Overrides {
         if let Some(seed) = self.seed {
             loaded.settings.seed = seed;
         }
+        if let Some(sampling) = self.sampling {
+            loaded.settings.sampling = sampling;
+        }
         if let Some((w, h)) = self.res {
             loaded.scene.camera = loaded.scene.camera.with_resolution(w, h);
         }
@@ -128,6 +133,7 @@ mod tests {
             res: Some((40, 30)),
             seed: Some(9),
             footprint_filter: None,
+            sampling: None,
         }
         .apply(&mut loaded)
         .unwrap();
