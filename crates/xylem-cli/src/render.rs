@@ -138,11 +138,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     };
     let cam = &loaded.scene.camera;
     eprintln!(
-        "{}: {}x{}, {} spp, {}, {} triangles (BVH built in {:.1} ms)",
+        "{}: {}x{}, {} spp ({}), {}, {} triangles (BVH built in {:.1} ms)",
         loaded.name,
         cam.width,
         cam.height,
         loaded.settings.spp,
+        loaded.settings.sampling,
         loaded.settings.integrator,
         loaded.scene.accel.triangle_count(),
         loaded.scene.accel.build_time.as_secs_f64() * 1e3
@@ -232,6 +233,7 @@ fn summary(
         "height": cam.height,
         "spp": loaded.settings.spp,
         "seed": loaded.settings.seed,
+        "sampling": loaded.settings.sampling.to_string(),
         "integrator": loaded.settings.integrator.to_string(),
         "camera": meta.iter().find(|m| m.0 == "camera").map(|m| m.1.clone()),
         "lights": loaded.scene.lights.len(),
