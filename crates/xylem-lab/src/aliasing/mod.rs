@@ -452,7 +452,7 @@ pub fn report_md(rows: &[Row], command: &str) -> (String, Vec<Check>) {
          Written by `xylem validate aliasing` (crates/xylem-lab/src/aliasing/; derivation in \
          notes/render.md, \"The aliasing estimator\"). Each wood scene is rendered K times with \
          seeds of their own under each setting — today's default (wood band-limited by the pixel \
-         footprint, Sobol-stratified samples), today's samples with the wood point-sampled, and, \
+         footprint, Sobol-stratified samples spread adaptively, `render`'s default), today's samples with the wood point-sampled, and, \
          with `--baseline BIN`, the default issue 28 was filed against rendered by that binary \
          (`xylem` built from 5a8ffa9^ = 2934293: independent samples, point-sampled wood) — against a converged point-sampled reference \
          of R independent parts. **Energy**: the power of the 3 × 3 high-pass of a render's \

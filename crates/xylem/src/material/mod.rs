@@ -137,6 +137,9 @@ impl std::fmt::Debug for TextureMaterial {
     }
 }
 
+/// [`Material::shading_cost`] of procedural wood, in rays.
+pub const WOOD_SHADING_COST: u32 = 16;
+
 /// Solid wood: the volume, the finish over it, and the bump-mapping strength.
 #[derive(Clone, Debug)]
 pub struct WoodMaterial {
@@ -182,6 +185,23 @@ impl Material {
             Material::Wood(w) => w.switches.footprint_filter = on,
             Material::BakedWood(b) => b.switches.footprint_filter = on,
             _ => {}
+        }
+    }
+
+    /// What shading one hit of this material costs, in rays (a ray traced with its share of the
+    /// path loop = 1): what adaptive sampling weighs a pixel's samples by (`render::adaptive`).
+    /// Procedural wood 16, measured on the carved bunny (420 × 360, 16 spp, uniform, 2 threads,
+    /// 2 runs each): 4.53–4.65 user s with red oak against 1.67–1.93 s with a Lambertian bunny,
+    /// the difference over its first hits ≈ 16 rays' time each ([`WOOD_SHADING_COST`]); the
+    /// texture-map materials and solid textures a few lookups, counted as 2; the rest 1.
+    pub fn shading_cost(&self) -> u32 {
+        match self {
+            Material::Wood(_) => WOOD_SHADING_COST,
+            Material::BakedWood(_) | Material::Measured(_) | Material::Texture(_) => 2,
+            Material::Lambertian { .. }
+            | Material::Fiber { .. }
+            | Material::Mirror { .. }
+            | Material::Glass { .. } => 1,
         }
     }
 

@@ -74,16 +74,28 @@ pub struct PrimarySample {
     pub bounce_footprint: (f32, f32),
 }
 
-/// Counts of rays traced, for the rays/s report.
+/// Counts of rays traced, for the rays/s report, and of the shading work done
+/// ([`crate::material::Material::shading_cost`] summed), for adaptive sampling's costs.
 #[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct RayCount(pub u64);
+pub(crate) struct RayCount {
+    pub rays: u64,
+    pub shading: u64,
+}
+
+impl RayCount {
+    /// Rays plus shading, in rays: what the samples so far cost.
+    pub(crate) fn work(&self) -> u64 {
+        self.rays + self.shading
+    }
+}
 
 /// Builds the shading point of a hit seen along `ray`. `aov` is given at the camera's first hit,
 /// with the pixel footprint at the hit (times `footprint_scale`, [`footprint_scale`]), which
 /// band-limits the textures. Written into `out`, where the caller keeps it: a shading point holds
 /// a whole BSDF (484 bytes), and returning it by value cost a copy of all of them per vertex
 /// (`memcpy`, 3–5 % of a Cornell-box render in `perf`); the BSDF itself is copied by its variant
-/// ([`SurfaceBsdf::copied`]).
+/// ([`SurfaceBsdf::copied`]). Returns the material's shading cost
+/// ([`crate::material::Material::shading_cost`]).
 #[inline(never)]
 pub(crate) fn shading_point(
     scene: &Scene,
@@ -91,7 +103,7 @@ pub(crate) fn shading_point(
     hit: &Hit,
     footprint: Footprint,
     out: &mut Option<ShadingPoint>,
-) {
+) -> u32 {
     let s = scene.accel.surface(ray, hit);
     let inst = &scene.accel.instances[s.instance as usize];
     let material = &scene.materials[inst.material as usize];
@@ -150,6 +162,7 @@ pub(crate) fn shading_point(
     sp.wo = frame.to_local(wo_world);
     shading.bsdf.copy_to(&mut sp.bsdf);
     sp.eps = 2e-5 * scene.accel.scale();
+    material.shading_cost()
 }
 
 /// The share of the pixel footprint each of `spp` camera samples band-limits its first hit by:
@@ -213,7 +226,8 @@ impl PrimarySample {
 
 /// [`primary_sample`] into `out`, with the camera's per-ray constants worked out by the caller
 /// (`camera` = `scene.camera.rays()`, once per tile); the same bits. Written in place, since a
-/// sample holds a whole BSDF ([`shading_point`]).
+/// sample holds a whole BSDF ([`shading_point`]). Returns the first hit's shading cost (0 on a
+/// miss).
 #[inline(always)]
 pub(crate) fn primary_sample_into(
     scene: &Scene,
@@ -223,7 +237,7 @@ pub(crate) fn primary_sample_into(
     seed: u64,
     footprint_scale: f32,
     out: &mut PrimarySample,
-) {
+) -> u32 {
     let index = pixel.y as u64 * scene.camera.width as u64 + pixel.x as u64;
     let u = pixel_sample(seed, index, sample);
     let film = pixel.as_vec2() + Vec2::splat(0.5) + scene.filter.sample(Vec2::new(u[0], u[1]));
@@ -242,11 +256,12 @@ pub(crate) fn primary_sample_into(
                 &hit,
                 Footprint::Pixel(&mut out.aov, pixel),
                 &mut out.point,
-            );
+            )
         }
         None => {
             out.t_hit = f32::INFINITY;
             out.point = None;
+            0
         }
     }
 }
@@ -283,7 +298,7 @@ pub(crate) fn light_term(
         o: offset_origin(sp, ls.wi),
         d: ls.wi,
     };
-    rays.0 += 1;
+    rays.rays += 1;
     if !shadow.unoccluded(&ray, shadow_t_max(ls.dist)) {
         return Vec3::ZERO;
     }
@@ -469,7 +484,7 @@ pub(crate) fn light_terms(
         };
         [or[k], og[k], ob[k]] = term.to_array();
     }
-    rays.0 += shadowed.iter().map(|&s| s as u64).sum::<u64>();
+    rays.rays += shadowed.iter().map(|&s| s as u64).sum::<u64>();
     let culled = &culled[..n];
     for k in 0..n {
         if !shadowed[k] | culled[k] {
@@ -730,7 +745,10 @@ pub(crate) fn radiance_frames<const ONE: bool>(
             let Some(c) = kept else { break };
             (path, depth, at_first) = (c.path, 1, false);
             match c.hit {
-                Some(h) if !last => shading_point(scene, &path.ray, &h, footprint(), &mut bounce),
+                Some(h) if !last => {
+                    rays.shading +=
+                        shading_point(scene, &path.ray, &h, footprint(), &mut bounce) as u64
+                }
                 _ => bounce = None,
             }
             continue;
@@ -744,7 +762,7 @@ pub(crate) fn radiance_frames<const ONE: bool>(
         if !path.scatter(sp, u, depth) {
             break;
         }
-        rays.0 += 1;
+        rays.rays += 1;
         at_first = false;
         let hit = scene.accel.intersect(&path.ray, f32::INFINITY);
         path.t_hit = hit.map_or(f32::INFINITY, |h| h.t);
@@ -757,7 +775,9 @@ pub(crate) fn radiance_frames<const ONE: bool>(
         }
         match hit {
             // The last vertex only needs its distance (emission in front of it), not shading.
-            Some(h) if !last => shading_point(scene, &path.ray, &h, footprint(), &mut bounce),
+            Some(h) if !last => {
+                rays.shading += shading_point(scene, &path.ray, &h, footprint(), &mut bounce) as u64
+            }
             _ => bounce = None,
         }
     }

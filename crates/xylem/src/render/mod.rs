@@ -69,20 +69,21 @@ pub struct RenderSettings {
     pub integrator: Integrator,
     /// Random seed: the same seed gives the same image on any thread count.
     pub seed: u64,
-    /// How [`render`] spreads the image's W·H·spp samples over its pixels.
+    /// How [`render`] spreads the image's samples over its pixels.
     pub sampling: Sampling,
 }
 
-/// How [`render`] spreads an image's W·H·spp samples over its pixels (`[render] sampling`).
+/// How [`render`] spreads an image's samples over its pixels (`[render] sampling`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Sampling {
     /// spp samples in every pixel.
     Uniform,
-    /// A pilot of spp/4 samples in every pixel, then the rest of the W·H·spp where the pilot
-    /// found the pixel's neighbours noisy, at most 16 spp a pixel (Neyman allocation,
-    /// unbiased: notes/render.md, "Adaptive sampling"). Uniform below 8 spp, and in
-    /// [`render_frames`] (a sweep's frames share their samples).
+    /// A pilot of spp/4 samples in every pixel, then the cost of the uniform render's remaining
+    /// samples spent where the pilot found the pixel's neighbours noisy and cheap, at most
+    /// 16 spp a pixel (Neyman allocation with costs, unbiased: notes/render.md, "Adaptive
+    /// sampling"). Uniform below 8 spp, and in [`render_frames`] (a sweep's frames share their
+    /// samples).
     #[default]
     Adaptive,
 }
@@ -401,8 +402,8 @@ pub fn render_frames_reusing(
 }
 
 /// [`render_frames`] of one frame with [`Sampling::Adaptive`]: every pixel's first `pilot`
-/// samples, then the rest of the image's W·H·spp samples spread by [`adaptive::allocate`]
-/// over the pilot's variances, each pixel continuing its own sample sequence where the pilot
+/// samples, then the cost of the rest of a uniform render's samples spread by
+/// [`adaptive::allocate`] over the pilot's variances and costs, each pixel continuing its own sample sequence where the pilot
 /// left it (so a pixel's samples are those of a uniform render with more spp, in order).
 fn render_adaptive(
     scene: &Scene,
@@ -424,16 +425,18 @@ fn render_adaptive(
         };
         render_tile(scene, lights, &shadow, settings, job)
     })?;
-    let mut variance = vec![0.0f64; (w * h) as usize];
+    let mut measured = vec![adaptive::Pilot::default(); (w * h) as usize];
     for (&origin, tile) in tiles.iter().zip(&pilots) {
         for (i, sum) in tile.sums.frame(0).enumerate() {
-            variance[tile_pixel(w, origin, i)] = sum.luminance_variance();
+            measured[tile_pixel(w, origin, i)] = adaptive::Pilot {
+                var: sum.luminance_variance(),
+                cost: tile.work[i] as f64 / pilot as f64,
+            };
         }
     }
-    let pixels = w as u64 * h as u64;
-    let budget = pixels * (settings.spp - pilot) as u64;
     let cap = adaptive::MAX_FACTOR * settings.spp - pilot;
-    let extra = adaptive::allocate(w, h, &variance, budget, cap, settings.seed);
+    let m = settings.spp - pilot;
+    let extra = adaptive::allocate(w, h, &measured, m, cap, settings.seed);
     let mut carried: Vec<Option<TileSums>> = pilots.into_iter().map(Some).collect();
     let carried = std::sync::Mutex::new(&mut carried);
     let results = pass.run(&tiles, |t, origin| {
@@ -653,6 +656,8 @@ struct TileSums {
     sums: FrameSums,
     aov_sums: Vec<PixelSum>,
     rays: u64,
+    /// Per pixel, what its samples cost in rays ([`RayCount::work`]).
+    work: Vec<u64>,
     kept: Vec<KeptSample>,
 }
 
@@ -771,9 +776,13 @@ fn tile_frames<const ONE: bool>(
     let max_depth = settings.integrator.max_depth();
     // Pixel-major (pixel i, frame k at i·frames + k): a pixel's samples update one contiguous
     // run of sums instead of one cache line in each of `frames` arrays.
-    let (mut sums, mut aov_sums) = match carry {
-        Some(c) => (c.sums, c.aov_sums),
-        None => (FrameSums::new(n, frames), vec![PixelSum::default(); n]),
+    let (mut sums, mut aov_sums, mut work) = match carry {
+        Some(c) => (c.sums, c.aov_sums, c.work),
+        None => (
+            FrameSums::new(n, frames),
+            vec![PixelSum::default(); n],
+            vec![0; n],
+        ),
     };
     // Each frame's radiance of the sample at hand, by channel ([`integrator::Columns`]).
     let mut radiance = integrator::Columns::default();
@@ -799,6 +808,7 @@ fn tile_frames<const ONE: bool>(
             Span::All(n) => 0..n,
             Span::After { first, extra } => first..first + extra[i],
         };
+        let before = rays.work();
         for s in samples {
             let (ps, reused) = match primary {
                 Primary::Reuse(p) => {
@@ -806,8 +816,8 @@ fn tile_frames<const ONE: bool>(
                     (&k.primary, Some(&k.next))
                 }
                 Primary::Compute | Primary::Keep => {
-                    rays.0 += 1;
-                    primary_sample_into(
+                    rays.rays += 1;
+                    rays.shading += primary_sample_into(
                         scene,
                         &camera,
                         pixel,
@@ -815,7 +825,7 @@ fn tile_frames<const ONE: bool>(
                         settings.seed,
                         fp_scale,
                         &mut computed,
-                    );
+                    ) as u64;
                     (&computed, None)
                 }
             };
@@ -844,13 +854,15 @@ fn tile_frames<const ONE: bool>(
             sums.add(i, &radiance);
             aov_sums[i].add(Vec3::ZERO, &ps.aov);
         }
+        work[i] += rays.work() - before;
     }
     TileSums {
         width: tw,
         height: th,
         sums,
         aov_sums,
-        rays: rays.0,
+        rays: rays.rays,
+        work,
         kept,
     }
 }
