@@ -194,6 +194,9 @@ pub fn run(b: &RenderBench) -> Result<RenderTimes, RenderBenchError> {
         ));
     }
     loaded.settings.spp = b.spp;
+    // spp in every pixel, as Mitsuba samples: samples/s and RMSE per sample compare like with
+    // like (adaptive sampling, `render`'s default, spreads a pixel's samples unevenly).
+    loaded.settings.sampling = xylem::render::Sampling::Uniform;
     let (w, h) = (loaded.scene.camera.width, loaded.scene.camera.height);
     let opts = RunOptions {
         threads: b.threads,
