@@ -6,8 +6,16 @@ use crate::*;
 pub(crate) fn parse_quality(
     quality: Option<&str>,
 ) -> PyResult<Option<xylem::scene::quality::Quality>> {
-    quality
-        .map(|q| q.parse().map_err(|e| value_error(format!("quality: {e}"))))
+    parse_named("quality", quality)
+}
+
+/// A keyword argument given by name (`quality`, `sampling`), parsed; its error names it.
+fn parse_named<T: std::str::FromStr>(field: &str, value: Option<&str>) -> PyResult<Option<T>>
+where
+    T::Err: std::fmt::Display,
+{
+    value
+        .map(|v| v.parse().map_err(|e| value_error(format!("{field}: {e}"))))
         .transpose()
 }
 
@@ -88,7 +96,8 @@ pub(crate) fn interruptible<T: Send>(
 /// renders a scene (a file path, a built-in scene name, a dict as `load_dict` takes, or a
 /// `Scene`) as `xylem render` does — `quality` is `--quality` (`draft`, `default`, `final`: spp
 /// and wood-model knobs, validation/TRADEOFF.md), `spp` and `footprint_filter` override it;
-/// `sampling` is `--sampling` (`adaptive`, the default, or `uniform`) — and returns a dict of (H, W[, 3]) float32 arrays, top row first: `beauty`
+/// `sampling` is `--sampling` (`adaptive`, the default, or `uniform`) — and returns a dict of
+/// (H, W[, 3]) float32 arrays, top row first: `beauty`
 /// (linear RGB), `std_error` (of each pixel's luminance), and the first-hit AOVs `albedo`,
 /// `normal`, `depth`, `fiber`, `ray_mask`, `growth_time`; plus `nonfinite` (samples dropped) and
 /// `seconds`. The GIL is released while rendering; Ctrl-C stops it within a tile and raises
@@ -108,16 +117,13 @@ pub(crate) fn render<'py>(
     sampling: Option<&str>,
 ) -> PyResult<Bound<'py, PyDict>> {
     check_threads(threads)?;
-    let sampling = sampling
-        .map(|s| s.parse().map_err(|e| value_error(format!("sampling: {e}"))))
-        .transpose()?;
     let o = Overrides {
         quality: parse_quality(quality)?,
         spp,
         res,
         seed,
         footprint_filter,
-        sampling,
+        sampling: parse_named("sampling", sampling)?,
     };
     let out = with_scene(py, scene, &o, |loaded| {
         interruptible(py, |stop| {

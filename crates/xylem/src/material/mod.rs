@@ -190,10 +190,11 @@ impl Material {
 
     /// What shading one hit of this material costs, in rays (a ray traced with its share of the
     /// path loop = 1): what adaptive sampling weighs a pixel's samples by (`render::adaptive`).
-    /// Procedural wood 16, measured on the carved bunny (420 × 360, 16 spp, uniform, 2 threads,
-    /// 2 runs each): 4.53–4.65 user s with red oak against 1.67–1.93 s with a Lambertian bunny,
-    /// the difference over its first hits ≈ 16 rays' time each ([`WOOD_SHADING_COST`]); the
-    /// texture-map materials and solid textures a few lookups, counted as 2; the rest 1.
+    /// Procedural wood 16 ([`WOOD_SHADING_COST`]), measured on the carved bunny (420 × 360,
+    /// 16 spp, uniform, 2 threads, 2 runs each): 4.53–4.65 user s with red oak against 1.67–1.93 s
+    /// with a Lambertian bunny, 2.8 s over the 0.65 M samples whose first hit is the bunny, 16.9
+    /// rays' time each (notes/render.md "Adaptive sampling"); the texture-map materials and
+    /// solid textures a few lookups, counted as 2; the rest 1.
     pub fn shading_cost(&self) -> u32 {
         match self {
             Material::Wood(_) => WOOD_SHADING_COST,

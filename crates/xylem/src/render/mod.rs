@@ -89,29 +89,35 @@ pub enum Sampling {
 }
 
 impl Sampling {
+    /// Both ways, in the order of [`Sampling::NAMES`].
+    pub const ALL: [Sampling; 2] = [Sampling::Uniform, Sampling::Adaptive];
     /// The names a scene file or a command line gives.
-    pub const NAMES: [&'static str; 2] = ["adaptive", "uniform"];
+    pub const NAMES: [&'static str; 2] = ["uniform", "adaptive"];
+
+    /// The `--sampling` name (`adaptive`).
+    pub fn name(self) -> &'static str {
+        Self::NAMES[self as usize]
+    }
 }
 
 impl std::str::FromStr for Sampling {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "adaptive" => Ok(Sampling::Adaptive),
-            "uniform" => Ok(Sampling::Uniform),
-            _ => Err(format!(
-                "unknown sampling {s:?} (one of: adaptive, uniform)"
-            )),
-        }
+        Self::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| {
+                format!(
+                    "`{s}` is not a sampling (allowed: {})",
+                    Self::NAMES.join(", ")
+                )
+            })
     }
 }
 
 impl std::fmt::Display for Sampling {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            Sampling::Uniform => "uniform",
-            Sampling::Adaptive => "adaptive",
-        })
+        f.write_str(self.name())
     }
 }
 
@@ -374,7 +380,7 @@ pub fn render_frames_reusing(
     let shadow = ShadowTest::culled(&scene.accel);
     let start = Instant::now();
     let mut pass = TilePass::new(run, tiles.len() as u64, 1, &progress_unit(lights.len()))?;
-    let results = pass.run(&tiles, |t, origin| {
+    let results = pass.run(tiles.iter().map(|&o| (o, ())).collect(), |t, origin, ()| {
         let primary = match reuse {
             Some(p) => Primary::Reuse(&p.tiles[t]),
             None if keep => Primary::Keep,
@@ -386,7 +392,8 @@ pub fn render_frames_reusing(
             span: Span::All(settings.spp),
             carry: None,
         };
-        render_tile(scene, lights, &shadow, settings, job).finish()
+        let tile = render_tile(scene, lights, &shadow, settings, job).finish();
+        (tile.rays, tile)
     })?;
     let rays = pass.finish();
     let mut results: Vec<(UVec2, TileFrames)> = tiles.into_iter().zip(results).collect();
@@ -403,8 +410,9 @@ pub fn render_frames_reusing(
 
 /// [`render_frames`] of one frame with [`Sampling::Adaptive`]: every pixel's first `pilot`
 /// samples, then the cost of the rest of a uniform render's samples spread by
-/// [`adaptive::allocate`] over the pilot's variances and costs, each pixel continuing its own sample sequence where the pilot
-/// left it (so a pixel's samples are those of a uniform render with more spp, in order).
+/// [`adaptive::allocate`] over the pilot's variances and costs, each pixel continuing its own
+/// sample sequence where the pilot left it (so a pixel's samples are those of a uniform render
+/// with more spp, in order).
 fn render_adaptive(
     scene: &Scene,
     lights: &LightFrames,
@@ -416,14 +424,15 @@ fn render_adaptive(
     let shadow = ShadowTest::culled(&scene.accel);
     let start = Instant::now();
     let mut pass = TilePass::new(run, tiles.len() as u64, 2, "tiles (pilot, then the rest)")?;
-    let pilots = pass.run(&tiles, |_, origin| {
+    let pilots = pass.run(tiles.iter().map(|&o| (o, ())).collect(), |_, origin, ()| {
         let job = TileJob {
             origin,
             primary: Primary::Compute,
             span: Span::All(pilot),
             carry: None,
         };
-        render_tile(scene, lights, &shadow, settings, job)
+        let tile = render_tile(scene, lights, &shadow, settings, job);
+        (tile.rays, tile)
     })?;
     let mut measured = vec![adaptive::Pilot::default(); (w * h) as usize];
     for (&origin, tile) in tiles.iter().zip(&pilots) {
@@ -437,10 +446,8 @@ fn render_adaptive(
     let cap = adaptive::MAX_FACTOR * settings.spp - pilot;
     let m = settings.spp - pilot;
     let extra = adaptive::allocate(w, h, &measured, m, cap, settings.seed);
-    let mut carried: Vec<Option<TileSums>> = pilots.into_iter().map(Some).collect();
-    let carried = std::sync::Mutex::new(&mut carried);
-    let results = pass.run(&tiles, |t, origin| {
-        let carry = carried.lock().expect("no panic holds it")[t].take();
+    let carried = tiles.iter().copied().zip(pilots).collect();
+    let results = pass.run(carried, |_, origin, carry| {
         let tw = TILE.min(w - origin.x) as usize;
         let th = TILE.min(h - origin.y) as usize;
         let counts: Vec<u32> = (0..tw * th)
@@ -453,9 +460,10 @@ fn render_adaptive(
                 first: pilot,
                 extra: &counts,
             },
-            carry,
+            carry: Some(carry),
         };
-        render_tile(scene, lights, &shadow, settings, job).finish()
+        let tile = render_tile(scene, lights, &shadow, settings, job).finish();
+        (tile.rays, tile)
     })?;
     let rays = pass.finish();
     let results: Vec<(UVec2, TileFrames)> = tiles.into_iter().zip(results).collect();
@@ -507,25 +515,24 @@ impl<'a> TilePass<'a> {
         })
     }
 
-    /// `tile(index, origin)` for every tile, in tile order.
-    fn run<T: Send + Rayed>(
+    /// `tile(index, origin, input)` for every (tile origin, input) of `jobs`, in their order;
+    /// each gives its result and the rays it traced.
+    fn run<I: Send, T: Send>(
         &mut self,
-        tiles: &[UVec2],
-        tile: impl Fn(usize, UVec2) -> T + Sync + Send,
+        jobs: Vec<(UVec2, I)>,
+        tile: impl Fn(usize, UVec2, I) -> (u64, T) + Sync + Send,
     ) -> Result<Vec<T>, RenderError> {
         let stopped = std::sync::atomic::AtomicBool::new(false);
         let this = &*self;
         let results: Vec<Option<T>> = self.pool.install(|| {
-            tiles
-                .par_iter()
+            jobs.into_par_iter()
                 .enumerate()
-                .map(|(t, &origin)| {
+                .map(|(t, (origin, input))| {
                     if stopped.load(Ordering::Relaxed) || this.run.progress.stop() {
                         stopped.store(true, Ordering::Relaxed);
                         return None;
                     }
-                    let out = tile(t, origin);
-                    let rays = out.rays();
+                    let (rays, out) = tile(t, origin, input);
                     let total = this.rays.fetch_add(rays, Ordering::Relaxed) + rays;
                     let secs = this.start.elapsed().as_secs_f64().max(1e-9);
                     let done = this.done.fetch_add(1, Ordering::Relaxed) + 1;
@@ -549,23 +556,6 @@ impl<'a> TilePass<'a> {
     fn finish(self) -> u64 {
         self.run.progress.finish();
         self.rays.into_inner()
-    }
-}
-
-/// What a tile pass counts its rays from.
-trait Rayed {
-    fn rays(&self) -> u64;
-}
-
-impl Rayed for TileFrames {
-    fn rays(&self) -> u64 {
-        self.rays
-    }
-}
-
-impl Rayed for TileSums {
-    fn rays(&self) -> u64 {
-        self.rays
     }
 }
 
