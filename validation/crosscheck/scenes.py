@@ -204,13 +204,17 @@ CASES = {c()["name"]: c for c in (cornell_lambertian, cornell_spheres, plane_poi
 
 
 def write_obj(path, mesh):
+    """The mesh as an OBJ file, written whole under a temporary name first (a concurrent run
+    writing the same file never leaves a reader half of it)."""
     v, f = mesh
-    with open(path, "w") as out:
+    tmp = f"{path}.{os.getpid()}.partial"
+    with open(tmp, "w") as out:
         out.write("# written by validation/crosscheck/scenes.py\n")
         for p in v:
             out.write(f"v {p[0]:.9g} {p[1]:.9g} {p[2]:.9g}\n")
         for t in f:
             out.write(f"f {t[0] + 1} {t[1] + 1} {t[2] + 1}\n")
+    os.replace(tmp, path)
 
 
 def write_meshes(case, folder):

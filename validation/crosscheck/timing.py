@@ -1,7 +1,10 @@
-"""Timing mode: Mitsuba 3 rendering the Lambertian Cornell box (scenes/cornell_box.toml's scene,
-256 × 256, xylem depth 8 = Mitsuba depth 9, box filter), its samples/s and its RMSE against a
-high-spp reference, and the same figures for a xylem image of the scene if one is given
-(`xylem bench render` passes its own).
+"""Timing mode: Mitsuba 3 rendering a Cornell box (256 × 256, xylem depth 8 = Mitsuba depth 9,
+box filter; `--case`: `cornell_box`, the Lambertian box of scenes/cornell_box.toml, or
+`cornell_spheres`, the same walls with a mirror and a glass sphere), its samples/s and its RMSE
+against a high-spp reference, and the same figures for a xylem image of the scene if one is
+given (`xylem bench render` passes its own). With `--serve` the case is also written as a xylem
+scene file (`xylem_<case>.toml` in the work folder, its meshes beside it) whose path ends the
+`ready` line, so that xylem renders the very scene Mitsuba renders.
 
 samples/s = width · height · spp / seconds of the render itself: the scene is loaded and rendered
 once (Dr.Jit compiles its kernels then), and later renders of the same scene and seed, which
@@ -33,12 +36,17 @@ from . import render, scenes
 
 RES = (256, 256)
 DEPTH = 8
+# The cases `--case` names.
+CASES = {"cornell_box": scenes.cornell_lambertian, "cornell_spheres": scenes.cornell_spheres}
 # Mitsuba's `rr_depth` equal to xylem's roulette start (bounce 3), for the timed render.
 RR_DEPTH = 3
 
 
 def add_arguments(ap):
     g = ap.add_argument_group("timing")
+    g.add_argument("--case", default="cornell_box", choices=sorted(CASES),
+                   help="the scene: the Lambertian Cornell box (default) or the box with a "
+                        "mirror and a glass sphere")
     g.add_argument("--spp", type=int, default=64, help="spp of the timed render (64)")
     g.add_argument("--reference-spp", type=int, default=2048)
     g.add_argument("--xylem-image", default=None, help="a xylem EXR of the scene to score")
@@ -52,14 +60,14 @@ def add_arguments(ap):
                    help="time one render per `render` line on stdin, then score (see above)")
 
 
-def reference(mi, folder, meshes, spp):
-    """The cached high-spp Mitsuba image (H, W, 3)."""
-    path = os.path.join(folder, f"reference_cornell_box_{RES[0]}x{RES[1]}_d{DEPTH}_{spp}spp.exr")
+def reference(mi, folder, case, meshes, spp):
+    """The cached high-spp Mitsuba image (H, W, 3) of `case`."""
+    path = os.path.join(folder,
+                        f"reference_{case['name']}_{RES[0]}x{RES[1]}_d{DEPTH}_{spp}spp.exr")
     if os.path.exists(path):
         return render.read_exr_rgb(mi, path), path
     chunk = min(256, spp)
-    scene = mi.load_dict(scenes.mitsuba_dict(mi, scenes.cornell_lambertian(), meshes, DEPTH,
-                                             chunk, 0, RES))
+    scene = mi.load_dict(scenes.mitsuba_dict(mi, case, meshes, DEPTH, chunk, 0, RES))
     acc = np.zeros((RES[1], RES[0], 3))
     for k in range(spp // chunk):
         acc += np.array(mi.render(scene, seed=100_000 + k, spp=chunk), dtype=np.float64)[..., :3]
@@ -90,16 +98,23 @@ def rmse_surfaces(a, ref):
     return float(np.sqrt(np.mean((a[keep] - ref[keep]) ** 2)))
 
 
+def mean_ratio(a, ref):
+    """The image's mean luminance over the reference's: 1 within noise when both render one
+    scene (a quick like-with-like check; the cross-check proper is `--small`/`--full`)."""
+    lum = np.array([0.2126, 0.7152, 0.0722])
+    return float((a @ lum).mean() / (ref @ lum).mean())
+
+
 def run(mi, args):
     import drjit as dr
 
     os.makedirs(args.work, exist_ok=True)
-    meshes = scenes.write_meshes(scenes.cornell_lambertian(), os.path.join(args.work, "meshes"))
-    ref, ref_path = reference(mi, args.work, meshes, args.reference_spp)
+    case = CASES[args.case]()
+    meshes = scenes.write_meshes(case, os.path.join(args.work, "meshes"))
+    ref, ref_path = reference(mi, args.work, case, meshes, args.reference_spp)
     t0 = time.perf_counter()
-    scene = mi.load_dict(scenes.mitsuba_dict(mi, scenes.cornell_lambertian(), meshes, DEPTH,
-                                             args.spp, 1, RES, rr_depth=RR_DEPTH,
-                                             sampler=args.sampler))
+    scene = mi.load_dict(scenes.mitsuba_dict(mi, case, meshes, DEPTH, args.spp, 1, RES,
+                                             rr_depth=RR_DEPTH, sampler=args.sampler))
     load_s = time.perf_counter() - t0
     def timed():
         t0 = time.perf_counter()
@@ -111,7 +126,14 @@ def run(mi, args):
     img, first = timed()  # JIT compilation
     times, xylem = [], None
     if args.serve:
-        print("ready", flush=True)
+        # The same case for xylem (seed 1, as Mitsuba's), written whole under a temporary name
+        # first: a concurrent run never reads half a file.
+        toml = os.path.join(args.work, f"xylem_{case['name']}.toml")
+        tmp = f"{toml}.{os.getpid()}.partial"
+        with open(tmp, "w") as f:
+            f.write(scenes.xylem_toml(case, meshes, DEPTH, args.spp, 1, RES))
+        os.replace(tmp, toml)
+        print(f"ready {os.path.abspath(toml)}", flush=True)
         for line in sys.stdin:
             word, _, rest = line.strip().partition(" ")
             if word == "render":
@@ -140,7 +162,7 @@ def run(mi, args):
          "rmse_surfaces": rmse_surfaces(img, ref)}
     m["rmse_equal_time"] = m["rmse"]
     m["rmse_surfaces_equal_time"] = m["rmse_surfaces"]
-    out = {"res": list(RES), "xylem_depth": DEPTH, "mitsuba_depth": DEPTH + 1,
+    out = {"case": case["name"], "res": list(RES), "xylem_depth": DEPTH, "mitsuba_depth": DEPTH + 1,
            "mitsuba_rr_depth": RR_DEPTH,
            "reference": os.path.relpath(ref_path), "reference_spp": args.reference_spp,
            "reference_mean": ref.mean(axis=(0, 1)).tolist(), "mitsuba": m,
@@ -148,7 +170,8 @@ def run(mi, args):
     if xylem:
         x = render.read_exr_rgb(mi, xylem["image"])
         xs = {"renderer": "xylem", "image": xylem["image"], "rmse": rmse(x, ref),
-              "rmse_surfaces": rmse_surfaces(x, ref), "spp": xylem["spp"]}
+              "rmse_surfaces": rmse_surfaces(x, ref), "spp": xylem["spp"],
+              "mean_ratio": mean_ratio(x, ref)}
         if xylem["seconds"]:
             xsec = float(np.median(xylem["seconds"]))
             xs["seconds"] = xsec
@@ -166,7 +189,7 @@ def run(mi, args):
 
 
 def table(out):
-    lines = [f"Cornell box {out['res'][0]}x{out['res'][1]}, xylem depth {out['xylem_depth']} "
+    lines = [f"{out.get('case', 'cornell_box')} {out['res'][0]}x{out['res'][1]}, xylem depth {out['xylem_depth']} "
              f"(Mitsuba {out['mitsuba_depth']}, rr_depth {out['mitsuba_rr_depth']} = xylem's "
              f"roulette start), Mitsuba sampler {out['mitsuba'].get('sampler', 'independent')}, "
              f"reference {out['reference']} "
@@ -192,6 +215,7 @@ def table(out):
                      f"{x['rmse_equal_time'] / m['rmse_equal_time']:.3f}; off the light: RMSE "
                      f"{x['rmse_surfaces'] / m['rmse_surfaces']:.3f}, at equal time "
                      f"{x['rmse_surfaces_equal_time'] / m['rmse_surfaces_equal_time']:.3f}")
+        lines.append(f"xylem's mean luminance / the reference's: {x['mean_ratio']:.4f}")
         if "ratio_range" in x:
             lo, hi = x["ratio_range"]
             lines.append(f"samples/s ratio over {x['repeats']} interleaved pairs: "

@@ -1,16 +1,21 @@
-//! `xylem bench render`: xylem against Mitsuba 3 on the Lambertian Cornell box, renders timed
-//! interleaved, both scored against one Mitsuba reference ([`xylem_lab::bench::render`]).
+//! `xylem bench render`: xylem against Mitsuba 3 on a Cornell box (Lambertian, or with a mirror
+//! and a glass sphere), renders timed interleaved, both scored against one Mitsuba reference
+//! ([`xylem_lab::bench::render`]).
 
 use std::path::PathBuf;
 use std::process::ExitCode;
-use xylem_lab::bench::render::{run as bench, RenderBench};
+use xylem_lab::bench::render::{run as bench, RenderBench, CASES};
 use xylem_lab::tradeoff::median_range;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// The scene (a file, or a built-in scene's name).
-    #[arg(long, default_value = "scenes/cornell_box.toml")]
-    scene: PathBuf,
+    /// The scene both render: `cornell_box` (Lambertian) or `cornell_spheres` (a mirror and a
+    /// glass sphere in the box), written as a xylem scene file by Mitsuba's timing process.
+    #[arg(long, default_value = "cornell_box", value_parser = CASES)]
+    case: String,
+    /// Time xylem alone (with --no-mitsuba) on this scene (a file, or a built-in scene's name).
+    #[arg(long)]
+    scene: Option<PathBuf>,
     /// Samples per pixel of each timed render (both renderers).
     #[arg(long, default_value_t = 64)]
     spp: u32,
@@ -39,6 +44,7 @@ pub struct Args {
 
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let t = bench(&RenderBench {
+        case: args.case,
         scene: args.scene,
         spp: args.spp,
         threads: args.threads,

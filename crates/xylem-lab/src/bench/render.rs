@@ -1,8 +1,9 @@
-//! The render benchmark behind `xylem bench render`: xylem against Mitsuba 3 on the Lambertian
-//! Cornell box (scenes/cornell_box.toml: 256², path tracing to depth 8, box filter) in one run:
-//! xylem renders it through the library (`render::render`), then `python -m
-//! validation.crosscheck --timing` renders it in Mitsuba (depth 9 in Mitsuba's counting) and
-//! scores both images against one high-spp Mitsuba reference. Both renders are timed after a
+//! The render benchmark behind `xylem bench render`: xylem against Mitsuba 3 on a Cornell box
+//! (256², path tracing to depth 8, box filter; the Lambertian box of scenes/cornell_box.toml, or
+//! the box with a mirror and a glass sphere) in one run: `python -m validation.crosscheck
+//! --timing --case …` writes the case as a xylem scene file and renders it in Mitsuba (depth 9
+//! in Mitsuba's counting), xylem renders that file through the library (`render::render`), and
+//! Mitsuba's process scores both images against one high-spp Mitsuba reference. Both renders are timed after a
 //! first, untimed one (scene loading and Mitsuba's JIT compilation excluded), `repeats` times
 //! each, interleaved (xylem, Mitsuba, xylem, …: Mitsuba's process stays up between its renders,
 //! `--serve`), so that a change of machine load falls on both; medians and ranges are reported.
@@ -18,8 +19,12 @@ use xylem::scene::SceneError;
 /// What `xylem bench render` measures.
 #[derive(Clone, Debug)]
 pub struct RenderBench {
-    /// The scene (a file, or a built-in scene's name).
-    pub scene: PathBuf,
+    /// The scene both renderers render: a case of `validation.crosscheck --timing`
+    /// ([`CASES`]), written as a xylem scene file by Mitsuba's timing process.
+    pub case: String,
+    /// A scene (a file, or a built-in scene's name) to time xylem alone on, with `no_mitsuba`;
+    /// `None`: the case's (scenes/cornell_box.toml for `cornell_box` without Mitsuba).
+    pub scene: Option<PathBuf>,
     /// Samples per pixel of each timed render (both renderers), 1 to 1000000.
     pub spp: u32,
     /// Render threads (xylem) and Dr.Jit worker threads (Mitsuba), 1 to 256.
@@ -80,12 +85,18 @@ pub struct RenderTimes {
     pub mitsuba_table: Option<String>,
 }
 
+/// The cases `validation.crosscheck --timing --case` renders: the Lambertian Cornell box
+/// (scenes/cornell_box.toml's scene) and the same walls with a mirror and a glass sphere.
+pub const CASES: [&str; 2] = ["cornell_box", "cornell_spheres"];
+
 /// Mitsuba's timing process (`python -m validation.crosscheck --timing --serve`): one timed
 /// render per request, the scores at the end.
 struct Mitsuba {
     child: std::process::Child,
     stdin: std::process::ChildStdin,
     stdout: BufReader<std::process::ChildStdout>,
+    /// The case as a xylem scene file, written by the process (its `ready` line).
+    scene: PathBuf,
 }
 
 impl Mitsuba {
@@ -105,12 +116,16 @@ impl Mitsuba {
             child,
             stdin,
             stdout: BufReader::new(stdout),
+            scene: PathBuf::new(),
         };
         let ready = m.line()?;
-        if ready != "ready" {
-            return Err(RenderBenchError::Mitsuba(format!(
-                "Mitsuba's timing process said `{ready}` instead of `ready`"
-            )));
+        match ready.strip_prefix("ready ") {
+            Some(scene) => m.scene = PathBuf::from(scene),
+            None => {
+                return Err(RenderBenchError::Mitsuba(format!(
+                    "Mitsuba's timing process said `{ready}` instead of `ready SCENE`"
+                )))
+            }
         }
         Ok(m)
     }
@@ -183,25 +198,18 @@ pub fn run(b: &RenderBench) -> Result<RenderTimes, RenderBenchError> {
     if !(1..=256).contains(&b.threads) {
         return bad(format!("--threads {}: allowed 1 to 256", b.threads));
     }
-    let mut loaded = xylem::scene::load(&b.scene)?;
-    if !b.no_mitsuba && loaded.name != "cornell_box" {
-        // The Mitsuba side (validation/crosscheck --timing) builds the Cornell box only: timing
-        // it against another scene would compare different images.
+    if !CASES.contains(&b.case.as_str()) {
+        return bad(format!("--case {}: allowed {}", b.case, CASES.join(", ")));
+    }
+    if let (Some(scene), false) = (&b.scene, b.no_mitsuba) {
+        // Mitsuba renders the case's scene: timing it against another would compare different
+        // images.
         return bad(format!(
-            "--scene {}: the Mitsuba 3 side of this benchmark renders only the Cornell box \
-             (validation/crosscheck --timing); pass --no-mitsuba to time xylem alone",
-            b.scene.display()
+            "--scene {}: the Mitsuba 3 side of this benchmark renders its own case (--case); \
+             pass --no-mitsuba to time xylem alone on another scene",
+            scene.display()
         ));
     }
-    loaded.settings.spp = b.spp;
-    // spp in every pixel, as Mitsuba samples: samples/s and RMSE per sample compare like with
-    // like (adaptive sampling, `render`'s default, spreads a pixel's samples unevenly).
-    loaded.settings.sampling = xylem::render::Sampling::Uniform;
-    let (w, h) = (loaded.scene.camera.width, loaded.scene.camera.height);
-    let opts = RunOptions {
-        threads: b.threads,
-        ..Default::default()
-    };
     if !(1..=100).contains(&b.repeats) {
         return bad(format!("--repeats {}: allowed 1 to 100", b.repeats));
     }
@@ -212,6 +220,29 @@ pub fn run(b: &RenderBench) -> Result<RenderTimes, RenderBenchError> {
             Ok(m) => (Some(m), None),
             Err(why) => (None, Some(why)),
         }
+    };
+    let scene = match (&mitsuba, &b.scene) {
+        (Some(m), _) => m.scene.clone(),
+        (None, Some(scene)) => scene.clone(),
+        (None, None) if b.case == "cornell_box" => PathBuf::from("scenes/cornell_box.toml"),
+        (None, None) => {
+            return bad(format!(
+                "--case {}: its scene file is written by Mitsuba's timing process, which did \
+                 not start ({}); pass --scene FILE --no-mitsuba to time xylem alone",
+                b.case,
+                mitsuba_skipped.as_deref().unwrap_or("--no-mitsuba")
+            ))
+        }
+    };
+    let mut loaded = xylem::scene::load(&scene)?;
+    loaded.settings.spp = b.spp;
+    // spp in every pixel, as Mitsuba samples: samples/s and RMSE per sample compare like with
+    // like (adaptive sampling, `render`'s default, spreads a pixel's samples unevenly).
+    loaded.settings.sampling = xylem::render::Sampling::Uniform;
+    let (w, h) = (loaded.scene.camera.width, loaded.scene.camera.height);
+    let opts = RunOptions {
+        threads: b.threads,
+        ..Default::default()
     };
     render(&loaded.scene, &loaded.settings, &opts)?; // warm-up, untimed
     let (mut xylem_s, mut mitsuba_s) = (Vec::new(), Vec::new());
@@ -240,7 +271,7 @@ pub fn run(b: &RenderBench) -> Result<RenderTimes, RenderBenchError> {
     let work = repository()
         .map(|r| r.join("target/crosscheck/timing"))
         .ok_or_else(|| RenderBenchError::Mitsuba("the repository".into()))?;
-    let exr = work.join("xylem_bench_render.exr");
+    let exr = work.join(format!("xylem_bench_render_{}.exr", b.case));
     image_io::write_image_exr(&exr, &out.image, &[])?;
     let score = serde_json::json!({
         "image": exr, "spp": b.spp, "seconds": times.xylem_s,
@@ -276,6 +307,7 @@ fn mitsuba_process(b: &RenderBench) -> Result<Started, RenderBenchError> {
         .map_err(|e| RenderBenchError::Mitsuba(format!("cannot create {}: {e}", work.display())))?;
     let mut cmd = Command::new(&python);
     cmd.args(["-m", "validation.crosscheck", "--timing", "--serve"])
+        .args(["--case", &b.case])
         .args(["--threads", &b.threads.to_string()])
         .args(["--spp", &b.spp.to_string()])
         .args(["--reference-spp", &b.reference_spp.to_string()])
