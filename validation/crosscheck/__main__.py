@@ -6,8 +6,10 @@ Mitsuba 3 on the same scenes (validation/CROSSCHECK.md says what is compared and
           (crates/xylem-cli/tests/crosscheck.rs runs it in `cargo test --release`).
 --full    every case at xylem depths 1, 2 and 8; writes validation/CROSSCHECK.md and the
           pictures in validation/plots/crosscheck/.
---timing  Mitsuba's speed and error on the Lambertian Cornell box (`xylem bench render` runs it
-          beside xylem's).
+--timing  Mitsuba's speed and error on one scene, `--case cornell_box` (the Lambertian Cornell
+          box), `cornell_spheres` (the box with a mirror and a glass sphere) or `wood_board`
+          (a mahogany board through the xylem_wood plugin); `xylem bench render` runs it
+          beside xylem's.
 """
 
 import argparse

@@ -161,6 +161,39 @@ def cornell_spheres():
     }
 
 
+def wood_board():
+    """(f) sweep_board's finished board under a rect light, path traced: the mahogany board
+    (260 × 110 × 18 mm on a dark table; the tree axis along x, the pith 120 mm from the board's
+    centre line at the top face's height, so the top face is quartersawn, as sweep_board's) with
+    a rough finish (roughness 0.25) under a 120 mm square light above and to the side. Mitsuba
+    renders it through the `xylem_wood` plugin (the same wood and BSDF, point-sampled: xylem's
+    footprint filter is off, and the plugin has no pore bump, so neither has one). For the speed
+    benchmark (`xylem bench render --case wood_board`), not the cross-check's cases."""
+    # edge_u × edge_v points down: the light faces the board.
+    light = {"type": "rect", "corner": [90.0, -60.0, 400.0], "edge_u": [0.0, 120.0, 0.0],
+             "edge_v": [120.0, 0.0, 0.0], "radiance": 50.0}
+    return {
+        "name": "wood_board", "res": (256, 192),
+        "camera": {"eye": [0.0, -250.0, 190.0], "target": [0.0, 0.0, 5.0],
+                   "up": [0.0, 0.0, 1.0], "fov_deg": 38.0},
+        "render": {"footprint_filter": False},
+        "materials": {
+            "table": {"type": "lambertian", "albedo": [0.03, 0.03, 0.035]},
+            "board": {"type": "wood", "preset": "african_mahogany", "seed": 7, "eta": 1.5,
+                      "roughness": 0.25, "bump": 0.0},
+            "black": {"type": "lambertian", "albedo": [0.0, 0.0, 0.0]},
+        },
+        "lights": [light],
+        "shapes": [
+            ("table", box([900, 900, 20], translate=[0, 0, -10]), "table"),
+            ("board", box([260, 110, 18], translate=[0, 0, 9]), "board"),
+            ("light_housing", housing(light), "black"),
+        ],
+        "trees": {"board": {"origin": [0.0, 120.0, 18.0], "axis": [1.0, 0.0, 0.0],
+                            "rotation_deg": 0.0}},
+    }
+
+
 PLANE_CAMERA = {"eye": [0.0, -420.0, 260.0], "target": [0.0, 0.0, 0.0], "up": [0.0, 0.0, 1.0],
                 "fov_deg": 50.0}
 
@@ -228,6 +261,10 @@ def write_meshes(case, folder):
 
 
 def toml_value(x):
+    if isinstance(x, bool):
+        return "true" if x else "false"
+    if isinstance(x, int):
+        return str(x)
     if isinstance(x, str):
         return f'"{x}"'
     if isinstance(x, (list, tuple, np.ndarray)):
@@ -240,7 +277,9 @@ def xylem_toml(case, meshes, max_depth, spp, seed, res=None):
     w, h = res or case["res"]
     cam = case["camera"]
     lines = ["[render]", f"width = {w}", f"height = {h}", f"spp = {spp}", 'integrator = "path"',
-             f"max_depth = {max_depth}", f"seed = {seed}", 'filter = "box"', "", "[camera]"]
+             f"max_depth = {max_depth}", f"seed = {seed}", 'filter = "box"']
+    lines += [f"{k} = {toml_value(v)}" for k, v in case.get("render", {}).items()]
+    lines += ["", "[camera]"]
     lines += [f"{k} = {toml_value(cam[k])}" for k in ("eye", "target", "up", "fov_deg")]
     for light in case["lights"]:
         lines += ["", "[[lights]]"] + [f"{k} = {toml_value(v)}" for k, v in light.items()]
@@ -250,6 +289,10 @@ def xylem_toml(case, meshes, max_depth, spp, seed, res=None):
         lines += ["", "[[objects]]", f'name = "{name}"', 'shape = "mesh"',
                   f"file = {toml_value(os.path.abspath(meshes[name]))}", "smooth = false",
                   f'material = "{material}"']
+        tree = case.get("trees", {}).get(name)
+        if tree:
+            fields = ", ".join(f"{k} = {toml_value(v)}" for k, v in tree.items())
+            lines.append(f'tree = {{ {fields}, space = "world" }}')
     return "\n".join(lines) + "\n"
 
 
@@ -257,8 +300,17 @@ def rgb(v):
     return {"type": "rgb", "value": [float(x) for x in v]}
 
 
-def mitsuba_bsdf(m):
-    """xylem's material as Mitsuba's: opaque ones two-sided, as xylem shades them."""
+def mitsuba_bsdf(m, tree=None):
+    """xylem's material as Mitsuba's: opaque ones two-sided, as xylem shades them; wood as the
+    `xylem_wood` plugin (scene units mm) with the object's `tree` placement (world space)."""
+    if m["type"] == "wood":
+        tree = tree or {}
+        vec = lambda v: ", ".join(f"{float(x):g}" for x in v)
+        return {"type": "xylem_wood", "preset": m["preset"], "seed": int(m["seed"]),
+                "eta": float(m["eta"]), "roughness": float(m["roughness"]), "units": "mm",
+                "origin": vec(tree.get("origin", [0, 0, 0])),
+                "axis": vec(tree.get("axis", [0, 0, 1])),
+                "rotation_deg": float(tree.get("rotation_deg", 0.0))}
     if m["type"] == "lambertian":
         return {"type": "twosided", "b": {"type": "diffuse", "reflectance": rgb(m["albedo"])}}
     if m["type"] == "mirror":
@@ -311,5 +363,7 @@ def mitsuba_dict(mi, case, meshes, max_depth, spp, seed, res=None, rr_depth=5,
             raise ValueError(f"no Mitsuba equivalent for light type {light['type']!r}")
     for name, _, material in case["shapes"]:
         scene[name] = {"type": "obj", "filename": os.path.abspath(meshes[name]),
-                       "face_normals": True, "bsdf": mitsuba_bsdf(case["materials"][material])}
+                       "face_normals": True,
+                       "bsdf": mitsuba_bsdf(case["materials"][material],
+                                            case.get("trees", {}).get(name))}
     return scene

@@ -24,6 +24,7 @@ survival at 0.95, xylem at 1. The reference keeps Mitsuba's default (5): any unb
 converges to the same image.
 """
 
+import contextlib
 import json
 import math
 import os
@@ -34,10 +35,10 @@ import numpy as np
 
 from . import render, scenes
 
-RES = (256, 256)
 DEPTH = 8
 # The cases `--case` names.
-CASES = {"cornell_box": scenes.cornell_lambertian, "cornell_spheres": scenes.cornell_spheres}
+CASES = {"cornell_box": scenes.cornell_lambertian, "cornell_spheres": scenes.cornell_spheres,
+         "wood_board": scenes.wood_board}
 # Mitsuba's `rr_depth` equal to xylem's roulette start (bounce 3), for the timed render.
 RR_DEPTH = 3
 
@@ -60,17 +61,44 @@ def add_arguments(ap):
                    help="time one render per `render` line on stdin, then score (see above)")
 
 
+def uses_plugin(case):
+    """Whether the case has wood, which Mitsuba renders through xylem's `xylem_wood` plugin."""
+    return any(m["type"] == "wood" for m in case["materials"].values())
+
+
+def mitsuba_mode(case):
+    """The Dr.Jit mode Mitsuba renders `case` in: the plugin reads its inputs into numpy, so
+    wood renders inside `xylem.mitsuba.evaluated()` (wavefront mode); the boxes in Dr.Jit's
+    default (symbolic, one megakernel). Registers the plugin first (it must be, before the
+    scene loads)."""
+    if not uses_plugin(case):
+        return contextlib.nullcontext()
+    try:
+        import xylem.mitsuba
+    except ImportError as e:
+        raise SystemExit(
+            f"--case {case['name']}: Mitsuba renders its wood through xylem's plugin, and the "
+            f"xylem Python package is not importable ({e}): `cargo test --release --test python` "
+            "stages it in target/python-test/site (`xylem bench render` puts that on "
+            "PYTHONPATH), or `pip install ./python`")
+    xylem.mitsuba.register()
+    return xylem.mitsuba.evaluated()
+
+
 def reference(mi, folder, case, meshes, spp):
     """The cached high-spp Mitsuba image (H, W, 3) of `case`."""
-    path = os.path.join(folder,
-                        f"reference_{case['name']}_{RES[0]}x{RES[1]}_d{DEPTH}_{spp}spp.exr")
+    w, h = case["res"]
+    path = os.path.join(folder, f"reference_{case['name']}_{w}x{h}_d{DEPTH}_{spp}spp.exr")
     if os.path.exists(path):
         return render.read_exr_rgb(mi, path), path
     chunk = min(256, spp)
-    scene = mi.load_dict(scenes.mitsuba_dict(mi, case, meshes, DEPTH, chunk, 0, RES))
-    acc = np.zeros((RES[1], RES[0], 3))
+    mitsuba_mode(case)  # registers the plugin where the case needs it
+    scene = mi.load_dict(scenes.mitsuba_dict(mi, case, meshes, DEPTH, chunk, 0))
+    acc = np.zeros((h, w, 3))
     for k in range(spp // chunk):
-        acc += np.array(mi.render(scene, seed=100_000 + k, spp=chunk), dtype=np.float64)[..., :3]
+        with mitsuba_mode(case):
+            img = mi.render(scene, seed=100_000 + k, spp=chunk)
+        acc += np.array(img, dtype=np.float64)[..., :3]
     img = acc / (spp // chunk)
     bmp = mi.Bitmap(img.astype(np.float32), mi.Bitmap.PixelFormat.RGB)
     tmp = path[: -len(".exr")] + ".partial.exr"
@@ -113,14 +141,16 @@ def run(mi, args):
     meshes = scenes.write_meshes(case, os.path.join(args.work, "meshes"))
     ref, ref_path = reference(mi, args.work, case, meshes, args.reference_spp)
     t0 = time.perf_counter()
-    scene = mi.load_dict(scenes.mitsuba_dict(mi, case, meshes, DEPTH, args.spp, 1, RES,
+    mitsuba_mode(case)  # registers the plugin where the case needs it
+    scene = mi.load_dict(scenes.mitsuba_dict(mi, case, meshes, DEPTH, args.spp, 1,
                                              rr_depth=RR_DEPTH, sampler=args.sampler))
     load_s = time.perf_counter() - t0
     def timed():
         t0 = time.perf_counter()
-        img = mi.render(scene, seed=1, spp=args.spp)
-        dr.eval(img)
-        dr.sync_thread()
+        with mitsuba_mode(case):
+            img = mi.render(scene, seed=1, spp=args.spp)
+            dr.eval(img)
+            dr.sync_thread()
         return img, time.perf_counter() - t0
 
     img, first = timed()  # JIT compilation
@@ -131,7 +161,7 @@ def run(mi, args):
         toml = os.path.join(args.work, f"xylem_{case['name']}.toml")
         tmp = f"{toml}.{os.getpid()}.partial"
         with open(tmp, "w") as f:
-            f.write(scenes.xylem_toml(case, meshes, DEPTH, args.spp, 1, RES))
+            f.write(scenes.xylem_toml(case, meshes, DEPTH, args.spp, 1))
         os.replace(tmp, toml)
         print(f"ready {os.path.abspath(toml)}", flush=True)
         for line in sys.stdin:
@@ -152,7 +182,7 @@ def run(mi, args):
     if not times:
         raise SystemExit("--serve: no `render` line before `score`")
     img = np.array(img, dtype=np.float64)[..., :3]
-    samples = RES[0] * RES[1] * args.spp
+    samples = case["res"][0] * case["res"][1] * args.spp
     sec = float(np.median(times))
     m = {"renderer": f"Mitsuba {mi.__version__} {mi.variant()}", "sampler": args.sampler,
          "threads": args.threads,
@@ -162,7 +192,7 @@ def run(mi, args):
          "rmse_surfaces": rmse_surfaces(img, ref)}
     m["rmse_equal_time"] = m["rmse"]
     m["rmse_surfaces_equal_time"] = m["rmse_surfaces"]
-    out = {"case": case["name"], "res": list(RES), "xylem_depth": DEPTH, "mitsuba_depth": DEPTH + 1,
+    out = {"case": case["name"], "res": list(case["res"]), "xylem_depth": DEPTH, "mitsuba_depth": DEPTH + 1,
            "mitsuba_rr_depth": RR_DEPTH,
            "reference": os.path.relpath(ref_path), "reference_spp": args.reference_spp,
            "reference_mean": ref.mean(axis=(0, 1)).tolist(), "mitsuba": m,
@@ -177,7 +207,7 @@ def run(mi, args):
             xs["seconds"] = xsec
             xs["seconds_range"] = [min(xylem["seconds"]), max(xylem["seconds"])]
             xs["repeats"] = len(xylem["seconds"])
-            xs["samples_per_s"] = RES[0] * RES[1] * xs["spp"] / xsec
+            xs["samples_per_s"] = case["res"][0] * case["res"][1] * xs["spp"] / xsec
             scale = math.sqrt(xsec / m["seconds"])
             xs["rmse_equal_time"] = xs["rmse"] * scale
             xs["rmse_surfaces_equal_time"] = xs["rmse_surfaces"] * scale

@@ -16,10 +16,10 @@
 
 mod common;
 
-use common::python::{libllvm, venv};
+use common::python::{libllvm, stage_package, venv};
 use glam::{Vec2, Vec3};
 use serde_json::{json, Value};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::Command;
 use xylem::bsdf::{Bsdf, WoodBsdf, WoodBsdfParams};
 use xylem::material::{Cutting, Material, MaterialHit, Placement, WoodMaterial};
@@ -214,36 +214,6 @@ fn render_case() -> Value {
         "sweep": sweep.frames.iter().map(|f| rows(&f.beauty)).collect::<Vec<_>>(),
         "sweep_light_deg": (0..3).map(|k| path.light_deg(k)).collect::<Vec<_>>(),
     })
-}
-
-/// The package as pip would install it: python/xylem/*.py, *.pyi, py.typed and the extension module that this
-/// `cargo test` built (the `_xylem` example, from python/src/lib.rs) in target/python-test/site.
-fn stage_package(dir: &Path) -> PathBuf {
-    let exe = std::env::current_exe().expect("test binary path");
-    // target/<profile>/deps/python-<hash> → target/<profile>/examples/lib_xylem.so
-    let profile = exe
-        .parent()
-        .and_then(Path::parent)
-        .expect("target/<profile>");
-    let ext = profile.join("examples/lib_xylem.so");
-    assert!(
-        ext.exists(),
-        "{} is missing: `cargo test --release` builds it as the `_xylem` example (when selecting tests, build it first: `cargo build --release --example _xylem`)",
-        ext.display()
-    );
-    let site = dir.join("site");
-    let pkg = site.join("xylem");
-    std::fs::create_dir_all(&pkg).unwrap();
-    for entry in std::fs::read_dir(root().join("python/xylem")).unwrap() {
-        let p = entry.unwrap().path();
-        // Sources, type stubs and the PEP 561 marker, as the wheel carries them.
-        let name = p.file_name().unwrap().to_string_lossy();
-        if p.extension().is_some_and(|e| e == "py" || e == "pyi") || name == "py.typed" {
-            std::fs::copy(&p, pkg.join(p.file_name().unwrap())).unwrap();
-        }
-    }
-    std::fs::copy(&ext, pkg.join("_xylem.abi3.so")).unwrap();
-    site
 }
 
 #[test]

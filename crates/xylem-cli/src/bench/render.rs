@@ -9,8 +9,10 @@ use xylem_lab::tradeoff::median_range;
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// The scene both render: `cornell_box` (Lambertian) or `cornell_spheres` (a mirror and a
-    /// glass sphere in the box), written as a xylem scene file by Mitsuba's timing process.
+    /// The scene both render: `cornell_box` (Lambertian), `cornell_spheres` (a mirror and a
+    /// glass sphere in the box) or `wood_board` (sweep_board's board under a rect light;
+    /// Mitsuba through the `xylem_wood` plugin), written as a xylem scene file by Mitsuba's
+    /// timing process.
     #[arg(long, default_value = "cornell_box", value_parser = CASES)]
     case: String,
     /// Time xylem alone (with --no-mitsuba) on this scene (a file, or a built-in scene's name).

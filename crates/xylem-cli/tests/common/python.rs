@@ -78,3 +78,33 @@ pub fn libllvm() -> Option<PathBuf> {
         .flat_map(|d| names.iter().map(move |n| Path::new(d).join(n)))
         .find(|p| p.exists())
 }
+
+/// The package as pip would install it: python/xylem/*.py, *.pyi, py.typed and the extension module that this
+/// `cargo test` built (the `_xylem` example, from python/src/lib.rs) in target/python-test/site.
+pub fn stage_package(dir: &Path) -> PathBuf {
+    let exe = std::env::current_exe().expect("test binary path");
+    // target/<profile>/deps/python-<hash> → target/<profile>/examples/lib_xylem.so
+    let profile = exe
+        .parent()
+        .and_then(Path::parent)
+        .expect("target/<profile>");
+    let ext = profile.join("examples/lib_xylem.so");
+    assert!(
+        ext.exists(),
+        "{} is missing: `cargo test --release` builds it as the `_xylem` example (when selecting tests, build it first: `cargo build --release --example _xylem`)",
+        ext.display()
+    );
+    let site = dir.join("site");
+    let pkg = site.join("xylem");
+    std::fs::create_dir_all(&pkg).unwrap();
+    for entry in std::fs::read_dir(root().join("python/xylem")).unwrap() {
+        let p = entry.unwrap().path();
+        // Sources, type stubs and the PEP 561 marker, as the wheel carries them.
+        let name = p.file_name().unwrap().to_string_lossy();
+        if p.extension().is_some_and(|e| e == "py" || e == "pyi") || name == "py.typed" {
+            std::fs::copy(&p, pkg.join(p.file_name().unwrap())).unwrap();
+        }
+    }
+    std::fs::copy(&ext, pkg.join("_xylem.abi3.so")).unwrap();
+    site
+}

@@ -86,8 +86,9 @@ pub struct RenderTimes {
 }
 
 /// The cases `validation.crosscheck --timing --case` renders: the Lambertian Cornell box
-/// (scenes/cornell_box.toml's scene) and the same walls with a mirror and a glass sphere.
-pub const CASES: [&str; 2] = ["cornell_box", "cornell_spheres"];
+/// (scenes/cornell_box.toml's scene), the same walls with a mirror and a glass sphere, and
+/// sweep_board's mahogany board under a rect light (Mitsuba through the `xylem_wood` plugin).
+pub const CASES: [&str; 3] = ["cornell_box", "cornell_spheres", "wood_board"];
 
 /// Mitsuba's timing process (`python -m validation.crosscheck --timing --serve`): one timed
 /// render per request, the scores at the end.
@@ -313,6 +314,18 @@ fn mitsuba_process(b: &RenderBench) -> Result<Started, RenderBenchError> {
         .args(["--reference-spp", &b.reference_spp.to_string()])
         .args(["--sampler", &b.mitsuba_sampler])
         .current_dir(&repo);
+    // The xylem package for the wood case's plugin: `$PYTHONPATH`'s first, then the one the
+    // test suite stages (tests/python.rs), then an installed one.
+    let staged = repo.join("target/python-test/site");
+    if staged.is_dir() {
+        let mut paths: Vec<PathBuf> = std::env::var_os("PYTHONPATH")
+            .map(|p| std::env::split_paths(&p).collect())
+            .unwrap_or_default();
+        paths.push(staged);
+        if let Ok(joined) = std::env::join_paths(paths) {
+            cmd.env("PYTHONPATH", joined);
+        }
+    }
     if std::env::var_os("DRJIT_LIBLLVM_PATH").is_none() {
         if let Some(p) = libllvm_19() {
             cmd.env("DRJIT_LIBLLVM_PATH", p);
