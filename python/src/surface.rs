@@ -135,8 +135,7 @@ impl PyWoodSurface {
         Ok(PyWoodSurface {
             material: Material::Wood(Box::new(WoodMaterial {
                 volume: Arc::new(volume),
-                eta,
-                roughness,
+                finish: xylem::bsdf::Finish::new(eta, roughness),
                 bump: 0.0,
                 switches: ShadingSwitches::default(),
             })),

@@ -133,8 +133,7 @@ fn surface_case() -> Value {
     let volume = WoodVolume::new(xylem::wood::preset("african_mahogany").unwrap(), 7).unwrap();
     let material = Material::Wood(Box::new(WoodMaterial {
         volume: std::sync::Arc::new(volume),
-        eta: 1.5,
-        roughness: 0.2,
+        finish: xylem::bsdf::Finish::new(1.5, 0.2),
         bump: 0.0,
         switches: Default::default(),
     }));

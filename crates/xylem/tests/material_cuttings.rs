@@ -11,8 +11,7 @@ use xylem::wood::{self, BoardLayout, Cut, Needs, TreeRegion, WoodVolume};
 fn material(preset: &str, bump: f32) -> WoodMaterial {
     WoodMaterial {
         volume: Arc::new(WoodVolume::new(wood::preset(preset).unwrap(), 3).unwrap()),
-        eta: 1.5,
-        roughness: 0.0,
+        finish: xylem::bsdf::Finish::new(1.5, 0.0),
         bump,
         switches: ShadingSwitches::default(),
     }

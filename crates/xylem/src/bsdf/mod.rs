@@ -22,7 +22,7 @@ pub use fresnel::{
 pub use ggx::Ggx;
 pub use lambertian::Lambertian;
 pub use specular::{Glass, Mirror};
-pub use wood::{FinishModel, WoodAtWo, WoodBsdf};
+pub use wood::{Finish, FinishModel, WoodAtWo, WoodBsdf};
 
 use crate::math::is_zero;
 use glam::{Vec2, Vec3};

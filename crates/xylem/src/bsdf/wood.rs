@@ -143,9 +143,66 @@ fn sampling_about(spread: &[PsiSpread; 2], beta: f32) -> (f32, f32) {
     )
 }
 
+/// The part of a [`WoodBsdf`] that depends on its finish's index and roughness alone: the rough
+/// finish's reflectance tables interpolated for them, its transmission's table position, and
+/// the finish's hemispherical reflectance. Worked out once per material
+/// ([`crate::material::WoodMaterial::finish`]) instead of at every shading point, where it
+/// cost 2.7 % of a rough-finished board's path-traced render (notes/render.md).
+#[derive(Clone, Copy, Debug)]
+pub struct Finish {
+    eta: f32,
+    roughness: f32,
+    rough: Option<RoughFinish>,
+    transmission: Option<RoughTransmission>,
+    /// R̄: the mean reflectance of the finish from outside (Fresnel's under a smooth finish).
+    avg_reflectance: f32,
+}
+
+impl Finish {
+    /// The finish of index `eta` and GGX `roughness` (rough from roughness 10⁻³ up);
+    /// values out of [`WoodBsdf::new`]'s ranges give a finish no BSDF will use, never a panic.
+    pub fn new(eta: f32, roughness: f32) -> Finish {
+        let rough = (roughness >= MIN_ROUGHNESS).then(|| RoughFinish::new(roughness, eta));
+        Finish {
+            eta,
+            roughness,
+            rough,
+            transmission: rough.map(|_| RoughTransmission::new(roughness, eta)),
+            avg_reflectance: rough
+                .map_or_else(|| fresnel_diffuse_reflectance(eta), |r| r.avg_reflectance()),
+        }
+    }
+
+    /// The finish's refractive index.
+    pub fn eta(&self) -> f32 {
+        self.eta
+    }
+
+    /// The finish's GGX roughness.
+    pub fn roughness(&self) -> f32 {
+        self.roughness
+    }
+
+    /// Whether this is the finish of `params` (the same bits of index and roughness).
+    fn is_for(&self, params: &WoodBsdfParams) -> bool {
+        self.eta.to_bits() == params.eta.to_bits()
+            && self.roughness.to_bits() == params.roughness.to_bits()
+    }
+}
+
 impl WoodBsdf {
     /// Validates `params` (every field finite and in range) and precomputes what every call needs.
     pub fn new(params: WoodBsdfParams) -> Result<WoodBsdf, BsdfError> {
+        WoodBsdf::under(params, None)
+    }
+
+    /// [`WoodBsdf::new`] under a finish worked out before ([`Finish::new`]), the same bits; a
+    /// finish of another index or roughness than `params`' is not used.
+    pub fn new_under(params: WoodBsdfParams, finish: &Finish) -> Result<WoodBsdf, BsdfError> {
+        WoodBsdf::under(params, Some(finish))
+    }
+
+    fn under(params: WoodBsdfParams, finish: Option<&Finish>) -> Result<WoodBsdf, BsdfError> {
         for (spec, v) in WOOD_BSDF_PARAMS.iter().zip(params.values()) {
             spec.check(v)?;
         }
@@ -158,10 +215,11 @@ impl WoodBsdf {
         params.ray_dir = ray_dir;
 
         let eta = params.eta;
-        let f_ext = fresnel_diffuse_reflectance(eta);
-        let rough =
-            (params.roughness >= MIN_ROUGHNESS).then(|| RoughFinish::new(params.roughness, eta));
-        let r_avg = rough.map_or(f_ext, |r| r.avg_reflectance());
+        let finish = match finish {
+            Some(f) if f.is_for(&params) => *f,
+            _ => Finish::new(eta, params.roughness),
+        };
+        let (rough, r_avg) = (finish.rough, finish.avg_reflectance);
         let escape = (1.0 - r_avg) / (eta * eta);
         let f_int = 1.0 - escape;
         let rho = bounded_diffuse(&params);
@@ -177,7 +235,7 @@ impl WoodBsdf {
             inv_eta2: 1.0 / (eta * eta),
             z_crit: safe_sqrt(1.0 - 1.0 / (eta * eta)),
             rough,
-            transmission: rough.map(|_| RoughTransmission::new(params.roughness, eta)),
+            transmission: finish.transmission,
         })
     }
 

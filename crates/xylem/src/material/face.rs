@@ -112,7 +112,7 @@ pub(crate) fn face_shading(
         eta,
         roughness,
     };
-    wood_shading(local, frame, fiber_world, 0.0, finish)
+    wood_shading(local, frame, fiber_world, 0.0, finish, None)
 }
 
 #[cfg(test)]

@@ -26,7 +26,7 @@ pub use placement::{CutAt, Cutting, Placement, SawnCut, SawnCutError};
 pub(crate) use surface::SurfaceAtWo;
 pub use surface::SurfaceBsdf;
 
-use crate::bsdf::{FinishModel, Glass, Lambertian, Mirror, WoodBsdf, WoodBsdfParams};
+use crate::bsdf::{Finish, FinishModel, Glass, Lambertian, Mirror, WoodBsdf, WoodBsdfParams};
 use crate::math::Frame;
 use crate::wood::{Footprint, Needs, WoodVolume};
 use glam::{Mat3, Vec3};
@@ -145,10 +145,9 @@ pub const WOOD_SHADING_COST: u32 = 16;
 pub struct WoodMaterial {
     /// The procedural wood volume (colours, fibres, pores) of a preset and tree.
     pub volume: Arc<WoodVolume>,
-    /// Refractive index of the finish (1 = unfinished).
-    pub eta: f32,
-    /// GGX roughness of the finish.
-    pub roughness: f32,
+    /// The finish: its refractive index (1 = unfinished) and GGX roughness, with what the BSDF
+    /// needs of them worked out once ([`Finish::new`]).
+    pub finish: Finish,
     /// Scale of the pore-mask bump (0 = no bump mapping, and the volume skips the bump work).
     pub bump: f32,
     /// Speed/accuracy switches (`xylem tradeoff`); the default is the full model.
@@ -234,7 +233,14 @@ impl Material {
                     ray_dir: to_local(params.ray_dir),
                     ..*params
                 };
-                wood_shading(local, frame, fiber_world, 0.0, FinishModel::ClosedForm)
+                wood_shading(
+                    local,
+                    frame,
+                    fiber_world,
+                    0.0,
+                    FinishModel::ClosedForm,
+                    None,
+                )
             }
             Material::Wood(w) => w.shade(hit),
             Material::BakedWood(b) => b.shade(hit),
@@ -299,8 +305,13 @@ fn wood_shading(
     fiber_world: Vec3,
     growth_time: f32,
     finish: FinishModel,
+    tables: Option<&Finish>,
 ) -> Shading {
-    match WoodBsdf::new(local) {
+    let bsdf = match tables {
+        Some(t) => WoodBsdf::new_under(local, t),
+        None => WoodBsdf::new(local),
+    };
+    match bsdf {
         Ok(b) => Shading {
             bsdf: SurfaceBsdf::Wood(b.with_finish(finish)),
             frame,
@@ -381,8 +392,8 @@ impl WoodMaterial {
             ray_dir: frame.to_local(to_world(texel.ray_dir)),
             ray_mask: texel.ray_mask,
             highlight_width: texel.highlight_width,
-            eta: self.eta,
-            roughness: self.roughness,
+            eta: self.finish.eta(),
+            roughness: self.finish.roughness(),
         };
         wood_shading(
             local,
@@ -390,6 +401,7 @@ impl WoodMaterial {
             fiber_world,
             texel.growth_time,
             self.switches.finish,
+            Some(&self.finish),
         )
     }
 }

@@ -296,17 +296,23 @@ impl Placement {
 
     /// The affine object → tree map of a solid cutting.
     pub fn object_to_tree(&self) -> Affine3A {
-        Affine3A::from_mat3_translation(self.rotation_matrix() * self.scale, self.origin)
+        self.solid_map(self.rotation_matrix())
+    }
+
+    /// [`Placement::object_to_tree`] of the rotation `r` ([`Placement::rotation_matrix`]).
+    fn solid_map(&self, r: Mat3) -> Affine3A {
+        Affine3A::from_mat3_translation(r * self.scale, self.origin)
     }
 
     /// The tree point of surface point `p` with unit normal `n` (both in the placement's space),
     /// and the rotation `J` carrying directions from that space into tree space.
     pub fn to_tree(&self, p: Vec3, n: Vec3) -> (Vec3, Mat3) {
         match self.cutting {
-            Cutting::Solid => (
-                self.object_to_tree().transform_point3(p),
-                self.rotation_matrix(),
-            ),
+            Cutting::Solid => {
+                // The rotation worked out once, for the map and for J.
+                let r = self.rotation_matrix();
+                (self.solid_map(r).transform_point3(p), r)
+            }
             Cutting::Veneer { region, seed } => {
                 let f = |q: Vec3| veneer_to_tree(q * self.scale, n, &region, seed);
                 (f(p), surface_rotation(&f, p, n))

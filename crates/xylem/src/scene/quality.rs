@@ -221,8 +221,8 @@ pub fn apply(loaded: &mut LoadedScene, k: &Knobs) -> Result<(), TradeoffError> {
                     face,
                     fiber_saturation: w.volume.params().color.fiber_saturation.into(),
                     fibers: k.baked_fibers,
-                    eta: w.eta,
-                    roughness: w.roughness,
+                    eta: w.finish.eta(),
+                    roughness: w.finish.roughness(),
                     bump: w.bump,
                     switches: w.switches,
                 }));

@@ -274,3 +274,41 @@ fn energy_bounded_lobe_never_exceeds_one() {
         }
     }
 }
+
+/// A BSDF built under a finish worked out beforehand (`new_under`, what a wood material does)
+/// equals the one `new` builds, value for value, for smooth and rough finishes; a finish of
+/// another roughness is not used (the BSDF is the params' own). Control: a BSDF of the other
+/// roughness does differ, so the comparison can see a wrong finish.
+#[test]
+fn a_finish_worked_out_once_gives_the_same_bsdf() {
+    let mut rng = Pcg32::new(11, 5);
+    let pairs: Vec<(Vec3, Vec3)> = (0..60)
+        .map(|k| {
+            let wo = [dir(10.0, 20.0), dir(55.0, 200.0), dir(80.0, 95.0)][k % 3];
+            (wo, dir(rng.next_f32() * 89.0, rng.next_f32() * 360.0))
+        })
+        .collect();
+    let values = |b: &WoodBsdf| -> Vec<u32> {
+        let at = |&(wo, wi): &(Vec3, Vec3)| {
+            let (f, pdf) = (b.eval(wo, wi), b.pdf(wo, wi));
+            [f.x, f.y, f.z, pdf].map(f32::to_bits)
+        };
+        pairs.iter().flat_map(at).collect()
+    };
+    for p in configs() {
+        let own = values(&WoodBsdf::new(p).unwrap());
+        let under = WoodBsdf::new_under(p, &Finish::new(p.eta, p.roughness)).unwrap();
+        assert_eq!(own, values(&under), "{p:?}");
+        let other = Finish::new(p.eta, if p.roughness > 0.1 { 0.0 } else { 0.3 });
+        assert_eq!(
+            own,
+            values(&WoodBsdf::new_under(p, &other).unwrap()),
+            "{p:?}"
+        );
+        let changed = WoodBsdfParams {
+            roughness: other.roughness(),
+            ..p
+        };
+        assert_ne!(own, values(&WoodBsdf::new(changed).unwrap()), "{p:?}");
+    }
+}

@@ -1,5 +1,6 @@
 //! The `[materials]` tables of a scene file, checked and built (measured maps read here).
 
+use crate::bsdf::Finish;
 use crate::scene::fields::*;
 use crate::scene::*;
 
@@ -75,8 +76,10 @@ impl Builder<'_> {
                         .map_err(|e| self.invalid(f(&PRESET), e.to_string()))?;
                     Material::Wood(Box::new(WoodMaterial {
                         volume: Arc::new(volume),
-                        eta: self.number(&at, &ETA, *eta)?,
-                        roughness: self.number(&at, &ROUGHNESS, *roughness)?,
+                        finish: Finish::new(
+                            self.number(&at, &ETA, *eta)?,
+                            self.number(&at, &ROUGHNESS, *roughness)?,
+                        ),
                         bump,
                         switches: Default::default(),
                     }))
