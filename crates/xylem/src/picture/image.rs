@@ -5,7 +5,7 @@
 use super::exr::{read_exr_rgb_checked, stage_exr_layers, ExrCompression, ExrLayer};
 use super::file::{commit, ImageError};
 use super::png::{read_png_linear, stage_png_linear};
-use super::srgb::{srgb8_to_linear, Srgb8};
+use super::srgb::Srgb8;
 use crate::output::Staged;
 use crate::resources::{any_size, SizeCheck};
 use glam::Vec3;
@@ -184,7 +184,7 @@ impl Rgb8 {
                     for x in tx * f..((tx + 1) * f).min(self.width) {
                         let i = (y as usize * self.width as usize + x as usize) * 3;
                         for (a, &v) in acc.iter_mut().zip(&self.data[i..i + 3]) {
-                            *a += srgb8_to_linear(v);
+                            *a += enc.decode(v);
                         }
                         n += 1.0;
                     }

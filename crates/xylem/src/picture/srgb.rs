@@ -82,6 +82,8 @@ const BUCKETS: usize = (127 << 23 >> BUCKET_SHIFT) as usize - FIRST_BUCKET + 1;
 pub struct Srgb8 {
     thresholds: [f32; 256],
     base: [u8; BUCKETS],
+    /// The linear value of each code ([`srgb8_to_linear`]), for [`Srgb8::decode`].
+    linear: [f32; 256],
 }
 
 impl Default for Srgb8 {
@@ -121,7 +123,19 @@ impl Srgb8 {
             let start = f32::from_bits(((FIRST_BUCKET + i) << BUCKET_SHIFT) as u32);
             *b = thresholds[..255].partition_point(|&t| t <= start) as u8;
         }
-        Srgb8 { thresholds, base }
+        Srgb8 {
+            thresholds,
+            base,
+            linear: std::array::from_fn(|v| srgb8_to_linear(v as u8)),
+        }
+    }
+
+    /// The linear value of an 8-bit sRGB code: [`srgb8_to_linear`] by table (a `powf` a
+    /// channel was 4 % of a README sweep's process, in the animation's and contact sheet's
+    /// downsampling; notes/picture.md).
+    #[inline]
+    pub fn decode(&self, v: u8) -> f32 {
+        self.linear[v as usize]
     }
 
     /// The linear value where the code first exceeds `k` (k < 255).
@@ -378,6 +392,8 @@ mod tests {
         let enc = Srgb8::new();
         for v in 0..=255u8 {
             assert_eq!(enc.encode(srgb8_to_linear(v)), v, "{v}");
+            // The table decodes as the formula does, bit for bit.
+            assert_eq!(enc.decode(v).to_bits(), srgb8_to_linear(v).to_bits(), "{v}");
         }
     }
 }
