@@ -82,7 +82,7 @@ const BUCKETS: usize = (127 << 23 >> BUCKET_SHIFT) as usize - FIRST_BUCKET + 1;
 pub struct Srgb8 {
     thresholds: [f32; 256],
     base: [u8; BUCKETS],
-    /// The linear value of each code ([`srgb8_to_linear`]), for [`Srgb8::decode`].
+    /// The linear value of each code (`srgb8_to_linear`), for [`Srgb8::decode`].
     linear: [f32; 256],
 }
 
@@ -130,9 +130,9 @@ impl Srgb8 {
         }
     }
 
-    /// The linear value of an 8-bit sRGB code: [`srgb8_to_linear`] by table (a `powf` a
-    /// channel was 4 % of a README sweep's process, in the animation's and contact sheet's
-    /// downsampling; notes/picture.md).
+    /// The linear value of an 8-bit sRGB code: [`srgb_to_linear`] of `v / 255`, by table (a
+    /// `powf` a channel was 4 % of a README sweep's process, in the animation's and contact
+    /// sheet's downsampling; notes/picture.md).
     #[inline]
     pub fn decode(&self, v: u8) -> f32 {
         self.linear[v as usize]
