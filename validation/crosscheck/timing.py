@@ -214,6 +214,12 @@ def run(mi, args):
             # The ratio's spread: each interleaved pair's xylem / Mitsuba samples/s.
             pairs = [(xylem["spp"] / a) / (args.spp / b) for a, b in zip(xylem["seconds"], times)]
             xs["ratio_range"] = [min(pairs), max(pairs)]
+            # And of the error at equal time: each pair's xylem / Mitsuba seconds, on the two
+            # images' error ratio (one image each, so only the times spread).
+            for key in ("rmse", "rmse_surfaces"):
+                eq = [xs[key] / m[key] * math.sqrt(a / b)
+                      for a, b in zip(xylem["seconds"], times)]
+                xs[f"{key}_equal_time_ratio_range"] = [min(eq), max(eq)]
         out["xylem"] = xs
     return out
 
@@ -250,5 +256,9 @@ def table(out):
             lo, hi = x["ratio_range"]
             lines.append(f"samples/s ratio over {x['repeats']} interleaved pairs: "
                          f"{lo:.3f}-{hi:.3f} (the medians' ratio above)")
+            (a, b), (c, d) = (x["rmse_equal_time_ratio_range"],
+                              x["rmse_surfaces_equal_time_ratio_range"])
+            lines.append(f"RMSE at equal time ratio over the pairs: {a:.3f}-{b:.3f}; off the "
+                         f"light {c:.3f}-{d:.3f}")
     lines.append(f"load average {out['load_average'][0]:.2f}")
     return "\n".join(lines)
