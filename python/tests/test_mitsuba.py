@@ -297,6 +297,53 @@ def test_gradients_are_refused_not_wrong():
         bsdf.sample(ctx, si, mi.Float(0.5), mi.Point2f(0.3, 0.6))
 
 
+def test_bsdf_context_masks_are_honoured_or_refused():
+    """BSDFContext masks (Mitsuba's components: 0 the diffuse and fibre lobes and a rough
+    finish's reflection, 1 a smooth finish's mirror) are honoured where the plugin can: nothing
+    kept gives zeros, the mirror alone is sampled exactly (direction, pdf 1, weight Fresnel's
+    reflectance); masks it cannot honour raise instead of being ignored (the plugin used to
+    sample every lobe whatever the context). Control: the default context evaluates the wood."""
+    use("llvm_ad_rgb")
+    flags = mi.BSDFFlags
+    si, wo, _ = one_hit()
+
+    def ctx(component=None, type_mask=None):
+        c = mi.BSDFContext()
+        if component is not None:
+            c.component = component
+        if type_mask is not None:
+            c.type_mask = int(type_mask)
+        return c
+
+    for roughness in (0.0, 0.25):
+        bsdf = mi.load_dict(dict(BOARD, roughness=roughness))
+        assert np.array(bsdf.eval(ctx(), si, wo)).max() > 0            # the control
+        # Component 1 alone: the mirror where the finish is smooth; nothing where it is rough.
+        value, pdf = bsdf.eval_pdf(ctx(component=1), si, wo)
+        assert np.array(value).max() == 0 and np.array(pdf).max() == 0
+        bs, weight = bsdf.sample(ctx(component=1), si, mi.Float(0.3), mi.Point2f(0.2, 0.7))
+        if roughness == 0.0:
+            np.testing.assert_allclose(np.array(bs.wo).ravel(), [-0.3, 0.0, 0.954])
+            assert np.array(bs.pdf).ravel()[0] == 1.0
+            assert int(np.array(bs.sampled_component).ravel()[0]) == 1
+            f = float(np.array(mi.fresnel(mi.Float(0.954), 1.5)[0]).ravel()[0])
+            np.testing.assert_allclose(np.array(weight).ravel(), [f] * 3, rtol=1e-6)
+            assert 0.03 < f < 0.06
+        else:
+            assert np.array(bs.pdf).max() == 0 and np.array(weight).max() == 0
+        # No lobe type kept: nothing.
+        bs, weight = bsdf.sample(ctx(type_mask=flags.Transmission), si, mi.Float(0.3),
+                                 mi.Point2f(0.2, 0.7))
+        assert np.array(weight).max() == 0
+        # Part of component 0 (its diffuse lobe without its glossy ones): refused.
+        with pytest.raises(NotImplementedError, match="xylem_wood_baked"):
+            bsdf.eval(ctx(type_mask=flags.DiffuseReflection), si, wo)
+    # The smooth finish's lobes without its mirror: refused.
+    bsdf = mi.load_dict(dict(BOARD, roughness=0.0))
+    with pytest.raises(NotImplementedError, match="xylem_wood_baked"):
+        bsdf.sample(ctx(component=0), si, mi.Float(0.3), mi.Point2f(0.2, 0.7))
+
+
 def test_parameters_are_traversable():
     use("llvm_ad_rgb")
     bsdf = mi.load_dict(BOARD)

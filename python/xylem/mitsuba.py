@@ -30,6 +30,15 @@ Dr.Jit variables of ``si.p`` and ``si.sh_frame`` and, failing that, by their val
 ``sample`` (the last call at an interaction) releases it. ``share_wood`` (default true) is a
 debug switch: false evaluates the wood again in every call, as before (the tests' control).
 
+Contexts: ``BSDFContext`` masks select Mitsuba's components, 0 (the diffuse and fibre lobes, and
+a rough finish's reflection) and 1 (a smooth finish's mirror). The plugin draws its lobes
+together, so it honours the masks that keep all of them, none of them, or the mirror alone
+(sampled exactly: the mirror direction with probability 1 and Fresnel's reflectance as its
+weight), and raises ``NotImplementedError`` for the others (the smooth finish's lobes without
+its mirror, or part of component 0's lobes) rather than ignore them: ``xylem_wood_baked``
+renormalises its lobe probabilities over what a mask keeps. The transport mode is not read
+(xylem's BSDF has no adjoint form).
+
 Frames: Mitsuba hands the BSDF directions in the hit's shading frame ``si.sh_frame``. xylem
 shades the world point with the frame it builds itself (z = the same shading normal, x along the
 fibre), exactly as xylem's renderer does; ``WoodSurface.prepare`` composes the two into one
@@ -259,6 +268,35 @@ def _bsdf_class(mi, dr):
                     "gradients enabled on the geometry, the sensor or the directions"
                 )
 
+        def _enabled(self, ctx):
+            """(the mirror, the other lobes) as `ctx` asks for them (component 1 / 0, as
+            `xylem_wood_baked`'s): True, False, or None where `ctx` keeps part of component
+            0's lobes (its diffuse but not its glossy ones, or the reverse), which this plugin
+            cannot split."""
+            flags = mi.BSDFFlags
+            diffuse = ctx.is_enabled(flags.DiffuseReflection, 0)
+            glossy = ctx.is_enabled(flags.GlossyReflection, 0)
+            rest = diffuse if diffuse == glossy else None
+            mirror = len(self.m_components) == 2 and ctx.is_enabled(flags.DeltaReflection, 1)
+            return mirror, rest
+
+        def _mask(self, ctx):
+            """What `ctx` leaves of the BSDF: "all", "none", or "mirror" (a smooth finish's
+            mirror alone, sampled here exactly). Masks that keep only part of the lobes the
+            plugin draws together (the smooth finish's lobes without its mirror, or part of
+            component 0) are refused: sampling them needs the lobe probabilities renormalised
+            over what is kept, which `xylem_wood_baked` does and this plugin cannot."""
+            mirror, rest = self._enabled(ctx)
+            smooth = len(self.m_components) == 2
+            if rest is True and (mirror or not smooth):
+                return "all"
+            if rest is False:
+                return "mirror" if mirror else "none"
+            raise NotImplementedError(
+                f"xylem_wood cannot honour this BSDFContext (component {ctx.component}, type "
+                f"mask {ctx.type_mask:#x}): it draws its lobes together; xylem_wood_baked "
+                "honours masks per component")
+
         def _hits(self, si):
             """The wood at the interaction's points, shaded once (`WoodSurface.prepare`) and
             shared by every call at the same interaction: the path integrator calls
@@ -290,6 +328,8 @@ def _bsdf_class(mi, dr):
 
         def pdf(self, ctx, si, wo, active=True):
             self._check(si.p, si.wi, si.sh_frame.n, wo)
+            if self._mask(ctx) != "all":  # nothing, or a delta lobe alone: no density
+                return dr.zeros(mi.Float, dr.width(wo))
             pdf = from_np1(self._hits(si).pdf(to_np3(si.wi), to_np3(wo)))
             ok = active & (mi.Frame3f.cos_theta(si.wi) > 0) & (mi.Frame3f.cos_theta(wo) > 0)
             return dr.select(ok, pdf, 0.0)
@@ -297,6 +337,9 @@ def _bsdf_class(mi, dr):
         def eval_pdf(self, ctx, si, wo, active=True):
             """f cos(theta_o) and the pdf of `wo`: one pass over the shared wood."""
             self._check(si.p, si.wi, si.sh_frame.n, wo)
+            if self._mask(ctx) != "all":  # nothing, or a delta lobe alone: no value, no density
+                n = dr.width(wo)
+                return dr.zeros(mi.Color3f, n), dr.zeros(mi.Float, n)
             f, pdf = self._hits(si).eval_pdf(to_np3(si.wi), to_np3(wo))
             cos_o = mi.Frame3f.cos_theta(wo)
             ok = active & (mi.Frame3f.cos_theta(si.wi) > 0) & (cos_o > 0)
@@ -305,6 +348,9 @@ def _bsdf_class(mi, dr):
 
         def sample(self, ctx, si, sample1, sample2, active=True):
             self._check(si.p, si.wi, si.sh_frame.n)
+            mask = self._mask(ctx)
+            if mask != "all":
+                return self._sample_masked(mask, si, dr.width(sample1), active)
             s = self._hits(si).sample(to_np3(si.wi), to_np1(sample1), to_np2(sample2))
             # `sample` is the last call Mitsuba's integrators make at an interaction (after
             # eval_pdf for emitter sampling): the entry (0.5 KB per lane) is released here
@@ -328,6 +374,23 @@ def _bsdf_class(mi, dr):
             f = from_np3(mi.Color3f, s["f"])
             weight = f * mi.Frame3f.cos_theta(wo) / dr.select(ok, pdf, 1.0)
             return bs, dr.select(ok, weight, 0.0)
+
+        def _sample_masked(self, mask, si, n, active):
+            """`sample` where `ctx` keeps nothing (an invalid sample) or a smooth finish's
+            mirror alone: the mirror direction, chosen with probability 1, weight Fresnel's
+            reflectance (Mitsuba's `fresnel`, the formula of xylem's `fresnel_dielectric`)."""
+            bs = dr.zeros(mi.BSDFSample3f, n)
+            if mask == "none":
+                return bs, dr.zeros(mi.Color3f, n)
+            cos_o = mi.Frame3f.cos_theta(si.wi)
+            ok = active & (cos_o > 0)
+            bs.wo = mi.Vector3f(-si.wi.x, -si.wi.y, si.wi.z)
+            bs.pdf = dr.select(ok, 1.0, 0.0)
+            bs.eta = 1.0
+            bs.sampled_type = mi.UInt32(+mi.BSDFFlags.DeltaReflection)
+            bs.sampled_component = mi.UInt32(1)
+            f = mi.fresnel(dr.maximum(cos_o, 0.0), self.eta)[0]
+            return bs, dr.select(ok, mi.Color3f(f), 0.0)
 
         def traverse(self, callback):
             # Dr.Jit values (params.update() assigns them in place); none is differentiable
