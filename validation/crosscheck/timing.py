@@ -91,17 +91,25 @@ def reference(mi, folder, case, meshes, spp):
     path = os.path.join(folder, f"reference_{case['name']}_{w}x{h}_d{DEPTH}_{spp}spp.exr")
     if os.path.exists(path):
         return render.read_exr_rgb(mi, path), path
-    chunk = min(256, spp)
+    # Chunks of at most 256 spp (Dr.Jit's wavefront for the plugin's wood grows with spp),
+    # the last one the remainder, averaged by their samples.
+    chunks = [256] * (spp // 256) + ([spp % 256] if spp % 256 else [])
     mitsuba_mode(case)  # registers the plugin where the case needs it
-    scene = mi.load_dict(scenes.mitsuba_dict(mi, case, meshes, DEPTH, chunk, 0))
+    scene = mi.load_dict(scenes.mitsuba_dict(mi, case, meshes, DEPTH, chunks[0], 0))
     acc = np.zeros((h, w, 3))
-    for k in range(spp // chunk):
+    for k, n in enumerate(chunks):
+        # Progress on stderr (stdout is `xylem bench render`'s protocol): a first reference of
+        # the wood takes minutes.
+        print(f"Mitsuba reference of {case['name']}: chunk {k + 1} of {len(chunks)} ({n} spp)",
+              file=sys.stderr, flush=True)
         with mitsuba_mode(case):
-            img = mi.render(scene, seed=100_000 + k, spp=chunk)
-        acc += np.array(img, dtype=np.float64)[..., :3]
-    img = acc / (spp // chunk)
+            img = mi.render(scene, seed=100_000 + k, spp=n)
+        acc += n * np.array(img, dtype=np.float64)[..., :3]
+    img = acc / spp
     bmp = mi.Bitmap(img.astype(np.float32), mi.Bitmap.PixelFormat.RGB)
-    tmp = path[: -len(".exr")] + ".partial.exr"
+    # Written whole under a name of this process's own, then renamed: a concurrent run never
+    # reads half a reference.
+    tmp = f"{path[: -len('.exr')]}.{os.getpid()}.partial.exr"
     bmp.write(tmp)
     os.replace(tmp, path)
     return img, path
@@ -136,6 +144,9 @@ def mean_ratio(a, ref):
 def run(mi, args):
     import drjit as dr
 
+    if not (1 <= args.reference_spp <= 1_000_000 and 1 <= args.spp <= 1_000_000):
+        raise SystemExit(f"--spp {args.spp}, --reference-spp {args.reference_spp}: allowed 1 to "
+                         "1000000")
     os.makedirs(args.work, exist_ok=True)
     case = CASES[args.case]()
     meshes = scenes.write_meshes(case, os.path.join(args.work, "meshes"))

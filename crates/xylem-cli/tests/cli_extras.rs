@@ -337,4 +337,11 @@ fn bench_render_compares_only_like_scenes() {
     );
     let o = bench(&["--no-mitsuba"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // A reference of no samples is refused before anything starts (it used to reach Python).
+    let o = bench(&["--no-mitsuba", "--reference-spp", "0"]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && e.contains("--reference-spp 0: allowed 1 to 1000000"),
+        "{e}"
+    );
 }

@@ -199,6 +199,12 @@ pub fn run(b: &RenderBench) -> Result<RenderTimes, RenderBenchError> {
     if !(1..=256).contains(&b.threads) {
         return bad(format!("--threads {}: allowed 1 to 256", b.threads));
     }
+    if !(1..=1_000_000).contains(&b.reference_spp) {
+        return bad(format!(
+            "--reference-spp {}: allowed 1 to 1000000",
+            b.reference_spp
+        ));
+    }
     if !CASES.contains(&b.case.as_str()) {
         return bad(format!("--case {}: allowed {}", b.case, CASES.join(", ")));
     }
