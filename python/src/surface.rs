@@ -413,6 +413,17 @@ impl PyWoodHits {
         out(py, p, &shape)
     }
 
+    /// The probability that `sample` takes a smooth finish's mirror at `wo` (..., 3), shape
+    /// (...); 0 under a rough finish. `sample` picks the mirror for `uc` below it.
+    fn mirror_probability<'py>(
+        &self,
+        py: Python<'py>,
+        wo: ArrayIn<'py>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (p, shape) = self.at_pairs(py, &wo, &wo, |b, o, _| b.delta_probability(o))?;
+        out(py, p, &shape)
+    }
+
     /// `(eval(wo, wi), pdf(wo, wi))` in one pass over the points (the same numbers).
     fn eval_pdf<'py>(
         &self,

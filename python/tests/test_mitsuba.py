@@ -299,10 +299,11 @@ def test_gradients_are_refused_not_wrong():
 
 def test_bsdf_context_masks_are_honoured_or_refused():
     """BSDFContext masks (Mitsuba's components: 0 the diffuse and fibre lobes and a rough
-    finish's reflection, 1 a smooth finish's mirror) are honoured where the plugin can: nothing
-    kept gives zeros, the mirror alone is sampled exactly (direction, pdf 1, weight Fresnel's
-    reflectance); masks it cannot honour raise instead of being ignored (the plugin used to
-    sample every lobe whatever the context). Control: the default context evaluates the wood."""
+    finish's reflection, 1 a smooth finish's mirror) are honoured: nothing kept gives zeros,
+    the mirror alone is sampled exactly (direction, pdf 1, weight Fresnel's reflectance), the
+    other lobes alone never give the mirror and carry their renormalised density; part of
+    component 0 raises instead of being ignored (the plugin used to sample every lobe whatever
+    the context). Control: the default context evaluates the wood."""
     use("llvm_ad_rgb")
     flags = mi.BSDFFlags
     si, wo, _ = one_hit()
@@ -336,12 +337,49 @@ def test_bsdf_context_masks_are_honoured_or_refused():
                                  mi.Point2f(0.2, 0.7))
         assert np.array(weight).max() == 0
         # Part of component 0 (its diffuse lobe without its glossy ones): refused.
-        with pytest.raises(NotImplementedError, match="xylem_wood_baked"):
+        with pytest.raises(NotImplementedError, match="draws together"):
             bsdf.eval(ctx(type_mask=flags.DiffuseReflection), si, wo)
-    # The smooth finish's lobes without its mirror: refused.
+    # The smooth finish's lobes without its mirror: never the mirror, and the density of what
+    # is drawn is the full one over the share the other lobes take (test_chi2_without_mirror).
     bsdf = mi.load_dict(dict(BOARD, roughness=0.0))
-    with pytest.raises(NotImplementedError, match="xylem_wood_baked"):
-        bsdf.sample(ctx(component=0), si, mi.Float(0.3), mi.Point2f(0.2, 0.7))
+    n = 64
+    wide = dr.zeros(mi.SurfaceInteraction3f, n)
+    wide.p, wide.sh_frame, wide.wi = si.p, si.sh_frame, si.wi
+    u = np.linspace(0.01, 0.98, n, dtype=np.float32)
+    bs, weight = bsdf.sample(ctx(component=0), wide, mi.Float(u), mi.Point2f(u[::-1], u))
+    assert not (np.array(bs.sampled_type) & int(flags.DeltaReflection)).any()
+    assert np.array(bs.pdf).min() > 0 and np.isfinite(np.array(weight)).all()
+    np.testing.assert_allclose(np.array(bsdf.pdf(ctx(component=0), wide, bs.wo)),
+                               np.array(bs.pdf), rtol=1e-5)
+    p = xylem.WoodSurface("african_mahogany", seed=7, eta=1.5, roughness=0.0,
+                          origin=(0, 120, 0), axis=(1, 0, 0), rotation_deg=20.0).prepare(
+        [10, 5, 0], np.eye(3)).mirror_probability([0.3, 0.0, 0.954])
+    assert 0.0 < float(p) < 0.5
+    np.testing.assert_allclose(np.array(bsdf.pdf(ctx(component=0), si, wo)),
+                               np.array(bsdf.pdf(ctx(), si, wo)) / (1.0 - float(p)), rtol=1e-5)
+
+
+def test_chi2_without_mirror(tmp_path, monkeypatch):
+    """A smooth finish's lobes without its mirror (component 0 alone) sample as their
+    renormalised pdf says (chi2_run, 1 %), the first chi-square test of a smooth finish (its
+    mirror, a delta lobe, keeps the whole BSDF from one). Control: the same samples against
+    the pdf with the mirror's share left in are rejected."""
+    use("llvm_ad_rgb")
+    from mitsuba.chi2 import BSDFAdapter
+
+    ctx = mi.BSDFContext()
+    ctx.component = 0
+    wi = [float(x) for x in np.array([0.8, 0.1, 0.59]) / np.linalg.norm([0.8, 0.1, 0.59])]
+    smooth = dict(BOARD, roughness=0.0)
+    sample_func, pdf_func = BSDFAdapter("xylem_wood", smooth, wi=wi, ctx=ctx)
+    ok, test = chi2_run(sample_func, pdf_func)
+    record("chi2/smooth_finish_without_mirror", {"p_value": float(test.p_value), "wi": wi,
+                                                  "passed": bool(ok)})
+    assert ok, test.messages
+    _, full_pdf = BSDFAdapter("xylem_wood", smooth, wi=wi)
+    monkeypatch.chdir(tmp_path)  # a rejected test writes chi2_data.py into the working folder
+    bad, _ = chi2_run(sample_func, full_pdf)
+    assert not bad, "the chi-square test cannot tell the unrenormalised pdf"
 
 
 def test_parameters_are_traversable():

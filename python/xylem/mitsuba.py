@@ -31,13 +31,14 @@ Dr.Jit variables of ``si.p`` and ``si.sh_frame`` and, failing that, by their val
 debug switch: false evaluates the wood again in every call, as before (the tests' control).
 
 Contexts: ``BSDFContext`` masks select Mitsuba's components, 0 (the diffuse and fibre lobes, and
-a rough finish's reflection) and 1 (a smooth finish's mirror). The plugin draws its lobes
-together, so it honours the masks that keep all of them, none of them, or the mirror alone
-(sampled exactly: the mirror direction with probability 1 and Fresnel's reflectance as its
-weight), and raises ``NotImplementedError`` for the others (the smooth finish's lobes without
-its mirror, or part of component 0's lobes) rather than ignore them: ``xylem_wood_baked``
-renormalises its lobe probabilities over what a mask keeps. The transport mode is not read
-(xylem's BSDF has no adjoint form).
+a rough finish's reflection) and 1 (a smooth finish's mirror), as ``xylem_wood_baked``'s do.
+Every mask of whole components is honoured: none gives zeros; the mirror alone is sampled
+exactly (the mirror direction with probability 1, Fresnel's reflectance as its weight); the
+other lobes alone are drawn with the mirror's share of ``uc`` skipped (xylem picks the mirror
+first, for ``uc`` below ``WoodHits.mirror_probability``) and their density divided by the
+share left. A mask that keeps part of component 0 (its diffuse lobe but not its glossy fibre
+lobes, or the reverse) raises ``NotImplementedError``: xylem draws those together. The
+transport mode is not read (xylem's BSDF has no adjoint form).
 
 Frames: Mitsuba hands the BSDF directions in the hit's shading frame ``si.sh_frame``. xylem
 shades the world point with the frame it builds itself (z = the same shading normal, x along the
@@ -281,21 +282,28 @@ def _bsdf_class(mi, dr):
             return mirror, rest
 
         def _mask(self, ctx):
-            """What `ctx` leaves of the BSDF: "all", "none", or "mirror" (a smooth finish's
-            mirror alone, sampled here exactly). Masks that keep only part of the lobes the
-            plugin draws together (the smooth finish's lobes without its mirror, or part of
-            component 0) are refused: sampling them needs the lobe probabilities renormalised
-            over what is kept, which `xylem_wood_baked` does and this plugin cannot."""
+            """What `ctx` leaves of the BSDF: "all", "none", "mirror" (a smooth finish's
+            mirror alone, sampled here exactly) or "rest" (a smooth finish's other lobes:
+            drawn with the mirror's share of `uc` skipped and their density divided by what
+            is left, `WoodHits.mirror_probability`). A mask that keeps part of component 0's
+            lobes (its diffuse but not its glossy ones) is refused: the plugin draws those
+            together; `xylem_wood_baked` cannot split them either."""
             mirror, rest = self._enabled(ctx)
             smooth = len(self.m_components) == 2
-            if rest is True and (mirror or not smooth):
-                return "all"
+            if rest is True:
+                return "all" if mirror or not smooth else "rest"
             if rest is False:
                 return "mirror" if mirror else "none"
             raise NotImplementedError(
                 f"xylem_wood cannot honour this BSDFContext (component {ctx.component}, type "
-                f"mask {ctx.type_mask:#x}): it draws its lobes together; xylem_wood_baked "
-                "honours masks per component")
+                f"mask {ctx.type_mask:#x}): it keeps part of the diffuse and fibre lobes, "
+                "which the plugin draws together")
+
+        def _kept(self, hits, wi):
+            """(p, 1 - p) at `wi` (numpy): the mirror's probability and the share of
+            `sample`'s draws the smooth finish's other lobes take."""
+            p = hits.mirror_probability(wi)
+            return p, (1.0 - p).astype(np.float32)
 
         def _hits(self, si):
             """The wood at the interaction's points, shaded once (`WoodSurface.prepare`) and
@@ -328,19 +336,28 @@ def _bsdf_class(mi, dr):
 
         def pdf(self, ctx, si, wo, active=True):
             self._check(si.p, si.wi, si.sh_frame.n, wo)
-            if self._mask(ctx) != "all":  # nothing, or a delta lobe alone: no density
+            mask = self._mask(ctx)
+            if mask in ("none", "mirror"):  # nothing, or a delta lobe alone: no density
                 return dr.zeros(mi.Float, dr.width(wo))
-            pdf = from_np1(self._hits(si).pdf(to_np3(si.wi), to_np3(wo)))
+            hits, wi = self._hits(si), to_np3(si.wi)
+            pdf = hits.pdf(wi, to_np3(wo))
+            if mask == "rest":
+                pdf = renormalised(pdf, self._kept(hits, wi)[1])
+            pdf = from_np1(pdf)
             ok = active & (mi.Frame3f.cos_theta(si.wi) > 0) & (mi.Frame3f.cos_theta(wo) > 0)
             return dr.select(ok, pdf, 0.0)
 
         def eval_pdf(self, ctx, si, wo, active=True):
             """f cos(theta_o) and the pdf of `wo`: one pass over the shared wood."""
             self._check(si.p, si.wi, si.sh_frame.n, wo)
-            if self._mask(ctx) != "all":  # nothing, or a delta lobe alone: no value, no density
+            mask = self._mask(ctx)
+            if mask in ("none", "mirror"):  # nothing, or a delta lobe alone: no value, density
                 n = dr.width(wo)
                 return dr.zeros(mi.Color3f, n), dr.zeros(mi.Float, n)
-            f, pdf = self._hits(si).eval_pdf(to_np3(si.wi), to_np3(wo))
+            hits, wi = self._hits(si), to_np3(si.wi)
+            f, pdf = hits.eval_pdf(wi, to_np3(wo))
+            if mask == "rest":
+                pdf = renormalised(pdf, self._kept(hits, wi)[1])
             cos_o = mi.Frame3f.cos_theta(wo)
             ok = active & (mi.Frame3f.cos_theta(si.wi) > 0) & (cos_o > 0)
             f = from_np3(mi.Color3f, f)
@@ -349,9 +366,20 @@ def _bsdf_class(mi, dr):
         def sample(self, ctx, si, sample1, sample2, active=True):
             self._check(si.p, si.wi, si.sh_frame.n)
             mask = self._mask(ctx)
-            if mask != "all":
+            if mask in ("none", "mirror"):
                 return self._sample_masked(mask, si, dr.width(sample1), active)
-            s = self._hits(si).sample(to_np3(si.wi), to_np1(sample1), to_np2(sample2))
+            hits, wi, uc = self._hits(si), to_np3(si.wi), to_np1(sample1)
+            kept = None
+            if mask == "rest":
+                # The mirror is picked for uc below its probability p (lobes in order, mirror
+                # first: wood.rs `pick`): uc mapped into [p, 1) draws only the others (p + a
+                # non-negative number rounds to p or above, never below).
+                p, kept = self._kept(hits, wi)
+                uc = (p + uc * kept).astype(np.float32)
+            s = hits.sample(wi, uc, to_np2(sample2))
+            if kept is not None:
+                s["pdf"] = renormalised(s["pdf"], kept)
+                s["valid"] = s["valid"] & ~s["is_delta"]
             # `sample` is the last call Mitsuba's integrators make at an interaction (after
             # eval_pdf for emitter sampling): the entry (0.5 KB per lane) is released here
             # rather than held until the next call.
@@ -414,6 +442,11 @@ def _bsdf_class(mi, dr):
                 f"XylemWood[preset={self.name}, eta={self.eta}, roughness={self.roughness}, "
                 f"units={self.units}]"
             )
+
+    def renormalised(pdf, kept):
+        """A density over the lobes `kept` of the draws take (numpy): pdf / kept, 0 where
+        nothing is kept."""
+        return np.where(kept > 0, pdf / np.where(kept > 0, kept, 1.0), 0.0).astype(np.float32)
 
     _CLASSES[key] = XylemWood
     return XylemWood

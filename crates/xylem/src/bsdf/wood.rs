@@ -433,6 +433,18 @@ impl WoodBsdf {
 
     /// The lobe whose cumulative probability interval holds `uc`; rounding never selects a
     /// lobe of probability 0 (the last positive one is the fallback).
+    /// The probability that `sample` takes a smooth finish's mirror (its one delta lobe) at
+    /// `wo`; 0 under a rough finish (its reflection has a density), without a finish, and below
+    /// the surface. The lobes are picked in the order mirror first (`pick`), so a caller that
+    /// leaves the mirror out (Mitsuba's component masks, python/xylem/mitsuba.py) draws the rest
+    /// with `uc` mapped into [p, 1) and divides their density by 1 − p.
+    pub fn mirror_probability(&self, wo: Vec3) -> f32 {
+        if self.rough.is_some() || !(wo.z > 0.0) {
+            return 0.0;
+        }
+        self.lobe_probs(wo).specular
+    }
+
     fn pick(probs: &LobeProbs, uc: f32) -> Lobe {
         let lobes = [
             (Lobe::Specular, probs.specular),

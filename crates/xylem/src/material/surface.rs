@@ -22,6 +22,17 @@ pub enum SurfaceBsdf {
 }
 
 impl SurfaceBsdf {
+    /// The probability that `sample` gives a delta lobe's direction at `wo`: a smooth wood
+    /// finish's mirror ([`WoodBsdf::mirror_probability`]), 1 for the mirror and glass (all
+    /// delta), 0 for the Lambertian.
+    pub fn delta_probability(&self, wo: Vec3) -> f32 {
+        match self {
+            SurfaceBsdf::Wood(b) => b.mirror_probability(wo),
+            SurfaceBsdf::Mirror(_) | SurfaceBsdf::Glass(_) => 1.0,
+            SurfaceBsdf::Lambertian(_) => 0.0,
+        }
+    }
+
     /// True when every lobe is a delta lobe (light sampling is useless there).
     pub fn is_delta(&self) -> bool {
         match self {

@@ -312,3 +312,27 @@ fn a_finish_worked_out_once_gives_the_same_bsdf() {
         assert_ne!(own, values(&WoodBsdf::new(changed).unwrap()), "{p:?}");
     }
 }
+
+/// `mirror_probability` is where `sample` switches from the smooth finish's mirror to the
+/// other lobes: uc just below it gives the mirror, uc at it does not; 0 under a rough finish,
+/// whose reflection is no delta lobe. Both sides of the boundary are checked, so a probability
+/// off by one f32 step either way fails.
+#[test]
+fn mirror_probability_is_where_sample_leaves_the_mirror() {
+    for p in configs() {
+        let b = WoodBsdf::new(p).unwrap();
+        for wo in [dir(10.0, 30.0), dir(60.0, 120.0), dir(85.0, 250.0)] {
+            let pm = b.mirror_probability(wo);
+            let u = Vec2::new(0.3, 0.6);
+            let is_delta = |uc: f32| b.sample(wo, uc, u).is_some_and(|s| s.is_delta);
+            if p.roughness > 0.0 || p.eta <= 1.0 {
+                assert_eq!(pm, 0.0, "{p:?}");
+                continue;
+            }
+            assert!(pm > 0.0 && pm < 1.0, "{p:?} {pm}");
+            assert!(is_delta(pm.next_down()) && is_delta(0.5 * pm), "{p:?} {pm}");
+            assert!(!is_delta(pm), "{p:?} {pm}");
+        }
+        assert_eq!(b.mirror_probability(dir(100.0, 0.0)), 0.0);
+    }
+}
