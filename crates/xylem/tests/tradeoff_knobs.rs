@@ -378,8 +378,7 @@ mod baked {
             face,
             fiber_saturation: preset("walnut").unwrap().color.fiber_saturation.into(),
             fibers: BakedFibers::Anisotropy,
-            eta: 1.5,
-            roughness: 0.0,
+            finish: xylem::bsdf::Finish::new(1.5, 0.0),
             bump: 0.0,
             switches: Default::default(),
         }));

@@ -17,6 +17,7 @@
 
 use super::face::{bilinear_taps, face_shading, FaceRect, FaceTexel};
 use super::{MaterialHit, Shading, ShadingSwitches};
+use crate::bsdf::Finish;
 use crate::math::safe_sqrt;
 use crate::wood::{Needs, WoodTexel, WoodVolume};
 use glam::{Affine3A, Mat3, Vec2, Vec3};
@@ -150,10 +151,8 @@ pub struct BakedWoodMaterial {
     pub fiber_saturation: Vec3,
     /// Where the fibre direction comes from.
     pub fibers: BakedFibers,
-    /// Refractive index of the finish (1–4).
-    pub eta: f32,
-    /// GGX roughness of the finish (0–1).
-    pub roughness: f32,
+    /// The finish (index 1–4, GGX roughness 0–1), worked out once ([`Finish::new`]).
+    pub finish: Finish,
     /// Normal-map strength (0 = off).
     pub bump: f32,
     /// Speed/accuracy switches (`xylem tradeoff`).
@@ -194,15 +193,7 @@ impl BakedWoodMaterial {
             ray_mask: t.ray_mask.clamp(0.0, 1.0),
             highlight_width: t.highlight_width.clamp(1e-3, 0.5 * std::f32::consts::PI),
         };
-        face_shading(
-            hit,
-            f,
-            n,
-            texel,
-            self.eta,
-            self.roughness,
-            self.switches.finish,
-        )
+        face_shading(hit, f, n, texel, &self.finish, self.switches.finish)
     }
 }
 

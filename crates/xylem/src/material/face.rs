@@ -4,7 +4,7 @@
 //! boards of Marschner et al. 2005.
 
 use super::{wood_shading, MaterialHit, Shading};
-use crate::bsdf::{FinishModel, WoodBsdfParams};
+use crate::bsdf::{Finish, FinishModel, WoodBsdfParams};
 use crate::math::Frame;
 use glam::{Vec2, Vec3};
 
@@ -95,9 +95,8 @@ pub(crate) fn face_shading(
     face: &FaceRect,
     n: Vec3,
     texel: FaceTexel,
-    eta: f32,
-    roughness: f32,
-    finish: FinishModel,
+    finish: &Finish,
+    model: FinishModel,
 ) -> Shading {
     let fiber_world =
         (hit.object_to_world * face.tangent_to_object(texel.fiber)).normalize_or_zero();
@@ -109,10 +108,10 @@ pub(crate) fn face_shading(
         ray_dir: frame.to_local(frame.t),
         ray_mask: texel.ray_mask,
         highlight_width: texel.highlight_width,
-        eta,
-        roughness,
+        eta: finish.eta(),
+        roughness: finish.roughness(),
     };
-    wood_shading(local, frame, fiber_world, 0.0, finish, None)
+    wood_shading(local, frame, fiber_world, 0.0, model, finish)
 }
 
 #[cfg(test)]

@@ -9,7 +9,7 @@
 
 use super::face::{bilinear_taps, face_shading, FaceRect, FaceTexel};
 use super::{MaterialHit, Shading};
-use crate::bsdf::FinishModel;
+use crate::bsdf::{Finish, FinishModel};
 use crate::picture::png::{decode_png, decode_png_text, decoded_rgb8, open_png};
 use crate::picture::Rgb8;
 use glam::{Vec2, Vec3};
@@ -405,10 +405,9 @@ pub struct MeasuredMaterial {
     pub clamped: usize,
     /// β (radians) where the board has no β map.
     pub highlight_width: f32,
-    /// Refractive index of the finish (1–4).
-    pub eta: f32,
-    /// GGX roughness of the finish (0–1, 0 = smooth).
-    pub roughness: f32,
+    /// The finish (index 1–4, GGX roughness 0–1, 0 = smooth), worked out once
+    /// ([`Finish::new`]).
+    pub finish: Finish,
 }
 
 impl MeasuredMaterial {
@@ -441,8 +440,7 @@ impl MeasuredMaterial {
             fiber_color,
             clamped,
             highlight_width,
-            eta,
-            roughness,
+            finish: Finish::new(eta, roughness),
         }
     }
 
@@ -483,8 +481,7 @@ impl MeasuredMaterial {
             &self.face,
             hit.ns,
             texel,
-            self.eta,
-            self.roughness,
+            &self.finish,
             FinishModel::ClosedForm,
         )
     }

@@ -233,13 +233,16 @@ impl Material {
                     ray_dir: to_local(params.ray_dir),
                     ..*params
                 };
+                // Worked out per hit: kept in this variant, a finish (≈ 300 bytes of tables)
+                // would grow every `Material`, and the fibre material is for validation scenes.
+                let finish = Finish::new(params.eta, params.roughness);
                 wood_shading(
                     local,
                     frame,
                     fiber_world,
                     0.0,
                     FinishModel::ClosedForm,
-                    None,
+                    &finish,
                 )
             }
             Material::Wood(w) => w.shade(hit),
@@ -297,23 +300,20 @@ fn lambertian(albedo: Vec3, frame: Frame) -> Shading {
     }
 }
 
-/// A wood BSDF from local-frame parameters; parameters the BSDF rejects (which a correct texel
-/// never produces) fall back to a Lambertian of the diffuse colour rather than a NaN.
+/// A wood BSDF from local-frame parameters under the material's `finish` (worked out once per
+/// material); parameters the BSDF rejects (which a correct texel never produces) fall back to a
+/// Lambertian of the diffuse colour rather than a NaN.
 fn wood_shading(
     local: WoodBsdfParams,
     frame: Frame,
     fiber_world: Vec3,
     growth_time: f32,
-    finish: FinishModel,
-    tables: Option<&Finish>,
+    model: FinishModel,
+    finish: &Finish,
 ) -> Shading {
-    let bsdf = match tables {
-        Some(t) => WoodBsdf::new_under(local, t),
-        None => WoodBsdf::new(local),
-    };
-    match bsdf {
+    match WoodBsdf::new_under(local, finish) {
         Ok(b) => Shading {
-            bsdf: SurfaceBsdf::Wood(b.with_finish(finish)),
+            bsdf: SurfaceBsdf::Wood(b.with_finish(model)),
             frame,
             aov: SurfaceAov {
                 albedo: local.diffuse,
@@ -401,7 +401,7 @@ impl WoodMaterial {
             fiber_world,
             texel.growth_time,
             self.switches.finish,
-            Some(&self.finish),
+            &self.finish,
         )
     }
 }

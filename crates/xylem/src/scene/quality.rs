@@ -221,8 +221,7 @@ pub fn apply(loaded: &mut LoadedScene, k: &Knobs) -> Result<(), TradeoffError> {
                     face,
                     fiber_saturation: w.volume.params().color.fiber_saturation.into(),
                     fibers: k.baked_fibers,
-                    eta: w.finish.eta(),
-                    roughness: w.finish.roughness(),
+                    finish: w.finish,
                     bump: w.bump,
                     switches: w.switches,
                 }));
