@@ -1,6 +1,7 @@
-"""Timing mode: Mitsuba 3 rendering a Cornell box (256 × 256, xylem depth 8 = Mitsuba depth 9,
-box filter; `--case`: `cornell_box`, the Lambertian box of scenes/cornell_box.toml, or
-`cornell_spheres`, the same walls with a mirror and a glass sphere), its samples/s and its RMSE
+"""Timing mode: Mitsuba 3 rendering one scene (xylem depth 8 = Mitsuba depth 9, box filter;
+`--case`: `cornell_box`, the Lambertian box of scenes/cornell_box.toml, `cornell_spheres`, the
+same walls with a mirror and a glass sphere, or `wood_board`, sweep_board's board under a rect
+light, its wood through xylem's `xylem_wood` plugin), its samples/s and its RMSE
 against a high-spp reference, and the same figures for a xylem image of the scene if one is
 given (`xylem bench render` passes its own). With `--serve` the case is also written as a xylem
 scene file (`xylem_<case>.toml` in the work folder, its meshes beside it) whose path ends the
@@ -36,6 +37,8 @@ import numpy as np
 from . import render, scenes
 
 DEPTH = 8
+# Rec. 709 luminance weights (xylem's `math::luminance`).
+LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
 # The cases `--case` names.
 CASES = {"cornell_box": scenes.cornell_lambertian, "cornell_spheres": scenes.cornell_spheres,
          "wood_board": scenes.wood_board}
@@ -46,8 +49,8 @@ RR_DEPTH = 3
 def add_arguments(ap):
     g = ap.add_argument_group("timing")
     g.add_argument("--case", default="cornell_box", choices=sorted(CASES),
-                   help="the scene: the Lambertian Cornell box (default) or the box with a "
-                        "mirror and a glass sphere")
+                   help="the scene: the Lambertian Cornell box (default), the box with a "
+                        "mirror and a glass sphere, or the wood board (through the plugin)")
     g.add_argument("--spp", type=int, default=64, help="spp of the timed render (64)")
     g.add_argument("--reference-spp", type=int, default=2048)
     g.add_argument("--xylem-image", default=None, help="a xylem EXR of the scene to score")
@@ -66,13 +69,11 @@ def uses_plugin(case):
     return any(m["type"] == "wood" for m in case["materials"].values())
 
 
-def mitsuba_mode(case):
-    """The Dr.Jit mode Mitsuba renders `case` in: the plugin reads its inputs into numpy, so
-    wood renders inside `xylem.mitsuba.evaluated()` (wavefront mode); the boxes in Dr.Jit's
-    default (symbolic, one megakernel). Registers the plugin first (it must be, before the
-    scene loads)."""
+def register_plugin(case):
+    """xylem's `xylem.mitsuba` module, its plugin registered (before the scene loads), where
+    `case` has wood; None where it has not."""
     if not uses_plugin(case):
-        return contextlib.nullcontext()
+        return None
     try:
         import xylem.mitsuba
     except ImportError as e:
@@ -82,7 +83,15 @@ def mitsuba_mode(case):
             "stages it in target/python-test/site (`xylem bench render` puts that on "
             "PYTHONPATH), or `pip install ./python`")
     xylem.mitsuba.register()
-    return xylem.mitsuba.evaluated()
+    return xylem.mitsuba
+
+
+def mitsuba_mode(case):
+    """The Dr.Jit mode Mitsuba renders `case` in: the plugin reads its inputs into numpy, so
+    wood renders inside `xylem.mitsuba.evaluated()` (wavefront mode); the boxes in Dr.Jit's
+    default (symbolic, one megakernel)."""
+    plugin = register_plugin(case)
+    return contextlib.nullcontext() if plugin is None else plugin.evaluated()
 
 
 def reference(mi, folder, case, meshes, spp):
@@ -94,7 +103,7 @@ def reference(mi, folder, case, meshes, spp):
     # Chunks of at most 256 spp (Dr.Jit's wavefront for the plugin's wood grows with spp),
     # the last one the remainder, averaged by their samples.
     chunks = [256] * (spp // 256) + ([spp % 256] if spp % 256 else [])
-    mitsuba_mode(case)  # registers the plugin where the case needs it
+    register_plugin(case)
     scene = mi.load_dict(scenes.mitsuba_dict(mi, case, meshes, DEPTH, chunks[0], 0))
     acc = np.zeros((h, w, 3))
     for k, n in enumerate(chunks):
@@ -129,7 +138,7 @@ SURFACE_MAX_LUMINANCE = 0.5
 
 def rmse_surfaces(a, ref):
     """RMSE over the pixels off the light and its edge (reference luminance ≤ 0.5)."""
-    lum = ref @ np.array([0.2126, 0.7152, 0.0722])
+    lum = ref @ LUMINANCE
     keep = lum <= SURFACE_MAX_LUMINANCE
     return float(np.sqrt(np.mean((a[keep] - ref[keep]) ** 2)))
 
@@ -137,8 +146,7 @@ def rmse_surfaces(a, ref):
 def mean_ratio(a, ref):
     """The image's mean luminance over the reference's: 1 within noise when both render one
     scene (a quick like-with-like check; the cross-check proper is `--small`/`--full`)."""
-    lum = np.array([0.2126, 0.7152, 0.0722])
-    return float((a @ lum).mean() / (ref @ lum).mean())
+    return float((a @ LUMINANCE).mean() / (ref @ LUMINANCE).mean())
 
 
 def run(mi, args):
@@ -152,7 +160,7 @@ def run(mi, args):
     meshes = scenes.write_meshes(case, os.path.join(args.work, "meshes"))
     ref, ref_path = reference(mi, args.work, case, meshes, args.reference_spp)
     t0 = time.perf_counter()
-    mitsuba_mode(case)  # registers the plugin where the case needs it
+    register_plugin(case)
     scene = mi.load_dict(scenes.mitsuba_dict(mi, case, meshes, DEPTH, args.spp, 1,
                                              rr_depth=RR_DEPTH, sampler=args.sampler))
     load_s = time.perf_counter() - t0

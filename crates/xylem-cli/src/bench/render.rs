@@ -1,6 +1,6 @@
 //! `xylem bench render`: xylem against Mitsuba 3 on a Cornell box (Lambertian, or with a mirror
-//! and a glass sphere), renders timed interleaved, both scored against one Mitsuba reference
-//! ([`xylem_lab::bench::render`]).
+//! and a glass sphere) or a wood board, renders timed interleaved, both scored against one
+//! Mitsuba reference ([`xylem_lab::bench::render`]).
 
 use std::path::PathBuf;
 use std::process::ExitCode;

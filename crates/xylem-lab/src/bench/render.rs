@@ -1,12 +1,14 @@
-//! The render benchmark behind `xylem bench render`: xylem against Mitsuba 3 on a Cornell box
-//! (256², path tracing to depth 8, box filter; the Lambertian box of scenes/cornell_box.toml, or
-//! the box with a mirror and a glass sphere) in one run: `python -m validation.crosscheck
-//! --timing --case …` writes the case as a xylem scene file and renders it in Mitsuba (depth 9
-//! in Mitsuba's counting), xylem renders that file through the library (`render::render`), and
-//! Mitsuba's process scores both images against one high-spp Mitsuba reference. Both renders are timed after a
-//! first, untimed one (scene loading and Mitsuba's JIT compilation excluded), `repeats` times
-//! each, interleaved (xylem, Mitsuba, xylem, …: Mitsuba's process stays up between its renders,
-//! `--serve`), so that a change of machine load falls on both; medians and ranges are reported.
+//! The render benchmark behind `xylem bench render`: xylem against Mitsuba 3 on one of
+//! [`CASES`] (path tracing to depth 8, box filter: the Lambertian Cornell box of
+//! scenes/cornell_box.toml, the box with a mirror and a glass sphere, or sweep_board's board
+//! under a rect light, which Mitsuba shades through the `xylem_wood` plugin) in one run: `python
+//! -m validation.crosscheck --timing --case …` writes the case as a xylem scene file and renders
+//! it in Mitsuba (depth 9 in Mitsuba's counting), xylem renders that file through the library
+//! (`render::render`), and Mitsuba's process scores both images against one high-spp Mitsuba
+//! reference. Both renders are timed after a first, untimed one (scene loading and Mitsuba's JIT
+//! compilation excluded), `repeats` times each, interleaved (xylem, Mitsuba, xylem, …: Mitsuba's
+//! process stays up between its renders, `--serve`), so that a change of machine load falls on
+//! both; medians and ranges are reported.
 //! samples/s = width · height · spp / seconds.
 
 use std::io::{BufRead, BufReader, Write};
