@@ -18,6 +18,7 @@ mi = pytest.importorskip("mitsuba")
 import drjit as dr  # noqa: E402
 
 import xylem.mitsuba  # noqa: E402
+import xylem.mitsuba_baked  # noqa: E402
 from test_mitsuba import FLAGS, chi2_run, chi2_sf, flags, luminance, record, use  # noqa: E402
 
 # The board `xylem bake` cuts by default (tangential, centre 150 mm from the pith, seed 1),
@@ -396,6 +397,63 @@ def test_baked_render_matches_solid_wood(maps):
     assert s_mean.mean() > 1e-3 and z.size > 0.5 * b_mean.size, "the board is lit and in view"
     assert within_bake_noise(z, b_mean, s_mean), z_stats(z)
     assert not within_bake_noise(zc, mirrored[0], s_mean), z_stats(zc)
+
+
+def test_particle_tracer_renders_the_board_as_the_path_tracer(maps):
+    """Mitsuba's particle tracer (`ptracer`: light paths, the BSDF called in importance
+    transport, si.wi towards the light) renders the board as the `direct` integrator (radiance
+    transport) does. The plugin does not read the transport mode: xylem's BSDF is reciprocal
+    (Rust: wood/tests.rs `eval_is_reciprocal`), so its adjoint is itself and Mitsuba's
+    `eval`, which carries the cosine of its second direction, gives importance transport's
+    integrand too. Per board pixel z of the luminance difference over 16 renders of each, the
+    image checks' criterion (`within_bake_noise`); the pore bump is off (a bumped frame about
+    a normal other than the shading normal would need Veach's adjoint correction, which
+    neither this plugin nor Mitsuba's own bump maps apply). Control: the plugin with the
+    mistake a mode-aware BSDF could make, the cosine of si.wi instead of wo in `eval` under
+    importance transport, fails it."""
+    use("llvm_ad_rgb")
+    gc.collect()
+    spp, seeds = 16, range(1, 17)
+    flat = baked(maps, bump=0.0, roughness=0.25)
+
+    def particles(bsdf):
+        scene = board_scene(bsdf, spp)
+        # The same scene with light paths: emitter -> board -> sensor (max_depth 2).
+        integrator = mi.load_dict({"type": "ptracer", "max_depth": 2})
+        imgs = [luminance(np.array(mi.render(scene, seed=s, integrator=integrator),
+                                   np.float64)) for s in seeds]
+        imgs = np.array(imgs)
+        return imgs.mean(0), imgs.std(0, ddof=1) / math.sqrt(len(seeds))
+
+    base = xylem.mitsuba_baked.bsdf_class(mi, dr)
+
+    class WrongCosine(base):
+        """Under importance transport, f times the cosine of si.wi rather than of wo."""
+
+        def eval_pdf(self, ctx, si, wo, active=True):
+            f, pdf = super().eval_pdf(ctx, si, wo, active)
+            swap = dr.abs(si.wi.z) / dr.maximum(dr.abs(wo.z), 1e-6)
+            importance = ctx.mode == mi.TransportMode.Importance
+            return (f * swap if importance else f), pdf
+
+        def eval(self, ctx, si, wo, active=True):
+            return self.eval_pdf(ctx, si, wo, active)[0]
+
+    mi.register_bsdf("xylem_wood_baked_wrong_cosine", lambda props: WrongCosine(props))
+    camera = mean_and_error(board_scene(flat, spp), [s + 100 for s in seeds], evaluated=False)
+    light = particles(flat)
+    wrong = particles(dict(flat, type="xylem_wood_baked_wrong_cosine"))
+    gc.collect()
+    z, zc = z_scores(light, camera), z_scores(wrong, camera)
+    record("baked/particle_tracer", {
+        "pixels": z.size, "spp": spp, "renders": len(seeds), **z_stats(z),
+        "mean_luminance_ptracer": float(light[0].mean()),
+        "mean_luminance_direct": float(camera[0].mean()),
+        "relative_difference_of_means": float(light[0].mean() / camera[0].mean() - 1),
+        "mean_luminance_control": float(wrong[0].mean()), "control_wrong_cosine": z_stats(zc)})
+    assert camera[0].mean() > 1e-3 and z.size > 0.5 * camera[0].size, "the board is lit"
+    assert within_bake_noise(z, light[0], camera[0]), z_stats(z)
+    assert not within_bake_noise(zc, wrong[0], camera[0]), z_stats(zc)
 
 
 # A sphere of radius SPHERE_MM (a UV sphere: u around the pole, OBJ v from the south pole to
