@@ -3,6 +3,7 @@ xylem's WoodBsdf at the baked texel, its sampling passes Mitsuba's chi-square te
 the board as the per-interaction `xylem_wood` does, its derivatives are right, and it runs in
 Dr.Jit's symbolic modes without breaking other scenes. Each check has a negative control."""
 
+import contextlib
 import gc
 import math
 import os
@@ -402,7 +403,7 @@ def test_baked_render_matches_solid_wood(maps):
 def test_particle_tracer_renders_the_board_as_the_path_tracer(maps):
     """Mitsuba's particle tracer (`ptracer`: light paths, the BSDF called in importance
     transport, si.wi towards the light) renders the board as the `direct` integrator (radiance
-    transport) does. The plugin does not read the transport mode: xylem's BSDF is reciprocal
+    transport) does, with either plugin. The plugin does not read the transport mode: xylem's BSDF is reciprocal
     (Rust: wood/tests.rs `eval_is_reciprocal`), so its adjoint is itself and Mitsuba's
     `eval`, which carries the cosine of its second direction, gives importance transport's
     integrand too. Per board pixel z of the luminance difference over 16 renders of each, the
@@ -416,12 +417,15 @@ def test_particle_tracer_renders_the_board_as_the_path_tracer(maps):
     spp, seeds = 16, range(1, 17)
     flat = baked(maps, bump=0.0, roughness=0.25)
 
-    def particles(bsdf):
+    def particles(bsdf, evaluated=False):
         scene = board_scene(bsdf, spp)
         # The same scene with light paths: emitter -> board -> sensor (max_depth 2).
         integrator = mi.load_dict({"type": "ptracer", "max_depth": 2})
-        imgs = [luminance(np.array(mi.render(scene, seed=s, integrator=integrator),
-                                   np.float64)) for s in seeds]
+        imgs = []
+        for seed in seeds:
+            with xylem.mitsuba.evaluated() if evaluated else contextlib.nullcontext():
+                img = mi.render(scene, seed=seed, integrator=integrator)
+                imgs.append(luminance(np.array(img, np.float64)))
         imgs = np.array(imgs)
         return imgs.mean(0), imgs.std(0, ddof=1) / math.sqrt(len(seeds))
 
@@ -454,6 +458,16 @@ def test_particle_tracer_renders_the_board_as_the_path_tracer(maps):
     assert camera[0].mean() > 1e-3 and z.size > 0.5 * camera[0].size, "the board is lit"
     assert within_bake_noise(z, light[0], camera[0]), z_stats(z)
     assert not within_bake_noise(zc, wrong[0], camera[0]), z_stats(zc)
+    # The per-interaction plugin too (its wood evaluated at each hit, `evaluated()` mode).
+    solid = dict(SOLID, roughness=0.25)
+    camera = mean_and_error(board_scene(solid, spp), [s + 100 for s in seeds], evaluated=True)
+    light = particles(solid, evaluated=True)
+    gc.collect()
+    z = z_scores(light, camera)
+    record("solid/particle_tracer", {
+        "pixels": z.size, **z_stats(z), "mean_luminance_ptracer": float(light[0].mean()),
+        "mean_luminance_direct": float(camera[0].mean())})
+    assert within_bake_noise(z, light[0], camera[0]), z_stats(z)
 
 
 # A sphere of radius SPHERE_MM (a UV sphere: u around the pole, OBJ v from the south pole to
