@@ -338,16 +338,14 @@ def board_scene(bsdf, spp, flip_u=False, width=48, height=24):
     })
 
 
-def mean_and_error(scene, seeds, evaluated):
-    """Per-pixel mean luminance over renders with `seeds` and its standard error (spread of
-    the renders / sqrt(count))."""
+def mean_and_error(scene, seeds, evaluated, integrator=None):
+    """Per-pixel mean luminance over renders with `seeds` (by the scene's integrator, or by
+    `integrator`) and its standard error (spread of the renders / sqrt(count))."""
     imgs = []
     for seed in seeds:
-        if evaluated:
-            with xylem.mitsuba.evaluated():
-                imgs.append(luminance(np.array(mi.render(scene, seed=seed), np.float64)))
-        else:
-            imgs.append(luminance(np.array(mi.render(scene, seed=seed), np.float64)))
+        with xylem.mitsuba.evaluated() if evaluated else contextlib.nullcontext():
+            img = mi.render(scene, seed=seed, integrator=integrator)
+            imgs.append(luminance(np.array(img, np.float64)))
     imgs = np.array(imgs)
     return imgs.mean(0), imgs.std(0, ddof=1) / math.sqrt(len(seeds))
 
@@ -401,15 +399,15 @@ def test_baked_render_matches_solid_wood(maps):
 
 
 def test_particle_tracer_renders_the_board_as_the_path_tracer(maps):
-    """Mitsuba's particle tracer (`ptracer`: light paths, the BSDF called in importance
-    transport, si.wi towards the light) renders the board as the `direct` integrator (radiance
-    transport) does, with either plugin. The plugin does not read the transport mode: xylem's BSDF is reciprocal
-    (Rust: wood/tests.rs `eval_is_reciprocal`), so its adjoint is itself and Mitsuba's
-    `eval`, which carries the cosine of its second direction, gives importance transport's
-    integrand too. Per board pixel z of the luminance difference over 16 renders of each, the
-    image checks' criterion (`within_bake_noise`); the pore bump is off (a bumped frame about
-    a normal other than the shading normal would need Veach's adjoint correction, which
-    neither this plugin nor Mitsuba's own bump maps apply). Control: the plugin with the
+    """Mitsuba's particle tracer (`ptracer`: light paths, the BSDF called in importance transport,
+    si.wi towards the light) renders the board as the `direct` integrator (radiance transport)
+    does, with either plugin. The plugins do not read the transport mode: xylem's BSDF is
+    reciprocal (Rust: wood/tests.rs `eval_is_reciprocal`), so its adjoint is itself and
+    Mitsuba's `eval`, which carries the cosine of its second direction, gives importance
+    transport's integrand too. Per board pixel z of the luminance difference over 16 renders of
+    each, the image checks' criterion (`within_bake_noise`); the pore bump is off (a bumped
+    frame about a normal other than the shading normal would need Veach's adjoint correction,
+    which neither plugin nor Mitsuba's own bump maps apply). Control: the plugin with the
     mistake a mode-aware BSDF could make, the cosine of si.wi instead of wo in `eval` under
     importance transport, fails it."""
     use("llvm_ad_rgb")
@@ -417,17 +415,11 @@ def test_particle_tracer_renders_the_board_as_the_path_tracer(maps):
     spp, seeds = 16, range(1, 17)
     flat = baked(maps, bump=0.0, roughness=0.25)
 
+    # The same scene with light paths: emitter -> board -> sensor (max_depth 2).
+    ptracer = mi.load_dict({"type": "ptracer", "max_depth": 2})
+
     def particles(bsdf, evaluated=False):
-        scene = board_scene(bsdf, spp)
-        # The same scene with light paths: emitter -> board -> sensor (max_depth 2).
-        integrator = mi.load_dict({"type": "ptracer", "max_depth": 2})
-        imgs = []
-        for seed in seeds:
-            with xylem.mitsuba.evaluated() if evaluated else contextlib.nullcontext():
-                img = mi.render(scene, seed=seed, integrator=integrator)
-                imgs.append(luminance(np.array(img, np.float64)))
-        imgs = np.array(imgs)
-        return imgs.mean(0), imgs.std(0, ddof=1) / math.sqrt(len(seeds))
+        return mean_and_error(board_scene(bsdf, spp), seeds, evaluated, ptracer)
 
     base = xylem.mitsuba_baked.bsdf_class(mi, dr)
 
