@@ -5,7 +5,7 @@ prints medians and spreads.
     DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1 \\
     PYTHONPATH=target/python-test/site target/python-venv/bin/python \\
         python/benchmarks/plugin_speed.py [--res 128 96] [--spp 8] [--repeats 5] [--profile]
-        [--before DIR] [--json FILE]
+        [--before DIR] [--json FILE] [--frozen]
 
 The scene: a 0.3 m board (a rectangle, scene units metres) seen from 0.4 m under one
 directional light and a dim constant environment, Mitsuba's ``path`` integrator (max depth 4).
@@ -26,6 +26,12 @@ Three renders per repeat, in turn:
 - ``xylem_wood_baked_rough_mip``: the same with mip-mapped lookups (``pixel_angle`` from the
   camera, ``xylem.mitsuba_baked.set_pixel_angle``).
 
+``--frozen`` renders every case through ``dr.freeze`` (the symbolic cases only): Dr.Jit
+records the render's kernels on the warm-up renders (four, with different seeds) and replays
+them when timed, so neither
+side pays for tracing its Python and C++ into Dr.Jit at every render (what a loop of renders,
+as in inverse rendering, would do).
+
 ``--cases a,b`` runs only those (and ``roughplastic``, the ratios' base); ``--before DIR`` runs
 each plugin case again with the package in DIR (``CASE_before``): the A/B pair of a change.
 
@@ -43,6 +49,7 @@ Dr.Jit conversions, the integrator).
 """
 
 import argparse
+import contextlib
 import cProfile
 import io
 import json
@@ -113,15 +120,19 @@ def scene(bsdf, res, spp, maps=None, bump=1.0):
     return sc
 
 
-def render(sc, seed, evaluated):
+@dr.freeze
+def frozen_render(sc, seed):
+    """`mi.render` as a frozen function (Dr.Jit's `dr.freeze`): its kernels recorded on the
+    first calls and replayed after, with no Python tracing; `seed` a `mi.UInt32`, an input
+    rather than a constant of the recording."""
+    return mi.render(sc, seed=seed)
+
+
+def render(sc, seed, evaluated, frozen=False):
     """(wall seconds, process CPU seconds: every thread of the process, Dr.Jit's and rayon's)"""
     start, cpu = time.perf_counter(), time.process_time()
-    if evaluated:
-        with xylem.mitsuba.evaluated():
-            img = mi.render(sc, seed=seed)
-            dr.eval(img)
-    else:
-        img = mi.render(sc, seed=seed)
+    with xylem.mitsuba.evaluated() if evaluated else contextlib.nullcontext():
+        img = frozen_render(sc, mi.UInt32(seed)) if frozen else mi.render(sc, seed=seed)
         dr.eval(img)
     dr.sync_thread()
     return time.perf_counter() - start, time.process_time() - cpu
@@ -144,6 +155,9 @@ def main():
                     "(default 1; 0 leaves the normal map unread)")
     ap.add_argument("--cases", help="comma-separated cases to run (default: all); "
                     "roughplastic is always run, as the ratios' base")
+    ap.add_argument("--frozen", action="store_true", help="render every case through "
+                    "dr.freeze (recorded on two warm-up renders, replayed when timed), "
+                    "which takes the per-render tracing out of both sides")
     ap.add_argument("--one", help=argparse.SUPPRESS)         # child process: this case only
     ap.add_argument("--seed", type=int, default=1, help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -160,6 +174,10 @@ def main():
         if unknown:
             ap.error(f"--cases: unknown {sorted(unknown)}")
         cases = [c for c in cases if c[0] in keep]
+    if args.frozen:
+        # xylem_wood goes through numpy in evaluated() mode, which a frozen function cannot
+        # record: only the cases in Dr.Jit's symbolic modes.
+        cases = [c for c in cases if not c[2]]
     if args.before or (args.one or "").endswith("_before"):
         # Each plugin case again with the older package: the A/B pair of a change.
         cases += [(name + "_before", b, ev) for name, b, ev in cases
@@ -167,11 +185,17 @@ def main():
     if args.one:                                 # child: one warm-up, one timed render
         name, b, ev = next(c for c in cases if c[0] == args.one)
         sc = scene(b, args.res, args.spp, args.maps, args.bump)
-        render(sc, 0, ev)
+        render(sc, 0, ev, args.frozen)
+        if args.frozen:
+            # More warm-ups with other seeds: Dr.Jit recorded this scene's render three times
+            # (a literal input that changes is made opaque and recorded again), and the first
+            # replay is slower than later ones.
+            for seed in (1, 2, 3):
+                render(sc, seed * 1_000_000, ev, args.frozen)
         if args.profile:
             prof = cProfile.Profile()
             prof.enable()
-        t, cpu = render(sc, args.seed, ev)
+        t, cpu = render(sc, args.seed, ev, args.frozen)
         if args.profile:
             prof.disable()
             buf = io.StringIO()
@@ -185,7 +209,7 @@ def main():
         cmd = [sys.executable, __file__, "--one", name, "--seed", str(seed), "--res",
                *map(str, args.res), "--spp", str(args.spp), "--maps", args.maps,
                "--bump", str(args.bump)] + (
-                   ["--profile"] if profile else [])
+                   ["--profile"] if profile else []) + (["--frozen"] if args.frozen else [])
         env = dict(os.environ)
         if name.endswith("_before"):
             env["PYTHONPATH"] = os.pathsep.join([args.before, env.get("PYTHONPATH", "")])
@@ -202,6 +226,7 @@ def main():
     times = {name: [] for name, _, _ in cases}
     cpu_times = {name: [] for name, _, _ in cases}
     print(f"{mi.variant()}, {args.res[0]}x{args.res[1]}, {args.spp} spp, {args.repeats} repeats, "
+          f"{'frozen (dr.freeze), ' if args.frozen else ''}"
           f"load average {os.getloadavg()[0]:.1f} at the start", flush=True)
     for r in range(args.repeats):                # interleaved, so load changes hit all alike
         for name, _, _ in cases:
@@ -213,7 +238,7 @@ def main():
         return {"median_s": statistics.median(ts), "min_s": min(ts), "max_s": max(ts),
                 "times_s": ts}
 
-    out = {"variant": mi.variant(), "res": list(args.res), "spp": args.spp,
+    out = {"variant": mi.variant(), "res": list(args.res), "spp": args.spp, "frozen": args.frozen,
            "bake_res": args.bake_res,
            "repeats": args.repeats, "machine": platform.processor() or platform.machine(),
            "cpus": os.cpu_count(), "load_avg": os.getloadavg(),

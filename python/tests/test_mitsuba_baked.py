@@ -462,6 +462,46 @@ def test_particle_tracer_renders_the_board_as_the_path_tracer(maps):
     assert within_bake_noise(z, light[0], camera[0]), z_stats(z)
 
 
+def test_baked_render_freezes(maps):
+    """A render with xylem_wood_baked can be a Dr.Jit frozen function (`dr.freeze`: its
+    kernels recorded once and replayed, without tracing the plugin's Python at every render,
+    python/benchmarks/plugin_speed.py `--frozen`): the replayed images equal the plain renders
+    to float rounding (≤ 1e-5), later renders replay rather than record, and after the maps are
+    changed through `mi.traverse` the frozen render follows them. Control: the image of before
+    the change differs from the one after it."""
+    use("llvm_ad_rgb")
+    gc.collect()
+    scene = board_scene(baked(maps, roughness=0.25), spp=4)
+
+    @dr.freeze
+    def render(scene, seed):
+        return mi.render(scene, seed=seed)
+
+    def both(seed):
+        plain = np.array(mi.render(scene, seed=seed))
+        return plain, np.array(render(scene, mi.UInt32(seed)))
+
+    for seed in range(4):                        # records, then replays
+        plain, frozen = both(seed)
+        assert np.abs(plain - frozen).max() <= 1e-5, seed
+    recordings = render.n_recordings
+    for seed in range(4, 7):
+        plain, frozen = both(seed)
+        assert np.abs(plain - frozen).max() <= 1e-5, seed
+    assert render.n_recordings == recordings <= 3, (recordings, render.n_recordings)
+    before = frozen
+    params = mi.traverse(scene)
+    key = next(k for k in params.keys() if k.endswith("bsdf.maps"))
+    params[key] = params[key] * 0.5
+    params.update()
+    plain, frozen = both(6)
+    record("baked/frozen", {"recordings": recordings,
+                            "max_difference_after_update": float(np.abs(plain - frozen).max()),
+                            "control_change": float(np.abs(before - frozen).max())})
+    assert np.abs(plain - frozen).max() <= 1e-5
+    assert np.abs(before - frozen).max() > 1e-3
+
+
 # A sphere of radius SPHERE_MM (a UV sphere: u around the pole, OBJ v from the south pole to
 # the north), carved at tree (0, 150, 0) with the fibres along z, seen from one side under one
 # distant light: the same OBJ file is baked by `xylem bake --mesh`, loaded by Mitsuba's OBJ

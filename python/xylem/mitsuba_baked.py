@@ -56,6 +56,17 @@ is differentiable by Dr.Jit's AD (directions, uv and the maps, which ``mi.traver
 ``maps``: an (H, W, 14) tensor of base colour, beta, fibre colour, ray mask, fibre direction
 and ray direction, and the tangent-space normal when ``bump`` > 0: (H, W, 17)).
 
+Every ``mi.render`` traces the plugin's Python into Dr.Jit again (about 10 ms of a short
+render's time). A loop of renders (an optimisation, a parameter study) avoids that by freezing
+the render, which records its kernels and replays them, and follows changes made through
+``mi.traverse`` (python/tests/test_mitsuba_baked.py ``test_baked_render_freezes``)::
+
+    @dr.freeze
+    def render(scene, seed):
+        return mi.render(scene, seed=seed)
+
+    image = render(scene, mi.UInt32(seed))   # a Python int seed would be recorded as a constant
+
 What it approximates compared with the solid wood of ``xylem_wood``: the wood is sampled at the
 texel centres and interpolated bilinearly (at ``--res 1024`` on a 300 mm board, 0.29 mm
 texels; pores and ray flecks narrower than that blur); the tangent frame is Mitsuba's per
