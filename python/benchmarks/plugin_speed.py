@@ -28,9 +28,8 @@ Three renders per repeat, in turn:
 
 ``--frozen`` renders every case through ``dr.freeze`` (the symbolic cases only): Dr.Jit
 records the render's kernels on the warm-up renders (four, with different seeds) and replays
-them when timed, so neither
-side pays for tracing its Python and C++ into Dr.Jit at every render (what a loop of renders,
-as in inverse rendering, would do).
+them when timed, so neither side pays for tracing its Python and C++ into Dr.Jit at every
+render (what a loop of renders, as in inverse rendering, would do).
 
 ``--cases a,b`` runs only those (and ``roughplastic``, the ratios' base); ``--before DIR`` runs
 each plugin case again with the package in DIR (``CASE_before``): the A/B pair of a change.
@@ -156,7 +155,7 @@ def main():
     ap.add_argument("--cases", help="comma-separated cases to run (default: all); "
                     "roughplastic is always run, as the ratios' base")
     ap.add_argument("--frozen", action="store_true", help="render every case through "
-                    "dr.freeze (recorded on two warm-up renders, replayed when timed), "
+                    "dr.freeze (recorded on four warm-up renders, replayed when timed), "
                     "which takes the per-render tracing out of both sides")
     ap.add_argument("--one", help=argparse.SUPPRESS)         # child process: this case only
     ap.add_argument("--seed", type=int, default=1, help=argparse.SUPPRESS)
@@ -182,7 +181,7 @@ def main():
         # Each plugin case again with the older package: the A/B pair of a change.
         cases += [(name + "_before", b, ev) for name, b, ev in cases
                   if name.startswith("xylem_wood")]
-    if args.one:                                 # child: one warm-up, one timed render
+    if args.one:                                 # child: warm-up(s), one timed render
         name, b, ev = next(c for c in cases if c[0] == args.one)
         sc = scene(b, args.res, args.spp, args.maps, args.bump)
         render(sc, 0, ev, args.frozen)
