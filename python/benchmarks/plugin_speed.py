@@ -35,7 +35,7 @@ render (what a loop of renders, as in inverse rendering, would do).
 each plugin case again with the package in DIR (``CASE_before``): the A/B pair of a change.
 
 Both baked cases use the plugin's pore bump at ``--bump`` (default 1, the plugin's default;
-0: the normal map is not read).
+0: the normal map is not read) and its texture filter, or ``--filter stochastic|bilinear``.
 
 Each case runs in its own Python process (a ``xylem_wood`` BSDF alive in a process makes every
 symbolic render there fail: Dr.Jit traces a symbolic call for every registered BSDF instance,
@@ -91,7 +91,7 @@ def bake(exe, res, out):
     return out
 
 
-def scene(bsdf, res, spp, maps=None, bump=1.0):
+def scene(bsdf, res, spp, maps=None, bump=1.0, filter=None):
     T = mi.ScalarTransform4f
     sc = mi.load_dict({
         "type": "scene",
@@ -109,7 +109,7 @@ def scene(bsdf, res, spp, maps=None, bump=1.0):
         "board": {"type": "rectangle", "to_world": T().scale([0.15, 0.15, 1.0]),
                   "bsdf": ({"type": "xylem_wood_baked", "maps": maps, "eta": 1.5,
                             "roughness": 0.25 if "_rough" in bsdf else 0.0,
-                            "bump": bump}
+                            "bump": bump, **({"filter": filter} if filter else {})}
                            if bsdf.startswith("xylem_wood_baked") else dict(BSDFS[bsdf]))},
     })
     if bsdf.endswith("_mip"):
@@ -152,6 +152,8 @@ def main():
                     "baking (default 1024)")
     ap.add_argument("--bump", type=float, default=1.0, help="the baked cases' pore bump "
                     "(default 1; 0 leaves the normal map unread)")
+    ap.add_argument("--filter", choices=("stochastic", "bilinear"),
+                    help="the baked cases' texture filter (default: the plugin's, stochastic)")
     ap.add_argument("--cases", help="comma-separated cases to run (default: all); "
                     "roughplastic is always run, as the ratios' base")
     ap.add_argument("--frozen", action="store_true", help="render every case through "
@@ -183,7 +185,7 @@ def main():
                   if name.startswith("xylem_wood")]
     if args.one:                                 # child: warm-up(s), one timed render
         name, b, ev = next(c for c in cases if c[0] == args.one)
-        sc = scene(b, args.res, args.spp, args.maps, args.bump)
+        sc = scene(b, args.res, args.spp, args.maps, args.bump, args.filter)
         render(sc, 0, ev, args.frozen)
         if args.frozen:
             # More warm-ups with other seeds: Dr.Jit recorded this scene's render three times
@@ -208,6 +210,7 @@ def main():
         cmd = [sys.executable, __file__, "--one", name, "--seed", str(seed), "--res",
                *map(str, args.res), "--spp", str(args.spp), "--maps", args.maps,
                "--bump", str(args.bump)] + (
+                   ["--filter", args.filter] if args.filter else []) + (
                    ["--profile"] if profile else []) + (["--frozen"] if args.frozen else [])
         env = dict(os.environ)
         if name.endswith("_before"):

@@ -813,3 +813,124 @@ def test_baked_scalar_variant_agrees(maps):
     assert not np.allclose(moved, f[0], rtol=1e-3), "another texel gives another f"
     img = np.array(mi.render(board_scene(baked(maps), 2, width=6, height=3)))
     assert img.shape == (3, 6, 3) and np.isfinite(img).all() and img.mean() > 1e-3
+
+
+
+def off_centre_hits(maps, u, v, count, rng):
+    """`count` interactions at uv (u, v) moved by up to 0.02 texel each (so that the numbers
+    hashed from their uv differ), on a flat frame of the board's texel aspect, seen from
+    (0.3, 0.2, 0.93); with mip maps on, 2^1.5 texels of level 0 wide (`_mip_level` with
+    pixel_angle 1e-3): levels 1 and 2 weigh 1/2 each."""
+    h, w = read_maps(maps)["base_color"].shape[:2]
+    si = dr.zeros(mi.SurfaceInteraction3f, count)
+    jitter = rng.uniform(-0.02, 0.02, (2, count)) / np.array([[w], [h]])
+    si.uv = mi.Point2f((np.array([[u], [v]]) + jitter).astype(np.float32))
+    si.sh_frame = mi.Frame3f(mi.Vector3f(0, 0, 1))
+    si.dp_du, si.dp_dv = mi.Vector3f(0.3, 0, 0), mi.Vector3f(0, -0.12, 0)
+    wi = np.array([0.3, 0.2, 0.93]) / np.linalg.norm([0.3, 0.2, 0.93])
+    si.wi = mi.Vector3f(*(float(x) for x in wi))
+    si.t = mi.Float(2 ** 1.5 * wi[2] * math.sqrt(0.3 * 0.12) / (1e-3 * math.sqrt(h * w)))
+    return si
+
+
+def between_texels(maps, count, seed):
+    """`count` uv points whose texel positions (uv x size - 1/2) in levels 0, 1 and 2 (halved
+    sizes, rounded up) are all at least 0.1 texel from a texel centre, so that the jitter of
+    `off_centre_hits` stays between the same texel centres."""
+    h, w = read_maps(maps)["base_color"].shape[:2]
+    rng, points = np.random.default_rng(seed), []
+    while len(points) < count:
+        uv = rng.uniform(0.05, 0.95, 2)
+        frac = [(uv * np.array([-(-w // 2 ** k), -(-h // 2 ** k)]) - 0.5) % 1.0
+                for k in range(3)]
+        if all(((f > 0.1) & (f < 0.9)).all() for f in frac):
+            points.append(tuple(uv))
+    return points
+
+
+@pytest.mark.parametrize("mip", [False, True], ids=["level_0", "mip"])
+def test_stochastic_lookup_draws_texels_by_their_filter_weights(maps, mip, monkeypatch):
+    """`filter` "stochastic" (the default) draws one texel per interaction with the bilinear
+    (trilinear) weights: at 4 uv points between texel centres (`between_texels`), 8192
+    interactions each (`off_centre_hits`), every lookup returns one of the 4 (8) neighbouring
+    texels' values exactly, and their mean equals `filter` "bilinear"'s lookup to within 4.5
+    standard errors in every channel that varies (to 1e-5 in those that vary only by float32
+    rounding). The control, the hashed numbers held at 0.5 (always the nearest texel), is
+    off."""
+    use("llvm_ad_rgb")
+    extra = dict(roughness=0.25, pixel_angle=1e-3 if mip else 0.0)
+    rng = np.random.default_rng(11)
+    n, points = 8192, between_texels(maps, 4, seed=11)
+    hits = [off_centre_hits(maps, u, v, n, rng) for u, v in points]
+
+    def lookups(bsdf):
+        return [np.array([np.array(c) for c in bsdf._lookup(si, True)]) for si in hits]
+
+    def worst(draws, reference):
+        """(largest |z| of the channels that vary by more than float32 rounding, largest
+        |difference| of those that do not)"""
+        want = reference.mean(1)
+        diff = np.abs(draws.mean(1) - want)
+        se = draws.std(1, ddof=1) / math.sqrt(draws.shape[1])
+        varies = se > 1e-6 * np.abs(want) + 1e-9
+        return (float((diff[varies] / se[varies]).max(initial=0.0)),
+                float(diff[~varies].max(initial=0.0)))
+
+    bilinear = lookups(mi.load_dict(baked(maps, filter="bilinear", **extra)))
+    drawn = lookups(mi.load_dict(baked(maps, **extra)))
+    distinct = [len(np.unique(d.T, axis=0)) for d in drawn]
+    zs = [worst(d, b) for d, b in zip(drawn, bilinear)]
+    monkeypatch.setattr(xylem.mitsuba_baked, "_interaction_numbers",
+                        lambda mi_, dr_, uv, count: [mi.Float(0.5)] * count)
+    nearest = lookups(mi.load_dict(baked(maps, **extra)))
+    control = [worst(d, b) for d, b in zip(nearest, bilinear)]
+    record(f"baked/stochastic/{'mip' if mip else 'level_0'}", {
+        "interactions": n, "points": len(points), "max_abs_z": max(z for z, _ in zs),
+        "distinct_texels_drawn": distinct,
+        "control_nearest_max_abs_z": max(z for z, _ in control),
+        "control_nearest_max_abs_difference_of_constant_channels": max(e for _, e in control)})
+    assert all(2 <= k <= (8 if mip else 4) for k in distinct), distinct
+    assert all(z < 4.5 and exact < 1e-5 for z, exact in zs), zs
+    assert any(z > 4.5 or exact > 1e-5 for z, exact in control), control
+
+
+def test_sample_and_eval_pdf_see_one_texel(maps, monkeypatch):
+    """`sample` and `eval_pdf` at one interaction draw the same texel: at 4 x 128 interactions
+    off the texel centres (rough finish 0.25), the weight `sample` returns equals f cos / pdf
+    of `eval_pdf` at the sampled direction to 1e-4 relative. The control, numbers that ignore
+    the interaction (a new draw at every call), breaks that at more than a tenth of them."""
+    use("llvm_ad_rgb")
+    bsdf = mi.load_dict(baked(maps, roughness=0.25))
+    rng = np.random.default_rng(12)
+    hits = [off_centre_hits(maps, u, v, 128, rng) for u, v in between_texels(maps, 4, seed=12)]
+    ctx = mi.BSDFContext()
+
+    def mismatches():
+        bad = total = 0
+        for si in hits:
+            count = dr.width(si.uv)
+            s1 = mi.Float(rng.random(count).astype(np.float32))
+            s2 = mi.Point2f(rng.random((2, count)).astype(np.float32))
+            bs, weight = bsdf.sample(ctx, si, s1, s2)
+            f, pdf = bsdf.eval_pdf(ctx, si, bs.wo)
+            ok = np.array(bs.pdf) > 0
+            weight, f = np.array(weight)[:, ok], np.array(f)[:, ok]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                again = f / np.array(pdf)[ok]        # a zero pdf here is a mismatch too
+            bad += int((~np.isclose(weight, again, rtol=1e-4, atol=1e-7)).any(0).sum())
+            total += int(ok.sum())
+        return bad, total
+
+    bad, total = mismatches()
+    calls = iter(range(1, 1 << 30))
+    monkeypatch.setattr(
+        xylem.mitsuba_baked, "_interaction_numbers",
+        lambda mi_, dr_, uv, count: [mi.Float(np.random.default_rng(next(calls))
+                                              .random(dr.width(uv.x)).astype(np.float32))
+                                     for _ in range(count)])
+    control_bad, control_total = mismatches()
+    record("baked/stochastic/sample_and_eval_pdf", {
+        "sampled": total, "mismatched": bad, "control_mismatched": control_bad,
+        "control_sampled": control_total})
+    assert total > 300 and bad == 0, (bad, total)
+    assert control_bad > 0.1 * control_total, (control_bad, control_total)

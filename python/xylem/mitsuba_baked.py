@@ -31,6 +31,13 @@ camera sample, which ``set_pixel_angle(scene)`` computes from the scene's camera
 every ``xylem_wood_baked`` there (Mitsuba's integrators give a BSDF no uv footprint); the
 lookups are then trilinear between the mip levels about the footprint (``_halve``,
 ``_lookup``).
+``filter`` (default ``"stochastic"``) is how a lookup filters the texels: ``"stochastic"``
+draws one texel (and one mip level) per interaction with the bilinear (trilinear) weights, by
+numbers hashed from si.uv, so that ``eval_pdf`` and ``sample`` at one interaction see the same
+texel (stochastic texture filtering, Pharr et al. 2024): the BSDFs of the texels are averaged
+over the pixel's samples rather than their parameters, for a quarter of the gathers (an
+eighth with mip maps), and uv gets no derivative; ``"bilinear"`` interpolates the parameters
+and is differentiable in uv.
 
 The BSDF at a texel is xylem's ``WoodBsdf`` (crates/xylem/src/bsdf/wood.rs) for the parameters
 xylem's own baked-map material builds there (``material/face.rs`` ``face_shading``): the
@@ -52,11 +59,12 @@ defines it; where ``dp/du`` is unset (a zero-initialised interaction, as
 ``mitsuba.chi2.BSDFAdapter`` makes) x is the shading frame's s.
 
 Unlike ``xylem_wood`` it needs no ``evaluated()`` mode, leaves other scenes renderable, and
-is differentiable by Dr.Jit's AD (directions, uv and the maps, which ``mi.traverse`` lists as
+is differentiable by Dr.Jit's AD (directions, the maps, which ``mi.traverse`` lists as
 ``maps``: an (H, W, 14) tensor of base colour, beta, fibre colour, ray mask, fibre direction
-and ray direction, and the tangent-space normal when ``bump`` > 0: (H, W, 17)).
+and ray direction, and the tangent-space normal when ``bump`` > 0: (H, W, 17); and uv with
+``filter`` ``"bilinear"``).
 
-Every ``mi.render`` traces the plugin's Python into Dr.Jit again (about 10 ms of a short
+Every ``mi.render`` traces the plugin's Python into Dr.Jit again (about 8 ms of a short
 render's time). A loop of renders (an optimisation, a parameter study) avoids that by freezing
 the render, which records its kernels and replays them, and follows changes made through
 ``mi.traverse`` (python/tests/test_mitsuba_baked.py ``test_baked_render_freezes``)::
@@ -68,13 +76,13 @@ the render, which records its kernels and replays them, and follows changes made
     image = render(scene, mi.UInt32(seed))   # a Python int seed would be recorded as a constant
 
 What it approximates compared with the solid wood of ``xylem_wood``: the wood is sampled at the
-texel centres and interpolated bilinearly (at ``--res 1024`` on a 300 mm board, 0.29 mm
+texel centres and filtered between them (at ``--res 1024`` on a 300 mm board, 0.29 mm
 texels; pores and ray flecks narrower than that blur); the tangent frame is Mitsuba's per
 triangle (dp/du, dp/dv) where the bake interpolated vertex tangents; a bake without
 ``ray_direction.exr`` gets the ray axis in the face across the fibre; the pore bump is the
-baked normal map's, bilinear between texel centres (pores are about a texel wide at
-``--res 1024``); mip levels average the BSDF's parameters (colours, axes with beta widened by
-their spread, the normal), not the BSDF. ``BSDFContext`` masks are honoured per component
+baked normal map's, filtered between texel centres (pores are about a texel wide at
+``--res 1024``); a mip level's texels average the BSDF's parameters over the texels below
+(colours, axes with beta widened by their spread, the normal), not the BSDF. ``BSDFContext`` masks are honoured per component
 (0: the diffuse and fibre lobes and a rough finish's reflection, 1: a smooth finish's mirror),
 with the lobe probabilities renormalised over what is enabled.
 """
@@ -291,6 +299,36 @@ def _atlas(dr, jit, levels):
         row, col = texel // w_, texel % w_
         dr.scatter(flat, lv.array, ((row + oy_) * width + col + ox_) * c + k)
     return jit.Tensor(flat, (height, width, c)), boxes
+
+
+def _hash(dr, h, wrap):
+    """Chris Wellons's `lowbias32` integer hash (hash-prospector), on 32-bit unsigned h; `wrap`
+    keeps the scalar variant's Python ints to 32 bits (identity for Dr.Jit's UInt32)."""
+    h = h ^ (h >> 16)
+    h = wrap(h * 0x7FEB352D)
+    h = h ^ (h >> 15)
+    h = wrap(h * 0x846CA68B)
+    return h ^ (h >> 16)
+
+
+def _interaction_numbers(mi, dr, uv, count):
+    """`count` numbers in [0, 1) that are a hash of the interaction's uv bits: the same for every
+    call at one interaction (`eval_pdf` and `sample` see one texel), uncorrelated between
+    interactions (uv is continuous; two paths that meet one uv exactly have measure zero)."""
+    if dr.is_jit_v(mi.Float):
+        bits = [dr.reinterpret_array(mi.UInt32, c) for c in (uv.x, uv.y)]
+        wrap = lambda h: h
+    else:
+        import struct
+
+        bits = [struct.unpack("<I", struct.pack("<f", float(c)))[0] for c in (uv.x, uv.y)]
+        wrap = lambda h: h & 0xFFFFFFFF
+    h = _hash(dr, bits[0] ^ _hash(dr, bits[1] ^ 0x9E3779B9, wrap), wrap)
+    out = []
+    for _ in range(count):
+        h = _hash(dr, h ^ 0x85EBCA6B, wrap)
+        out.append(mi.Float(h >> 8) * (1.0 / (1 << 24)))
+    return out
 
 
 def _frame_axes(mi, dr, si):
@@ -577,6 +615,10 @@ def bsdf_class(mi, dr):
                 raise ValueError(f"xylem_wood_baked: `pixel_angle` = {self.pixel_angle}: "
                                  "expected 0 (no mip maps) to 0.1 rad (`pixel_angle(scene)`)")
             self._pixel_angle = mi.Float(self.pixel_angle)
+            self.filter = str(props.get("filter", "stochastic"))
+            if self.filter not in ("stochastic", "bilinear"):
+                raise ValueError(f"xylem_wood_baked: `filter` = {self.filter!r}: expected "
+                                 "'stochastic' (one texel per interaction) or 'bilinear'")
             linear = dict(filter_mode=dr.FilterMode.Linear, wrap_mode=dr.WrapMode.Clamp)
             self._linear = linear
             self._tensor = mi.TensorXf(_maps(self.maps, normal=self.bump > 0))
@@ -824,12 +866,14 @@ def bsdf_class(mi, dr):
                 level = _halve(dr, jit, level)
                 levels.append(level)
             self._levels = len(levels)
-            if len(levels) == 1:
-                self._texture = mi.Texture2f(jit.out(level), **self._linear)
-                return
-            atlas, boxes = _atlas(dr, jit, levels)
-            self._texture = mi.Texture2f(jit.out(atlas), **self._linear)
-            self._boxes = [mi.Float(np.array(b, np.float32)) for b in zip(*boxes)]
+            if len(levels) > 1:
+                level, boxes = _atlas(dr, jit, levels)
+                self._boxes = [mi.Float(np.array(b, np.float32)) for b in zip(*boxes)]
+            table = jit.out(level)
+            # Evaluated here: the stochastic lookups gather from it inside Mitsuba's kernel.
+            dr.make_opaque(table)
+            self._table = table
+            self._texture = mi.Texture2f(table, **self._linear)
 
         def parameters_changed(self, keys=None):
             angle = self._pixel_angle
@@ -837,28 +881,20 @@ def bsdf_class(mi, dr):
             self._build()
 
         def _lookup(self, si, active):
-            """The shading maps at si.uv: bilinear in level 0 or, with a `pixel_angle`,
-            trilinear between the two mip levels about log2 of the footprint's width in
-            texels (each level looked up in the atlas, `_atlas`, clamped to its texels). The
-            footprint is a ray cone's (Amanatides 1984; Akenine-Moeller et al. 2019): width
-            pixel_angle * si.t across the ray, 1 / cos theta longer along the surface, in
-            texels by the texels per unit area, W H / |dp/du x dp/dv|. At a camera hit si.t is
-            the distance from the camera; at later bounces the segment from the last vertex,
-            which underestimates the cone (sharper, never blurrier)."""
+            """The shading maps at si.uv: one texel drawn by its bilinear weight (`filter`
+            "stochastic", `_stochastic_lookup`), or bilinear in level 0; with a `pixel_angle`,
+            in the mip level about log2 of the footprint's width in texels (`_mip_level`),
+            drawn by its weight or trilinear between the two (each level looked up in the
+            atlas, `_atlas`, clamped to its texels)."""
+            if self.filter == "stochastic":
+                return self._stochastic_lookup(si, active)
             if self._levels == 1:
                 return self._texture.eval(si.uv, active)
-            h, w = self._tensor.shape[:2]
-            area = dr.norm(dr.cross(si.dp_du, si.dp_dv))
-            per_length = dr.select(area > 1e-20, dr.rsqrt(dr.maximum(area, 1e-20)), 0.0)
-            texels = (self._pixel_angle * si.t * math.sqrt(h * w) * per_length
-                      / dr.maximum(dr.abs(si.wi.z), 1e-3))
-            lam = dr.clip(dr.log2(dr.maximum(texels, 1.0)), 0.0, self._levels - 1.0)
-            lower = mi.UInt32(dr.floor(lam))
-            frac = lam - mi.Float(lower)
+            lower, frac = self._mip_level(si)
             atlas = self._texture.shape
 
             def at(level, uv, active):
-                w, h, ox, oy = (dr.gather(mi.Float, b, level, active) for b in self._boxes)
+                w, h, ox, oy = self._box(level, active)
                 x = dr.clip(uv.x * w, 0.5, w - 0.5) + ox
                 y = dr.clip(uv.y * h, 0.5, h - 0.5) + oy
                 return self._texture.eval(mi.Point2f(x / atlas[1], y / atlas[0]), active)
@@ -872,10 +908,68 @@ def bsdf_class(mi, dr):
             top = dr.if_stmt((lower, si.uv, frac, active), frac > 0.0, upper, none)
             return [a * (1.0 - frac) + b for a, b in zip(at(lower, si.uv, active), top)]
 
+        def _mip_level(self, si):
+            """The mip level below the footprint and the weight of the one above: log2 of the
+            footprint's width in texels, a ray cone's (Amanatides 1984; Akenine-Moeller et al.
+            2019): width pixel_angle * si.t across the ray, 1 / cos theta longer along the
+            surface, in texels by the texels per unit area, W H / |dp/du x dp/dv|. At a camera
+            hit si.t is the distance from the camera; at later bounces the segment from the
+            last vertex, which underestimates the cone (sharper, never blurrier)."""
+            h, w = self._tensor.shape[:2]
+            area = dr.norm(dr.cross(si.dp_du, si.dp_dv))
+            per_length = dr.select(area > 1e-20, dr.rsqrt(dr.maximum(area, 1e-20)), 0.0)
+            texels = (self._pixel_angle * si.t * math.sqrt(h * w) * per_length
+                      / dr.maximum(dr.abs(si.wi.z), 1e-3))
+            lam = dr.clip(dr.log2(dr.maximum(texels, 1.0)), 0.0, self._levels - 1.0)
+            lower = mi.UInt32(dr.floor(lam))
+            return lower, lam - mi.Float(lower)
+
+        def _box(self, level, active):
+            """A mip level's (width, height, x offset, y offset) in the atlas, in texels."""
+            return tuple(dr.gather(mi.Float, b, level, active) for b in self._boxes)
+
+        def _stochastic_lookup(self, si, active):
+            """Stochastic texture filtering (Pharr, Wronski, Salvi & Fajardo 2024, "Filtering
+            after shading with stochastic texture filtering"): one texel, drawn with the
+            bilinear weights (and, with mip maps, one level drawn with the trilinear weight),
+            by numbers hashed from the interaction (`_interaction_numbers`), so that eval_pdf
+            and sample at one interaction see the same texel. The BSDF is then filtered after
+            shading: its expectation is the bilinear (trilinear) average of the texels' BSDFs
+            rather than the BSDF of the averaged parameters, for a quarter (an eighth) of the
+            gathers. At texel centres it is the texel's value exactly."""
+            xi = _interaction_numbers(mi, dr, si.uv, 3 if self._levels > 1 else 2)
+            height, width, channels = self._texture.shape
+            if self._levels == 1:
+                x, y = si.uv.x * width, si.uv.y * height
+                lo_x, lo_y, hi_x, hi_y = 0.0, 0.0, width - 1.0, height - 1.0
+            else:
+                lower, frac = self._mip_level(si)
+                level = lower + dr.select(xi[2] < frac, mi.UInt32(1), mi.UInt32(0))
+                w, h, ox, oy = self._box(level, active)
+                x = dr.clip(si.uv.x * w, 0.5, w - 0.5) + ox
+                y = dr.clip(si.uv.y * h, 0.5, h - 0.5) + oy
+                lo_x, lo_y, hi_x, hi_y = ox, oy, ox + w - 1.0, oy + h - 1.0
+
+            def pick(t, u, lo, hi):
+                """Texel index along one axis: the lower neighbour of t - 1/2, or the upper
+                with probability its bilinear weight; clamped as Dr.Jit's Clamp wrap mode."""
+                t = t - 0.5
+                i = dr.floor(t)
+                i = dr.select(u < t - i, i + 1.0, i)
+                return mi.UInt32(dr.clip(i, lo, hi))
+
+            texel = pick(y, xi[1], lo_y, hi_y) * width + pick(x, xi[0], lo_x, hi_x)
+            index = texel * channels
+            if not dr.is_jit_v(mi.Float):
+                return [mi.Float(self._table.array[index + k]) for k in range(channels)]
+            return [dr.gather(mi.Float, self._table.array, index + k, active)
+                    for k in range(channels)]
+
         def to_string(self):
             return (f"XylemWoodBaked[maps={self.maps}, eta={self.eta}, "
                     f"roughness={self.roughness}, bump={self.bump}, "
-                    f"pixel_angle={self.pixel_angle}, two_sided={self.two_sided}]")
+                    f"pixel_angle={self.pixel_angle}, filter={self.filter}, "
+                    f"two_sided={self.two_sided}]")
 
     _CLASSES[key] = XylemWoodBaked
     return XylemWoodBaked
