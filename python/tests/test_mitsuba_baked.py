@@ -934,3 +934,29 @@ def test_sample_and_eval_pdf_see_one_texel(maps, monkeypatch):
         "control_sampled": control_total})
     assert total > 300 and bad == 0, (bad, total)
     assert control_bad > 0.1 * control_total, (control_bad, control_total)
+
+
+@pytest.mark.parametrize("filt", ["stochastic", "bilinear"])
+@pytest.mark.parametrize("pixel_angle", [0.0, 1e-3], ids=["level_0", "mip"])
+def test_non_finite_uv_and_distance_give_finite_values(maps, filt, pixel_angle):
+    """Interactions whose uv or distance is NaN, infinite or huge (a degenerate mesh's) give
+    finite f, pdf and sample weights, the texel (0, 0) standing in for a non-finite uv. Before
+    the lookups sanitised them the stochastic lookup read out of its table and the process
+    died (SIGSEGV, 2026-12-04), and the bilinear one returned NaN f. The control: a finite
+    uv and distance in the same batch shade to non-zero values, so the check is not passed by
+    zeros."""
+    use("llvm_ad_rgb")
+    bsdf = mi.load_dict(baked(maps, roughness=0.25, filter=filt, pixel_angle=pixel_angle))
+    odd = [math.nan, math.inf, -math.inf, 1e30, -1e30, 0.5, 2.0, -3.0, 0.37]
+    si = dr.zeros(mi.SurfaceInteraction3f, len(odd))
+    si.uv = mi.Point2f(np.array([odd, odd[::-1][1:] + [0.61]], np.float32))
+    si.sh_frame = mi.Frame3f(mi.Vector3f(0, 0, 1))
+    si.dp_du, si.dp_dv = mi.Vector3f(0.3, 0, 0), mi.Vector3f(0, -0.12, 0)
+    si.wi = dr.normalize(mi.Vector3f(0.3, 0.2, 0.93))
+    si.t = mi.Float(np.array([math.nan, math.inf, 1e30, 0, -1, 0.3, 1e-30, 5, 0.4], np.float32))
+    ctx = mi.BSDFContext()
+    f, pdf = bsdf.eval_pdf(ctx, si, dr.normalize(mi.Vector3f(-0.2, 0.1, 0.9)))
+    bs, weight = bsdf.sample(ctx, si, mi.Float(0.5), mi.Point2f(0.3, 0.6))
+    values = [np.array(x) for x in (f, pdf, weight, bs.pdf, bs.wo)]
+    assert all(np.isfinite(v).all() for v in values), values
+    assert np.array(f)[:, -1].min() > 0 and np.array(pdf)[-1] > 0, values

@@ -886,10 +886,16 @@ def bsdf_class(mi, dr):
             in the mip level about log2 of the footprint's width in texels (`_mip_level`),
             drawn by its weight or trilinear between the two (each level looked up in the
             atlas, `_atlas`, clamped to its texels)."""
+            # A non-finite uv (a degenerate mesh's) reads texel (0, 0), and a huge one the edge
+            # as Clamp does, rather than NaNs (Dr.Jit's texture overflows its index) or, drawn
+            # stochastically, an index out of the table.
+            finite = dr.isfinite(si.uv.x) & dr.isfinite(si.uv.y)
+            uv = mi.Point2f(*(dr.clip(dr.select(finite, c, 0.0), -1.0, 2.0)
+                              for c in (si.uv.x, si.uv.y)))
             if self.filter == "stochastic":
-                return self._stochastic_lookup(si, active)
+                return self._stochastic_lookup(si, uv, active)
             if self._levels == 1:
-                return self._texture.eval(si.uv, active)
+                return self._texture.eval(uv, active)
             lower, frac = self._mip_level(si)
             atlas = self._texture.shape
 
@@ -905,8 +911,8 @@ def bsdf_class(mi, dr):
             def none(lower, uv, frac, active):
                 return tuple(mi.Float(0.0) for _ in range(atlas[2]))
 
-            top = dr.if_stmt((lower, si.uv, frac, active), frac > 0.0, upper, none)
-            return [a * (1.0 - frac) + b for a, b in zip(at(lower, si.uv, active), top)]
+            top = dr.if_stmt((lower, uv, frac, active), frac > 0.0, upper, none)
+            return [a * (1.0 - frac) + b for a, b in zip(at(lower, uv, active), top)]
 
         def _mip_level(self, si):
             """The mip level below the footprint and the weight of the one above: log2 of the
@@ -920,15 +926,16 @@ def bsdf_class(mi, dr):
             per_length = dr.select(area > 1e-20, dr.rsqrt(dr.maximum(area, 1e-20)), 0.0)
             texels = (self._pixel_angle * si.t * math.sqrt(h * w) * per_length
                       / dr.maximum(dr.abs(si.wi.z), 1e-3))
-            lam = dr.clip(dr.log2(dr.maximum(texels, 1.0)), 0.0, self._levels - 1.0)
-            lower = mi.UInt32(dr.floor(lam))
+            texels = dr.select(dr.isfinite(texels) & (texels > 1.0), texels, 1.0)
+            lam = dr.clip(dr.log2(texels), 0.0, self._levels - 1.0)
+            lower = dr.minimum(mi.UInt32(dr.floor(lam)), self._levels - 1)
             return lower, lam - mi.Float(lower)
 
         def _box(self, level, active):
             """A mip level's (width, height, x offset, y offset) in the atlas, in texels."""
             return tuple(dr.gather(mi.Float, b, level, active) for b in self._boxes)
 
-        def _stochastic_lookup(self, si, active):
+        def _stochastic_lookup(self, si, uv, active):
             """Stochastic texture filtering (Pharr, Wronski, Salvi & Fajardo 2024, "Filtering
             after shading with stochastic texture filtering"): one texel, drawn with the
             bilinear weights (and, with mip maps, one level drawn with the trilinear weight),
@@ -937,17 +944,17 @@ def bsdf_class(mi, dr):
             shading: its expectation is the bilinear (trilinear) average of the texels' BSDFs
             rather than the BSDF of the averaged parameters, for a quarter (an eighth) of the
             gathers. At texel centres it is the texel's value exactly."""
-            xi = _interaction_numbers(mi, dr, si.uv, 3 if self._levels > 1 else 2)
+            xi = _interaction_numbers(mi, dr, uv, 3 if self._levels > 1 else 2)
             height, width, channels = self._texture.shape
             if self._levels == 1:
-                x, y = si.uv.x * width, si.uv.y * height
+                x, y = uv.x * width, uv.y * height
                 lo_x, lo_y, hi_x, hi_y = 0.0, 0.0, width - 1.0, height - 1.0
             else:
                 lower, frac = self._mip_level(si)
                 level = lower + dr.select(xi[2] < frac, mi.UInt32(1), mi.UInt32(0))
                 w, h, ox, oy = self._box(level, active)
-                x = dr.clip(si.uv.x * w, 0.5, w - 0.5) + ox
-                y = dr.clip(si.uv.y * h, 0.5, h - 0.5) + oy
+                x = dr.clip(uv.x * w, 0.5, w - 0.5) + ox
+                y = dr.clip(uv.y * h, 0.5, h - 0.5) + oy
                 lo_x, lo_y, hi_x, hi_y = ox, oy, ox + w - 1.0, oy + h - 1.0
 
             def pick(t, u, lo, hi):
@@ -956,7 +963,7 @@ def bsdf_class(mi, dr):
                 t = t - 0.5
                 i = dr.floor(t)
                 i = dr.select(u < t - i, i + 1.0, i)
-                return mi.UInt32(dr.clip(i, lo, hi))
+                return dr.minimum(mi.UInt32(dr.clip(i, lo, hi)), mi.UInt32(hi))
 
             texel = pick(y, xi[1], lo_y, hi_y) * width + pick(x, xi[0], lo_x, hi_x)
             index = texel * channels
