@@ -82,9 +82,10 @@ triangle (dp/du, dp/dv) where the bake interpolated vertex tangents; a bake with
 ``ray_direction.exr`` gets the ray axis in the face across the fibre; the pore bump is the
 baked normal map's, filtered between texel centres (pores are about a texel wide at
 ``--res 1024``); a mip level's texels average the BSDF's parameters over the texels below
-(colours, axes with beta widened by their spread, the normal), not the BSDF. ``BSDFContext`` masks are honoured per component
-(0: the diffuse and fibre lobes and a rough finish's reflection, 1: a smooth finish's mirror),
-with the lobe probabilities renormalised over what is enabled.
+(colours, axes with beta widened by their spread, the normal), not the BSDF.
+``BSDFContext`` masks are honoured per component (0: the diffuse and fibre lobes and a rough
+finish's reflection, 1: a smooth finish's mirror), with the lobe probabilities renormalised
+over what is enabled.
 """
 
 import math
