@@ -1,6 +1,6 @@
 //! `XYLEM_SIMD` forces every SIMD level in a whole run of the binary, and every level gives the
 //! scalar level's images bit for bit: a wood render (fibre BSDF, distortion and pore noise, the
-//! wide-BVH traversal of a mesh), a flat wood slice (the batched colour blocks) and an fBm slice
+//! wide-BVH traversal of a mesh), a path-traced box of every material, a flat wood slice (the batched colour blocks) and an fBm slice
 //! (the gradient lane kernels). Every kernel promises the scalar values, so the expected image
 //! is the scalar run's. A level this CPU lacks is clamped down with a warning, never run; an
 //! unknown name is refused.
@@ -24,9 +24,18 @@ fn images(level: &str, dir: &Path) -> Vec<(String, Vec<u32>)> {
         env!("CARGO_MANIFEST_DIR"),
         "/../../scenes/carved_bunny.toml"
     );
-    let runs: [&[&str]; 3] = [
+    // The path tracer's every material (Lambertian, wood, texture, mirror, glass) and its rect
+    // light: the light sampling, shading and BSDF sampling the render tile inlines at each level.
+    let box_scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenes/cornell_wood_marble.toml"
+    );
+    let runs: [&[&str]; 4] = [
         &[
             "render", scene, "--res", "24x16", "--spp", "1", "--quiet", "--out", "r",
+        ],
+        &[
+            "render", box_scene, "--res", "24x24", "--spp", "4", "--quiet", "--out", "c",
         ],
         &[
             "texture",
@@ -52,7 +61,12 @@ fn images(level: &str, dir: &Path) -> Vec<(String, Vec<u32>)> {
             "{level}: {stderr}"
         );
     }
-    for file in ["r/carved_bunny.exr", "wood.exr", "fbm.exr"] {
+    for file in [
+        "r/carved_bunny.exr",
+        "c/cornell_wood_marble.exr",
+        "wood.exr",
+        "fbm.exr",
+    ] {
         for (name, values) in xylem::picture::exr::read_exr_channels(&dir.join(file)).unwrap() {
             out.push((
                 format!("{file} {name}"),

@@ -219,6 +219,7 @@ impl Material {
     }
 
     /// Evaluates the material at a hit.
+    #[inline(always)]
     pub fn shade(&self, hit: &MaterialHit) -> Shading {
         let geometric_frame = || Frame::from_normal_tangent(hit.ns, hit.tangent);
         match self {

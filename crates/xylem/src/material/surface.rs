@@ -98,6 +98,7 @@ impl Bsdf for SurfaceBsdf {
         }
     }
 
+    #[inline(always)]
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
         match self {
             SurfaceBsdf::Lambertian(b) => b.sample(wo, uc, u),

@@ -96,7 +96,7 @@ impl RayCount {
 /// (`memcpy`, 3–5 % of a Cornell-box render in `perf`); the BSDF itself is copied by its variant
 /// ([`SurfaceBsdf::copied`]). Returns the material's shading cost
 /// ([`crate::material::Material::shading_cost`]).
-#[inline(never)]
+#[inline(always)]
 pub(crate) fn shading_point(
     scene: &Scene,
     ray: &Ray,
@@ -275,7 +275,7 @@ pub(crate) fn path_numbers(scene: &Scene, pixel: UVec2, sample: u32, seed: u64) 
 /// The term of one light sample `ls` in next-event estimation: f · Li · |cos θi| · w / pdf when
 /// the light is unoccluded, w the power heuristic against BSDF sampling (1 for delta lights);
 /// zero when the sample failed, the BSDF vanishes or the light is occluded.
-#[inline]
+#[inline(always)]
 pub(crate) fn light_term(
     shadow: &ShadowTest,
     sp: &ShadingPoint,
@@ -339,7 +339,7 @@ fn glossy_wood(sp: &ShadingPoint) -> bool {
 /// §9.2.4, eq. 9.13 with counts: w_l = (n p_l)² / ((n p_l)² + p_b²), each sample weighted
 /// w_l / (n p_l)); [`PathState::add_emission`] weighs a BSDF sample that meets the light with
 /// the same n p_l. With n = 1 the plain term.
-#[inline]
+#[inline(always)]
 fn split_light_term(
     shadow: &ShadowTest,
     sp: &ShadingPoint,

@@ -9,6 +9,7 @@
 /// elementary interval of area 2^−m: a 4 × 4 grid at 16 spp), so the sub-pixel texture of the
 /// wood averages out faster than independent samples do; pixels stay independent of each
 /// other. The sequence holds 2^16 points: each further 2^16 samples take a fresh scramble.
+#[inline(always)]
 pub(crate) fn pixel_sample(seed: u64, pixel_index: u64, sample: u32) -> [f32; 4] {
     let block = u64::from(sample >> 16);
     let scramble = splitmix64(seed ^ splitmix64(pixel_index ^ (block << 48) ^ (1 << 63)));
@@ -133,7 +134,7 @@ impl PathNumbers {
     /// [`PathNumbers::point`] at sequence index `index` (a split role's points sit at
     /// consecutive indices, [`PathNumbers::light_split`]). The Sobol points take indices below
     /// 2^16; each further block of 2^16 is scrambled on its own, as the samples' blocks are.
-    #[inline]
+    #[inline(always)]
     fn point_at(&self, depth: u32, role: u64, index: u32) -> [f32; 4] {
         let role = (u64::from(depth) << 33) | role;
         let mut scramble = splitmix64(self.key ^ splitmix64(role));

@@ -291,6 +291,7 @@ impl Accel {
     }
 
     /// Closest hit with `t` in [0, t_max).
+    #[inline(always)]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
         let mut best = self.world.closest(ray.o, ray.d, t_max).map(|h| {
             let k = match self.range_of.get(h.triangle as usize) {
@@ -414,6 +415,7 @@ impl Accel {
     }
 
     /// Position, normals and object-space point of a hit.
+    #[inline(always)]
     pub fn surface(&self, ray: &Ray, hit: &Hit) -> SurfaceHit {
         let inst = &self.instances[hit.instance as usize];
         let mesh = &inst.mesh;

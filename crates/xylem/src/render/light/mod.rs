@@ -107,6 +107,7 @@ impl Light {
 
     /// [`Light::sample`] with the uniform numbers prepared: for a sphere light the azimuth's sine
     /// and cosine come from `u` (identical results; the trigonometry is done once per `u`).
+    #[inline(always)]
     pub fn sample_at(&self, p: Vec3, u: &LightU) -> Option<LightSample> {
         match self {
             Light::Sphere(l) => l.sample(p, u.u.x, u.azimuth),
@@ -120,6 +121,7 @@ impl Light {
 
     /// Where a ray first meets this light, what it emits towards the ray's origin, and the
     /// solid-angle density `sample` would have chosen that direction with from `ray.o`.
+    #[inline(always)]
     pub fn hit(&self, ray: &Ray) -> Option<LightHit> {
         match self {
             Light::Rect(l) => l.hit(ray),
