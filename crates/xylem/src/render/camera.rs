@@ -107,7 +107,7 @@ pub struct CameraRays<'a> {
 
 impl CameraRays<'_> {
     /// [`Camera::ray`].
-    #[inline]
+    #[inline(always)]
     pub fn ray(&self, film: Vec2, lens: Vec2) -> Ray {
         let cam = self.camera;
         let (w, h) = (cam.width as f32, cam.height as f32);

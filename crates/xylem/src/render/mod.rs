@@ -735,10 +735,11 @@ simd_wide! {
 /// The body of [`render_tile`], compiled once per SIMD level (`simd_level!`): the per-frame
 /// loops it inlines (light samples, next-event terms, BSDF batches, sums) run in that level's
 /// lanes. The path loop's steps are `#[inline(always)]` so that each level's copy holds them
-/// too (shading points, `Material::shade`, light sampling, hits and terms, BSDF sampling, Sobol
-/// points, closest hits): in VEX's three-operand forms the scalar chains lose their register
-/// copies, 4.8 % of a Cornell-box render on the AVX-512 Xeon (notes/render.md). The same IEEE
-/// operations at every level, so the same bits (crates/xylem-cli/tests/simd_levels.rs).
+/// too (shading points, `Material::shade`, light sampling, hits and terms, shadow tests, BSDF
+/// sampling, camera rays, Sobol points, closest hits): in VEX's three-operand forms the scalar
+/// chains lose their register copies, 14 % of a Cornell-box render on the AVX-512 Xeon
+/// (notes/render.md). The same IEEE operations at every level, so the same bits
+/// (crates/xylem-cli/tests/simd_levels.rs).
 #[inline(always)]
 fn render_tile_in(
     scene: &Scene,

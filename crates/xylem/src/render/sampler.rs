@@ -174,7 +174,7 @@ impl PathNumbers {
     /// The numbers of the continuation from vertex `depth`: the direction's two (the first
     /// two Sobol dimensions, the pair stratified as a (0, m, 2)-net), the lobe choice and the
     /// Russian roulette test of the path it starts (each stratified on its own).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn bounce(&self, depth: u32) -> [f32; 4] {
         self.point(depth, 1)
     }

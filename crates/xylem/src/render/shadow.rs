@@ -117,7 +117,7 @@ impl<'a> ShadowTest<'a> {
     }
 
     /// True when nothing blocks the segment `o + t·d`, t in (0, t_max) ([`Accel::unoccluded`]).
-    #[inline]
+    #[inline(always)]
     pub fn unoccluded(&self, ray: &Ray, t_max: f32) -> bool {
         if let Some(boxes) = &self.boxes {
             let inv = Vec3A::ONE / Vec3A::from(ray.d);

@@ -94,6 +94,7 @@ impl Light {
     ///
     /// Same as `sample_at(p, &LightU::new(u))`; a caller that samples many placements of one
     /// light with the same numbers (a light sweep) makes the [`LightU`] once.
+    #[inline(always)]
     pub fn sample(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
         match self {
             Light::Point(l) => l.sample(p),
@@ -170,6 +171,7 @@ fn azimuth(v: f32) -> (f32, f32) {
 }
 
 /// The nearest light a ray meets before `t_max`: its index in `lights` and where it is met.
+#[inline(always)]
 pub fn nearest_light(lights: &[Light], ray: &Ray, t_max: f32) -> Option<(usize, LightHit)> {
     let mut best: Option<(usize, LightHit)> = None;
     for (i, l) in lights.iter().enumerate() {

@@ -76,7 +76,7 @@ impl RectLight {
 
     /// Where `ray` meets the front of the parallelogram, with the density [`RectLight::sample`]
     /// gives that direction.
-    #[inline]
+    #[inline(always)]
     pub fn hit(&self, ray: &Ray) -> Option<LightHit> {
         let [uu, uv, vv, det] = self.gram;
         let (n, area) = (self.normal, self.area);
