@@ -960,3 +960,44 @@ def test_non_finite_uv_and_distance_give_finite_values(maps, filt, pixel_angle):
     values = [np.array(x) for x in (f, pdf, weight, bs.pdf, bs.wo)]
     assert all(np.isfinite(v).all() for v in values), values
     assert np.array(f)[:, -1].min() > 0 and np.array(pdf)[-1] > 0, values
+
+
+def test_scalar_variant_has_mip_maps_and_both_filters(maps):
+    """The scalar variant loads with mip maps on (it raised a TypeError building the level
+    boxes until 2026-12-04) and gives the LLVM variant's f and pdf (to 1e-5 relative) with both
+    filters, mip-mapped, at 4 interactions between texel centres (`off_centre_hits`: the
+    footprint between levels 1 and 2). The control: the same interactions without mip maps
+    give other values."""
+    use("llvm_ad_rgb")
+    rng = np.random.default_rng(13)
+    hits = [off_centre_hits(maps, u, v, 1, rng) for u, v in between_texels(maps, 4, seed=13)]
+    wo = [float(x) for x in np.array([-0.2, 0.1, 0.9]) / np.linalg.norm([-0.2, 0.1, 0.9])]
+
+    def flat(si):
+        """The interaction's fields as Python numbers (uv, t, frame, tangents, wi)."""
+        get = lambda v: [float(np.array(c).ravel()[0]) for c in (v.x, v.y, v.z)]
+        return ([float(np.array(si.uv.x)[0]), float(np.array(si.uv.y)[0])],
+                float(np.array(si.t)[0]), get(si.dp_du), get(si.dp_dv), get(si.wi))
+
+    fields = [flat(si) for si in hits]
+    want = {}
+    for filt in ("stochastic", "bilinear"):
+        for angle in (0.0, 1e-3):
+            b = mi.load_dict(baked(maps, roughness=0.25, filter=filt, pixel_angle=angle))
+            for k, si in enumerate(hits):
+                f, pdf = b.eval_pdf(mi.BSDFContext(), si, mi.Vector3f(*wo))
+                want[filt, angle, k] = (np.array(f).ravel(), float(np.array(pdf)[0]))
+    use("scalar_rgb")
+    for filt in ("stochastic", "bilinear"):
+        b = mi.load_dict(baked(maps, roughness=0.25, filter=filt, pixel_angle=1e-3))
+        for k, (uv, t, du, dv, wi) in enumerate(fields):
+            s = dr.zeros(mi.SurfaceInteraction3f)
+            s.uv, s.t = mi.Point2f(*uv), t
+            s.sh_frame = mi.Frame3f(mi.Vector3f(0, 0, 1))
+            s.dp_du, s.dp_dv, s.wi = mi.Vector3f(*du), mi.Vector3f(*dv), mi.Vector3f(*wi)
+            f, pdf = b.eval_pdf(mi.BSDFContext(), s, mi.Vector3f(*wo))
+            f_want, pdf_want = want[filt, 1e-3, k]
+            np.testing.assert_allclose(np.array(f), f_want, rtol=1e-5, atol=1e-9)
+            np.testing.assert_allclose(pdf, pdf_want, rtol=1e-5, atol=1e-9)
+            f_flat = want[filt, 0.0, k][0]
+            assert not np.allclose(f_flat, f_want, rtol=1e-3), (filt, k)

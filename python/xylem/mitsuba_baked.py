@@ -869,7 +869,10 @@ def bsdf_class(mi, dr):
             self._levels = len(levels)
             if len(levels) > 1:
                 level, boxes = _atlas(dr, jit, levels)
-                self._boxes = [mi.Float(np.array(b, np.float32)) for b in zip(*boxes)]
+                # Per level (width, height, x offset, y offset); the scalar variant indexes a
+                # numpy array where the JIT variants gather.
+                wrap = mi.Float if dr.is_jit_v(mi.Float) else (lambda a: a)
+                self._boxes = [wrap(np.array(b, np.float32)) for b in zip(*boxes)]
             table = jit.out(level)
             # Evaluated here: the stochastic lookups gather from it inside Mitsuba's kernel.
             dr.make_opaque(table)
@@ -934,6 +937,8 @@ def bsdf_class(mi, dr):
 
         def _box(self, level, active):
             """A mip level's (width, height, x offset, y offset) in the atlas, in texels."""
+            if not dr.is_jit_v(mi.Float):
+                return tuple(float(b[int(level)]) for b in self._boxes)
             return tuple(dr.gather(mi.Float, b, level, active) for b in self._boxes)
 
         def _stochastic_lookup(self, si, uv, active):
