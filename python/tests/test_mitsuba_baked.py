@@ -1001,3 +1001,39 @@ def test_scalar_variant_has_mip_maps_and_both_filters(maps):
             np.testing.assert_allclose(pdf, pdf_want, rtol=1e-5, atol=1e-9)
             f_flat = want[filt, 0.0, k][0]
             assert not np.allclose(f_flat, f_want, rtol=1e-3), (filt, k)
+
+
+def test_bad_properties_and_maps_are_refused_by_name(maps, tmp_path):
+    """Every property out of its range, a missing map and a map holding NaN or infinity are
+    refused when the scene loads, with a message that names the property (and its range) or
+    the file; none renders NaN. The control: the same folder and properties, valid, load."""
+    use("llvm_ad_rgb")
+    bad = tmp_path / "bad"
+    bad.mkdir()
+    for f in maps.iterdir():
+        if f.suffix == ".exr":
+            (bad / f.name).write_bytes(f.read_bytes())
+    colour = np.array(mi.Bitmap(str(bad / "base_color.exr")), np.float32)
+    colour[7, 11, 1] = np.nan
+    colour[8, 3, 0] = np.inf
+    mi.Bitmap(colour).write(str(bad / "base_color.exr"))
+    missing = tmp_path / "missing"
+    missing.mkdir()
+    (missing / "base_color.exr").write_bytes((maps / "base_color.exr").read_bytes())
+    cases = [
+        (baked(maps, eta=0.5), "`eta` = 0.5: expected 1 to 4"),
+        (baked(maps, roughness=1.5), "`roughness` = 1.5: expected 0 (smooth) to 1"),
+        (baked(maps, bump=-1.0), "`bump` = -1.0: expected 0 (off) to 100"),
+        (baked(maps, pixel_angle=0.5), "`pixel_angle` = 0.5: expected 0 (no mip maps)"),
+        (baked(maps, filter="trilinear"), "`filter` = 'trilinear': expected 'stochastic'"),
+        ({"type": "xylem_wood_baked"}, "`maps` (a `xylem bake` output folder) is required"),
+        (baked(missing), "highlight_width.exr is missing"),
+        (baked(bad), "base_color.exr holds 2 non-finite values (the first at row 7, column 11"),
+    ]
+    for props, message in cases:
+        with pytest.raises(Exception) as e:
+            mi.load_dict(props)
+        assert message in str(e.value), (message, str(e.value)[-400:])
+    valid = mi.load_dict(baked(maps, roughness=0.3, filter="bilinear", pixel_angle=1e-3,
+                               bump=2.0))
+    assert isinstance(valid, mi.BSDF), valid

@@ -130,6 +130,12 @@ def _maps(folder, normal):
         a = a.reshape(a.shape[0], a.shape[1], -1)
         if a.shape[2] != channels:
             raise ValueError(f"xylem_wood_baked: {path} has {a.shape[2]} channels, not {channels}")
+        bad = ~np.isfinite(a)
+        if bad.any():
+            row, col, ch = (int(i[0]) for i in np.nonzero(bad))
+            raise ValueError(f"xylem_wood_baked: {path} holds {int(bad.sum())} non-finite values "
+                             f"(the first at row {row}, column {col}, channel {ch}): a bake "
+                             "writes finite maps")
         return a
 
     layers = [read("base_color", 3), read("highlight_width", 1), read("fiber_color", 3),
