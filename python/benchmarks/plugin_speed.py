@@ -5,7 +5,7 @@ prints medians and spreads.
     DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1 \\
     PYTHONPATH=target/python-test/site target/python-venv/bin/python \\
         python/benchmarks/plugin_speed.py [--res 128 96] [--spp 8] [--repeats 5] [--profile]
-        [--before DIR] [--json FILE] [--frozen]
+        [--before DIR] [--json FILE] [--frozen] [--renders N]
 
 The scene: a 0.3 m board (a rectangle, scene units metres) seen from 0.4 m under one
 directional light and a dim constant environment, Mitsuba's ``path`` integrator (max depth 4).
@@ -41,7 +41,8 @@ Each case runs in its own Python process (a ``xylem_wood`` BSDF alive in a proce
 symbolic render there fail: Dr.Jit traces a symbolic call for every registered BSDF instance,
 so the plugin's symbolic-scope error fires even for a scene that does not use it), one process
 per case and repeat, interleaved: case A, B, C, A, B, C, ... Each render is timed from
-``mi.render`` to ``dr.eval`` + ``dr.sync_thread`` of the image, after one untimed warm-up
+``mi.render`` to ``dr.eval`` + ``dr.sync_thread`` of the image (``--renders N``: the median of
+N renders with different seeds, which steadies short renders), after one untimed warm-up
 render in the same process (Dr.Jit's kernel cache, first-call costs). ``--profile`` adds a cProfile of
 one plugin render: where the time goes (the wood's preparation, the BSDF calls, the numpy and
 Dr.Jit conversions, the integrator).
@@ -152,6 +153,8 @@ def main():
                     "baking (default 1024)")
     ap.add_argument("--bump", type=float, default=1.0, help="the baked cases' pore bump "
                     "(default 1; 0 leaves the normal map unread)")
+    ap.add_argument("--renders", type=int, default=1,
+                    help="timed renders per process, their median reported (default 1)")
     ap.add_argument("--filter", choices=("stochastic", "bilinear"),
                     help="the baked cases' texture filter (default: the plugin's, stochastic)")
     ap.add_argument("--cases", help="comma-separated cases to run (default: all); "
@@ -183,7 +186,7 @@ def main():
         # Each plugin case again with the older package: the A/B pair of a change.
         cases += [(name + "_before", b, ev) for name, b, ev in cases
                   if name.startswith("xylem_wood")]
-    if args.one:                                 # child: warm-up(s), one timed render
+    if args.one:                                 # child: warm-up(s), timed render(s)
         name, b, ev = next(c for c in cases if c[0] == args.one)
         sc = scene(b, args.res, args.spp, args.maps, args.bump, args.filter)
         render(sc, 0, ev, args.frozen)
@@ -196,7 +199,11 @@ def main():
         if args.profile:
             prof = cProfile.Profile()
             prof.enable()
-        t, cpu = render(sc, args.seed, ev, args.frozen)
+        # The median of --renders timed renders (seeds seed, seed + 1000, ...): one short render
+        # is at the mercy of a thread's wake-up (8-spp `roughplastic`: 9-19 ms wall).
+        timed = [render(sc, args.seed + 1000 * k, ev, args.frozen)
+                 for k in range(args.renders)]
+        t, cpu = (statistics.median(x) for x in zip(*timed))
         if args.profile:
             prof.disable()
             buf = io.StringIO()
@@ -209,7 +216,7 @@ def main():
     def child(name, seed, profile=False):
         cmd = [sys.executable, __file__, "--one", name, "--seed", str(seed), "--res",
                *map(str, args.res), "--spp", str(args.spp), "--maps", args.maps,
-               "--bump", str(args.bump)] + (
+               "--bump", str(args.bump), "--renders", str(args.renders)] + (
                    ["--filter", args.filter] if args.filter else []) + (
                    ["--profile"] if profile else []) + (["--frozen"] if args.frozen else [])
         env = dict(os.environ)
@@ -242,7 +249,7 @@ def main():
 
     out = {"variant": mi.variant(), "res": list(args.res), "spp": args.spp, "frozen": args.frozen,
            "bake_res": args.bake_res,
-           "repeats": args.repeats, "machine": platform.processor() or platform.machine(),
+           "repeats": args.repeats, "renders": args.renders, "machine": platform.processor() or platform.machine(),
            "cpus": os.cpu_count(), "load_avg": os.getloadavg(),
            "cases": {k: summary(v) for k, v in times.items()},
            "cpu": {k: summary(v) for k, v in cpu_times.items()}}
