@@ -582,3 +582,45 @@ def test_units_errors(extra, message):
     with pytest.raises(Exception) as raised:
         mi.load_dict(dict(BOARD, **extra))
     assert message in error_chain(raised), error_chain(raised)
+
+
+def test_non_finite_points_give_zero_not_an_error():
+    """An interaction whose point or shading frame holds NaN or infinity (a lane masked off
+    with garbage in it, a degenerate mesh) gives zero f, pdf and sample weight there, in a
+    batch whose other lanes are shaded as they are alone (LLVM variant, in `evaluated()`); the
+    scalar variant the same one interaction at a time. Until 2026-12-04 the bindings refused
+    the whole batch ("p: element (1, 0) is NaN"). The control: the finite lanes shade to
+    f > 0."""
+    use("llvm_ad_rgb")
+    bsdf = mi.load_dict(BOARD)
+    si, wo, (p, normals, wi_l, wo_l) = tilted_hits(6, seed=9)
+    u1 = mi.Float(np.linspace(0.1, 0.9, 6).astype(np.float32))
+    u2 = mi.Point2f(np.array([[0.3] * 6, [0.6] * 6], np.float32))
+    bad_p = p.copy()
+    bad_p[1, 0], bad_p[2, 1] = np.nan, np.inf
+    bad_n = normals.copy()
+    bad_n[3, 2] = np.nan
+    odd = dr.zeros(mi.SurfaceInteraction3f, 6)
+    odd.p = mi.Point3f(bad_p.T.astype(np.float32))
+    odd.sh_frame = mi.Frame3f(mi.Vector3f(bad_n.T.astype(np.float32)))
+    odd.wi = mi.Vector3f(wi_l.T)
+    with xylem.mitsuba.evaluated():
+        good = calls(bsdf, si, wo, u1, u2)
+        got = calls(mi.load_dict(BOARD), odd, wo, u1, u2)
+    bad, fine = [1, 2, 3], [0, 4, 5]
+    for key in ("f", "pdf", "f2", "pdf2", "bs_pdf", "weight"):
+        assert np.isfinite(got[key]).all(), key
+        assert (got[key][..., bad] == 0).all(), key
+        np.testing.assert_allclose(got[key][..., fine], good[key][..., fine], rtol=1e-6,
+                                   err_msg=key)
+    assert (good["f"][..., fine].sum(0) > 0).all(), good["f"]
+    use("scalar_rgb")
+    bsdf = mi.load_dict(BOARD)
+    for point in ((np.nan, 0.0, 0.0), (0.0, np.inf, 0.0)):
+        s = dr.zeros(mi.SurfaceInteraction3f)
+        s.p = mi.Point3f(*point)
+        s.sh_frame = mi.Frame3f(mi.Vector3f(0, 0, 1))
+        s.wi = mi.Vector3f(0.3, 0.2, 0.933)
+        f, pdf = bsdf.eval_pdf(mi.BSDFContext(), s, mi.Vector3f(-0.2, 0.1, 0.975))
+        _, w = bsdf.sample(mi.BSDFContext(), s, 0.5, mi.Point2f(0.3, 0.6))
+        assert list(f) == [0, 0, 0] and pdf == 0 and list(w) == [0, 0, 0], (point, f, pdf, w)

@@ -246,13 +246,29 @@ def _bsdf_class(mi, dr):
 
         def _frame(self, si):
             """Mitsuba's shading frame, or the identity where it is unset (a zero-initialised
-            interaction, as `mitsuba.chi2.BSDFAdapter` makes)."""
+            interaction, as `mitsuba.chi2.BSDFAdapter` makes) or not finite (`_valid`)."""
             n = si.sh_frame.n
-            unset = dr.squared_norm(n) < 0.5
+            unset = (dr.squared_norm(n) < 0.5) | self._invalid(si)
             s = dr.select(unset, mi.Vector3f(1, 0, 0), si.sh_frame.s)
             t = dr.select(unset, mi.Vector3f(0, 1, 0), si.sh_frame.t)
             n = dr.select(unset, mi.Vector3f(0, 0, 1), n)
             return mi.Frame3f(s, t, n)
+
+        def _invalid(self, si):
+            """Where the interaction's point or shading frame is not finite. There (a lane
+            masked off with garbage in it, a degenerate mesh) the wood is shaded at the
+            origin and the BSDF gives zero, rather than the bindings refusing the whole batch
+            for one non-finite number. (`|` of comparisons, not `~`: the scalar variant's
+            masks are Python bools.)"""
+            bad = False
+            for v in (si.p, si.sh_frame.s, si.sh_frame.t, si.sh_frame.n):
+                for c in (v.x, v.y, v.z):
+                    bad = bad | dr.isnan(c) | dr.isinf(c)
+            return bad
+
+        def _valid(self, si):
+            """Where `_invalid` is not."""
+            return dr.select(self._invalid(si), False, True)
 
         def _check(self, *values):
             """Refuses what the plugin cannot do right: a symbolic scope (it reads its inputs
@@ -320,7 +336,8 @@ def _bsdf_class(mi, dr):
                 key, held = jit_key(si)
                 if cached is not None and cached[0] == key:
                     return cached[1]
-            p, frame = to_np3(si.p), frame_np(self._frame(si))
+            p = to_np3(dr.select(self._invalid(si), 0.0, si.p))
+            frame = frame_np(self._frame(si))
             if cached is not None:
                 _, hits, p0, frame0, _ = cached
                 if np.array_equal(p, p0) and np.array_equal(frame, frame0):
@@ -344,7 +361,8 @@ def _bsdf_class(mi, dr):
             if mask == "rest":
                 pdf = renormalised(pdf, self._kept(hits, wi)[1])
             pdf = from_np1(pdf)
-            ok = active & (mi.Frame3f.cos_theta(si.wi) > 0) & (mi.Frame3f.cos_theta(wo) > 0)
+            ok = (active & self._valid(si) & (mi.Frame3f.cos_theta(si.wi) > 0)
+                  & (mi.Frame3f.cos_theta(wo) > 0))
             return dr.select(ok, pdf, 0.0)
 
         def eval_pdf(self, ctx, si, wo, active=True):
@@ -359,7 +377,7 @@ def _bsdf_class(mi, dr):
             if mask == "rest":
                 pdf = renormalised(pdf, self._kept(hits, wi)[1])
             cos_o = mi.Frame3f.cos_theta(wo)
-            ok = active & (mi.Frame3f.cos_theta(si.wi) > 0) & (cos_o > 0)
+            ok = active & self._valid(si) & (mi.Frame3f.cos_theta(si.wi) > 0) & (cos_o > 0)
             f = from_np3(mi.Color3f, f)
             return dr.select(ok, f * cos_o, 0.0), dr.select(ok, from_np1(pdf), 0.0)
 
@@ -389,7 +407,8 @@ def _bsdf_class(mi, dr):
             pdf = from_np1(s["pdf"])
             delta = from_bool(s["is_delta"])
             valid = from_bool(s["valid"]) & (pdf > 0)
-            ok = active & valid & (mi.Frame3f.cos_theta(si.wi) > 0) & (mi.Frame3f.cos_theta(wo) > 0)
+            ok = (active & valid & self._valid(si) & (mi.Frame3f.cos_theta(si.wi) > 0)
+                  & (mi.Frame3f.cos_theta(wo) > 0))
             bs.wo = wo
             bs.pdf = dr.select(ok, pdf, 0.0)
             bs.eta = 1.0
