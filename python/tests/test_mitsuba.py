@@ -585,35 +585,42 @@ def test_units_errors(extra, message):
 
 
 def test_non_finite_points_give_zero_not_an_error():
-    """An interaction whose point or shading frame holds NaN or infinity (a lane masked off
-    with garbage in it, a degenerate mesh) gives zero f, pdf and sample weight there, in a
-    batch whose other lanes are shaded as they are alone (LLVM variant, in `evaluated()`); the
-    scalar variant the same one interaction at a time. Until 2026-12-04 the bindings refused
-    the whole batch ("p: element (1, 0) is NaN"). The control: the finite lanes shade to
-    f > 0."""
+    """An interaction whose point, shading frame or view holds NaN or infinity (a lane masked
+    off with garbage in it, a degenerate mesh), a light direction or sample numbers that do,
+    give zero f, pdf and sample weight there, in a batch whose other lanes are shaded as they
+    are alone (LLVM variant, in `evaluated()`); the scalar variant the same one interaction at
+    a time. Until 2026-12-04 the bindings refused the whole batch ("p: element (1, 0) is
+    NaN"). The control: the finite lanes shade to f > 0."""
     use("llvm_ad_rgb")
-    bsdf = mi.load_dict(BOARD)
-    si, wo, (p, normals, wi_l, wo_l) = tilted_hits(6, seed=9)
-    u1 = mi.Float(np.linspace(0.1, 0.9, 6).astype(np.float32))
-    u2 = mi.Point2f(np.array([[0.3] * 6, [0.6] * 6], np.float32))
-    bad_p = p.copy()
+    n = 9
+    si, wo, (p, normals, wi_l, wo_l) = tilted_hits(n, seed=9)
+    u1 = np.linspace(0.1, 0.9, n).astype(np.float32)
+    u2 = np.array([[0.3] * n, [0.6] * n], np.float32)
+    bad_p, bad_n, bad_wi, bad_wo = p.copy(), normals.copy(), wi_l.copy(), wo_l.copy()
     bad_p[1, 0], bad_p[2, 1] = np.nan, np.inf
-    bad_n = normals.copy()
     bad_n[3, 2] = np.nan
-    odd = dr.zeros(mi.SurfaceInteraction3f, 6)
+    bad_wi[4, 0] = np.nan
+    bad_wo[5, 1] = -np.inf                     # the light direction: eval and pdf only
+    bad_u1 = u1.copy()
+    bad_u1[6] = np.nan                         # a sample number: sample only
+    odd = dr.zeros(mi.SurfaceInteraction3f, n)
     odd.p = mi.Point3f(bad_p.T.astype(np.float32))
     odd.sh_frame = mi.Frame3f(mi.Vector3f(bad_n.T.astype(np.float32)))
-    odd.wi = mi.Vector3f(wi_l.T)
+    odd.wi = mi.Vector3f(bad_wi.T.astype(np.float32))
     with xylem.mitsuba.evaluated():
-        good = calls(bsdf, si, wo, u1, u2)
-        got = calls(mi.load_dict(BOARD), odd, wo, u1, u2)
-    bad, fine = [1, 2, 3], [0, 4, 5]
-    for key in ("f", "pdf", "f2", "pdf2", "bs_pdf", "weight"):
-        assert np.isfinite(got[key]).all(), key
-        assert (got[key][..., bad] == 0).all(), key
-        np.testing.assert_allclose(got[key][..., fine], good[key][..., fine], rtol=1e-6,
-                                   err_msg=key)
-    assert (good["f"][..., fine].sum(0) > 0).all(), good["f"]
+        good = calls(mi.load_dict(BOARD), si, wo, mi.Float(u1), mi.Point2f(u2))
+        got = calls(mi.load_dict(BOARD), odd, mi.Vector3f(bad_wo.T.astype(np.float32)),
+                    mi.Float(bad_u1), mi.Point2f(u2))
+    for keys, bad in ((("f", "pdf", "f2", "pdf2"), [1, 2, 3, 4, 5]),
+                      (("bs_pdf", "weight"), [1, 2, 3, 4, 6])):
+        fine = [k for k in range(n) if k not in bad]
+        for key in keys:
+            assert np.isfinite(got[key]).all(), key
+            assert (got[key][..., bad] == 0).all(), (key, got[key])
+            np.testing.assert_allclose(got[key][..., fine], good[key][..., fine], rtol=1e-6,
+                                       err_msg=key)
+    assert np.isfinite(got["wo"]).all(), got["wo"]
+    assert (good["f"].sum(0) > 0).all(), good["f"]
     use("scalar_rgb")
     bsdf = mi.load_dict(BOARD)
     for point in ((np.nan, 0.0, 0.0), (0.0, np.inf, 0.0)):

@@ -942,9 +942,10 @@ def test_non_finite_uv_and_distance_give_finite_values(maps, filt, pixel_angle):
     """Interactions whose uv or distance is NaN, infinite or huge (a degenerate mesh's) give
     finite f, pdf and sample weights, the texel (0, 0) standing in for a non-finite uv. Before
     the lookups sanitised them the stochastic lookup read out of its table and the process
-    died (SIGSEGV, 2026-12-04), and the bilinear one returned NaN f. The control: a finite
-    uv and distance in the same batch shade to non-zero values, so the check is not passed by
-    zeros."""
+    died (SIGSEGV, 2026-12-04), and the bilinear one returned NaN f. So do non-finite views,
+    light directions and sample numbers at a finite interaction (f was NaN, 2026-12-04). The
+    control: finite lanes in the same batches shade to non-zero values, so the check is not
+    passed by zeros."""
     use("llvm_ad_rgb")
     bsdf = mi.load_dict(baked(maps, roughness=0.25, filter=filt, pixel_angle=pixel_angle))
     odd = [math.nan, math.inf, -math.inf, 1e30, -1e30, 0.5, 2.0, -3.0, 0.37]
@@ -960,6 +961,21 @@ def test_non_finite_uv_and_distance_give_finite_values(maps, filt, pixel_angle):
     values = [np.array(x) for x in (f, pdf, weight, bs.pdf, bs.wo)]
     assert all(np.isfinite(v).all() for v in values), values
     assert np.array(f)[:, -1].min() > 0 and np.array(pdf)[-1] > 0, values
+    # Non-finite directions and sample numbers at a finite interaction: zero, not NaN.
+    good = dr.zeros(mi.SurfaceInteraction3f, 3)
+    good.uv = mi.Point2f(0.37, 0.61)
+    good.sh_frame = mi.Frame3f(mi.Vector3f(0, 0, 1))
+    good.dp_du, good.dp_dv = mi.Vector3f(0.3, 0, 0), mi.Vector3f(0, -0.12, 0)
+    good.t = mi.Float(0.4)
+    good.wi = mi.Vector3f(np.array([[math.nan, 0.3, 0.3], [0.2, 0.2, 0.2], [0.93] * 3],
+                                   np.float32))
+    light = mi.Vector3f(np.array([[-0.2, -math.inf, -0.2], [0.1] * 3, [0.97] * 3], np.float32))
+    f, pdf = bsdf.eval_pdf(ctx, good, light)
+    bs, weight = bsdf.sample(ctx, good, mi.Float(np.array([0.5, 0.5, math.nan], np.float32)),
+                             mi.Point2f(0.3, 0.6))
+    values = [np.array(x) for x in (f, pdf, weight, bs.pdf, bs.wo)]
+    assert all(np.isfinite(v).all() for v in values), values
+    assert np.array(f)[:, 2].min() > 0 and np.array(weight)[:, 1].min() > 0, values
 
 
 def test_scalar_variant_has_mip_maps_and_both_filters(maps):

@@ -254,21 +254,38 @@ def _bsdf_class(mi, dr):
             n = dr.select(unset, mi.Vector3f(0, 0, 1), n)
             return mi.Frame3f(s, t, n)
 
-        def _invalid(self, si):
-            """Where the interaction's point or shading frame is not finite. There (a lane
-            masked off with garbage in it, a degenerate mesh) the wood is shaded at the
-            origin and the BSDF gives zero, rather than the bindings refusing the whole batch
-            for one non-finite number. (`|` of comparisons, not `~`: the scalar variant's
-            masks are Python bools.)"""
+        @staticmethod
+        def _nonfinite(*values):
+            """Where a component of any of `values` (Floats, 2- or 3-vectors) is NaN or
+            infinite. (`|` of comparisons, not `~`: the scalar variant's masks are Python
+            bools.)"""
             bad = False
-            for v in (si.p, si.sh_frame.s, si.sh_frame.t, si.sh_frame.n):
-                for c in (v.x, v.y, v.z):
+            for v in values:
+                if isinstance(v, (mi.Vector3f, mi.Point3f, mi.Normal3f)):
+                    components = (v.x, v.y, v.z)
+                elif isinstance(v, (mi.Vector2f, mi.Point2f)):
+                    components = (v.x, v.y)
+                else:
+                    components = (v,)
+                for c in components:
                     bad = bad | dr.isnan(c) | dr.isinf(c)
             return bad
+
+        def _invalid(self, si):
+            """Where the interaction's point, shading frame or view is not finite. There (a
+            lane masked off with garbage in it, a degenerate mesh) the wood is shaded at the
+            origin, the view taken as the normal, and the BSDF gives zero, rather than the
+            bindings refusing the whole batch for one non-finite number."""
+            return self._nonfinite(si.p, si.sh_frame.s, si.sh_frame.t, si.sh_frame.n, si.wi)
 
         def _valid(self, si):
             """Where `_invalid` is not."""
             return dr.select(self._invalid(si), False, True)
+
+        @staticmethod
+        def _up(v, bad):
+            """Directions `v` as numpy, the normal (0, 0, 1) standing in where `bad`."""
+            return to_np3(dr.select(bad, mi.Vector3f(0, 0, 1), v))
 
         def _check(self, *values):
             """Refuses what the plugin cannot do right: a symbolic scope (it reads its inputs
@@ -356,13 +373,14 @@ def _bsdf_class(mi, dr):
             mask = self._mask(ctx)
             if mask in ("none", "mirror"):  # nothing, or a delta lobe alone: no density
                 return dr.zeros(mi.Float, dr.width(wo))
-            hits, wi = self._hits(si), to_np3(si.wi)
-            pdf = hits.pdf(wi, to_np3(wo))
+            bad, bad_o = self._invalid(si), self._nonfinite(wo)
+            hits, wi = self._hits(si), self._up(si.wi, bad)
+            pdf = hits.pdf(wi, self._up(wo, bad_o))
             if mask == "rest":
                 pdf = renormalised(pdf, self._kept(hits, wi)[1])
             pdf = from_np1(pdf)
-            ok = (active & self._valid(si) & (mi.Frame3f.cos_theta(si.wi) > 0)
-                  & (mi.Frame3f.cos_theta(wo) > 0))
+            ok = (active & dr.select(bad | bad_o, False, True)
+                  & (mi.Frame3f.cos_theta(si.wi) > 0) & (mi.Frame3f.cos_theta(wo) > 0))
             return dr.select(ok, pdf, 0.0)
 
         def eval_pdf(self, ctx, si, wo, active=True):
@@ -372,12 +390,14 @@ def _bsdf_class(mi, dr):
             if mask in ("none", "mirror"):  # nothing, or a delta lobe alone: no value, density
                 n = dr.width(wo)
                 return dr.zeros(mi.Color3f, n), dr.zeros(mi.Float, n)
-            hits, wi = self._hits(si), to_np3(si.wi)
-            f, pdf = hits.eval_pdf(wi, to_np3(wo))
+            bad, bad_o = self._invalid(si), self._nonfinite(wo)
+            hits, wi = self._hits(si), self._up(si.wi, bad)
+            f, pdf = hits.eval_pdf(wi, self._up(wo, bad_o))
             if mask == "rest":
                 pdf = renormalised(pdf, self._kept(hits, wi)[1])
             cos_o = mi.Frame3f.cos_theta(wo)
-            ok = active & self._valid(si) & (mi.Frame3f.cos_theta(si.wi) > 0) & (cos_o > 0)
+            ok = (active & dr.select(bad | bad_o, False, True)
+                  & (mi.Frame3f.cos_theta(si.wi) > 0) & (cos_o > 0))
             f = from_np3(mi.Color3f, f)
             return dr.select(ok, f * cos_o, 0.0), dr.select(ok, from_np1(pdf), 0.0)
 
@@ -386,7 +406,9 @@ def _bsdf_class(mi, dr):
             mask = self._mask(ctx)
             if mask in ("none", "mirror"):
                 return self._sample_masked(mask, si, dr.width(sample1), active)
-            hits, wi, uc = self._hits(si), to_np3(si.wi), to_np1(sample1)
+            bad = self._invalid(si) | self._nonfinite(sample1, sample2)
+            hits, wi = self._hits(si), self._up(si.wi, bad)
+            uc = to_np1(dr.select(bad, 0.5, sample1))
             kept = None
             if mask == "rest":
                 # The mirror is picked for uc below its probability p (lobes in order, mirror
@@ -394,7 +416,7 @@ def _bsdf_class(mi, dr):
                 # non-negative number rounds to p or above, never below).
                 p, kept = self._kept(hits, wi)
                 uc = (p + uc * kept).astype(np.float32)
-            s = hits.sample(wi, uc, to_np2(sample2))
+            s = hits.sample(wi, uc, to_np2(dr.select(bad, mi.Point2f(0.5, 0.5), sample2)))
             if kept is not None:
                 s["pdf"] = renormalised(s["pdf"], kept)
                 s["valid"] = s["valid"] & ~s["is_delta"]
@@ -407,8 +429,8 @@ def _bsdf_class(mi, dr):
             pdf = from_np1(s["pdf"])
             delta = from_bool(s["is_delta"])
             valid = from_bool(s["valid"]) & (pdf > 0)
-            ok = (active & valid & self._valid(si) & (mi.Frame3f.cos_theta(si.wi) > 0)
-                  & (mi.Frame3f.cos_theta(wo) > 0))
+            ok = (active & valid & dr.select(bad, False, True)
+                  & (mi.Frame3f.cos_theta(si.wi) > 0) & (mi.Frame3f.cos_theta(wo) > 0))
             bs.wo = wo
             bs.pdf = dr.select(ok, pdf, 0.0)
             bs.eta = 1.0

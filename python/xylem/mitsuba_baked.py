@@ -802,7 +802,8 @@ def bsdf_class(mi, dr):
             view = View(self, t, t.local(si.wi))
             wi = t.local(wo)
             f, pdf = self._eval_pdf(t, view, self._probs(t, view, ctx), wi)
-            active = active & self._enabled(ctx)[1]
+            # (wi.z > 0: f is 0 elsewhere already, and a NaN direction's f * wi.z is NaN.)
+            active = active & self._enabled(ctx)[1] & (wi.z > 0)
             return dr.select(active, f * wi.z, 0.0), dr.select(active, pdf, 0.0)
 
         def sample(self, ctx, si, sample1, sample2, active=True):
@@ -837,7 +838,10 @@ def bsdf_class(mi, dr):
             f, pdf = self._eval_pdf(t, view, probs, wi)
             ok = active & (wo.z > 0) & (wi.z > 0) & (spec | diff | (lobe_ok & leaves))
             bs = dr.zeros(mi.BSDFSample3f, dr.width(sample1))
-            bs.wo = t.world(wi)
+            # A direction made of non-finite inputs (pdf 0 there) is the normal instead.
+            world = t.world(wi)
+            bs.wo = dr.select(dr.isfinite(world.x + world.y + world.z), world,
+                              mi.Vector3f(0, 0, 1))
             bs.eta = 1.0
             if self._rough is None:
                 ok &= spec | (pdf > 0)
