@@ -165,6 +165,8 @@ def main():
     ap.add_argument("--one", help=argparse.SUPPRESS)         # child process: this case only
     ap.add_argument("--seed", type=int, default=1, help=argparse.SUPPRESS)
     args = ap.parse_args()
+    if args.renders < 1 or args.repeats < 1:
+        ap.error(f"--renders {args.renders}, --repeats {args.repeats}: each must be at least 1")
 
     cases = [("roughplastic", "roughplastic", False),
              ("roughplastic_evaluated", "roughplastic", True),
