@@ -333,7 +333,9 @@ def _bsdf_class(mi, dr):
             Dr.Jit variables of `si.p` and `si.sh_frame` (held while cached) and, when they
             differ, by their values (an interaction gathered again holds the same numbers in
             new variables); the scalar variant keys by value only. One entry per thread: a new
-            interaction replaces the old one, and `sample` releases it."""
+            interaction replaces the old one, and `sample` releases it. Returns the `WoodHits`
+            and, as numpy, the lanes whose point or frame is not finite (shaded at the origin
+            in the identity frame; their BSDF values are set to zero, `_finite`)."""
             thread = threading.get_ident()
             cached = self._entries.get(thread)
             key = held = None
