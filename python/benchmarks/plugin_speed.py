@@ -251,7 +251,8 @@ def main():
 
     out = {"variant": mi.variant(), "res": list(args.res), "spp": args.spp, "frozen": args.frozen,
            "bake_res": args.bake_res,
-           "repeats": args.repeats, "renders": args.renders, "machine": platform.processor() or platform.machine(),
+           "repeats": args.repeats, "renders": args.renders,
+           "machine": platform.processor() or platform.machine(),
            "cpus": os.cpu_count(), "load_avg": os.getloadavg(),
            "cases": {k: summary(v) for k, v in times.items()},
            "cpu": {k: summary(v) for k, v in cpu_times.items()}}

@@ -14,9 +14,10 @@ does, so si.uv is the bake's uv): the plugin reads ``base_color.exr``, ``fiber_c
 ``fiber_direction.exr`` and ``ray_direction.exr`` (the signed tangent-space fibre and ray
 axes), ``highlight_width.exr`` (beta, radians) and ``ray_mask.exr``, derives from them once
 per texel what the BSDF needs (``_shading_maps``: the bounded diffuse, clamped values, unit
-axes and bumped normal) into one 14- or 17-channel ``mi.Texture2f`` (bilinear, clamped at the
-edges, texel centres at (i + 1/2)/W as xylem's own ``BakedMaps::lookup``; one texture, so a
-lookup computes its taps once) and looks it up at ``si.uv`` (texel (0, 0) is the image's
+axes and bumped normal) into one 14- or 17-channel table (clamped at the edges, texel
+centres at (i + 1/2)/W as xylem's own ``BakedMaps::lookup``; one table, so a lookup finds its
+texels once; a ``mi.Texture2f`` of it for the bilinear ``filter``) and looks it up at
+``si.uv`` (texel (0, 0) is the image's
 top-left, v runs down the rows, as glTF and the bake write them). ``eta`` is the finish's
 index (1-4, default 1.5) and ``roughness`` its GGX roughness (0-1, default 0; below 1e-3 the
 finish is smooth, as in ``WoodBsdf``). ``bump`` (0-100, default 1) scales the slope of the
@@ -887,7 +888,9 @@ def bsdf_class(mi, dr):
             # Evaluated here: the stochastic lookups gather from it inside Mitsuba's kernel.
             dr.make_opaque(table)
             self._table = table
-            self._texture = mi.Texture2f(table, **self._linear)
+            # Only the bilinear filter reads it through a texture.
+            self._texture = (mi.Texture2f(table, **self._linear) if self.filter == "bilinear"
+                             else None)
 
         def parameters_changed(self, keys=None):
             angle = self._pixel_angle
@@ -911,12 +914,10 @@ def bsdf_class(mi, dr):
             if self._levels == 1:
                 return self._texture.eval(uv, active)
             lower, frac = self._mip_level(si)
-            atlas = self._texture.shape
+            atlas = self._table.shape
 
             def at(level, uv, active):
-                w, h, ox, oy = self._box(level, active)
-                x = dr.clip(uv.x * w, 0.5, w - 0.5) + ox
-                y = dr.clip(uv.y * h, 0.5, h - 0.5) + oy
+                x, y, _ = self._in_level(level, uv, active)
                 return self._texture.eval(mi.Point2f(x / atlas[1], y / atlas[0]), active)
 
             def upper(lower, uv, frac, active):
@@ -945,11 +946,17 @@ def bsdf_class(mi, dr):
             lower = dr.minimum(mi.UInt32(dr.floor(lam)), self._levels - 1)
             return lower, lam - mi.Float(lower)
 
-        def _box(self, level, active):
-            """A mip level's (width, height, x offset, y offset) in the atlas, in texels."""
-            if not dr.is_jit_v(mi.Float):
-                return tuple(float(b[int(level)]) for b in self._boxes)
-            return tuple(dr.gather(mi.Float, b, level, active) for b in self._boxes)
+        def _in_level(self, level, uv, active):
+            """uv in mip level `level`'s texels in the atlas, clamped to its texel centres (so
+            that no other level bleeds in), and the level's box: (x, y, (x0, y0, x1, y1)) with
+            its first and last texels."""
+            if dr.is_jit_v(mi.Float):
+                w, h, ox, oy = (dr.gather(mi.Float, b, level, active) for b in self._boxes)
+            else:
+                w, h, ox, oy = (float(b[int(level)]) for b in self._boxes)
+            x = dr.clip(uv.x * w, 0.5, w - 0.5) + ox
+            y = dr.clip(uv.y * h, 0.5, h - 0.5) + oy
+            return x, y, (ox, oy, ox + w - 1.0, oy + h - 1.0)
 
         def _stochastic_lookup(self, si, uv, active):
             """Stochastic texture filtering (Pharr, Wronski, Salvi & Fajardo 2024, "Filtering
@@ -961,17 +968,14 @@ def bsdf_class(mi, dr):
             rather than the BSDF of the averaged parameters, for a quarter (an eighth) of the
             gathers. At texel centres it is the texel's value exactly."""
             xi = _interaction_numbers(mi, dr, uv, 3 if self._levels > 1 else 2)
-            height, width, channels = self._texture.shape
+            height, width, channels = self._table.shape
             if self._levels == 1:
                 x, y = uv.x * width, uv.y * height
                 lo_x, lo_y, hi_x, hi_y = 0.0, 0.0, width - 1.0, height - 1.0
             else:
                 lower, frac = self._mip_level(si)
                 level = lower + dr.select(xi[2] < frac, mi.UInt32(1), mi.UInt32(0))
-                w, h, ox, oy = self._box(level, active)
-                x = dr.clip(uv.x * w, 0.5, w - 0.5) + ox
-                y = dr.clip(uv.y * h, 0.5, h - 0.5) + oy
-                lo_x, lo_y, hi_x, hi_y = ox, oy, ox + w - 1.0, oy + h - 1.0
+                x, y, (lo_x, lo_y, hi_x, hi_y) = self._in_level(level, uv, active)
 
             def pick(t, u, lo, hi):
                 """Texel index along one axis: the lower neighbour of t - 1/2, or the upper

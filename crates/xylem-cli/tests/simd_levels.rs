@@ -1,7 +1,7 @@
 //! `XYLEM_SIMD` forces every SIMD level in a whole run of the binary, and every level gives the
 //! scalar level's images bit for bit: a wood render (fibre BSDF, distortion and pore noise, the
-//! wide-BVH traversal of a mesh), a path-traced box of every material, a flat wood slice (the batched colour blocks) and an fBm slice
-//! (the gradient lane kernels). Every kernel promises the scalar values, so the expected image
+//! wide-BVH traversal of a mesh), a path-traced box of every material, a flat wood slice (the
+//! batched colour blocks) and an fBm slice (the gradient lane kernels). Every kernel promises the scalar values, so the expected image
 //! is the scalar run's. A level this CPU lacks is clamped down with a warning, never run; an
 //! unknown name is refused.
 
