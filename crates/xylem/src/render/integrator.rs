@@ -129,18 +129,13 @@ pub(crate) fn shading_point(
         },
     };
     let shading = material.shade(&mh);
-    let mut frame = shading.frame;
-    let mut ng = s.ng;
     let wo_world = -ray.d;
-    if !shading.bsdf.is_transmissive() && ng.dot(wo_world) < 0.0 {
-        // Opaque surfaces are two-sided: face the viewer.
-        ng = -ng;
-        frame = Frame {
-            s: frame.s,
-            t: -frame.t,
-            n: -frame.n,
-        };
-    }
+    let (ng, frame) = facing(
+        s.ng,
+        shading.frame,
+        wo_world,
+        shading.bsdf.is_transmissive(),
+    );
     if let Footprint::Pixel(a, _) = footprint {
         *a = Aov {
             albedo: shading.aov.albedo,
@@ -163,6 +158,22 @@ pub(crate) fn shading_point(
     shading.bsdf.copy_to(&mut sp.bsdf);
     sp.eps = 2e-5 * scene.accel.scale();
     material.shading_cost()
+}
+
+/// The geometric normal `ng` and shading frame of a hit seen from `wo_world`, turned to face
+/// the viewer unless the surface transmits: opaque surfaces are two-sided.
+#[inline(always)]
+pub(crate) fn facing(ng: Vec3, frame: Frame, wo_world: Vec3, transmissive: bool) -> (Vec3, Frame) {
+    if !transmissive && ng.dot(wo_world) < 0.0 {
+        let flipped = Frame {
+            s: frame.s,
+            t: -frame.t,
+            n: -frame.n,
+        };
+        (-ng, flipped)
+    } else {
+        (ng, frame)
+    }
 }
 
 /// The share of the pixel footprint each of `spp` camera samples band-limits its first hit by:
@@ -379,7 +390,14 @@ fn split_sample(
 /// f · Li · |cos θi| · w / pdf of an unoccluded light sample, w the power heuristic (Veach 1997
 /// eq. 9.13) of the light's density against the BSDF's (1 for delta lights).
 #[inline(always)]
-fn weighted_term(f: Vec3, li: Vec3, wi_z: f32, pdf: f32, bsdf_pdf: f32, is_delta: bool) -> Vec3 {
+pub(crate) fn weighted_term(
+    f: Vec3,
+    li: Vec3,
+    wi_z: f32,
+    pdf: f32,
+    bsdf_pdf: f32,
+    is_delta: bool,
+) -> Vec3 {
     f * li * mis_scale(wi_z, pdf, bsdf_pdf, is_delta)
 }
 

@@ -18,6 +18,7 @@ pub mod resources;
 mod sampler;
 pub mod shading;
 pub mod shadow;
+mod wave;
 pub mod wide_bvh;
 
 pub use camera::{Camera, CameraRays, Projection};
@@ -801,10 +802,42 @@ fn tile_frames<const ONE: bool>(
     if let Primary::Reuse(p) = primary {
         assert_eq!(p.len(), n * spp, "primaries of another render");
     }
-    for (i, pixel) in (origin.y..origin.y + th)
-        .flat_map(|y| (origin.x..origin.x + tw).map(move |x| UVec2::new(x, y)))
-        .enumerate()
+    let pixels = (origin.y..origin.y + th)
+        .flat_map(|y| (origin.x..origin.x + tw).map(move |x| UVec2::new(x, y)));
+    if ONE
+        && matches!(primary, Primary::Compute)
+        && std::env::var("XYLEM_WAVES").as_deref() != Ok("off")
+        && wave::lanes_apply(scene, lights)
     {
+        let mut samples = Vec::new();
+        for (i, pixel) in pixels.enumerate() {
+            let range = match span {
+                Span::All(n) => 0..n,
+                Span::After { first, extra } => first..first + extra[i],
+            };
+            samples.extend(range.map(|s| (i as u32, pixel, s)));
+        }
+        wave::tile_waves(
+            scene,
+            lights,
+            shadow,
+            (settings.seed, max_depth),
+            &samples,
+            &mut wave::WaveScratch::default(),
+            (&mut sums, &mut aov_sums, &mut work),
+            &mut rays,
+        );
+        return TileSums {
+            width: tw,
+            height: th,
+            sums,
+            aov_sums,
+            rays: rays.rays,
+            work,
+            kept,
+        };
+    }
+    for (i, pixel) in pixels.enumerate() {
         let samples = match span {
             Span::All(n) => 0..n,
             Span::After { first, extra } => first..first + extra[i],

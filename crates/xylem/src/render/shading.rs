@@ -40,7 +40,14 @@ impl ShadingPoint {
 
 /// Origin of a ray leaving `sp` along `dir`: the hit point moved `eps` along the geometric
 /// normal, to the side `dir` points to, so the ray does not hit the surface it starts on.
+#[inline(always)]
 pub(crate) fn offset_origin(sp: &ShadingPoint, dir: Vec3) -> Vec3 {
-    let side = if sp.ng.dot(dir) >= 0.0 { 1.0 } else { -1.0 };
-    sp.p + sp.ng * (side * sp.eps)
+    offset_ray_origin(sp.p, sp.ng, sp.eps, dir)
+}
+
+/// [`offset_origin`] from the point `p` with geometric normal `ng` and offset length `eps`.
+#[inline(always)]
+pub(crate) fn offset_ray_origin(p: Vec3, ng: Vec3, eps: f32, dir: Vec3) -> Vec3 {
+    let side = if ng.dot(dir) >= 0.0 { 1.0 } else { -1.0 };
+    p + ng * (side * eps)
 }

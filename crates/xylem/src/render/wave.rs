@@ -1,0 +1,353 @@
+//! A tile's pixel samples as waves of paths in lanes, for scenes whose every material is
+//! Lambertian (the Cornell box; `lanes_apply`): a path's state is a few columns of numbers
+//! rather than a shading point holding a whole BSDF, and each stage of a bounce — emission met,
+//! light samples, shadow rays, BSDF samples, closest hits, shading points — is one loop over the
+//! wave's live paths. Every path makes the operations of [`integrator::radiance_frames`] on the
+//! same values in the same order (the same functions: light sampling, the BSDF, MIS, roulette,
+//! ray offsets), and the sums are added in sample order, so a wave renders the same bits as the
+//! per-path loop (crates/xylem-cli/tests/simd_levels.rs compares them at every SIMD level).
+
+use super::film::{Aov, FrameSums, PixelSum};
+use super::frames::LightFrames;
+use super::geometry::{Hit, Ray};
+use super::integrator::{self, weighted_term, Columns, RayCount};
+use super::sampler::{pixel_sample, PathNumbers};
+use super::shading::offset_ray_origin;
+use super::shadow::{shadow_t_max, ShadowTest};
+use super::Scene;
+use crate::bsdf::{Bsdf, Lambertian};
+use crate::material::Material;
+use crate::math::{power_heuristic, Frame};
+use glam::{UVec2, Vec2, Vec3};
+
+/// Paths advanced together: enough that each stage's loop runs long, few enough that their
+/// state stays in the L1 and L2 caches.
+const WAVE: usize = 256;
+
+/// Whether a one-frame render of `scene` with `lights` can run as waves: every material
+/// Lambertian (each path's vertex then needs only its albedo and frame).
+pub(super) fn lanes_apply(scene: &Scene, lights: &LightFrames) -> bool {
+    lights.len() == 1
+        && scene
+            .materials
+            .iter()
+            .all(|m| matches!(m, Material::Lambertian { .. }))
+}
+
+/// A path's vertex on a Lambertian surface: what [`integrator::shading_point`] keeps of it.
+#[derive(Clone, Copy, Debug)]
+struct Vertex {
+    p: Vec3,
+    /// Geometric normal, facing the viewer.
+    ng: Vec3,
+    frame: Frame,
+    /// Towards the viewer, local frame.
+    wo: Vec3,
+    albedo: Vec3,
+}
+
+/// One path of the wave.
+#[derive(Clone, Copy, Debug)]
+struct Lane {
+    /// The tile pixel the sample belongs to.
+    pixel: u32,
+    numbers: PathNumbers,
+    beta: Vec3,
+    eta_scale: f32,
+    prev_pdf: f32,
+    specular: bool,
+    ray: Ray,
+    t_hit: f32,
+    depth: u32,
+    /// The vertex the ray reached (none after a miss or the last bounce).
+    vertex: Option<Vertex>,
+    radiance: Vec3,
+    cost: RayCount,
+}
+
+/// Scratch of [`tile_waves`], reused from wave to wave.
+#[derive(Default)]
+pub(super) struct WaveScratch {
+    lanes: Vec<Lane>,
+    aov: Vec<Aov>,
+    active: Vec<u32>,
+    next: Vec<u32>,
+    hits: Vec<Option<Hit>>,
+    /// Per active lane and light: the unoccluded term and its shadow ray (`None`: no term).
+    terms: Vec<Option<(Vec3, Ray, f32)>>,
+    radiance: Columns,
+}
+
+/// The samples `samples` (tile pixel index, pixel, sample number, in the order their sums are
+/// added) of a one-frame render whose scene [`lanes_apply`] to, as waves of [`WAVE`] paths;
+/// adds each sample's radiance and AOVs to `sums` and `aov_sums` and its cost to `work` and
+/// `rays`, as the per-path loop of `tile_frames` does.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(super) fn tile_waves(
+    scene: &Scene,
+    lights: &LightFrames,
+    shadow: &ShadowTest,
+    (seed, max_depth): (u64, u32),
+    samples: &[(u32, UVec2, u32)],
+    scratch: &mut WaveScratch,
+    (sums, aov_sums, work): (&mut FrameSums, &mut [PixelSum], &mut [u64]),
+    rays: &mut RayCount,
+) {
+    let camera = scene.camera.rays();
+    let eps = 2e-5 * scene.accel.scale();
+    let lights_all = lights.first();
+    for chunk in samples.chunks(WAVE) {
+        let WaveScratch {
+            lanes,
+            aov,
+            active,
+            next,
+            hits,
+            terms,
+            radiance,
+        } = scratch;
+        // Camera rays and their closest hits, as `primary_sample_into`.
+        lanes.clear();
+        aov.clear();
+        for &(i, pixel, s) in chunk {
+            let index = pixel.y as u64 * scene.camera.width as u64 + pixel.x as u64;
+            let u = pixel_sample(seed, index, s);
+            let film =
+                pixel.as_vec2() + Vec2::splat(0.5) + scene.filter.sample(Vec2::new(u[0], u[1]));
+            let ray = camera.ray(film, Vec2::new(u[2], u[3]));
+            lanes.push(Lane {
+                pixel: i,
+                numbers: PathNumbers::new(seed, index, s),
+                beta: Vec3::ONE,
+                eta_scale: 1.0,
+                prev_pdf: 0.0,
+                specular: true,
+                ray,
+                t_hit: f32::INFINITY,
+                depth: 0,
+                vertex: None,
+                radiance: Vec3::ZERO,
+                cost: RayCount {
+                    rays: 1,
+                    shading: 0,
+                },
+            });
+            aov.push(Aov::default());
+        }
+        hits.clear();
+        hits.extend(
+            lanes
+                .iter()
+                .map(|l| scene.accel.intersect(&l.ray, f32::INFINITY)),
+        );
+        for ((lane, hit), aov) in lanes.iter_mut().zip(hits.iter()).zip(aov.iter_mut()) {
+            let Some(hit) = hit else { continue };
+            lane.t_hit = hit.t;
+            let v = vertex(scene, &lane.ray, hit);
+            *aov = Aov {
+                albedo: v.albedo,
+                normal: v.frame.n,
+                depth: hit.t,
+                coverage: 1.0,
+                ..Aov::default()
+            };
+            lane.vertex = Some(v);
+            lane.cost.shading += 1;
+        }
+        active.clear();
+        active.extend(0..lanes.len() as u32);
+        while !active.is_empty() {
+            // Emission the rays meet before their hits (a path ends where it meets a light),
+            // and the paths that end at their vertex.
+            next.clear();
+            for &l in active.iter() {
+                let lane = &mut lanes[l as usize];
+                let met = add_emission(lights_all, lane);
+                if !met && lane.vertex.is_some() && lane.depth < max_depth {
+                    next.push(l);
+                }
+            }
+            std::mem::swap(active, next);
+            // Next-event estimation: each light's sample and unoccluded term, then the shadow
+            // rays, then the sums in the lights' order.
+            terms.clear();
+            for &l in active.iter() {
+                let lane = &mut lanes[l as usize];
+                let v = lane.vertex.as_ref().expect("active lanes have a vertex");
+                for (j, light) in lights_all.iter().enumerate() {
+                    let u = Vec2::from(lane.numbers.light_split(lane.depth, j, 0, 1));
+                    terms.push(light.sample(v.p, u).and_then(|ls| {
+                        if !(ls.pdf > 0.0) || ls.li == Vec3::ZERO {
+                            return None;
+                        }
+                        let wi = v.frame.to_local(ls.wi);
+                        let (f, bsdf_pdf) =
+                            Lambertian { albedo: v.albedo }.eval_pdf(v.wo, wi, !ls.is_delta);
+                        if f == Vec3::ZERO {
+                            return None;
+                        }
+                        let ray = Ray {
+                            o: offset_ray_origin(v.p, v.ng, eps, ls.wi),
+                            d: ls.wi,
+                        };
+                        let term = weighted_term(f, ls.li, wi.z, ls.pdf, bsdf_pdf, ls.is_delta);
+                        Some((term, ray, shadow_t_max(ls.dist)))
+                    }));
+                }
+            }
+            for t in terms.iter_mut() {
+                if let Some((_, ray, t_max)) = t {
+                    if !shadow.unoccluded(ray, *t_max) {
+                        *t = Some((Vec3::ZERO, *ray, *t_max));
+                    }
+                }
+            }
+            let n_lights = lights_all.len();
+            for (k, &l) in active.iter().enumerate() {
+                let lane = &mut lanes[l as usize];
+                let mut nee = Vec3::ZERO;
+                for t in &terms[k * n_lights..(k + 1) * n_lights] {
+                    nee += match t {
+                        Some((term, _, _)) => {
+                            lane.cost.rays += 1;
+                            *term
+                        }
+                        None => Vec3::ZERO,
+                    };
+                }
+                // Channel by channel, as `add_next_event` adds them.
+                lane.radiance = Vec3::from_array(std::array::from_fn(|c| {
+                    lane.radiance[c] + lane.beta[c] * nee[c]
+                }));
+            }
+            // The BSDF samples and roulette; the paths that go on trace their rays.
+            next.clear();
+            for &l in active.iter() {
+                let lane = &mut lanes[l as usize];
+                let last = lane.depth + 1 >= max_depth;
+                if last && !lights.hittable() {
+                    continue;
+                }
+                let u = lane.numbers.bounce(lane.depth);
+                lane.depth += 1;
+                if scatter(lane, u, eps) {
+                    lane.cost.rays += 1;
+                    next.push(l);
+                }
+            }
+            std::mem::swap(active, next);
+            hits.clear();
+            hits.extend(
+                active
+                    .iter()
+                    .map(|&l| scene.accel.intersect(&lanes[l as usize].ray, f32::INFINITY)),
+            );
+            for (&l, hit) in active.iter().zip(hits.iter()) {
+                let lane = &mut lanes[l as usize];
+                lane.t_hit = hit.map_or(f32::INFINITY, |h| h.t);
+                let last = lane.depth >= max_depth;
+                lane.vertex = match hit {
+                    Some(h) if !last => {
+                        lane.cost.shading += 1;
+                        Some(vertex(scene, &lane.ray, h))
+                    }
+                    _ => None,
+                };
+            }
+        }
+        // The sums in sample order, as the per-path loop adds them.
+        for c in radiance.iter_mut() {
+            c.resize(1, 0.0);
+        }
+        for (lane, aov) in lanes.iter().zip(aov.iter()) {
+            let i = lane.pixel as usize;
+            [radiance[0][0], radiance[1][0], radiance[2][0]] = lane.radiance.to_array();
+            sums.add(i, radiance);
+            aov_sums[i].add(Vec3::ZERO, aov);
+            work[i] += lane.cost.work();
+            rays.rays += lane.cost.rays;
+            rays.shading += lane.cost.shading;
+        }
+    }
+}
+
+/// The vertex at `hit` along `ray` on a Lambertian surface: [`integrator::shading_point`]'s
+/// values.
+#[inline(always)]
+fn vertex(scene: &Scene, ray: &Ray, hit: &Hit) -> Vertex {
+    let s = scene.accel.surface(ray, hit);
+    let inst = &scene.accel.instances[s.instance as usize];
+    let Material::Lambertian { albedo } = scene.materials[inst.material as usize] else {
+        unreachable!("lanes_apply admits Lambertian materials only")
+    };
+    let wo_world = -ray.d;
+    let (ng, frame) = integrator::facing(
+        s.ng,
+        Frame::from_normal_tangent(s.ns, s.tangent),
+        wo_world,
+        false,
+    );
+    Vertex {
+        p: s.p,
+        ng,
+        frame,
+        wo: frame.to_local(wo_world),
+        albedo,
+    }
+}
+
+/// [`integrator::PathState::add_emission`] for one frame: the light the ray meets before its
+/// hit, weighted; true where the path met one (and ends).
+#[inline(always)]
+fn add_emission(lights: &[super::light::Light], lane: &mut Lane) -> bool {
+    let hit_surface = lane.t_hit.is_finite();
+    let Some((_, hit)) = super::light::nearest_light(lights, &lane.ray, lane.t_hit) else {
+        return false;
+    };
+    if !(hit.distance < lane.t_hit || !hit_surface) {
+        return false;
+    }
+    let w = if lane.specular {
+        1.0
+    } else {
+        power_heuristic(lane.prev_pdf, 1.0 * hit.pdf)
+    };
+    lane.radiance += lane.beta * hit.radiance * w;
+    true
+}
+
+/// [`integrator::PathState::scatter`] on a Lambertian vertex.
+#[inline(always)]
+fn scatter(lane: &mut Lane, [u0, u1, uc, u_roulette]: [f32; 4], eps: f32) -> bool {
+    let v = lane
+        .vertex
+        .as_ref()
+        .expect("scattering lanes have a vertex");
+    let Some(bs) = (Lambertian { albedo: v.albedo }).sample(v.wo, uc, Vec2::new(u0, u1)) else {
+        return false;
+    };
+    if !(bs.pdf > 0.0) {
+        return false;
+    }
+    lane.beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
+    lane.eta_scale *= bs.eta * bs.eta;
+    lane.specular = bs.is_delta;
+    lane.prev_pdf = bs.pdf;
+    if lane.depth >= 3 {
+        let q = integrator::survival(lane.beta, lane.eta_scale);
+        if u_roulette >= q {
+            return false;
+        }
+        lane.beta /= q;
+    }
+    if !lane.beta.is_finite() || lane.beta == Vec3::ZERO {
+        return false;
+    }
+    let d = v.frame.to_world(bs.wi);
+    lane.ray = Ray {
+        o: offset_ray_origin(v.p, v.ng, eps, d),
+        d,
+    };
+    true
+}
