@@ -240,6 +240,7 @@ fn summary(
         "triangles": loaded.scene.accel.triangle_count(),
         "seconds": secs,
         "rays": out.rays,
+        "schedule": if out.waves { "waves" } else { "paths" },
         "mrays_per_s": out.rays as f64 / secs.max(1e-9) / 1e6,
         "nonfinite_samples": img.nonfinite,
         "mean_rgb": mean,

@@ -17,7 +17,7 @@ use super::frames::LightFrames;
 use super::geometry::{Hit, Ray};
 use super::light::{Light, LightSample, LightSamples, LightU};
 use super::sampler::{pixel_sample, PathNumbers};
-use super::shading::{offset_origin, ShadingPoint};
+use super::shading::{offset_length, offset_origin, ShadingPoint};
 use super::shadow::{shadow_t_max, Segments, ShadowTest};
 use super::Scene;
 use crate::bsdf::Bsdf;
@@ -156,7 +156,7 @@ pub(crate) fn shading_point(
     sp.frame = frame;
     sp.wo = frame.to_local(wo_world);
     shading.bsdf.copy_to(&mut sp.bsdf);
-    sp.eps = 2e-5 * scene.accel.scale();
+    sp.eps = offset_length(scene.accel.scale());
     material.shading_cost()
 }
 

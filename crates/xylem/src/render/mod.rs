@@ -199,6 +199,9 @@ pub struct RenderOutput {
     pub elapsed: Duration,
     /// Rays traced (camera, shadow and bounce rays).
     pub rays: u64,
+    /// Whether the tiles ran as waves of paths in lanes (every material Lambertian, and
+    /// `XYLEM_WAVES` not `off`) rather than one path at a time: the same image either way.
+    pub waves: bool,
 }
 
 /// Why a render could not start.
@@ -273,6 +276,7 @@ pub fn render(
         },
         elapsed: frames.elapsed,
         rays: frames.rays,
+        waves: wave::enabled(scene, &lights),
     })
 }
 
@@ -804,11 +808,7 @@ fn tile_frames<const ONE: bool>(
     }
     let pixels = (origin.y..origin.y + th)
         .flat_map(|y| (origin.x..origin.x + tw).map(move |x| UVec2::new(x, y)));
-    if ONE
-        && matches!(primary, Primary::Compute)
-        && std::env::var("XYLEM_WAVES").as_deref() != Ok("off")
-        && wave::lanes_apply(scene, lights)
-    {
+    if ONE && matches!(primary, Primary::Compute) && wave::enabled(scene, lights) {
         let mut samples = Vec::new();
         for (i, pixel) in pixels.enumerate() {
             let range = match span {

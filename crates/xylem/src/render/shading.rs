@@ -38,6 +38,14 @@ impl ShadingPoint {
     }
 }
 
+/// How far a ray leaving a surface starts from it ([`ShadingPoint::eps`]) in a scene of extent
+/// `scale` ([`crate::render::geometry::Accel::scale`]): 2·10⁻⁵ of it, above the rounding error
+/// of hit points across the scene.
+#[inline(always)]
+pub(crate) fn offset_length(scale: f32) -> f32 {
+    2e-5 * scale
+}
+
 /// Origin of a ray leaving `sp` along `dir`: the hit point moved `eps` along the geometric
 /// normal, to the side `dir` points to, so the ray does not hit the surface it starts on.
 #[inline(always)]

@@ -1,5 +1,5 @@
 //! A tile's pixel samples as waves of paths in lanes, for scenes whose every material is
-//! Lambertian (the Cornell box; `lanes_apply`): a path's state is a few columns of numbers
+//! Lambertian (the Cornell box; [`enabled`]): a path's state is a few columns of numbers
 //! rather than a shading point holding a whole BSDF, and each stage of a bounce — emission met,
 //! light samples, shadow rays, BSDF samples, closest hits, shading points — is one loop over the
 //! wave's live paths. Every path makes the operations of [`integrator::radiance_frames`] on the
@@ -12,7 +12,7 @@ use super::frames::LightFrames;
 use super::geometry::{Hit, Ray};
 use super::integrator::{self, weighted_term, Columns, RayCount};
 use super::sampler::{pixel_sample, PathNumbers};
-use super::shading::offset_ray_origin;
+use super::shading::{offset_length, offset_ray_origin};
 use super::shadow::{shadow_t_max, ShadowTest};
 use super::Scene;
 use crate::bsdf::{Bsdf, Lambertian};
@@ -24,14 +24,17 @@ use glam::{UVec2, Vec2, Vec3};
 /// state stays in the L1 and L2 caches.
 const WAVE: usize = 256;
 
-/// Whether a one-frame render of `scene` with `lights` can run as waves: every material
-/// Lambertian (each path's vertex then needs only its albedo and frame).
-pub(super) fn lanes_apply(scene: &Scene, lights: &LightFrames) -> bool {
+/// Whether a one-frame render of `scene` with `lights` runs as waves: every material
+/// Lambertian (each path's vertex then needs only its albedo and frame), and the environment
+/// variable `XYLEM_WAVES` not `off` (which keeps the per-path loop, for tests and comparisons:
+/// the image is the same bits either way).
+pub(super) fn enabled(scene: &Scene, lights: &LightFrames) -> bool {
     lights.len() == 1
         && scene
             .materials
             .iter()
             .all(|m| matches!(m, Material::Lambertian { .. }))
+        && std::env::var("XYLEM_WAVES").as_deref() != Ok("off")
 }
 
 /// A path's vertex on a Lambertian surface: what [`integrator::shading_point`] keeps of it.
@@ -79,7 +82,7 @@ pub(super) struct WaveScratch {
 }
 
 /// The samples `samples` (tile pixel index, pixel, sample number, in the order their sums are
-/// added) of a one-frame render whose scene [`lanes_apply`] to, as waves of [`WAVE`] paths;
+/// added) of a one-frame render whose waves are [`enabled`], as waves of [`WAVE`] paths;
 /// adds each sample's radiance and AOVs to `sums` and `aov_sums` and its cost to `work` and
 /// `rays`, as the per-path loop of `tile_frames` does.
 #[allow(clippy::too_many_arguments)]
@@ -95,7 +98,7 @@ pub(super) fn tile_waves(
     rays: &mut RayCount,
 ) {
     let camera = scene.camera.rays();
-    let eps = 2e-5 * scene.accel.scale();
+    let eps = offset_length(scene.accel.scale());
     let lights_all = lights.first();
     for chunk in samples.chunks(WAVE) {
         let WaveScratch {
@@ -279,7 +282,7 @@ fn vertex(scene: &Scene, ray: &Ray, hit: &Hit) -> Vertex {
     let s = scene.accel.surface(ray, hit);
     let inst = &scene.accel.instances[s.instance as usize];
     let Material::Lambertian { albedo } = scene.materials[inst.material as usize] else {
-        unreachable!("lanes_apply admits Lambertian materials only")
+        unreachable!("waves are enabled for Lambertian materials only")
     };
     let wo_world = -ray.d;
     let (ng, frame) = integrator::facing(
@@ -305,7 +308,8 @@ fn add_emission(lights: &[super::light::Light], lane: &mut Lane) -> bool {
     let Some((_, hit)) = super::light::nearest_light(lights, &lane.ray, lane.t_hit) else {
         return false;
     };
-    if !(hit.distance < lane.t_hit || !hit_surface) {
+    let in_front = hit.distance < lane.t_hit || !hit_surface;
+    if !in_front {
         return false;
     }
     let w = if lane.specular {
@@ -324,7 +328,7 @@ fn scatter(lane: &mut Lane, [u0, u1, uc, u_roulette]: [f32; 4], eps: f32) -> boo
         .vertex
         .as_ref()
         .expect("scattering lanes have a vertex");
-    let Some(bs) = (Lambertian { albedo: v.albedo }).sample(v.wo, uc, Vec2::new(u0, u1)) else {
+    let Some(bs) = Lambertian { albedo: v.albedo }.sample(v.wo, uc, Vec2::new(u0, u1)) else {
         return false;
     };
     if !(bs.pdf > 0.0) {
