@@ -28,6 +28,7 @@ impl Frame {
 
     /// A frame with normal `n` whose `s` axis is the projection of `tangent` onto the plane of `n`
     /// (Gram–Schmidt); falls back to [`Frame::from_normal`] when `tangent` is parallel to `n`.
+    #[inline(always)]
     pub fn from_normal_tangent(n: Vec3, tangent: Vec3) -> Self {
         let s = tangent - n * n.dot(tangent);
         let len2 = s.length_squared();

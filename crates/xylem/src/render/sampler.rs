@@ -165,7 +165,7 @@ impl PathNumbers {
     /// sequence's points n·i + k for pixel sample i, so a pixel's n · spp samples of the light
     /// are one Owen-scrambled Sobol sequence (each sample's n a stratified block of it, the
     /// whole a (0, m, 2)-net where n · spp = 2^m). With n = 1, [`PathNumbers::light`].
-    #[inline]
+    #[inline(always)]
     pub(crate) fn light_split(&self, depth: u32, light: usize, k: u32, n: u32) -> [f32; 2] {
         let p = self.point_at(depth, (light as u64) << 1, self.index * n + k);
         [p[0], p[1]]

@@ -139,11 +139,9 @@ pub(super) fn tile_waves(
             aov.push(Aov::default());
         }
         hits.clear();
-        hits.extend(
-            lanes
-                .iter()
-                .map(|l| scene.accel.intersect(&l.ray, f32::INFINITY)),
-        );
+        for l in lanes.iter() {
+            hits.push(scene.accel.intersect(&l.ray, f32::INFINITY));
+        }
         for ((lane, hit), aov) in lanes.iter_mut().zip(hits.iter()).zip(aov.iter_mut()) {
             let Some(hit) = hit else { continue };
             lane.t_hit = hit.t;
@@ -241,11 +239,9 @@ pub(super) fn tile_waves(
             }
             std::mem::swap(active, next);
             hits.clear();
-            hits.extend(
-                active
-                    .iter()
-                    .map(|&l| scene.accel.intersect(&lanes[l as usize].ray, f32::INFINITY)),
-            );
+            for &l in active.iter() {
+                hits.push(scene.accel.intersect(&lanes[l as usize].ray, f32::INFINITY));
+            }
             for (&l, hit) in active.iter().zip(hits.iter()) {
                 let lane = &mut lanes[l as usize];
                 lane.t_hit = hit.map_or(f32::INFINITY, |h| h.t);
