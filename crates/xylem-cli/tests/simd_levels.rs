@@ -107,13 +107,63 @@ fn an_unknown_level_is_refused_by_name() {
     );
 }
 
-/// The Cornell box's beauty and AOV channels as bits, and the schedule its run reports, from
-/// one run of the binary at `level` with `XYLEM_WAVES` set to `waves` (`on` or `off`).
-fn cornell(level: &str, waves: &str, extra: &[&str], dir: &Path) -> (Vec<u32>, String) {
-    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/cornell_box.toml");
+/// The Cornell box with a mirror sphere (flat facets) and a smooth-shaded glass sphere
+/// (vertex normals), written into `dir`.
+fn spheres_scene(dir: &Path) -> std::path::PathBuf {
+    let box_scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/cornell_box.toml");
+    let mut text = std::fs::read_to_string(box_scene).unwrap();
+    text.push_str(
+        r#"
+[materials.mirror]
+type = "mirror"
+reflectance = [0.9, 0.9, 0.9]
+
+[materials.glass]
+type = "glass"
+eta = 1.5
+
+[[objects]]
+shape = "sphere"
+radius = 90.0
+segments = 24
+smooth = false
+translate = [-130.0, 350.0, 90.0]
+material = "mirror"
+
+[[objects]]
+shape = "sphere"
+radius = 90.0
+segments = 24
+translate = [120.0, 180.0, 90.0]
+material = "glass"
+"#,
+    );
+    let path = dir.join("cornell_spheres.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// A scene's beauty and AOV channels as bits, and the schedule its run reports, from one run
+/// of the binary at `level` with `XYLEM_WAVES` set to `waves` (`on` or `off`).
+fn render_bits(
+    scene: &Path,
+    level: &str,
+    waves: &str,
+    extra: &[&str],
+    dir: &Path,
+) -> (Vec<u32>, String) {
     let out = format!("w_{level}_{waves}");
+    let name = scene.file_stem().unwrap().to_str().unwrap();
     let mut args = vec![
-        "render", scene, "--res", "40x40", "--quiet", "--out", &out, "--json", "-",
+        "render",
+        scene.to_str().unwrap(),
+        "--res",
+        "40x40",
+        "--quiet",
+        "--out",
+        &out,
+        "--json",
+        "-",
     ];
     args.extend_from_slice(extra);
     let o = Command::new(env!("CARGO_BIN_EXE_xylem"))
@@ -125,7 +175,8 @@ fn cornell(level: &str, waves: &str, extra: &[&str], dir: &Path) -> (Vec<u32>, S
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let json: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    let bits = xylem::picture::exr::read_exr_channels(&dir.join(&out).join("cornell_box.exr"))
+    let exr = dir.join(&out).join(format!("{name}.exr"));
+    let bits = xylem::picture::exr::read_exr_channels(&exr)
         .unwrap()
         .into_iter()
         .flat_map(|(_, v)| v.into_iter().map(f32::to_bits))
@@ -133,27 +184,35 @@ fn cornell(level: &str, waves: &str, extra: &[&str], dir: &Path) -> (Vec<u32>, S
     (bits, json["schedule"].as_str().unwrap_or("").to_string())
 }
 
-/// A Lambertian scene's tiles run as waves of paths in lanes (render/wave.rs), and the waves
-/// give the per-path loop's image bit for bit at every SIMD level this CPU has, for uniform
-/// and adaptive sampling (whose second pass continues each pixel's samples). Control: the
-/// same comparison tells two seeds apart.
+/// Scenes of Lambertian, mirror and glass materials run their tiles as waves of paths in lanes
+/// (render/wave.rs), and the waves give the per-path loop's image bit for bit at every SIMD
+/// level this CPU has, for uniform and adaptive sampling (whose second pass continues each
+/// pixel's samples): the Cornell box, and the box with a mirror and a glass sphere. Control:
+/// the same comparison tells two seeds apart.
 #[test]
 fn waves_give_the_per_path_images_at_every_level() {
     let tmp = tempfile::tempdir().unwrap();
+    let cornell_box = Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenes/cornell_box.toml"
+    ));
+    let spheres = spheres_scene(tmp.path());
     let settings: [&[&str]; 2] = [&["--spp", "4", "--sampling", "uniform"], &["--spp", "16"]];
-    for level in Simd::ALL.into_iter().filter(|&l| l <= Simd::detected()) {
-        for extra in settings {
-            let (waves, schedule) = cornell(level.name(), "on", extra, tmp.path());
-            let (paths, per_path) = cornell(level.name(), "off", extra, tmp.path());
-            assert_eq!((schedule.as_str(), per_path.as_str()), ("waves", "paths"));
-            assert_eq!(waves.len(), paths.len());
-            let differ = waves.iter().zip(&paths).filter(|(a, b)| a != b).count();
-            assert_eq!(differ, 0, "{level:?} {extra:?}: {differ} values differ");
+    for scene in [cornell_box, &spheres] {
+        for level in Simd::ALL.into_iter().filter(|&l| l <= Simd::detected()) {
+            for extra in settings {
+                let (waves, schedule) = render_bits(scene, level.name(), "on", extra, tmp.path());
+                let (paths, per_path) = render_bits(scene, level.name(), "off", extra, tmp.path());
+                assert_eq!((schedule.as_str(), per_path.as_str()), ("waves", "paths"));
+                assert_eq!(waves.len(), paths.len());
+                let differ = waves.iter().zip(&paths).filter(|(a, b)| a != b).count();
+                assert_eq!(differ, 0, "{scene:?} {level:?} {extra:?}: {differ} differ");
+            }
         }
     }
     let seed: &[&str] = &["--spp", "4", "--sampling", "uniform", "--seed", "2"];
-    let (other, _) = cornell("scalar", "on", seed, tmp.path());
-    let (paths, _) = cornell("scalar", "off", settings[0], tmp.path());
+    let (other, _) = render_bits(&spheres, "scalar", "on", seed, tmp.path());
+    let (paths, _) = render_bits(&spheres, "scalar", "off", settings[0], tmp.path());
     let differ = other.iter().zip(&paths).filter(|(a, b)| a != b).count();
     assert!(
         differ > 1000,

@@ -1,6 +1,7 @@
 //! A tile's pixel samples as waves of paths in lanes, for scenes whose every material is
-//! Lambertian (the Cornell box; [`enabled`]): a path's state is a few columns of numbers
-//! rather than a shading point holding a whole BSDF, and each stage of a bounce — emission met,
+//! Lambertian, a mirror or glass (the Cornell boxes; [`enabled`]): a path's state is a few
+//! numbers and one of those small BSDFs rather than a shading point holding a whole (wood)
+//! BSDF, and each stage of a bounce — emission met,
 //! light samples, shadow rays, BSDF samples, closest hits, shading points — is one loop over the
 //! wave's live paths. Every path makes the operations of [`integrator::radiance_frames`] on the
 //! same values in the same order (the same functions: light sampling, the BSDF, MIS, roulette,
@@ -15,7 +16,7 @@ use super::sampler::{pixel_sample, PathNumbers};
 use super::shading::{offset_length, offset_ray_origin};
 use super::shadow::{shadow_t_max, ShadowTest};
 use super::Scene;
-use crate::bsdf::{Bsdf, Lambertian};
+use crate::bsdf::{Bsdf, BsdfSample, Glass, Lambertian, Mirror};
 use crate::material::Material;
 use crate::math::{power_heuristic, Frame};
 use glam::{UVec2, Vec2, Vec3};
@@ -25,27 +26,69 @@ use glam::{UVec2, Vec2, Vec3};
 const WAVE: usize = 256;
 
 /// Whether a one-frame render of `scene` with `lights` runs as waves: every material
-/// Lambertian (each path's vertex then needs only its albedo and frame), and the environment
+/// Lambertian, a mirror or glass (each path's vertex then needs only its frame and a small
+/// BSDF, [`LaneBsdf`]), and the environment
 /// variable `XYLEM_WAVES` not `off` (which keeps the per-path loop, for tests and comparisons:
 /// the image is the same bits either way).
 pub(super) fn enabled(scene: &Scene, lights: &LightFrames) -> bool {
     lights.len() == 1
-        && scene
-            .materials
-            .iter()
-            .all(|m| matches!(m, Material::Lambertian { .. }))
+        && scene.materials.iter().all(|m| LaneBsdf::of(m).is_some())
         && std::env::var("XYLEM_WAVES").as_deref() != Ok("off")
 }
 
-/// A path's vertex on a Lambertian surface: what [`integrator::shading_point`] keeps of it.
+/// The BSDFs of the materials a wave shades: the [`crate::material::SurfaceBsdf`] variants
+/// of the same name, whose functions it calls.
+#[derive(Clone, Copy, Debug)]
+enum LaneBsdf {
+    Lambertian(Lambertian),
+    Mirror(Mirror),
+    Glass(Glass),
+}
+
+impl LaneBsdf {
+    /// The BSDF of `material` (`None` for materials the waves leave to the per-path loop)
+    /// and the albedo its AOV records, as `Material::shade` gives them.
+    #[inline(always)]
+    fn of(material: &Material) -> Option<(LaneBsdf, Vec3)> {
+        match *material {
+            Material::Lambertian { albedo } => {
+                Some((LaneBsdf::Lambertian(Lambertian { albedo }), albedo))
+            }
+            Material::Mirror { reflectance } => {
+                Some((LaneBsdf::Mirror(Mirror { reflectance }), reflectance))
+            }
+            Material::Glass { eta, tint } => Some((LaneBsdf::Glass(Glass { eta, tint }), tint)),
+            _ => None,
+        }
+    }
+
+    /// Whether every lobe is a delta lobe (no next-event estimation).
+    #[inline(always)]
+    fn is_delta(&self) -> bool {
+        !matches!(self, LaneBsdf::Lambertian(_))
+    }
+
+    #[inline(always)]
+    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
+        match self {
+            LaneBsdf::Lambertian(b) => b.sample(wo, uc, u),
+            LaneBsdf::Mirror(b) => b.sample(wo, uc, u),
+            LaneBsdf::Glass(b) => b.sample(wo, uc, u),
+        }
+    }
+}
+
+/// A path's vertex: what [`integrator::shading_point`] keeps of it.
 #[derive(Clone, Copy, Debug)]
 struct Vertex {
     p: Vec3,
-    /// Geometric normal, facing the viewer.
+    /// Geometric normal, facing the viewer unless the surface transmits.
     ng: Vec3,
     frame: Frame,
     /// Towards the viewer, local frame.
     wo: Vec3,
+    bsdf: LaneBsdf,
+    /// The albedo the first hit's AOV records.
     albedo: Vec3,
 }
 
@@ -176,6 +219,11 @@ pub(super) fn tile_waves(
             for &l in active.iter() {
                 let lane = &mut lanes[l as usize];
                 let v = lane.vertex.as_ref().expect("active lanes have a vertex");
+                // Delta BSDFs take no light samples (`radiance_frames`): no terms.
+                let LaneBsdf::Lambertian(lambertian) = v.bsdf else {
+                    terms.extend(lights_all.iter().map(|_| None));
+                    continue;
+                };
                 for (j, light) in lights_all.iter().enumerate() {
                     let u = Vec2::from(lane.numbers.light_split(lane.depth, j, 0, 1));
                     terms.push(light.sample(v.p, u).and_then(|ls| {
@@ -183,8 +231,7 @@ pub(super) fn tile_waves(
                             return None;
                         }
                         let wi = v.frame.to_local(ls.wi);
-                        let (f, bsdf_pdf) =
-                            Lambertian { albedo: v.albedo }.eval_pdf(v.wo, wi, !ls.is_delta);
+                        let (f, bsdf_pdf) = lambertian.eval_pdf(v.wo, wi, !ls.is_delta);
                         if f == Vec3::ZERO {
                             return None;
                         }
@@ -207,6 +254,9 @@ pub(super) fn tile_waves(
             let n_lights = lights_all.len();
             for (k, &l) in active.iter().enumerate() {
                 let lane = &mut lanes[l as usize];
+                if lane.vertex.is_some_and(|v| v.bsdf.is_delta()) {
+                    continue;
+                }
                 let mut nee = Vec3::ZERO;
                 for t in &terms[k * n_lights..(k + 1) * n_lights] {
                     nee += match t {
@@ -271,27 +321,28 @@ pub(super) fn tile_waves(
     }
 }
 
-/// The vertex at `hit` along `ray` on a Lambertian surface: [`integrator::shading_point`]'s
-/// values.
+/// The vertex at `hit` along `ray`: [`integrator::shading_point`]'s values.
 #[inline(always)]
 fn vertex(scene: &Scene, ray: &Ray, hit: &Hit) -> Vertex {
     let s = scene.accel.surface(ray, hit);
     let inst = &scene.accel.instances[s.instance as usize];
-    let Material::Lambertian { albedo } = scene.materials[inst.material as usize] else {
-        unreachable!("waves are enabled for Lambertian materials only")
+    let Some((bsdf, albedo)) = LaneBsdf::of(&scene.materials[inst.material as usize]) else {
+        unreachable!("waves are enabled for their materials only")
     };
     let wo_world = -ray.d;
+    let transmissive = matches!(bsdf, LaneBsdf::Glass(_));
     let (ng, frame) = integrator::facing(
         s.ng,
         Frame::from_normal_tangent(s.ns, s.tangent),
         wo_world,
-        false,
+        transmissive,
     );
     Vertex {
         p: s.p,
         ng,
         frame,
         wo: frame.to_local(wo_world),
+        bsdf,
         albedo,
     }
 }
@@ -324,7 +375,7 @@ fn scatter(lane: &mut Lane, [u0, u1, uc, u_roulette]: [f32; 4], eps: f32) -> boo
         .vertex
         .as_ref()
         .expect("scattering lanes have a vertex");
-    let Some(bs) = Lambertian { albedo: v.albedo }.sample(v.wo, uc, Vec2::new(u0, u1)) else {
+    let Some(bs) = v.bsdf.sample(v.wo, uc, Vec2::new(u0, u1)) else {
         return false;
     };
     if !(bs.pdf > 0.0) {
