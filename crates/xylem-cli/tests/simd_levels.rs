@@ -187,8 +187,8 @@ fn render_bits(
 /// Scenes of Lambertian, mirror and glass materials run their tiles as waves of paths in lanes
 /// (render/wave.rs), and the waves give the per-path loop's image bit for bit at every SIMD
 /// level this CPU has, for uniform and adaptive sampling (whose second pass continues each
-/// pixel's samples): the Cornell box, and the box with a mirror and a glass sphere. Control:
-/// the same comparison tells two seeds apart.
+/// pixel's samples): the Cornell box, and the box with a mirror and a glass sphere; and the
+/// same bits on 1 and 3 threads. Control: the same comparison tells two seeds apart.
 #[test]
 fn waves_give_the_per_path_images_at_every_level() {
     let tmp = tempfile::tempdir().unwrap();
@@ -210,6 +210,12 @@ fn waves_give_the_per_path_images_at_every_level() {
             }
         }
     }
+    // Any thread count: the waves are per tile.
+    let threads = |t| {
+        let args = ["--spp", "16", "--threads", t];
+        render_bits(&spheres, Simd::detected().name(), "on", &args, tmp.path()).0
+    };
+    assert!(threads("1") == threads("3"), "1 and 3 threads differ");
     let seed: &[&str] = &["--spp", "4", "--sampling", "uniform", "--seed", "2"];
     let (other, _) = render_bits(&spheres, "scalar", "on", seed, tmp.path());
     let (paths, _) = render_bits(&spheres, "scalar", "off", settings[0], tmp.path());
