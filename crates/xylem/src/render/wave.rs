@@ -142,6 +142,7 @@ pub(super) fn tile_waves(
 ) {
     let camera = scene.camera.rays();
     let eps = offset_length(scene.accel.scale());
+    let mut memo = FrameMemo::default();
     let lights_all = lights.first();
     for chunk in samples.chunks(WAVE) {
         let WaveScratch {
@@ -188,7 +189,7 @@ pub(super) fn tile_waves(
         for ((lane, hit), aov) in lanes.iter_mut().zip(hits.iter()).zip(aov.iter_mut()) {
             let Some(hit) = hit else { continue };
             lane.t_hit = hit.t;
-            let v = vertex(scene, &lane.ray, hit);
+            let v = vertex(scene, &lane.ray, hit, &mut memo);
             *aov = Aov {
                 albedo: v.albedo,
                 normal: v.frame.n,
@@ -299,7 +300,7 @@ pub(super) fn tile_waves(
                 lane.vertex = match hit {
                     Some(h) if !last => {
                         lane.cost.shading += 1;
-                        Some(vertex(scene, &lane.ray, h))
+                        Some(vertex(scene, &lane.ray, h, &mut memo))
                     }
                     _ => None,
                 };
@@ -321,9 +322,33 @@ pub(super) fn tile_waves(
     }
 }
 
+/// [`Frame::from_normal_tangent`] of the last normal and tangent it was given, kept: paths
+/// one after the other in a wave often hit the same flat triangle (a pixel's camera rays
+/// nearly always), whose normal and tangent are the same numbers, so the frame is too.
+#[derive(Default)]
+struct FrameMemo {
+    last: Option<(Vec3, Vec3, Frame)>,
+}
+
+impl FrameMemo {
+    #[inline(always)]
+    fn frame(&mut self, n: Vec3, tangent: Vec3) -> Frame {
+        let same =
+            |a: Vec3, b: Vec3| a.to_array().map(f32::to_bits) == b.to_array().map(f32::to_bits);
+        match self.last {
+            Some((ln, lt, frame)) if same(ln, n) && same(lt, tangent) => frame,
+            _ => {
+                let frame = Frame::from_normal_tangent(n, tangent);
+                self.last = Some((n, tangent, frame));
+                frame
+            }
+        }
+    }
+}
+
 /// The vertex at `hit` along `ray`: [`integrator::shading_point`]'s values.
 #[inline(always)]
-fn vertex(scene: &Scene, ray: &Ray, hit: &Hit) -> Vertex {
+fn vertex(scene: &Scene, ray: &Ray, hit: &Hit, memo: &mut FrameMemo) -> Vertex {
     let s = scene.accel.surface(ray, hit);
     let inst = &scene.accel.instances[s.instance as usize];
     let Some((bsdf, albedo)) = LaneBsdf::of(&scene.materials[inst.material as usize]) else {
@@ -331,12 +356,7 @@ fn vertex(scene: &Scene, ray: &Ray, hit: &Hit) -> Vertex {
     };
     let wo_world = -ray.d;
     let transmissive = matches!(bsdf, LaneBsdf::Glass(_));
-    let (ng, frame) = integrator::facing(
-        s.ng,
-        Frame::from_normal_tangent(s.ns, s.tangent),
-        wo_world,
-        transmissive,
-    );
+    let (ng, frame) = integrator::facing(s.ng, memo.frame(s.ns, s.tangent), wo_world, transmissive);
     Vertex {
         p: s.p,
         ng,
