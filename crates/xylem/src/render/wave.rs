@@ -183,8 +183,11 @@ pub(super) fn tile_waves(
             aov.push(Aov::default());
         }
         hits.clear();
-        for l in lanes.iter() {
-            hits.push(scene.accel.intersect(&l.ray, f32::INFINITY));
+        for pair in lanes.chunks(2) {
+            match pair {
+                [a, b] => hits.extend(scene.accel.intersect_pair([&a.ray, &b.ray], f32::INFINITY)),
+                _ => hits.push(scene.accel.intersect(&pair[0].ray, f32::INFINITY)),
+            }
         }
         for ((lane, hit), aov) in lanes.iter_mut().zip(hits.iter()).zip(aov.iter_mut()) {
             let Some(hit) = hit else { continue };
@@ -290,8 +293,12 @@ pub(super) fn tile_waves(
             }
             std::mem::swap(active, next);
             hits.clear();
-            for &l in active.iter() {
-                hits.push(scene.accel.intersect(&lanes[l as usize].ray, f32::INFINITY));
+            for pair in active.chunks(2) {
+                let ray = |i: usize| &lanes[pair[i] as usize].ray;
+                match pair.len() {
+                    2 => hits.extend(scene.accel.intersect_pair([ray(0), ray(1)], f32::INFINITY)),
+                    _ => hits.push(scene.accel.intersect(ray(0), f32::INFINITY)),
+                }
             }
             for (&l, hit) in active.iter().zip(hits.iter()) {
                 let lane = &mut lanes[l as usize];

@@ -2,7 +2,7 @@
 //! the reconstruction of a hit's surface.
 
 use super::{Hit, Instance, Ray, SurfaceHit, TriMesh};
-use crate::render::wide_bvh::{WideBvh, ROBUST_FAR};
+use crate::render::wide_bvh::{WideBvh, WideHit, ROBUST_FAR};
 use glam::{Vec3, Vec3A};
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::{reinsertion::ReinsertionOptimizer, Bvh2};
@@ -293,18 +293,43 @@ impl Accel {
     /// Closest hit with `t` in [0, t_max).
     #[inline(always)]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
-        let mut best = self.world.closest(ray.o, ray.d, t_max).map(|h| {
-            let k = match self.range_of.get(h.triangle as usize) {
-                Some(&k) => k as usize,
-                None => 0,
-            };
-            Hit {
-                t: h.t,
-                instance: self.flat[k],
-                triangle: h.triangle - self.offsets[k],
-                uv: h.uv,
-            }
-        });
+        let best = self
+            .world
+            .closest(ray.o, ray.d, t_max)
+            .map(|h| self.world_hit(h));
+        self.intersect_top(ray, t_max, best)
+    }
+
+    /// [`Accel::intersect`] of two rays, their world traversals advanced in turn
+    /// ([`WideBvh::closest_pair`]): each hit is `intersect`'s bit for bit.
+    #[inline(always)]
+    pub fn intersect_pair(&self, rays: [&Ray; 2], t_max: f32) -> [Option<Hit>; 2] {
+        let [a, b] = rays;
+        let [ha, hb] = self.world.closest_pair([(a.o, a.d), (b.o, b.d)], t_max);
+        [
+            self.intersect_top(a, t_max, ha.map(|h| self.world_hit(h))),
+            self.intersect_top(b, t_max, hb.map(|h| self.world_hit(h))),
+        ]
+    }
+
+    /// A hit of the flattened world's BVH as the instance's triangle.
+    #[inline(always)]
+    fn world_hit(&self, h: WideHit) -> Hit {
+        let k = match self.range_of.get(h.triangle as usize) {
+            Some(&k) => k as usize,
+            None => 0,
+        };
+        Hit {
+            t: h.t,
+            instance: self.flat[k],
+            triangle: h.triangle - self.offsets[k],
+            uv: h.uv,
+        }
+    }
+
+    /// The closest of `best` (the flattened world's hit) and the instanced meshes' hits.
+    #[inline(always)]
+    fn intersect_top(&self, ray: &Ray, t_max: f32, mut best: Option<Hit>) -> Option<Hit> {
         if let Some(top) = &self.top {
             let mut t_hit = best.map_or(t_max, |h| h.t);
             self.traverse_top(top, ray, &mut t_hit, |p, o, d, t| {

@@ -181,6 +181,38 @@ struct Entry {
     t: f32,
 }
 
+/// A closest-hit traversal between steps ([`WideBvh::closest_pair`]): the ray, the closest hit
+/// so far, the stack depth and the node or leaf to visit next.
+struct Walk {
+    r: RayData,
+    best: Option<(u32, f32, f32)>,
+    t_hit: f32,
+    sp: usize,
+    cur: u32,
+}
+
+impl Walk {
+    #[inline(always)]
+    fn new(root: u32, o: Vec3, d: Vec3, t_max: f32) -> Self {
+        Walk {
+            r: RayData::new(o, d),
+            best: None,
+            t_hit: t_max,
+            sp: 0,
+            cur: root,
+        }
+    }
+
+    #[inline(always)]
+    fn hit(&self) -> Option<WideHit> {
+        self.best.map(|(triangle, u, v)| WideHit {
+            t: self.t_hit,
+            triangle,
+            uv: Vec2::new(u, v),
+        })
+    }
+}
+
 impl WideBvh {
     /// Collapses an obvhs BVH2 (leaves of one primitive each, as PLOC builds them;
     /// `bvh2.primitive_indices` maps leaf entries to `triangles`) into the wide layout.
@@ -298,6 +330,22 @@ impl WideBvh {
         self.unoccluded_portable(o, d, t_max)
     }
 
+    /// [`WideBvh::closest`] of two rays at once: their traversals advance in turn, a node or a
+    /// leaf each, so that the CPU overlaps the two chains of dependent tests (a single ray's
+    /// traversal of a small tree is a chain of latencies). Each ray visits what it visits alone,
+    /// in the same order, so each hit is [`WideBvh::closest`]'s bit for bit.
+    pub fn closest_pair(&self, rays: [(Vec3, Vec3); 2], t_max: f32) -> [Option<WideHit>; 2] {
+        if self.root == EMPTY {
+            return [None, None];
+        }
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: as in `closest`.
+            return unsafe { self.closest_pair_avx2(rays, t_max) };
+        }
+        self.with_stacks(|a, b| self.closest_pair_in::<Portable>(rays, t_max, [a, b]))
+    }
+
     /// The traversal compiled for the baseline target (the reference the AVX2 path must equal).
     pub fn closest_portable(&self, o: Vec3, d: Vec3, t_max: f32) -> Option<WideHit> {
         self.with_stack(|s| self.closest_in::<Portable>(o, d, t_max, s))
@@ -316,6 +364,119 @@ impl WideBvh {
         unsafe fn unoccluded_avx2(&self, o: Vec3, d: Vec3, t_max: f32) -> bool {
             self.with_stack(|s| self.unoccluded_in::<Avx2>(o, d, t_max, s))
         }
+
+        unsafe fn closest_pair_avx2(
+            &self,
+            rays: [(Vec3, Vec3); 2],
+            t_max: f32,
+        ) -> [Option<WideHit>; 2] {
+            self.with_stacks(|a, b| self.closest_pair_in::<Avx2>(rays, t_max, [a, b]))
+        }
+    }
+
+    /// [`WideBvh::with_stack`] with two stacks, for [`WideBvh::closest_pair`].
+    #[inline(always)]
+    fn with_stacks<R>(&self, f: impl FnOnce(&mut [Entry], &mut [Entry]) -> R) -> R {
+        if self.stack_need <= SMALL_STACK {
+            let mut both = [Entry::default(); 2 * SMALL_STACK];
+            let (a, b) = both.split_at_mut(SMALL_STACK);
+            return f(a, b);
+        }
+        self.with_stack_of(2 * self.stack_need, |s| {
+            let (a, b) = s.split_at_mut(self.stack_need);
+            f(a, b)
+        })
+    }
+
+    /// The two traversals of [`WideBvh::closest_pair`], each a [`Walk`] stepped in turn.
+    #[inline(always)]
+    fn closest_pair_in<K: Kernel>(
+        &self,
+        [(oa, da), (ob, db)]: [(Vec3, Vec3); 2],
+        t_max: f32,
+        [sa, sb]: [&mut [Entry]; 2],
+    ) -> [Option<WideHit>; 2] {
+        let (mut a, mut b) = (
+            Walk::new(self.root, oa, da, t_max),
+            Walk::new(self.root, ob, db, t_max),
+        );
+        let (mut on_a, mut on_b) = (true, true);
+        while on_a & on_b {
+            on_a = self.step::<K>(&mut a, sa);
+            on_b = self.step::<K>(&mut b, sb);
+        }
+        while on_a {
+            on_a = self.step::<K>(&mut a, sa);
+        }
+        while on_b {
+            on_b = self.step::<K>(&mut b, sb);
+        }
+        [a.hit(), b.hit()]
+    }
+
+    /// One step of `closest_in`'s traversal for `w`: the leaf or node `w.cur` tested, and the
+    /// next one to visit chosen as `closest_in` chooses it (false when there is none left).
+    #[inline(always)]
+    fn step<K: Kernel>(&self, w: &mut Walk, stack: &mut [Entry]) -> bool {
+        let cur = w.cur;
+        if cur & LEAF != 0 {
+            let p = &self.packets[(cur & !LEAF) as usize];
+            if let Some((lane, t, u, v)) = K::packet(p, &w.r, 0.0, w.t_hit) {
+                w.t_hit = t;
+                w.best = Some((p.id[lane], u, v));
+            }
+        } else {
+            let node = &self.nodes[cur as usize];
+            prefetch(&node.child);
+            let (mut mask, t_near) = K::node(node, &w.r, 0.0, w.t_hit);
+            if mask != 0 {
+                let first = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                if mask == 0 {
+                    w.cur = node.child[first];
+                    return true;
+                }
+                self.prefetch(node.child[first]);
+                let mut rest = mask;
+                while rest != 0 {
+                    self.prefetch(node.child[rest.trailing_zeros() as usize]);
+                    rest &= rest - 1;
+                }
+                let base = w.sp;
+                stack[w.sp] = Entry {
+                    child: node.child[first],
+                    t: t_near[first],
+                };
+                w.sp += 1;
+                while mask != 0 {
+                    let i = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    let e = Entry {
+                        child: node.child[i],
+                        t: t_near[i],
+                    };
+                    let mut j = w.sp;
+                    while j > base && stack[j - 1].t < e.t {
+                        stack[j] = stack[j - 1];
+                        j -= 1;
+                    }
+                    stack[j] = e;
+                    w.sp += 1;
+                }
+                w.sp -= 1;
+                w.cur = stack[w.sp].child;
+                return true;
+            }
+        }
+        // Pop the nearest pending child that can still hold a closer hit.
+        while w.sp > 0 {
+            w.sp -= 1;
+            if stack[w.sp].t <= w.t_hit {
+                w.cur = stack[w.sp].child;
+                return true;
+            }
+        }
+        false
     }
 
     /// Runs `f` with a traversal stack large enough for this tree: for a shallow tree (at most
@@ -329,14 +490,20 @@ impl WideBvh {
         if self.stack_need <= SMALL_STACK {
             return f(&mut [Entry::default(); SMALL_STACK]);
         }
+        self.with_stack_of(self.stack_need, f)
+    }
+
+    /// Runs `f` with the per-thread traversal buffer, grown to at least `need` entries.
+    #[inline(always)]
+    fn with_stack_of<R>(&self, need: usize, f: impl FnOnce(&mut [Entry]) -> R) -> R {
         thread_local! {
             static STACK: std::cell::RefCell<Vec<Entry>> =
                 const { std::cell::RefCell::new(Vec::new()) };
         }
         STACK.with(|s| {
             let mut s = s.borrow_mut();
-            if s.len() < self.stack_need {
-                s.resize(self.stack_need, Entry::default());
+            if s.len() < need {
+                s.resize(need, Entry::default());
             }
             f(&mut s)
         })

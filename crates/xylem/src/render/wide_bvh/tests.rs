@@ -125,6 +125,16 @@ fn check_against_brute_force(bvh: &WideBvh, tris: &[[Vec3; 3]]) {
             assert_eq!(hit.map(|h| (h.t, h.triangle)), brute, "{o} {d}");
         }
         assert_eq!(bvh.unoccluded(o, d, f32::INFINITY), brute.is_none());
+        // Traced beside another ray (the per-thread stacks of deep trees), the same hit.
+        let other = (o + Vec3::Y, -d);
+        let [paired, _] = bvh.closest_pair([(o, d), other], f32::INFINITY);
+        let bits =
+            |h: Option<WideHit>| h.map(|h| (h.triangle, [h.t, h.uv.x, h.uv.y].map(f32::to_bits)));
+        assert_eq!(
+            bits(paired),
+            bits(bvh.closest(o, d, f32::INFINITY)),
+            "{o} {d}"
+        );
         hits += brute.is_some() as usize;
     }
     assert!(hits > 100, "{hits}");
