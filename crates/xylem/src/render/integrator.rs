@@ -20,7 +20,7 @@ use super::sampler::{pixel_sample, PathNumbers};
 use super::shading::{offset_length, offset_origin, ShadingPoint};
 use super::shadow::{shadow_t_max, Segments, ShadowTest};
 use super::Scene;
-use crate::bsdf::Bsdf;
+use crate::bsdf::{Bsdf, BsdfSample};
 use crate::material::{MaterialHit, SurfaceAtWo, SurfaceBsdf};
 use crate::math::{is_zero, power_heuristic, Frame};
 use glam::{Mat3, UVec2, Vec2, Vec3};
@@ -542,6 +542,30 @@ pub(crate) fn survival(beta: Vec3, eta_scale: f32) -> f32 {
     (beta.max_element() * eta_scale).min(1.0)
 }
 
+/// A path's throughput `beta` and η'² product `eta_scale` after the BSDF sample `bs` (of
+/// positive density) at bounce `depth`: β takes f · |cos θi| / pdf and, from bounce 3, Russian
+/// roulette with the number `u_roulette` ([`survival`]). False where the path ends (roulette,
+/// or a throughput that is zero or not finite).
+#[inline(always)]
+pub(crate) fn carry_on(
+    beta: &mut Vec3,
+    eta_scale: &mut f32,
+    bs: &BsdfSample,
+    depth: u32,
+    u_roulette: f32,
+) -> bool {
+    *beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
+    *eta_scale *= bs.eta * bs.eta;
+    if depth >= 3 {
+        let q = survival(*beta, *eta_scale);
+        if u_roulette >= q {
+            return false;
+        }
+        *beta /= q;
+    }
+    beta.is_finite() && *beta != Vec3::ZERO
+}
+
 /// The light-independent rest of a path's first bounce: the state [`radiance_frames`] reaches
 /// after sampling the BSDF at the first vertex and tracing the ray it gives (throughput, MIS
 /// state, the ray, what it hit, and the lighting stream after the draws), `None` in a
@@ -587,19 +611,10 @@ impl PathState {
         if !(bs.pdf > 0.0) {
             return false;
         }
-        self.beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
-        self.eta_scale *= bs.eta * bs.eta;
         self.specular = bs.is_delta;
         self.prev_pdf = bs.pdf;
         self.prev_glossy = glossy_wood(sp);
-        if depth >= 3 {
-            let q = survival(self.beta, self.eta_scale);
-            if u_roulette >= q {
-                return false;
-            }
-            self.beta /= q;
-        }
-        if !self.beta.is_finite() || self.beta == Vec3::ZERO {
+        if !carry_on(&mut self.beta, &mut self.eta_scale, &bs, depth, u_roulette) {
             return false;
         }
         let d = sp.frame.to_world(bs.wi);

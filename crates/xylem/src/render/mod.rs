@@ -697,6 +697,16 @@ enum Span<'a> {
     After { first: u32, extra: &'a [u32] },
 }
 
+impl Span<'_> {
+    /// The samples of the tile's pixel `i`.
+    fn of(&self, i: usize) -> std::ops::Range<u32> {
+        match *self {
+            Span::All(n) => 0..n,
+            Span::After { first, extra } => first..first + extra[i],
+        }
+    }
+}
+
 /// Where a tile's primary samples come from: computed, computed and kept, or read from an
 /// earlier pass (the tile's samples, pixel-major).
 #[derive(Clone, Copy)]
@@ -790,14 +800,7 @@ fn tile_frames<const ONE: bool>(
             vec![0; n],
         ),
     };
-    // Each frame's radiance of the sample at hand, by channel ([`integrator::Columns`]).
-    let mut radiance = integrator::Columns::default();
-    let mut scratch = FramesScratch::default();
     let mut rays = RayCount::default();
-    let fp_scale = integrator::footprint_scale(settings.spp);
-    let camera = scene.camera.rays();
-    // The primary sample of the pixel sample at hand, written in place ([`primary_sample_into`]).
-    let mut computed = PrimarySample::empty();
     let spp = settings.spp as usize;
     let mut kept = Vec::new();
     if let Primary::Keep = primary {
@@ -811,11 +814,7 @@ fn tile_frames<const ONE: bool>(
     if ONE && matches!(primary, Primary::Compute) && wave::enabled(scene, lights) {
         let mut samples = Vec::new();
         for (i, pixel) in pixels.enumerate() {
-            let range = match span {
-                Span::All(n) => 0..n,
-                Span::After { first, extra } => first..first + extra[i],
-            };
-            samples.extend(range.map(|s| (i as u32, pixel, s)));
+            samples.extend(span.of(i).map(|s| (i as u32, pixel, s)));
         }
         wave::tile_waves(
             scene,
@@ -827,21 +826,52 @@ fn tile_frames<const ONE: bool>(
             (&mut sums, &mut aov_sums, &mut work),
             &mut rays,
         );
-        return TileSums {
-            width: tw,
-            height: th,
-            sums,
-            aov_sums,
-            rays: rays.rays,
-            work,
-            kept,
-        };
+    } else {
+        tile_paths::<ONE>(
+            scene,
+            (lights, shadow),
+            settings,
+            (pixels, primary, span),
+            &mut kept,
+            (&mut sums, &mut aov_sums, &mut work),
+            &mut rays,
+        );
     }
+    TileSums {
+        width: tw,
+        height: th,
+        sums,
+        aov_sums,
+        rays: rays.rays,
+        work,
+        kept,
+    }
+}
+
+/// The per-path loop of [`tile_frames`]: each pixel's samples one path at a time, for every
+/// frame; sums into `sums`, `aov_sums` and `work`, kept samples into `kept`.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn tile_paths<const ONE: bool>(
+    scene: &Scene,
+    (lights, shadow): (&LightFrames, &ShadowTest),
+    settings: &RenderSettings,
+    (pixels, primary, span): (impl Iterator<Item = UVec2>, Primary, Span),
+    kept: &mut Vec<KeptSample>,
+    (sums, aov_sums, work): (&mut FrameSums, &mut [PixelSum], &mut [u64]),
+    rays: &mut RayCount,
+) {
+    let max_depth = settings.integrator.max_depth();
+    // Each frame's radiance of the sample at hand, by channel ([`integrator::Columns`]).
+    let mut radiance = integrator::Columns::default();
+    let mut scratch = FramesScratch::default();
+    let fp_scale = integrator::footprint_scale(settings.spp);
+    let camera = scene.camera.rays();
+    // The primary sample of the pixel sample at hand, written in place ([`primary_sample_into`]).
+    let mut computed = PrimarySample::empty();
+    let spp = settings.spp as usize;
     for (i, pixel) in pixels.enumerate() {
-        let samples = match span {
-            Span::All(n) => 0..n,
-            Span::After { first, extra } => first..first + extra[i],
-        };
+        let samples = span.of(i);
         let before = rays.work();
         for s in samples {
             let (ps, reused) = match primary {
@@ -879,7 +909,7 @@ fn tile_frames<const ONE: bool>(
                 max_depth,
                 &mut scratch,
                 &mut radiance,
-                &mut rays,
+                rays,
                 first,
             );
             if let Primary::Keep = primary {
@@ -889,14 +919,5 @@ fn tile_frames<const ONE: bool>(
             aov_sums[i].add(Vec3::ZERO, &ps.aov);
         }
         work[i] += rays.work() - before;
-    }
-    TileSums {
-        width: tw,
-        height: th,
-        sums,
-        aov_sums,
-        rays: rays.rays,
-        work,
-        kept,
     }
 }

@@ -408,18 +408,10 @@ fn scatter(lane: &mut Lane, [u0, u1, uc, u_roulette]: [f32; 4], eps: f32) -> boo
     if !(bs.pdf > 0.0) {
         return false;
     }
-    lane.beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
-    lane.eta_scale *= bs.eta * bs.eta;
     lane.specular = bs.is_delta;
     lane.prev_pdf = bs.pdf;
-    if lane.depth >= 3 {
-        let q = integrator::survival(lane.beta, lane.eta_scale);
-        if u_roulette >= q {
-            return false;
-        }
-        lane.beta /= q;
-    }
-    if !lane.beta.is_finite() || lane.beta == Vec3::ZERO {
+    let depth = lane.depth;
+    if !integrator::carry_on(&mut lane.beta, &mut lane.eta_scale, &bs, depth, u_roulette) {
         return false;
     }
     let d = v.frame.to_world(bs.wi);

@@ -414,8 +414,12 @@ impl WideBvh {
         [a.hit(), b.hit()]
     }
 
-    /// One step of `closest_in`'s traversal for `w`: the leaf or node `w.cur` tested, and the
-    /// next one to visit chosen as `closest_in` chooses it (false when there is none left).
+    /// One step of a closest-hit traversal (`closest_in`, `closest_pair_in`) for `w`: the leaf
+    /// or node `w.cur` tested and the next one to visit chosen (false when none is left). At a
+    /// node with two or more hit children all are prefetched (the ones pushed now are visited
+    /// later, so their cache misses overlap this subtree's work), pushed, that part of the stack
+    /// sorted by distance, farthest at the bottom, and the nearest taken; after a leaf, or a
+    /// node with no hit child, the nearest pending child that can still hold a closer hit.
     #[inline(always)]
     fn step<K: Kernel>(&self, w: &mut Walk, stack: &mut [Entry]) -> bool {
         let cur = w.cur;
@@ -509,9 +513,9 @@ impl WideBvh {
         })
     }
 
-    /// Closest-hit traversal, near child first: the hit children of a node are pushed farthest
-    /// first with their entry distance, and a popped entry farther than the closest hit so far is
-    /// skipped.
+    /// Closest-hit traversal, near child first ([`WideBvh::step`] until no node is left): the
+    /// hit children of a node are pushed farthest first with their entry distance, and a popped
+    /// entry farther than the closest hit so far is skipped.
     #[inline(always)]
     fn closest_in<K: Kernel>(
         &self,
@@ -520,84 +524,9 @@ impl WideBvh {
         t_max: f32,
         stack: &mut [Entry],
     ) -> Option<WideHit> {
-        let r = RayData::new(o, d);
-        let mut best: Option<(u32, f32, f32)> = None;
-        let mut t_hit = t_max;
-        let mut sp = 0usize;
-        let mut cur = self.root;
-        loop {
-            // Descend from `cur` until a leaf is tested or the node has no hit child.
-            loop {
-                if cur & LEAF != 0 {
-                    let p = &self.packets[(cur & !LEAF) as usize];
-                    if let Some((lane, t, u, v)) = K::packet(p, &r, 0.0, t_hit) {
-                        t_hit = t;
-                        best = Some((p.id[lane], u, v));
-                    }
-                    break;
-                }
-                let node = &self.nodes[cur as usize];
-                prefetch(&node.child);
-                let (mut mask, t_near) = K::node(node, &r, 0.0, t_hit);
-                if mask == 0 {
-                    break;
-                }
-                let first = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                if mask == 0 {
-                    cur = node.child[first];
-                    continue;
-                }
-                // Two or more children: prefetch them all (the ones pushed now are visited
-                // later, so their cache misses overlap this subtree's work), push all, sort that
-                // part of the stack by distance, farthest at the bottom, and continue with the
-                // nearest.
-                self.prefetch(node.child[first]);
-                let mut rest = mask;
-                while rest != 0 {
-                    self.prefetch(node.child[rest.trailing_zeros() as usize]);
-                    rest &= rest - 1;
-                }
-                let base = sp;
-                stack[sp] = Entry {
-                    child: node.child[first],
-                    t: t_near[first],
-                };
-                sp += 1;
-                while mask != 0 {
-                    let i = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    let e = Entry {
-                        child: node.child[i],
-                        t: t_near[i],
-                    };
-                    let mut j = sp;
-                    while j > base && stack[j - 1].t < e.t {
-                        stack[j] = stack[j - 1];
-                        j -= 1;
-                    }
-                    stack[j] = e;
-                    sp += 1;
-                }
-                sp -= 1;
-                cur = stack[sp].child;
-            }
-            // Pop the nearest pending child that can still hold a closer hit.
-            loop {
-                if sp == 0 {
-                    return best.map(|(triangle, u, v)| WideHit {
-                        t: t_hit,
-                        triangle,
-                        uv: Vec2::new(u, v),
-                    });
-                }
-                sp -= 1;
-                if stack[sp].t <= t_hit {
-                    cur = stack[sp].child;
-                    break;
-                }
-            }
-        }
+        let mut walk = Walk::new(self.root, o, d, t_max);
+        while self.step::<K>(&mut walk, stack) {}
+        walk.hit()
     }
 
     /// Prefetches the node or leaf packet a child reference points to.
