@@ -45,10 +45,20 @@ proptest! {
         // Random directions plus axis-aligned ones carrying signed zeros (an obvhs pitfall).
         let axis_rays = rays.iter().take(8).map(|(o, _)| (*o, [-0.0, -0.0, -1.0]));
         let all: Vec<([f32; 3], [f32; 3])> = rays.iter().copied().chain(axis_rays).collect();
+        let mut previous = Ray { o: Vec3::ZERO, d: Vec3::Z };
         for (o, d) in all {
             let d = Vec3::from_array(d);
             prop_assume!(d.length() > 1e-3);
             let ray = Ray { o: Vec3::from_array(o), d: d / d.length() };
+            // Traced beside the previous ray (through the instances' top level too), the same
+            // hits bit for bit.
+            let key = |h: Option<xylem::render::geometry::Hit>| {
+                h.map(|h| (h.instance, h.triangle, [h.t, h.uv.x, h.uv.y].map(f32::to_bits)))
+            };
+            let paired = accel.intersect_pair([&ray, &previous], f32::INFINITY).map(key);
+            let alone = [&ray, &previous].map(|r| key(accel.intersect(r, f32::INFINITY)));
+            prop_assert_eq!(paired, alone);
+            previous = ray;
             let bvh = accel.intersect(&ray, f32::INFINITY).map(|h| h.t);
             let brute = brute_force_closest(&accel, &ray, f32::INFINITY);
             match (bvh, brute) {
