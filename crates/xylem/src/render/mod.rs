@@ -199,8 +199,9 @@ pub struct RenderOutput {
     pub elapsed: Duration,
     /// Rays traced (camera, shadow and bounce rays).
     pub rays: u64,
-    /// Whether the tiles ran as waves of paths in lanes (every material Lambertian, and
-    /// `XYLEM_WAVES` not `off`) rather than one path at a time: the same image either way.
+    /// Whether the tiles ran as waves of paths (every material Lambertian, a mirror or glass,
+    /// and `XYLEM_WAVES` not `off`; `render::wave`) rather than one path at a time: the same
+    /// image either way.
     pub waves: bool,
 }
 

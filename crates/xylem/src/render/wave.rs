@@ -1,12 +1,15 @@
-//! A tile's pixel samples as waves of paths in lanes, for scenes whose every material is
-//! Lambertian, a mirror or glass (the Cornell boxes; [`enabled`]): a path's state is a few
-//! numbers and one of those small BSDFs rather than a shading point holding a whole (wood)
-//! BSDF, and each stage of a bounce — emission met,
-//! light samples, shadow rays, BSDF samples, closest hits, shading points — is one loop over the
-//! wave's live paths. Every path makes the operations of [`integrator::radiance_frames`] on the
-//! same values in the same order (the same functions: light sampling, the BSDF, MIS, roulette,
-//! ray offsets), and the sums are added in sample order, so a wave renders the same bits as the
-//! per-path loop (crates/xylem-cli/tests/simd_levels.rs compares them at every SIMD level).
+//! A tile's pixel samples as waves of paths, for scenes whose every material is Lambertian, a
+//! mirror or glass (the Cornell boxes; [`enabled`]). A path's state is a small record — a few
+//! numbers and one of those small BSDFs — rather than a shading point holding a whole (wood)
+//! BSDF, and each stage of a bounce (emission met, light samples, shadow rays, BSDF samples,
+//! closest hits two rays at a time, shading points) is one loop over the wave's live paths;
+//! paths that end leave the list. The stages run path by path inside the loops (a form with
+//! the state in columns for SIMD lanes measured slower: notes/render.md, "Waves of paths").
+//!
+//! Every path makes the operations of [`integrator::radiance_frames`] on the same values in
+//! the same order (the same functions: light sampling, the BSDF, MIS, roulette, ray offsets),
+//! and the sums are added in sample order, so a wave renders the same bits as the per-path loop
+//! (crates/xylem-cli/tests/simd_levels.rs compares them at every SIMD level).
 
 use super::film::{Aov, FrameSums, PixelSum};
 use super::frames::LightFrames;
@@ -27,9 +30,8 @@ const WAVE: usize = 256;
 
 /// Whether a one-frame render of `scene` with `lights` runs as waves: every material
 /// Lambertian, a mirror or glass (each path's vertex then needs only its frame and a small
-/// BSDF, [`LaneBsdf`]), and the environment
-/// variable `XYLEM_WAVES` not `off` (which keeps the per-path loop, for tests and comparisons:
-/// the image is the same bits either way).
+/// BSDF, [`LaneBsdf`]), and the environment variable `XYLEM_WAVES` not `off` (which keeps the
+/// per-path loop, for tests and comparisons: the image is the same bits either way).
 pub(super) fn enabled(scene: &Scene, lights: &LightFrames) -> bool {
     lights.len() == 1
         && scene.materials.iter().all(|m| LaneBsdf::of(m).is_some())
