@@ -15,9 +15,9 @@ use super::camera::CameraRays;
 use super::film::Aov;
 use super::frames::LightFrames;
 use super::geometry::{Hit, Ray};
-use super::light::{Light, LightSample, LightSamples, LightU};
+use super::light::{Light, LightHit, LightSample, LightSamples, LightU};
 use super::sampler::{pixel_sample, PathNumbers};
-use super::shading::{offset_length, offset_origin, ShadingPoint};
+use super::shading::{offset_length, offset_origin, offset_ray_origin, ShadingPoint};
 use super::shadow::{shadow_t_max, Segments, ShadowTest};
 use super::Scene;
 use crate::bsdf::{Bsdf, BsdfSample};
@@ -249,10 +249,7 @@ pub(crate) fn primary_sample_into(
     footprint_scale: f32,
     out: &mut PrimarySample,
 ) -> u32 {
-    let index = pixel.y as u64 * scene.camera.width as u64 + pixel.x as u64;
-    let u = pixel_sample(seed, index, sample);
-    let film = pixel.as_vec2() + Vec2::splat(0.5) + scene.filter.sample(Vec2::new(u[0], u[1]));
-    let ray = camera.ray(film, Vec2::new(u[2], u[3]));
+    let ray = camera_ray(scene, camera, pixel, sample, seed);
     out.ray = ray;
     out.aov = Aov::default();
     let (per_depth, constant) = camera.depth_footprint();
@@ -277,6 +274,22 @@ pub(crate) fn primary_sample_into(
     }
 }
 
+/// The camera ray of sample `sample` of pixel `pixel`: its film point drawn from the filter and
+/// its lens point, both from the pixel's Sobol point ([`pixel_sample`]).
+#[inline(always)]
+pub(crate) fn camera_ray(
+    scene: &Scene,
+    camera: &CameraRays,
+    pixel: UVec2,
+    sample: u32,
+    seed: u64,
+) -> Ray {
+    let index = pixel.y as u64 * scene.camera.width as u64 + pixel.x as u64;
+    let u = pixel_sample(seed, index, sample);
+    let film = pixel.as_vec2() + Vec2::splat(0.5) + scene.filter.sample(Vec2::new(u[0], u[1]));
+    camera.ray(film, Vec2::new(u[2], u[3]))
+}
+
 /// The path numbers of a sample ([`PathNumbers`]).
 pub(crate) fn path_numbers(scene: &Scene, pixel: UVec2, sample: u32, seed: u64) -> PathNumbers {
     let index = pixel.y as u64 * scene.camera.width as u64 + pixel.x as u64;
@@ -297,23 +310,44 @@ pub(crate) fn light_term(
     let Some(ls) = ls else {
         return Vec3::ZERO;
     };
-    if !(ls.pdf > 0.0) || ls.li == Vec3::ZERO {
+    let eval = |wi: Vec3, with_pdf| bsdf.eval_pdf(wi, with_pdf);
+    let Some((term, ray, t_max)) = unshadowed_term(&ls, sp.frame, (sp.p, sp.ng, sp.eps), eval)
+    else {
         return Vec3::ZERO;
-    }
-    let wi = sp.frame.to_local(ls.wi);
-    let (f, bsdf_pdf) = bsdf.eval_pdf(wi, !ls.is_delta);
-    if f == Vec3::ZERO {
-        return Vec3::ZERO;
-    }
-    let ray = Ray {
-        o: offset_origin(sp, ls.wi),
-        d: ls.wi,
     };
     rays.rays += 1;
-    if !shadow.unoccluded(&ray, shadow_t_max(ls.dist)) {
+    if !shadow.unoccluded(&ray, t_max) {
         return Vec3::ZERO;
     }
-    weighted_term(f, ls.li, wi.z, ls.pdf, bsdf_pdf, ls.is_delta)
+    term
+}
+
+/// [`light_term`] before its shadow test: the MIS-weighted term of light sample `ls` at the
+/// point `p` with geometric normal `ng` and shading `frame` (rays leave it offset by `eps`),
+/// `eval` giving the BSDF's value and density at a local direction, and the shadow segment
+/// (ray and its `t_max`) the term needs; `None` where there is no term (the sample failed or
+/// the BSDF vanishes), so no shadow ray either.
+#[inline(always)]
+pub(crate) fn unshadowed_term(
+    ls: &LightSample,
+    frame: Frame,
+    (p, ng, eps): (Vec3, Vec3, f32),
+    eval: impl FnOnce(Vec3, bool) -> (Vec3, f32),
+) -> Option<(Vec3, Ray, f32)> {
+    if !(ls.pdf > 0.0) || ls.li == Vec3::ZERO {
+        return None;
+    }
+    let wi = frame.to_local(ls.wi);
+    let (f, bsdf_pdf) = eval(wi, !ls.is_delta);
+    if f == Vec3::ZERO {
+        return None;
+    }
+    let ray = Ray {
+        o: offset_ray_origin(p, ng, eps, ls.wi),
+        d: ls.wi,
+    };
+    let term = weighted_term(f, ls.li, wi.z, ls.pdf, bsdf_pdf, ls.is_delta);
+    Some((term, ray, shadow_t_max(ls.dist)))
 }
 
 /// How many next-event samples light `light` takes at vertex `depth`, `glossy` saying whether
@@ -390,14 +424,7 @@ fn split_sample(
 /// f · Li · |cos θi| · w / pdf of an unoccluded light sample, w the power heuristic (Veach 1997
 /// eq. 9.13) of the light's density against the BSDF's (1 for delta lights).
 #[inline(always)]
-pub(crate) fn weighted_term(
-    f: Vec3,
-    li: Vec3,
-    wi_z: f32,
-    pdf: f32,
-    bsdf_pdf: f32,
-    is_delta: bool,
-) -> Vec3 {
+fn weighted_term(f: Vec3, li: Vec3, wi_z: f32, pdf: f32, bsdf_pdf: f32, is_delta: bool) -> Vec3 {
     f * li * mis_scale(wi_z, pdf, bsdf_pdf, is_delta)
 }
 
@@ -636,23 +663,20 @@ impl PathState {
         alive: &mut [bool],
         out: &mut Columns,
     ) {
-        let hit_surface = self.t_hit.is_finite();
         lights.nearest_per_frame(&self.ray, self.t_hit, |k, (i, hit)| {
-            if alive[k] && (hit.distance < self.t_hit || !hit_surface) {
-                // Against the light's n next-event samples, as `split_light_term` weighs them.
-                // The ray left the vertex before this one (depth − 1; the camera ray,
-                // depth 0, is `specular`), glossy wood or not (`prev_glossy`).
-                let splits = splits_at(
-                    &lights.first()[i],
-                    depth.saturating_sub(1),
-                    self.prev_glossy,
-                );
-                let w = if self.specular {
-                    1.0
-                } else {
-                    power_heuristic(self.prev_pdf, splits as f32 * hit.pdf)
-                };
-                let add = self.beta * hit.radiance * w;
+            if !alive[k] {
+                return;
+            }
+            // Against the light's n next-event samples, as `split_light_term` weighs them. The
+            // ray left the vertex before this one (depth − 1; the camera ray, depth 0, is
+            // `specular`), glossy wood or not (`prev_glossy`).
+            let splits = splits_at(
+                &lights.first()[i],
+                depth.saturating_sub(1),
+                self.prev_glossy,
+            );
+            let mis = (self.specular, self.prev_pdf, splits);
+            if let Some(add) = emission_met(&hit, self.t_hit, self.beta, mis) {
                 for (c, a) in out.iter_mut().zip(add.to_array()) {
                     c[k] += a;
                 }
@@ -660,6 +684,30 @@ impl PathState {
             }
         });
     }
+}
+
+/// The emission a path of throughput `beta` gains from light hit `hit` on a ray whose closest
+/// surface lies at `t_hit` (∞ for none): `None` when the light lies behind that surface, else
+/// β · Le weighted by the power heuristic against the light's `splits` next-event samples
+/// (Veach 1997 eq. 9.13; 1 after a `specular` BSDF sample), the BSDF having sampled the ray
+/// with density `prev_pdf`.
+#[inline(always)]
+pub(crate) fn emission_met(
+    hit: &LightHit,
+    t_hit: f32,
+    beta: Vec3,
+    (specular, prev_pdf, splits): (bool, f32, u32),
+) -> Option<Vec3> {
+    let in_front = hit.distance < t_hit || !t_hit.is_finite();
+    if !in_front {
+        return None;
+    }
+    let w = if specular {
+        1.0
+    } else {
+        power_heuristic(prev_pdf, splits as f32 * hit.pdf)
+    };
+    Some(beta * hit.radiance * w)
 }
 
 /// out += β · nee over the first `n` frames where `alive`, a channel at a time in lanes.

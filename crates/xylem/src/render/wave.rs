@@ -14,14 +14,14 @@
 use super::film::{Aov, FrameSums, PixelSum};
 use super::frames::LightFrames;
 use super::geometry::{Hit, Ray};
-use super::integrator::{self, weighted_term, Columns, RayCount};
-use super::sampler::{pixel_sample, PathNumbers};
+use super::integrator::{self, Columns, RayCount};
+use super::sampler::PathNumbers;
 use super::shading::{offset_length, offset_ray_origin};
-use super::shadow::{shadow_t_max, ShadowTest};
+use super::shadow::ShadowTest;
 use super::Scene;
 use crate::bsdf::{Bsdf, BsdfSample, Glass, Lambertian, Mirror};
 use crate::material::Material;
-use crate::math::{power_heuristic, Frame};
+use crate::math::Frame;
 use glam::{UVec2, Vec2, Vec3};
 
 /// Paths advanced together: enough that each stage's loop runs long, few enough that their
@@ -160,19 +160,14 @@ pub(super) fn tile_waves(
         lanes.clear();
         aov.clear();
         for &(i, pixel, s) in chunk {
-            let index = pixel.y as u64 * scene.camera.width as u64 + pixel.x as u64;
-            let u = pixel_sample(seed, index, s);
-            let film =
-                pixel.as_vec2() + Vec2::splat(0.5) + scene.filter.sample(Vec2::new(u[0], u[1]));
-            let ray = camera.ray(film, Vec2::new(u[2], u[3]));
             lanes.push(Lane {
                 pixel: i,
-                numbers: PathNumbers::new(seed, index, s),
+                numbers: integrator::path_numbers(scene, pixel, s, seed),
                 beta: Vec3::ONE,
                 eta_scale: 1.0,
                 prev_pdf: 0.0,
                 specular: true,
-                ray,
+                ray: integrator::camera_ray(scene, &camera, pixel, s, seed),
                 t_hit: f32::INFINITY,
                 depth: 0,
                 vertex: None,
@@ -232,29 +227,15 @@ pub(super) fn tile_waves(
                 };
                 for (j, light) in lights_all.iter().enumerate() {
                     let u = Vec2::from(lane.numbers.light_split(lane.depth, j, 0, 1));
+                    let eval = |wi, with_pdf| lambertian.eval_pdf(v.wo, wi, with_pdf);
                     terms.push(light.sample(v.p, u).and_then(|ls| {
-                        if !(ls.pdf > 0.0) || ls.li == Vec3::ZERO {
-                            return None;
-                        }
-                        let wi = v.frame.to_local(ls.wi);
-                        let (f, bsdf_pdf) = lambertian.eval_pdf(v.wo, wi, !ls.is_delta);
-                        if f == Vec3::ZERO {
-                            return None;
-                        }
-                        let ray = Ray {
-                            o: offset_ray_origin(v.p, v.ng, eps, ls.wi),
-                            d: ls.wi,
-                        };
-                        let term = weighted_term(f, ls.li, wi.z, ls.pdf, bsdf_pdf, ls.is_delta);
-                        Some((term, ray, shadow_t_max(ls.dist)))
+                        integrator::unshadowed_term(&ls, v.frame, (v.p, v.ng, eps), eval)
                     }));
                 }
             }
-            for t in terms.iter_mut() {
-                if let Some((_, ray, t_max)) = t {
-                    if !shadow.unoccluded(ray, *t_max) {
-                        *t = Some((Vec3::ZERO, *ray, *t_max));
-                    }
+            for (term, ray, t_max) in terms.iter_mut().flatten() {
+                if !shadow.unoccluded(ray, *t_max) {
+                    *term = Vec3::ZERO;
                 }
             }
             let n_lights = lights_all.len();
@@ -377,23 +358,18 @@ fn vertex(scene: &Scene, ray: &Ray, hit: &Hit, memo: &mut FrameMemo) -> Vertex {
 }
 
 /// [`integrator::PathState::add_emission`] for one frame: the light the ray meets before its
-/// hit, weighted; true where the path met one (and ends).
+/// hit, weighted ([`integrator::emission_met`]; one next-event sample a light at these
+/// vertices); true where the path met one (and ends).
 #[inline(always)]
 fn add_emission(lights: &[super::light::Light], lane: &mut Lane) -> bool {
-    let hit_surface = lane.t_hit.is_finite();
     let Some((_, hit)) = super::light::nearest_light(lights, &lane.ray, lane.t_hit) else {
         return false;
     };
-    let in_front = hit.distance < lane.t_hit || !hit_surface;
-    if !in_front {
+    let mis = (lane.specular, lane.prev_pdf, 1);
+    let Some(add) = integrator::emission_met(&hit, lane.t_hit, lane.beta, mis) else {
         return false;
-    }
-    let w = if lane.specular {
-        1.0
-    } else {
-        power_heuristic(lane.prev_pdf, 1.0 * hit.pdf)
     };
-    lane.radiance += lane.beta * hit.radiance * w;
+    lane.radiance += add;
     true
 }
 
