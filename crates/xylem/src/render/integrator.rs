@@ -284,16 +284,31 @@ pub(crate) fn camera_ray(
     sample: u32,
     seed: u64,
 ) -> Ray {
-    let index = pixel.y as u64 * scene.camera.width as u64 + pixel.x as u64;
-    let u = pixel_sample(seed, index, sample);
+    film_ray(
+        scene,
+        camera,
+        pixel,
+        pixel_sample(seed, pixel_index(scene, pixel), sample),
+    )
+}
+
+/// [`camera_ray`] of the pixel's Sobol point `u` (film, then lens).
+#[inline(always)]
+pub(crate) fn film_ray(scene: &Scene, camera: &CameraRays, pixel: UVec2, u: [f32; 4]) -> Ray {
     let film = pixel.as_vec2() + Vec2::splat(0.5) + scene.filter.sample(Vec2::new(u[0], u[1]));
     camera.ray(film, Vec2::new(u[2], u[3]))
 }
 
 /// The path numbers of a sample ([`PathNumbers`]).
 pub(crate) fn path_numbers(scene: &Scene, pixel: UVec2, sample: u32, seed: u64) -> PathNumbers {
-    let index = pixel.y as u64 * scene.camera.width as u64 + pixel.x as u64;
-    PathNumbers::new(seed, index, sample)
+    PathNumbers::new(seed, pixel_index(scene, pixel), sample)
+}
+
+/// The index of `pixel` that keys its numbers ([`pixel_sample`], [`PathNumbers`]): row-major
+/// over the whole image.
+#[inline(always)]
+pub(crate) fn pixel_index(scene: &Scene, pixel: UVec2) -> u64 {
+    pixel.y as u64 * scene.camera.width as u64 + pixel.x as u64
 }
 
 /// The term of one light sample `ls` in next-event estimation: f · Li · |cos θi| · w / pdf when

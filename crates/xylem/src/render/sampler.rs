@@ -11,9 +11,56 @@
 /// other. The sequence holds 2^16 points: each further 2^16 samples take a fresh scramble.
 #[inline(always)]
 pub(crate) fn pixel_sample(seed: u64, pixel_index: u64, sample: u32) -> [f32; 4] {
-    let block = u64::from(sample >> 16);
-    let scramble = splitmix64(seed ^ splitmix64(pixel_index ^ (block << 48) ^ (1 << 63)));
-    sobol_4d(sample & 0xFFFF, scramble as u32)
+    PixelKeys::new(seed, pixel_index, sample).film(sample)
+}
+
+/// What the samples of one pixel (and block of 2^16 samples) share: the film points' scramble
+/// ([`pixel_sample`]) and the path numbers' key ([`PathNumbers`]), two SplitMix64 chains each,
+/// worked out once for all of a pixel's samples where they are taken one after the other.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PixelKeys {
+    pixel_index: u64,
+    block: u32,
+    film: u32,
+    path: u64,
+}
+
+impl PixelKeys {
+    /// The keys of sample `sample`'s block of pixel `pixel_index` under `seed`.
+    #[inline(always)]
+    pub(crate) fn new(seed: u64, pixel_index: u64, sample: u32) -> Self {
+        let block = sample >> 16;
+        let salted = |salt: u64| {
+            splitmix64(seed ^ splitmix64(pixel_index ^ (u64::from(block) << 48) ^ salt))
+        };
+        PixelKeys {
+            pixel_index,
+            block,
+            film: salted(1 << 63) as u32,
+            path: salted(1 << 62),
+        }
+    }
+
+    /// Whether these are the keys of sample `sample` of pixel `pixel_index`.
+    #[inline(always)]
+    pub(crate) fn cover(&self, pixel_index: u64, sample: u32) -> bool {
+        self.pixel_index == pixel_index && self.block == sample >> 16
+    }
+
+    /// The film and lens numbers of sample `sample` ([`pixel_sample`]).
+    #[inline(always)]
+    pub(crate) fn film(&self, sample: u32) -> [f32; 4] {
+        sobol_4d(sample & 0xFFFF, self.film)
+    }
+
+    /// The path numbers of sample `sample` ([`PathNumbers::new`]).
+    #[inline(always)]
+    pub(crate) fn path(&self, sample: u32) -> PathNumbers {
+        PathNumbers {
+            key: self.path,
+            index: sample & 0xFFFF,
+        }
+    }
 }
 
 /// Point `index` (below 2^16) of the 4D Owen-scrambled Sobol sequence under `seed`: the bits of
@@ -118,11 +165,7 @@ pub(crate) struct PathNumbers {
 
 impl PathNumbers {
     pub(crate) fn new(seed: u64, pixel_index: u64, sample: u32) -> Self {
-        let block = u64::from(sample >> 16);
-        Self {
-            key: splitmix64(seed ^ splitmix64(pixel_index ^ (block << 48) ^ (1 << 62))),
-            index: sample & 0xFFFF,
-        }
+        PixelKeys::new(seed, pixel_index, sample).path(sample)
     }
 
     /// The point of role `role` (a small integer, unique per role) at vertex `depth`.
@@ -136,8 +179,7 @@ impl PathNumbers {
     /// 2^16; each further block of 2^16 is scrambled on its own, as the samples' blocks are.
     #[inline(always)]
     fn point_at(&self, depth: u32, role: u64, index: u32) -> [f32; 4] {
-        let role = (u64::from(depth) << 33) | role;
-        let mut scramble = splitmix64(self.key ^ splitmix64(role));
+        let mut scramble = splitmix64(self.key ^ role_hash(depth, role));
         if depth < STRATIFIED_DEPTH {
             let block = index >> 16;
             if block != 0 {
@@ -186,8 +228,40 @@ impl PathNumbers {
 /// pixel at its fixed seeds (no bias: 64 seeds each put it within 1.7σ; notes/render.md).
 const STRATIFIED_DEPTH: u32 = 1;
 
+/// SplitMix64 of role `role` at vertex `depth` (part of every point's scramble), from a table
+/// for the depths and roles most points have: one load instead of a chain of two
+/// multiplications on each point's critical path.
+#[inline(always)]
+fn role_hash(depth: u32, role: u64) -> u64 {
+    let key = |depth: u32, role: u64| splitmix64((u64::from(depth) << 33) | role);
+    const TABLE: [[u64; ROLES]; DEPTHS] = {
+        let mut t = [[0; ROLES]; DEPTHS];
+        let mut d = 0;
+        while d < DEPTHS {
+            let mut r = 0;
+            while r < ROLES {
+                t[d][r] = splitmix64(((d as u64) << 33) | r as u64);
+                r += 1;
+            }
+            d += 1;
+        }
+        t
+    };
+    match TABLE
+        .get(depth as usize)
+        .and_then(|row| row.get(role as usize))
+    {
+        Some(&hash) => hash,
+        None => key(depth, role),
+    }
+}
+
+/// The vertex depths and roles [`role_hash`] keeps in its table (the bounce and four lights).
+const DEPTHS: usize = 16;
+const ROLES: usize = 8;
+
 /// SplitMix64 finaliser (Steele, Lea, Flood 2014): a bijective 64-bit mix.
-pub(super) fn splitmix64(x: u64) -> u64 {
+pub(super) const fn splitmix64(x: u64) -> u64 {
     let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
@@ -387,6 +461,46 @@ mod tests {
         assert!(
             controls <= 1,
             "independent lights filled the grid in {controls} of 50 pixels"
+        );
+    }
+
+    /// The keys a wave keeps for a pixel's samples give each sample the numbers it gets alone,
+    /// across the 2^16-sample block boundary, and the role table holds SplitMix64's values (in
+    /// it and past it). Control: keys kept past the block boundary give other numbers.
+    #[test]
+    fn kept_pixel_keys_give_each_sample_its_own_numbers() {
+        for depth in 0..2 * DEPTHS as u32 {
+            for role in 0..2 * ROLES as u64 {
+                let expected = splitmix64((u64::from(depth) << 33) | role);
+                assert_eq!(
+                    role_hash(depth, role),
+                    expected,
+                    "depth {depth}, role {role}"
+                );
+            }
+        }
+        for pixel in [0u64, 5, 1 << 20] {
+            let mut keys = PixelKeys::new(7, pixel, 0);
+            for s in (0..40u32).chain(65530..65545) {
+                if !keys.cover(pixel, s) {
+                    keys = PixelKeys::new(7, pixel, s);
+                }
+                assert_eq!(keys.film(s), pixel_sample(7, pixel, s));
+                let (kept, alone) = (keys.path(s), PathNumbers::new(7, pixel, s));
+                assert_eq!(kept.bounce(0), alone.bounce(0), "pixel {pixel}, sample {s}");
+                assert_eq!(
+                    kept.light(3, 1),
+                    alone.light(3, 1),
+                    "pixel {pixel}, sample {s}"
+                );
+            }
+        }
+        let stale = PixelKeys::new(7, 5, 0);
+        assert!(!stale.cover(5, 1 << 16) && !stale.cover(6, 0));
+        assert_ne!(stale.film(1 << 16), pixel_sample(7, 5, 1 << 16));
+        assert_ne!(
+            stale.path(1 << 16).bounce(0),
+            PathNumbers::new(7, 5, 1 << 16).bounce(0)
         );
     }
 }

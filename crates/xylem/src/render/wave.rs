@@ -15,7 +15,7 @@ use super::film::{Aov, FrameSums, PixelSum};
 use super::frames::LightFrames;
 use super::geometry::{Hit, Ray};
 use super::integrator::{self, Columns, RayCount};
-use super::sampler::PathNumbers;
+use super::sampler::{PathNumbers, PixelKeys};
 use super::shading::{offset_length, offset_ray_origin};
 use super::shadow::ShadowTest;
 use super::Scene;
@@ -145,6 +145,8 @@ pub(super) fn tile_waves(
     let camera = scene.camera.rays();
     let eps = offset_length(scene.accel.scale());
     let mut memo = FrameMemo::default();
+    // A pixel's samples come one after the other: their keys are worked out once.
+    let mut keys = PixelKeys::new(seed, 0, 0);
     let lights_all = lights.first();
     for chunk in samples.chunks(WAVE) {
         let WaveScratch {
@@ -160,14 +162,18 @@ pub(super) fn tile_waves(
         lanes.clear();
         aov.clear();
         for &(i, pixel, s) in chunk {
+            let index = integrator::pixel_index(scene, pixel);
+            if !keys.cover(index, s) {
+                keys = PixelKeys::new(seed, index, s);
+            }
             lanes.push(Lane {
                 pixel: i,
-                numbers: integrator::path_numbers(scene, pixel, s, seed),
+                numbers: keys.path(s),
                 beta: Vec3::ONE,
                 eta_scale: 1.0,
                 prev_pdf: 0.0,
                 specular: true,
-                ray: integrator::camera_ray(scene, &camera, pixel, s, seed),
+                ray: integrator::film_ray(scene, &camera, pixel, keys.film(s)),
                 t_hit: f32::INFINITY,
                 depth: 0,
                 vertex: None,
