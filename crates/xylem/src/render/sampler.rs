@@ -21,8 +21,8 @@ pub(crate) fn pixel_sample(seed: u64, pixel_index: u64, sample: u32) -> [f32; 4]
 pub(crate) struct PixelKeys {
     pixel_index: u64,
     block: u32,
-    film: u32,
-    path: u64,
+    film: SobolScramble,
+    path: PathNumbers,
 }
 
 impl PixelKeys {
@@ -36,8 +36,8 @@ impl PixelKeys {
         PixelKeys {
             pixel_index,
             block,
-            film: salted(1 << 63) as u32,
-            path: salted(1 << 62),
+            film: SobolScramble::new(salted(1 << 63) as u32),
+            path: PathNumbers::keyed(salted(1 << 62)),
         }
     }
 
@@ -50,15 +50,15 @@ impl PixelKeys {
     /// The film and lens numbers of sample `sample` ([`pixel_sample`]).
     #[inline(always)]
     pub(crate) fn film(&self, sample: u32) -> [f32; 4] {
-        sobol_4d(sample & 0xFFFF, self.film)
+        self.film.point(sample & 0xFFFF)
     }
 
     /// The path numbers of sample `sample` ([`PathNumbers::new`]).
     #[inline(always)]
     pub(crate) fn path(&self, sample: u32) -> PathNumbers {
         PathNumbers {
-            key: self.path,
             index: sample & 0xFFFF,
+            ..self.path
         }
     }
 }
@@ -79,17 +79,50 @@ fn sobol_4d(index: u32, seed: u32) -> [f32; 4] {
 /// [`sobol_4d`] with the byte tables given (the test's control changes them).
 #[inline(always)]
 fn sobol_4d_by(bytes: &[[[u32; 4]; 256]; 2], index: u32, seed: u32) -> [f32; 4] {
-    use sobol_burley::parts::{hash, owen_scramble_rev, u32_to_f32_norm};
-    let shuffled = owen_scramble_rev(index.reverse_bits(), hash(seed ^ 0x79c6_8e4a));
-    let hi = &bytes[0][(shuffled >> 24) as usize];
-    let lo = &bytes[1][((shuffled >> 16) & 0xFF) as usize];
-    // The crate's per-dimension scramble seeds (dimension set 0).
-    let seed = seed.wrapping_mul(0x9c8f_2d3b);
-    let salt = [0x912f_69ba, 0x174f_18ab, 0x691e_72ca, 0xb40c_c1b8];
-    std::array::from_fn(|d| {
-        let sobol = hi[d] ^ lo[d];
-        u32_to_f32_norm(owen_scramble_rev(sobol, hash(seed ^ salt[d])).reverse_bits())
-    })
+    SobolScramble::new(seed).point_by(bytes, index)
+}
+
+/// The hashed seeds of one scramble of the Sobol sequence ([`sobol_4d`]): the index shuffle's
+/// and each dimension's. A scramble whose points are drawn again and again (a pixel's film
+/// points, a role's first-vertex points) hashes its seed once; each point then starts its
+/// chain of multiplications without the hash's.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct SobolScramble {
+    shuffle: u32,
+    dims: [u32; 4],
+}
+
+impl SobolScramble {
+    /// The scramble of `seed`, as `sobol_burley` hashes it (dimension set 0).
+    #[inline(always)]
+    fn new(seed: u32) -> Self {
+        use sobol_burley::parts::hash;
+        let dim_seed = seed.wrapping_mul(0x9c8f_2d3b);
+        let salt = [0x912f_69ba, 0x174f_18ab, 0x691e_72ca, 0xb40c_c1b8];
+        SobolScramble {
+            shuffle: hash(seed ^ 0x79c6_8e4a),
+            dims: salt.map(|s| hash(dim_seed ^ s)),
+        }
+    }
+
+    /// Point `index` (below 2^16) under this scramble.
+    #[inline(always)]
+    fn point(&self, index: u32) -> [f32; 4] {
+        self.point_by(&SOBOL_BYTES, index)
+    }
+
+    /// [`SobolScramble::point`] with the byte tables given.
+    #[inline(always)]
+    fn point_by(&self, bytes: &[[[u32; 4]; 256]; 2], index: u32) -> [f32; 4] {
+        use sobol_burley::parts::{owen_scramble_rev, u32_to_f32_norm};
+        let shuffled = owen_scramble_rev(index.reverse_bits(), self.shuffle);
+        let hi = &bytes[0][(shuffled >> 24) as usize];
+        let lo = &bytes[1][((shuffled >> 16) & 0xFF) as usize];
+        std::array::from_fn(|d| {
+            let sobol = hi[d] ^ lo[d];
+            u32_to_f32_norm(owen_scramble_rev(sobol, self.dims[d]).reverse_bits())
+        })
+    }
 }
 
 /// The direction numbers of the first four Sobol dimensions (Joe and Kuo 2008, as the
@@ -161,11 +194,36 @@ pub(crate) struct PathNumbers {
     key: u64,
     /// The point's index in the sequence.
     index: u32,
+    /// The first vertex's scrambles of light 0 and of the bounce (roles 0 and 1), which
+    /// nearly every path draws: [`PathNumbers::scramble`] of them, hashed once a pixel.
+    first: [SobolScramble; 2],
 }
 
 impl PathNumbers {
     pub(crate) fn new(seed: u64, pixel_index: u64, sample: u32) -> Self {
         PixelKeys::new(seed, pixel_index, sample).path(sample)
+    }
+
+    /// The numbers of key `key` (point index 0).
+    #[inline(always)]
+    fn keyed(key: u64) -> Self {
+        let scramble = |role| SobolScramble::new(Self::scramble(key, 0, role, 0));
+        PathNumbers {
+            key,
+            index: 0,
+            first: [scramble(0), scramble(1)],
+        }
+    }
+
+    /// The Sobol scramble of role `role` at vertex `depth` (below [`STRATIFIED_DEPTH`]) for
+    /// the points of block `block` (indices `block` · 2^16 on).
+    #[inline(always)]
+    fn scramble(key: u64, depth: u32, role: u64, block: u32) -> u32 {
+        let scramble = splitmix64(key ^ role_hash(depth, role));
+        match block {
+            0 => scramble as u32,
+            _ => splitmix64(scramble ^ u64::from(block)) as u32,
+        }
     }
 
     /// The point of role `role` (a small integer, unique per role) at vertex `depth`.
@@ -179,14 +237,14 @@ impl PathNumbers {
     /// 2^16; each further block of 2^16 is scrambled on its own, as the samples' blocks are.
     #[inline(always)]
     fn point_at(&self, depth: u32, role: u64, index: u32) -> [f32; 4] {
-        let mut scramble = splitmix64(self.key ^ role_hash(depth, role));
         if depth < STRATIFIED_DEPTH {
             let block = index >> 16;
-            if block != 0 {
-                scramble = splitmix64(scramble ^ u64::from(block));
+            if let (0, 0 | 1, 0) = (depth, role, block) {
+                return self.first[role as usize].point(index);
             }
-            return sobol_4d(index & 0xFFFF, scramble as u32);
+            return sobol_4d(index & 0xFFFF, Self::scramble(self.key, depth, role, block));
         }
+        let scramble = splitmix64(self.key ^ role_hash(depth, role));
         let a = splitmix64(scramble ^ u64::from(index));
         let b = splitmix64(a);
         // The top 24 bits of each 32-bit half: uniform on [0, 1) in steps of 2^−24.
@@ -492,6 +550,16 @@ mod tests {
                     kept.light(3, 1),
                     alone.light(3, 1),
                     "pixel {pixel}, sample {s}"
+                );
+            }
+        }
+        for sample in [0, 3, 1 << 16] {
+            let n = PathNumbers::new(9, 11, sample);
+            for role in 0..2 {
+                let formula = SobolScramble::new(PathNumbers::scramble(n.key, 0, role, 0));
+                assert_eq!(
+                    n.first[role as usize], formula,
+                    "sample {sample}, role {role}"
                 );
             }
         }
