@@ -37,8 +37,12 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 /// One preset's figures.
 fn print(r: &TraceReport) {
     let row = |label: &str, f: &TraceFigures| {
+        let pairs = f
+            .closest_pair_mrays_per_s
+            .map(|p| format!("  closest-hit in pairs {p:>7.2} Mrays/s"))
+            .unwrap_or_default();
         println!(
-            "  {label:<10} {:>9} rays  closest-hit {:>7.2} Mrays/s  any-hit {:>7.2} Mrays/s  ({} hits)",
+            "  {label:<10} {:>9} rays  closest-hit {:>7.2} Mrays/s  any-hit {:>7.2} Mrays/s  ({} hits){pairs}",
             f.rays, f.closest_mrays_per_s, f.any_hit_mrays_per_s, f.closest_hits
         )
     };
@@ -65,6 +69,10 @@ fn print(r: &TraceReport) {
             println!(
                 "  xylem / Embree closest-hit: coherent {:.2}x, incoherent {:.2}x",
                 e.closest_ratio_coherent, e.closest_ratio_incoherent
+            );
+            println!(
+                "  xylem in pairs (as the renderer traces) / Embree one at a time: coherent {:.2}x, incoherent {:.2}x",
+                e.pair_ratio[0], e.pair_ratio[1]
             );
         }
         None => println!("  (Embree comparison: build with --features embree-anchor)"),

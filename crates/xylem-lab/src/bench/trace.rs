@@ -93,6 +93,9 @@ pub struct TraceFigures {
     pub closest_mrays_per_s: f64,
     /// Any-hit (occlusion) speed (million rays per second of thread CPU time).
     pub any_hit_mrays_per_s: f64,
+    /// Closest-hit speed with the rays traced two at a time, each pair's traversals stepped in
+    /// turn (`Accel::intersect_pair`, as the renderer's waves trace their rays); xylem only.
+    pub closest_pair_mrays_per_s: Option<f64>,
 }
 
 /// The whole benchmark report (serialised with `--json`).
@@ -192,6 +195,7 @@ pub fn figures(rays: usize, hits: usize, closest: Duration, any: Duration) -> Tr
         closest_hits: hits,
         closest_mrays_per_s: rate(closest),
         any_hit_mrays_per_s: rate(any),
+        closest_pair_mrays_per_s: None,
     }
 }
 
@@ -208,6 +212,9 @@ pub struct EmbreeFigures {
     pub closest_ratio_coherent: f64,
     /// xylem's closest-hit speed over Embree's, incoherent rays.
     pub closest_ratio_incoherent: f64,
+    /// xylem's closest-hit speed with rays two at a time over Embree's one at a time, coherent
+    /// and incoherent rays (the renderer's tracing against Embree's single-ray queries).
+    pub pair_ratio: [f64; 2],
 }
 
 /// Traces `rays` closest-hit and any-hit on the calling thread and times both.
@@ -229,7 +236,30 @@ pub fn time_rays(accel: &Accel, rays: &[Ray]) -> TraceFigures {
     }
     let any = t1.elapsed();
     debug_assert_eq!(free + hits, rays.len());
-    figures(rays.len(), hits, closest, any)
+    let t2 = CpuTimer::thread();
+    let mut pair_hits = 0usize;
+    for pair in rays.chunks(2) {
+        pair_hits += match pair {
+            [a, b] => accel
+                .intersect_pair([a, b], f32::INFINITY)
+                .iter()
+                .flatten()
+                .count(),
+            _ => pair
+                .iter()
+                .filter_map(|r| accel.intersect(r, f32::INFINITY))
+                .count(),
+        };
+    }
+    let pairs = t2.elapsed();
+    assert_eq!(
+        pair_hits, hits,
+        "rays traced in pairs hit what they hit alone"
+    );
+    TraceFigures {
+        closest_pair_mrays_per_s: Some(figures(rays.len(), hits, pairs, any).closest_mrays_per_s),
+        ..figures(rays.len(), hits, closest, any)
+    }
 }
 
 /// Keeps the faster of two measurements per figure: on a shared machine the least disturbed run
@@ -239,6 +269,11 @@ fn keep_best(best: &mut Option<TraceFigures>, r: TraceFigures) {
         Some(b) => {
             b.closest_mrays_per_s = b.closest_mrays_per_s.max(r.closest_mrays_per_s);
             b.any_hit_mrays_per_s = b.any_hit_mrays_per_s.max(r.any_hit_mrays_per_s);
+            b.closest_pair_mrays_per_s =
+                match (b.closest_pair_mrays_per_s, r.closest_pair_mrays_per_s) {
+                    (Some(x), Some(y)) => Some(x.max(y)),
+                    (x, y) => x.or(y),
+                };
         }
         None => *best = Some(r),
     }
@@ -301,6 +336,9 @@ pub fn run_trace_benchmark(
             build_s: e.build_time.as_secs_f64(),
             closest_ratio_coherent: c.closest_mrays_per_s / ec.closest_mrays_per_s,
             closest_ratio_incoherent: i.closest_mrays_per_s / ei.closest_mrays_per_s,
+            pair_ratio: [(&c, &ec), (&i, &ei)].map(|(x, e)| {
+                x.closest_pair_mrays_per_s.unwrap_or(f64::NAN) / e.closest_mrays_per_s
+            }),
             coherent: ec,
             incoherent: ei,
         });
@@ -400,5 +438,9 @@ mod tests {
         // The sphere (radius ≈ 100 mm at 300 mm) covers π·100² / (2·300·tan 25°)² ≈ 40 % of the view.
         assert!((120..=220).contains(&r.coherent.closest_hits), "{r:?}");
         assert!(r.incoherent.closest_hits > 0);
+        for f in [&r.coherent, &r.incoherent] {
+            assert!(f.closest_pair_mrays_per_s.is_some_and(|p| p > 0.0), "{f:?}");
+        }
+        assert!(r.obvhs_cwbvh.coherent.closest_pair_mrays_per_s.is_none());
     }
 }
