@@ -127,7 +127,7 @@ mod tests {
     /// The quarter-turn polynomials are within 1 ulp (0.97); control: without their highest terms
     /// (Taylor's series to x³ and x⁴) the measure finds thousands of ulp.
     #[test]
-    fn sin_cos_quarter_is_within_two_ulp() {
+    fn sin_cos_quarter_is_within_one_ulp() {
         let worst = worst_ulps(sin_cos_quarter);
         assert!(worst <= 1.0, "{worst} ulp");
         let short = |phi: f32| {

@@ -291,14 +291,13 @@ const STRATIFIED_DEPTH: u32 = 1;
 /// multiplications on each point's critical path.
 #[inline(always)]
 fn role_hash(depth: u32, role: u64) -> u64 {
-    let key = |depth: u32, role: u64| splitmix64((u64::from(depth) << 33) | role);
     const TABLE: [[u64; ROLES]; DEPTHS] = {
         let mut t = [[0; ROLES]; DEPTHS];
         let mut d = 0;
         while d < DEPTHS {
             let mut r = 0;
             while r < ROLES {
-                t[d][r] = splitmix64(((d as u64) << 33) | r as u64);
+                t[d][r] = role_key(d as u32, r as u64);
                 r += 1;
             }
             d += 1;
@@ -310,8 +309,13 @@ fn role_hash(depth: u32, role: u64) -> u64 {
         .and_then(|row| row.get(role as usize))
     {
         Some(&hash) => hash,
-        None => key(depth, role),
+        None => role_key(depth, role),
     }
+}
+
+/// SplitMix64 of role `role` at vertex `depth`: what [`role_hash`] tabulates.
+const fn role_key(depth: u32, role: u64) -> u64 {
+    splitmix64(((depth as u64) << 33) | role)
 }
 
 /// The vertex depths and roles [`role_hash`] keeps in its table (the bounce and four lights).
